@@ -1,0 +1,335 @@
+"""Polygon geometry kernels: checks, normalisation, hull, stable edges, pin contact.
+
+Conventions (spec section 1): vertices are an ``(n, 2)`` float64 array; a
+normalised part is counter-clockwise with its area centroid at the origin.
+Contact features are encoded as ``(kind, index)`` with ``kind`` ``EDGE`` (edge
+``j`` runs from vertex ``j`` to vertex ``j + 1``) or ``VERTEX``.
+"""
+import math
+
+import numpy as np
+
+from ._numba import jit
+
+EDGE = 0
+VERTEX = 1
+
+# Validation codes returned by ``_polygon_problem`` (0 = fine); the Python
+# wrapper ``pipeline.parts`` turns them into messages.
+POLY_OK = 0
+POLY_TOO_FEW = 1
+POLY_NOT_FINITE = 2
+POLY_REPEATED = 3
+POLY_SELF_INTERSECTING = 4
+POLY_ZERO_AREA = 5
+
+
+@jit
+def _signed_area(xy):
+    """Shoelace signed area: positive for counter-clockwise vertices."""
+    n = xy.shape[0]
+    s = 0.0
+    for j in range(n):
+        k = (j + 1) % n
+        s += xy[j, 0] * xy[k, 1] - xy[k, 0] * xy[j, 1]
+    return 0.5 * s
+
+
+@jit
+def _segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
+    """True if closed segments ab and cd share a point (collinear overlap included)."""
+    d1 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+    d2 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+    d3 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    d4 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    if ((d1 > 0 and d2 < 0) or (d1 < 0 and d2 > 0)) and ((d3 > 0 and d4 < 0) or (d3 < 0 and d4 > 0)):
+        return True
+    # Touching or collinear cases: a point lying on the other segment.
+    if d1 == 0 and min(cx, dx) <= ax <= max(cx, dx) and min(cy, dy) <= ay <= max(cy, dy):
+        return True
+    if d2 == 0 and min(cx, dx) <= bx <= max(cx, dx) and min(cy, dy) <= by <= max(cy, dy):
+        return True
+    if d3 == 0 and min(ax, bx) <= cx <= max(ax, bx) and min(ay, by) <= cy <= max(ay, by):
+        return True
+    if d4 == 0 and min(ax, bx) <= dx <= max(ax, bx) and min(ay, by) <= dy <= max(ay, by):
+        return True
+    return False
+
+
+@jit
+def _polygon_problem(xy):
+    """Return a validation code for a vertex list (``POLY_OK`` if it is a simple polygon).
+
+    Returns ``(code, j, k)``: the offending vertex or edge indices where useful.
+    """
+    n = xy.shape[0]
+    if n < 3:
+        return POLY_TOO_FEW, n, -1
+    for j in range(n):
+        if not (math.isfinite(xy[j, 0]) and math.isfinite(xy[j, 1])):
+            return POLY_NOT_FINITE, j, -1
+    for j in range(n):
+        for k in range(j + 1, n):
+            if xy[j, 0] == xy[k, 0] and xy[j, 1] == xy[k, 1]:
+                return POLY_REPEATED, j, k
+    # Non-adjacent edges must not meet (O(n^2): parts have few vertices).
+    for j in range(n):
+        j1 = (j + 1) % n
+        for k in range(j + 1, n):
+            k1 = (k + 1) % n
+            if k == j1 or j == k1:
+                continue
+            if _segments_cross(xy[j, 0], xy[j, 1], xy[j1, 0], xy[j1, 1],
+                               xy[k, 0], xy[k, 1], xy[k1, 0], xy[k1, 1]):
+                return POLY_SELF_INTERSECTING, j, k
+    # Adjacent edges folding back onto each other also self-intersect.
+    for j in range(n):
+        i = (j - 1 + n) % n
+        k = (j + 1) % n
+        ux, uy = xy[i, 0] - xy[j, 0], xy[i, 1] - xy[j, 1]
+        vx, vy = xy[k, 0] - xy[j, 0], xy[k, 1] - xy[j, 1]
+        if ux * vy - uy * vx == 0.0 and ux * vx + uy * vy > 0.0:
+            return POLY_SELF_INTERSECTING, i, j
+    scale = 0.0
+    for j in range(n):
+        scale = max(scale, abs(xy[j, 0]), abs(xy[j, 1]))
+    if abs(_signed_area(xy)) <= 1e-12 * scale * scale:
+        return POLY_ZERO_AREA, -1, -1
+    return POLY_OK, -1, -1
+
+
+@jit
+def _centroid(xy):
+    """Area centroid ``(cx, cy)`` and signed area of a simple polygon."""
+    n = xy.shape[0]
+    # Shift by the first vertex to keep the sums well conditioned.
+    ox, oy = xy[0, 0], xy[0, 1]
+    a2 = 0.0
+    sx = 0.0
+    sy = 0.0
+    for j in range(n):
+        k = (j + 1) % n
+        x0, y0 = xy[j, 0] - ox, xy[j, 1] - oy
+        x1, y1 = xy[k, 0] - ox, xy[k, 1] - oy
+        cr = x0 * y1 - x1 * y0
+        a2 += cr
+        sx += (x0 + x1) * cr
+        sy += (y0 + y1) * cr
+    return ox + sx / (3.0 * a2), oy + sy / (3.0 * a2), 0.5 * a2
+
+
+@jit
+def _normalise(xy):
+    """Counter-clockwise copy of ``xy`` with the area centroid at the origin.
+
+    Returns ``(verts, area, a)`` where ``a`` is the largest centroid-vertex distance.
+    """
+    n = xy.shape[0]
+    cx, cy, area = _centroid(xy)
+    out = np.empty((n, 2))
+    for j in range(n):
+        src = j if area > 0 else n - 1 - j
+        out[j, 0] = xy[src, 0] - cx
+        out[j, 1] = xy[src, 1] - cy
+    a = 0.0
+    for j in range(n):
+        a = max(a, math.hypot(out[j, 0], out[j, 1]))
+    return out, abs(area), a
+
+
+@jit
+def _is_convex(verts):
+    """True if a counter-clockwise polygon has no reflex vertex."""
+    n = verts.shape[0]
+    for j in range(n):
+        i = (j - 1 + n) % n
+        k = (j + 1) % n
+        cr = ((verts[j, 0] - verts[i, 0]) * (verts[k, 1] - verts[j, 1])
+              - (verts[j, 1] - verts[i, 1]) * (verts[k, 0] - verts[j, 0]))
+        if cr < 0.0:
+            return False
+    return True
+
+
+@jit
+def _cross_o(verts, o, a, b):
+    return ((verts[a, 0] - verts[o, 0]) * (verts[b, 1] - verts[o, 1])
+            - (verts[a, 1] - verts[o, 1]) * (verts[b, 0] - verts[o, 0]))
+
+
+@jit
+def _convex_hull(verts):
+    """Indices of the convex hull vertices, counter-clockwise (Andrew's monotone chain).
+
+    Collinear points on hull edges are dropped, so every hull edge is maximal.
+    """
+    n = verts.shape[0]
+    order = np.arange(n)
+    for j in range(1, n):  # insertion sort by (x, y): parts have few vertices
+        k = j
+        while k > 0:
+            a, b = order[k - 1], order[k]
+            if verts[a, 0] > verts[b, 0] or (verts[a, 0] == verts[b, 0] and verts[a, 1] > verts[b, 1]):
+                order[k - 1], order[k] = b, a
+                k -= 1
+            else:
+                break
+    hull = np.empty(2 * n, dtype=np.int64)
+    m = 0
+    for p in range(n):  # lower hull
+        while m >= 2 and _cross_o(verts, hull[m - 2], hull[m - 1], order[p]) <= 0.0:
+            m -= 1
+        hull[m] = order[p]
+        m += 1
+    lower = m + 1
+    for p in range(n - 2, -1, -1):  # upper hull
+        while m >= lower and _cross_o(verts, hull[m - 2], hull[m - 1], order[p]) <= 0.0:
+            m -= 1
+        hull[m] = order[p]
+        m += 1
+    return hull[: m - 1].copy()
+
+
+@jit
+def _stable_edges(verts):
+    """Stable resting edges against a fence (spec section 6).
+
+    A hull edge is stable when the centroid (origin) projects strictly inside
+    it. Returns an ``(m, 5)`` array of rows ``(i, j, theta, y_c, t)``: hull
+    vertex indices of the edge, the orientation (radians, [0, 2 pi)) that puts
+    the edge on the fence ``y = 0`` with the part on the ``+y`` side, the
+    centroid's height above the fence, and where along the edge (0..1) the
+    centroid projects.
+    """
+    hull = _convex_hull(verts)
+    h = hull.shape[0]
+    out = np.empty((h, 5))
+    m = 0
+    for p in range(h):
+        i, j = hull[p], hull[(p + 1) % h]
+        ex, ey = verts[j, 0] - verts[i, 0], verts[j, 1] - verts[i, 1]
+        length = math.hypot(ex, ey)
+        t = -(verts[i, 0] * ex + verts[i, 1] * ey) / (length * length)
+        if t <= 1e-12 or t >= 1.0 - 1e-12:
+            continue
+        # Rotate so the edge direction (CCW, interior on its left) becomes +x:
+        # the interior then lies on +y, i.e. the part rests on the fence below it.
+        theta = -math.atan2(ey, ex)
+        theta = theta % (2.0 * math.pi)
+        yc = (verts[i, 0] * ey - verts[i, 1] * ex) / length  # distance centroid -> edge line
+        out[m, 0] = i
+        out[m, 1] = j
+        out[m, 2] = theta
+        out[m, 3] = abs(yc)
+        out[m, 4] = t
+        m += 1
+    return out[:m].copy()
+
+
+@jit
+def _closest_on_segment(verts, j, qx, qy):
+    """Closest point of edge ``j`` to ``q``: ``(px, py, t, length)`` with ``t`` in [0, length]."""
+    n = verts.shape[0]
+    k = (j + 1) % n
+    ex, ey = verts[k, 0] - verts[j, 0], verts[k, 1] - verts[j, 1]
+    length = math.hypot(ex, ey)
+    ex /= length
+    ey /= length
+    t = (qx - verts[j, 0]) * ex + (qy - verts[j, 1]) * ey
+    t = min(max(t, 0.0), length)
+    return verts[j, 0] + t * ex, verts[j, 1] + t * ey, t, length
+
+
+@jit
+def _closest_feature(verts, qx, qy):
+    """Closest boundary feature to the point ``q`` (a pin axis).
+
+    Returns ``(kind, index, distance, cx, cy, nx, ny)``: the feature, the
+    distance from ``q`` to the polygon boundary, the closest point ``c`` and the
+    unit contact normal ``n`` pointing from ``q`` into the part (spec section 3).
+    A closest point within ``1e-12`` (relative) of an edge end is a vertex.
+    """
+    n = verts.shape[0]
+    best = np.inf
+    bj = 0
+    bt = 0.0
+    bl = 1.0
+    bx = 0.0
+    by = 0.0
+    for j in range(n):
+        px, py, t, length = _closest_on_segment(verts, j, qx, qy)
+        dist = math.hypot(qx - px, qy - py)
+        if dist < best:
+            best, bj, bt, bl, bx, by = dist, j, t, length, px, py
+    tol = 1e-12 * bl
+    if bt <= tol:
+        kind, idx = VERTEX, bj
+    elif bt >= bl - tol:
+        kind, idx = VERTEX, (bj + 1) % n
+    else:
+        kind, idx = EDGE, bj
+    if kind == EDGE:
+        k = (bj + 1) % n
+        ex, ey = (verts[k, 0] - verts[bj, 0]) / bl, (verts[k, 1] - verts[bj, 1]) / bl
+        nx, ny = -ey, ex  # inward normal of a CCW edge
+    else:
+        dx, dy = verts[idx, 0] - qx, verts[idx, 1] - qy
+        dd = math.hypot(dx, dy)
+        nx, ny = (dx / dd, dy / dd) if dd > 0 else (0.0, 0.0)
+        bx, by = verts[idx, 0], verts[idx, 1]
+    return kind, idx, best, bx, by, nx, ny
+
+
+@jit
+def _ray_first_contact(verts, qx, qy, wx, wy, r_pin, s_lo):
+    """First ``s > s_lo`` at which a disc of radius ``r_pin`` centred at
+    ``q + s w`` touches the polygon while approaching it.
+
+    The set of disc centres touching the polygon is bounded by the outward
+    offsets of the edges and circles around the vertices; only entering
+    crossings count, so a pin that is leaving a contact is not caught again.
+    Returns ``(s, kind, index)``, ``s = inf`` if the path misses the part.
+    """
+    n = verts.shape[0]
+    ww = wx * wx + wy * wy
+    best = np.inf
+    kind = -1
+    idx = -1
+    for j in range(n):
+        k = (j + 1) % n
+        ex, ey = verts[k, 0] - verts[j, 0], verts[k, 1] - verts[j, 1]
+        length = math.hypot(ex, ey)
+        ex /= length
+        ey /= length
+        mx, my = ey, -ex  # outward normal
+        wm = wx * mx + wy * my
+        if wm < 0.0:
+            s = (r_pin - ((qx - verts[j, 0]) * mx + (qy - verts[j, 1]) * my)) / wm
+            if s_lo < s < best:
+                t = (qx + s * wx - verts[j, 0]) * ex + (qy + s * wy - verts[j, 1]) * ey
+                if 0.0 < t < length:
+                    best, kind, idx = s, EDGE, j
+        # Vertex circle: entering root of |q + s w - v|^2 = r^2.
+        dx, dy = qx - verts[j, 0], qy - verts[j, 1]
+        b = wx * dx + wy * dy
+        c = dx * dx + dy * dy - r_pin * r_pin
+        disc = b * b - ww * c
+        if disc > 0.0 and b < 0.0:
+            s = (-b - math.sqrt(disc)) / ww
+            if s_lo < s < best:
+                best, kind, idx = s, VERTEX, j
+    return best, kind, idx
+
+
+@jit
+def _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature):
+    """Smallest ``distance - r_pin`` from ``q`` to boundary points that are not
+    the current contact ``c`` (closest points within ``same_feature`` of ``c``
+    are the same feature). Negative means a second contact (a notch)."""
+    n = verts.shape[0]
+    gap = np.inf
+    for j in range(n):
+        px, py, t, length = _closest_on_segment(verts, j, qx, qy)
+        if math.hypot(px - cx, py - cy) > same_feature:
+            gap = min(gap, math.hypot(qx - px, qy - py) - r_pin)
+    return gap

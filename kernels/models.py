@@ -1,0 +1,323 @@
+"""Contact models: from a pin contact to the part's twist and the pin force.
+
+All quantities are in the part's body frame with the centroid at the origin
+and lengths in units of a (the rollout normalises). A contact is the body
+point ``c``, the unit normal ``n`` pointing into the part, the pin velocity
+``v_p`` relative to the belt and the contact friction ``mu_c``.
+
+Models (spec section 3):
+
+``MINPOWER``
+    The twist minimises the belt power ``P`` over the twists the contact
+    allows (Peshkin and Sanderson). Sticking: ``u(c) = v_p``; sliding:
+    ``e . u(c) = 1`` with ``e`` the friction-cone edge, then rescaled so the
+    pin does not penetrate. Both are convex problems in 1 or 2 unknowns,
+    solved by ``_minimise`` (damped Newton, warm-started).
+``TIP``
+    The centre of rotation is the tip of Peshkin's COR locus for the force
+    line: on the perpendicular from the centroid to the line, on the far
+    side, at distance ``a^2 / rho``.
+``ELLIPSOID``
+    Ellipsoidal limit surface ``H = |f|^2 + m^2 / m_max^2``; the twist is
+    ``grad H``.
+
+Every model returns ``(status, vx, vy, om, fx, fy, mode)``: ``status`` is
+``TWIST_OK`` or ``TWIST_NO_PUSH`` (the pin moves into the part but no pushing
+solution exists, i.e. the part is jammed), the twist, the force ``f`` of the
+pin on the part (units of mu_s m g) and the contact ``mode`` (``STICK``,
+``SLIDE_POS`` with friction along ``+t``, ``SLIDE_NEG``; ``t = z x n``).
+"""
+import math
+
+from ._numba import jit
+from .support import _power
+
+MINPOWER = 0
+TIP = 1
+ELLIPSOID = 2
+MODEL_NAMES = ("minpower", "tip", "ellipsoid")
+
+STICK = 0
+SLIDE_POS = 1
+SLIDE_NEG = -1
+SEPARATE = 2
+
+TWIST_OK = 0
+TWIST_NO_PUSH = 1
+
+_NEWTON_MAX_IT = 60
+
+
+@jit
+def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
+    """Minimise ``P(x + y1 b + y2 c)`` over ``y`` (``k`` = 1 or 2 unknowns).
+
+    Parameters
+    ----------
+    verts, quad, area : polygon, its fan quadrature and area (see ``support``).
+    x0..x2, b0..b2, c0..c2 : the affine family of twists ``x + y1 b + y2 c``.
+    k : number of free parameters (``c`` is ignored when ``k == 1``).
+    y1, y2 : warm start.
+
+    Returns
+    -------
+    (P, y1, y2, gx, gy, converged)
+        The minimum, its parameters and the force part of grad P there.
+
+    Notes
+    -----
+    P is convex and positively homogeneous in the twist, and strictly convex
+    on these affine families, which do not contain the origin. Newton's
+    method with an Armijo backtracking line search converges from any start;
+    warm-started from the previous integration stage it needs one to three
+    iterations. The stopping test is the Newton decrement at rounding level.
+    """
+    vx = x0 + y1 * b0 + y2 * c0
+    vy = x1 + y1 * b1 + y2 * c1
+    om = x2 + y1 * b2 + y2 * c2
+    p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = _power(verts, quad, area, vx, vy, om)
+    converged = False
+    for _ in range(_NEWTON_MAX_IT):
+        gb = g0 * b0 + g1 * b1 + g2 * b2
+        hb0 = h00 * b0 + h01 * b1 + h02 * b2
+        hb1 = h01 * b0 + h11 * b1 + h12 * b2
+        hb2 = h02 * b0 + h12 * b1 + h22 * b2
+        hbb = b0 * hb0 + b1 * hb1 + b2 * hb2
+        if k == 1:
+            d1 = -gb / hbb if hbb > 0.0 else -gb
+            d2 = 0.0
+            dec = -gb * d1
+        else:
+            gc = g0 * c0 + g1 * c1 + g2 * c2
+            hbc = c0 * hb0 + c1 * hb1 + c2 * hb2
+            hcc = (c0 * (h00 * c0 + h01 * c1 + h02 * c2) + c1 * (h01 * c0 + h11 * c1 + h12 * c2)
+                   + c2 * (h02 * c0 + h12 * c1 + h22 * c2))
+            det = hbb * hcc - hbc * hbc
+            if det <= 1e-14 * (hbb * hcc) or hbb <= 0.0:
+                d1, d2 = -gb, -gc  # not positive definite here: gradient step
+            else:
+                d1 = -(hcc * gb - hbc * gc) / det
+                d2 = -(hbb * gc - hbc * gb) / det
+            dec = -(gb * d1 + gc * d2)
+        if dec <= 1e-28 * (p + 1e-300):
+            converged = True
+            break
+        t = 1.0
+        accepted = False
+        while t > 1e-12:
+            ty1 = y1 + t * d1
+            ty2 = y2 + t * d2
+            vx = x0 + ty1 * b0 + ty2 * c0
+            vy = x1 + ty1 * b1 + ty2 * c1
+            om = x2 + ty1 * b2 + ty2 * c2
+            res = _power(verts, quad, area, vx, vy, om)
+            if res[0] <= p - 1e-4 * t * dec + 4e-16 * p:
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted:
+            converged = dec <= 1e-20 * (p + 1e-300)
+            break
+        y1, y2 = ty1, ty2
+        p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = res
+        if t * (abs(d1) + abs(d2)) <= 1e-15 * (1.0 + abs(y1) + abs(y2)):
+            converged = True
+            break
+    return p, y1, y2, g0, g1, converged
+
+
+@jit
+def _cone_side(fx, fy, nx, ny, mu):
+    """Contact mode of a sticking force: ``STICK`` if ``f`` lies in the friction
+    cone, else the side to slide on (the sign of ``f . t``)."""
+    fn = fx * nx + fy * ny
+    ft = -fx * ny + fy * nx  # t = z x n = (-n_y, n_x)
+    if fn > 0.0 and abs(ft) <= mu * fn:
+        return STICK
+    return SLIDE_POS if ft >= 0.0 else SLIDE_NEG
+
+
+@jit
+def _cone_edge(nx, ny, mu, side):
+    """Unit edge ``normalise(n + side mu t)`` of the friction cone."""
+    ex = nx - side * mu * ny
+    ey = ny + side * mu * nx
+    norm = math.hypot(ex, ey)
+    return ex / norm, ey / norm
+
+
+@jit
+def _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy):
+    """Factor that makes ``n . u(c) = n . v_p`` (no penetration), or -1 if the
+    twist does not push the part away from the pin at the contact."""
+    ucn = (vx - om * cy) * nx + (vy + om * cx) * ny
+    if ucn <= 1e-14 * (abs(vx) + abs(vy) + abs(om)):
+        return -1.0
+    return (vpx * nx + vpy * ny) / ucn
+
+
+# --------------------------------------------------------------------------- minpower
+
+
+@jit
+def _minpower_stick(verts, quad, area, cx, cy, vpx, vpy, om_warm):
+    """Sticking: minimise P over twists with ``u(c) = v_p`` (1 unknown, omega)."""
+    p, om, _, fx, fy, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
+                                       0.0, 0.0, 0.0, 1, om_warm, 0.0)
+    return vpx + om * cy, vpy - om * cx, om, fx, fy, conv
+
+
+@jit
+def _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom):
+    """Sliding: minimise P over twists with ``e . u(c) = 1`` (2 unknowns).
+
+    ``(wvx, wvy, wom)`` is a warm-start twist of any scale."""
+    ke = cx * ey - cy * ex  # e . (z x c)
+    ue = (wvx - wom * cy) * ex + (wvy + wom * cx) * ey
+    if ue > 0.0:
+        y1 = (-wvx * ey + wvy * ex) / ue
+        y2 = wom / ue
+    else:
+        y1 = 0.0
+        y2 = 0.0
+    p, y1, y2, fx, fy, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
+                                        -ke * ex, -ke * ey, 1.0, 2, y1, y2)
+    vx = ex - y1 * ey - y2 * ke * ex
+    vy = ey + y1 * ex - y2 * ke * ey
+    return vx, vy, y2, fx, fy, conv
+
+
+@jit
+def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom):
+    if mu > 0.0:
+        vx, vy, om, fx, fy, conv = _minpower_stick(verts, quad, area, cx, cy, vpx, vpy, wom)
+        side = _cone_side(fx, fy, nx, ny, mu)
+        if side == STICK:
+            return TWIST_OK, vx, vy, om, fx, fy, STICK
+    else:
+        side = SLIDE_POS
+        vx, vy, om = wvx, wvy, wom
+    ex, ey = _cone_edge(nx, ny, mu, side)
+    vx, vy, om, fx, fy, conv = _minpower_slide(verts, quad, area, cx, cy, ex, ey, vx, vy, om)
+    scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
+    if scale <= 0.0:
+        return TWIST_NO_PUSH, 0.0, 0.0, 0.0, fx, fy, side
+    return TWIST_OK, scale * vx, scale * vy, scale * om, fx, fy, side
+
+
+# --------------------------------------------------------------------------- tip
+
+
+@jit
+def _tip_twist_for_line(cx, cy, fx, fy):
+    """Twist (unit rotation rate, or unit translation) about the COR-locus tip
+    for the force line through ``c`` along unit ``f`` (a = 1)."""
+    along = cx * fx + cy * fy
+    qx, qy = cx - along * fx, cy - along * fy  # foot of the perpendicular
+    rho2 = qx * qx + qy * qy
+    if rho2 <= 1e-24:
+        return fx, fy, 0.0
+    rx, ry = -qx / rho2, -qy / rho2
+    om = 1.0 if cx * fy - cy * fx > 0.0 else -1.0
+    return om * ry, -om * rx, om
+
+
+@jit
+def _power_balance_force(verts, quad, area, vx, vy, om, cx, cy, fx, fy):
+    """Scale the unit force direction ``f`` so the pin's power ``f . u(c)``
+    equals the belt's dissipation ``P`` of the twist (uniform pressure)."""
+    ucf = (vx - om * cy) * fx + (vy + om * cx) * fy
+    p = _power(verts, quad, area, vx, vy, om)[0]
+    k = p / ucf if ucf > 0.0 else 0.0
+    return k * fx, k * fy
+
+
+@jit
+def _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu):
+    # Sticking: the COR lies on the line through c perpendicular to v_p
+    # (r = c + lam t_v, t_v = z x v_p / |v_p|) and is the tip for a line
+    # through c iff c . r = -a^2, which fixes lam in closed form.
+    vp = math.hypot(vpx, vpy)
+    tvx, tvy = -vpy / vp, vpx / vp
+    ct = cx * tvx + cy * tvy
+    if abs(ct) <= 1e-14:
+        fx, fy = vpx / vp, vpy / vp
+        vx, vy, om = vpx, vpy, 0.0
+    else:
+        lam = -(1.0 + cx * cx + cy * cy) / ct
+        rx, ry = cx + lam * tvx, cy + lam * tvy
+        r2 = rx * rx + ry * ry
+        qx, qy = -rx / r2, -ry / r2
+        dx, dy = cx - qx, cy - qy
+        dn = math.hypot(dx, dy)
+        if dn <= 1e-14:
+            dx, dy, dn = -qy, qx, math.hypot(qx, qy)
+        fx, fy = dx / dn, dy / dn
+        vx, vy, om = _tip_twist_for_line(cx, cy, fx, fy)
+        ucx, ucy = vx - om * cy, vy + om * cx
+        if ucx * vpx + ucy * vpy < 0.0:
+            fx, fy, vx, vy, om = -fx, -fy, -vx, -vy, -om
+            ucx, ucy = -ucx, -ucy
+        k = vp / math.hypot(ucx, ucy)
+        vx, vy, om = k * vx, k * vy, k * om
+    side = _cone_side(fx, fy, nx, ny, mu)
+    if side == STICK and mu > 0.0:
+        fx, fy = _power_balance_force(verts, quad, area, vx, vy, om, cx, cy, fx, fy)
+        return TWIST_OK, vx, vy, om, fx, fy, STICK
+    if mu == 0.0:
+        side = SLIDE_POS
+    ex, ey = _cone_edge(nx, ny, mu, side)
+    vx, vy, om = _tip_twist_for_line(cx, cy, ex, ey)
+    scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
+    if scale <= 0.0:
+        return TWIST_NO_PUSH, 0.0, 0.0, 0.0, 0.0, 0.0, side
+    vx, vy, om = scale * vx, scale * vy, scale * om
+    fx, fy = _power_balance_force(verts, quad, area, vx, vy, om, cx, cy, ex, ey)
+    return TWIST_OK, vx, vy, om, fx, fy, side
+
+
+# --------------------------------------------------------------------------- ellipsoid
+
+
+@jit
+def _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max):
+    mm2 = m_max * m_max
+    # Sticking: (I + k k^T / m_max^2) f = v_p with k = z x c (Sherman-Morrison).
+    kx, ky = -cy, cx
+    kv = kx * vpx + ky * vpy
+    den = mm2 + kx * kx + ky * ky
+    fx, fy = vpx - kx * kv / den, vpy - ky * kv / den
+    side = _cone_side(fx, fy, nx, ny, mu)
+    if side == STICK and mu > 0.0:
+        m = cx * fy - cy * fx
+        vx, vy, om = fx, fy, m / mm2
+        hs = math.sqrt(fx * fx + fy * fy + m * m / mm2)
+        return TWIST_OK, vx, vy, om, fx / hs, fy / hs, STICK
+    if mu == 0.0:
+        side = SLIDE_POS
+    ex, ey = _cone_edge(nx, ny, mu, side)
+    m = cx * ey - cy * ex
+    vx, vy, om = ex, ey, m / mm2
+    scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
+    if scale <= 0.0:
+        return TWIST_NO_PUSH, 0.0, 0.0, 0.0, 0.0, 0.0, side
+    hs = math.sqrt(1.0 + m * m / mm2)
+    return TWIST_OK, scale * vx, scale * vy, scale * om, ex / hs, ey / hs, side
+
+
+@jit
+def _contact_twist(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
+                   wvx, wvy, wom):
+    """Twist and pin force for one contact under ``model`` (see module doc).
+
+    ``(wvx, wvy, wom)`` is the previous twist, used to warm-start minpower.
+    A pin moving away from the part (``n . v_p <= 0``) exerts no force and the
+    part stays at rest: mode ``SEPARATE``.
+    """
+    if vpx * nx + vpy * ny <= 0.0:
+        return TWIST_OK, 0.0, 0.0, 0.0, 0.0, 0.0, SEPARATE
+    if model == MINPOWER:
+        return _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom)
+    if model == TIP:
+        return _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu)
+    return _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max)

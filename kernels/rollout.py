@@ -1,0 +1,432 @@
+"""One passage of a part past one pin (spec section 4).
+
+Notes
+-----
+The state is integrated in the belt frame, where the belt is at rest and the
+pin moves with ``v_p = (-1, v_pin / v_b)`` per unit belt travel ``s``. The
+variables are ``y = (theta, q_x, q_y, X_x, X_y)``: the part's orientation, the
+pin axis in the part's body frame (centroid origin) and the centroid in the
+belt frame, all lengths in units of ``a``. With the body twist ``(v, omega)``
+from ``models._contact_twist``::
+
+    d theta / ds = omega
+    d q / ds     = R(theta)^T v_p - (v + omega z x q)   (pin relative to the body)
+    d X / ds     = R(theta) v
+
+Within one contact feature (an edge or a vertex) the right-hand side is
+smooth, so a classical Runge-Kutta step is accurate to O(ds^4); the pin is
+projected back to distance ``r_pin`` after every step to stop drift. Feature
+changes, separation and second contacts are events located by the Illinois
+method on the step fraction, so the step never straddles one. The step is
+capped by ``ds_max`` and by a rotation of ``dtheta_max`` per step.
+"""
+import math
+
+import numpy as np
+
+from ._numba import jit
+from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
+                       _ray_first_contact)
+from .models import SEPARATE, TWIST_OK, _contact_twist
+from .support import _fan_quadrature, _max_moment
+
+OK = 0
+MISS = 1
+JAMMED = 2
+TRUNCATED = 3
+STATUS_NAMES = ("ok", "miss", "jammed", "truncated")
+
+JAM_NONE = 0
+JAM_NO_ROTATION = 1  # held by the pin: no rotation over 3 a of pin travel
+JAM_NOTCH = 2  # two simultaneous contacts
+JAM_TRAVEL = 3  # pin travel in contact past 50 a
+JAM_NO_PUSH = 4  # the pin moves into the part and no pushing solution exists
+JAM_CHATTER = 5  # contact feature changes without progress
+JAM_REASONS = ("", "no rotation", "notch", "travel limit", "no pushing solution", "chatter")
+
+_EVENT_TOL = 1e-10  # event functions may dip this far below zero (units of a)
+_SAME_FEATURE = 1e-3  # contact points closer than this (units of a) are one feature
+_NOTCH_TOL = 1e-6  # a second contact counts when this much closer than r_pin
+_JAM_ANGLE = 1e-5  # radians
+_JAM_TRAVEL = 3.0  # units of a
+_MAX_TRAVEL = 50.0  # units of a
+_MAX_CHANGES = 10000
+
+DEFAULT_DS_MAX = 0.04  # units of a
+DEFAULT_DTHETA_MAX = 0.05  # radians
+
+
+@jit
+def _prepare(xy):
+    """Normalise a vertex list for rollouts.
+
+    Returns ``(verts, area, a, quad, m_max, convex)`` with ``verts`` counter-
+    clockwise, centred and scaled to ``a = 1`` (area and m_max in those units).
+    """
+    verts, area, a = _normalise(xy)
+    verts = verts / a
+    area = area / (a * a)
+    quad = _fan_quadrature(verts)
+    return verts, area, a, quad, _max_moment(verts, area), _is_convex(verts)
+
+
+@jit
+def _contact_geometry(verts, kind, idx, qx, qy):
+    """Contact point ``c``, inward normal ``n`` and the two feature-bound event
+    values (negative once the pin leaves the feature) for the pin at ``q``."""
+    n = verts.shape[0]
+    if kind == EDGE:
+        k = (idx + 1) % n
+        ex, ey = verts[k, 0] - verts[idx, 0], verts[k, 1] - verts[idx, 1]
+        length = math.hypot(ex, ey)
+        ex /= length
+        ey /= length
+        t = (qx - verts[idx, 0]) * ex + (qy - verts[idx, 1]) * ey
+        return verts[idx, 0] + t * ex, verts[idx, 1] + t * ey, -ey, ex, t, length - t
+    i = (idx - 1 + n) % n
+    k = (idx + 1) % n
+    vx, vy = verts[idx, 0], verts[idx, 1]
+    ox, oy = qx - vx, qy - vy
+    dist = math.hypot(ox, oy)
+    # Outward normals of the edges before and after the vertex.
+    ax, ay = vx - verts[i, 0], vy - verts[i, 1]
+    la = math.hypot(ax, ay)
+    bx, by = verts[k, 0] - vx, verts[k, 1] - vy
+    lb = math.hypot(bx, by)
+    mpx, mpy = ay / la, -ax / la
+    mnx, mny = by / lb, -bx / lb
+    g_prev = (mpx * oy - mpy * ox) / dist
+    g_next = (ox * mny - oy * mnx) / dist
+    return vx, vy, -ox / dist, -oy / dist, g_prev, g_next
+
+
+@jit
+def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, warm, out):
+    """Right-hand side at state ``y`` into ``out``; updates the warm-start twist.
+
+    Returns ``(status, mode, fx, fy)`` with the pin force on the part in the
+    body frame.
+    """
+    cx, cy, nx, ny, _, _ = _contact_geometry(verts, kind, idx, y[1], y[2])
+    cs, sn = math.cos(y[0]), math.sin(y[0])
+    vpx = cs * vpwx + sn * vpwy
+    vpy = -sn * vpwx + cs * vpwy
+    st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
+                                                  nx, ny, vpx, vpy, mu, warm[0], warm[1],
+                                                  warm[2])
+    if st == TWIST_OK and mode != SEPARATE:
+        warm[0], warm[1], warm[2] = vx, vy, om
+    out[0] = om
+    out[1] = vpx - (vx - om * y[2])
+    out[2] = vpy - (vy + om * y[1])
+    out[3] = cs * vx - sn * vy
+    out[4] = sn * vx + cs * vy
+    return st, mode, fx, fy
+
+
+@jit
+def _project(verts, kind, idx, rp, y):
+    """Put the pin back at distance ``rp`` from its contact feature."""
+    n = verts.shape[0]
+    if kind == EDGE:
+        k = (idx + 1) % n
+        ex, ey = verts[k, 0] - verts[idx, 0], verts[k, 1] - verts[idx, 1]
+        length = math.hypot(ex, ey)
+        mx, my = ey / length, -ex / length
+        off = rp - ((y[1] - verts[idx, 0]) * mx + (y[2] - verts[idx, 1]) * my)
+        y[1] += off * mx
+        y[2] += off * my
+    else:
+        ox, oy = y[1] - verts[idx, 0], y[2] - verts[idx, 1]
+        dist = math.hypot(ox, oy)
+        y[1] = verts[idx, 0] + rp * ox / dist
+        y[2] = verts[idx, 1] + rp * oy / dist
+
+
+@jit
+def _rk4(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1, h, y1,
+         stage, tmp, warm):
+    """One classical Runge-Kutta step of size ``h`` from ``y0`` (slope ``k1``
+    given) into ``y1``. Returns False if a stage found no pushing solution."""
+    for i in range(5):
+        tmp[i] = y0[i] + 0.5 * h * k1[i]
+        y1[i] = k1[i]
+    st = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp, warm,
+                     stage)[0]
+    for i in range(5):
+        y1[i] += 2.0 * stage[i]
+        tmp[i] = y0[i] + 0.5 * h * stage[i]
+    st2 = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp, warm,
+                      stage)[0]
+    for i in range(5):
+        y1[i] += 2.0 * stage[i]
+        tmp[i] = y0[i] + h * stage[i]
+    st3 = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp, warm,
+                      stage)[0]
+    for i in range(5):
+        y1[i] = y0[i] + h / 6.0 * (y1[i] + stage[i])
+    _project(verts, kind, idx, rp, y1)
+    return st == TWIST_OK and st2 == TWIST_OK and st3 == TWIST_OK
+
+
+@jit
+def _events(verts, convex, kind, idx, rp, vpwx, vpwy, y, g):
+    """Event values at ``y`` into ``g``: leave the feature at its start/end,
+    separation (``n . v_p``) and a second contact; all negative when crossed."""
+    cx, cy, nx, ny, g[0], g[1] = _contact_geometry(verts, kind, idx, y[1], y[2])
+    cs, sn = math.cos(y[0]), math.sin(y[0])
+    g[2] = nx * (cs * vpwx + sn * vpwy) + ny * (-sn * vpwx + cs * vpwy)
+    if convex:
+        g[3] = np.inf
+    else:
+        g[3] = _other_contact_gap(verts, y[1], y[2], cx, cy, rp, _SAME_FEATURE) + _NOTCH_TOL
+
+
+@jit
+def _first_event(g, tol):
+    """Index of the most negative event value below ``-tol``, or -1."""
+    ev = -1
+    worst = -tol
+    for j in range(4):
+        if g[j] < worst:
+            worst = g[j]
+            ev = j
+    return ev
+
+
+@jit
+def _min_over(g, mask):
+    m = np.inf
+    for j in range(4):
+        if mask[j] and g[j] < m:
+            m = g[j]
+    return m
+
+
+@jit
+def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vpwy, y0, k1, h,
+            g1, y_out, stage, tmp, warm, g, mask):
+    """Shrink the step from ``y0`` to end on the first event crossed by a full
+    step of size ``h`` (event values ``g1`` at its end). The state just before
+    the crossing goes to ``y_out``. Returns ``(fraction, event)``."""
+    for j in range(4):
+        mask[j] = g1[j] < -_EVENT_TOL
+    _events(verts, convex, kind, idx, rp, vpwx, vpwy, y0, g)
+    lo, hi = 0.0, 1.0
+    f_lo = _min_over(g, mask)
+    f_hi = _min_over(g1, mask)
+    side = 0
+    for i in range(5):
+        y_out[i] = y0[i]
+    y_try = np.empty(5)
+    for _ in range(80):
+        if f_hi < f_lo and f_lo - f_hi > 0.0:
+            alpha = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+        else:
+            alpha = 0.5 * (lo + hi)
+        if not (lo < alpha < hi):
+            alpha = 0.5 * (lo + hi)
+        _rk4(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1,
+             alpha * h, y_try, stage, tmp, warm)
+        _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_try, g)
+        for j in range(4):
+            if not mask[j] and g[j] < -_EVENT_TOL:
+                mask[j] = True  # an earlier event than the ones seen so far
+                side = 0
+        f = _min_over(g, mask)
+        if f < 0.0:
+            hi, f_hi = alpha, f
+            if side == -1:
+                f_lo *= 0.5  # Illinois modification
+            side = -1
+        else:
+            lo, f_lo = alpha, f
+            for i in range(5):
+                y_out[i] = y_try[i]
+            if side == 1:
+                f_hi *= 0.5
+            side = 1
+        if (f >= 0.0 and f < 1e-13) or (hi - lo) * h < 1e-15:
+            break
+    _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_out, g)
+    ev = 0
+    best = np.inf
+    for j in range(4):
+        if mask[j] and g[j] < best:
+            best, ev = g[j], j
+    return lo, ev
+
+
+@jit
+def _grow(buf, m):
+    if m < buf.shape[0]:
+        return buf
+    out = np.empty((2 * buf.shape[0], buf.shape[1]))
+    out[: buf.shape[0]] = buf
+    return out
+
+
+@jit
+def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
+             max_travel, ds_max, dtheta_max, record):
+    """Roll a prepared part (see ``_prepare``) past one pin.
+
+    Parameters
+    ----------
+    verts, area, a, quad, m_max, convex : output of ``_prepare``.
+    model : ``models.MINPOWER``, ``TIP`` or ``ELLIPSOID``.
+    mu_c : contact friction coefficient (>= 0).
+    r_pin : pin radius (same length unit as the part).
+    theta_i : initial orientation (radians).
+    d : contact parameter ``(y_pin - y_com) / a``, the pin's offset as it
+        passes the centroid's starting station.
+    v_pin : pin speed across the belt in units of the belt speed (0: static).
+    max_travel : stop after this belt travel since first contact (inf: never).
+    ds_max, dtheta_max : step caps (units of a, radians).
+    record : keep the trajectory and force history.
+
+    Returns
+    -------
+    (status, jam_reason, theta_f, dy, contact_travel, feature_changes,
+     peak_force, trajectory, force)
+        ``theta_f`` in radians in [0, 2 pi); lengths in the part's unit;
+        ``trajectory`` rows ``(s, x, y, theta)`` (theta unwrapped, radians) and
+        ``force`` rows ``(s, f_x, f_y)`` (force on the pin, units of mu_s m g);
+        both empty unless ``record``.
+    """
+    rp = r_pin / a
+    s_cap = max_travel / a
+    traj = np.empty((64 if record else 0, 4))
+    force = np.empty((64 if record else 0, 3))
+    n_traj = 0
+    n_force = 0
+    two_pi = 2.0 * math.pi
+    vpwx, vpwy = -1.0, v_pin
+    # The pin path passes y = 0 at the centroid's starting station x = 0.
+    s0 = -(2.0 + rp + abs(d)) * (1.0 + abs(v_pin))
+    px, py = -s0 * 1.0, s0 * v_pin
+    cs, sn = math.cos(theta_i), math.sin(theta_i)
+    dx, dy0 = px - 0.0, py + d
+    qx, qy = cs * dx + sn * dy0, -sn * dx + cs * dy0
+    wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
+    sigma, kind, idx = _ray_first_contact(verts, qx, qy, wx, wy, rp, 0.0)
+    theta_wrapped = theta_i % two_pi
+    if not math.isfinite(sigma):
+        return MISS, JAM_NONE, theta_wrapped, 0.0, 0.0, 0, 0.0, traj[:0], force[:0]
+    y = np.array([theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d])
+    y_new = np.empty(5)
+    k1 = np.empty(5)
+    stage = np.empty(5)
+    tmp = np.empty(5)
+    g = np.empty(4)
+    g_end = np.empty(4)
+    g_work = np.empty(4)
+    mask = np.zeros(4, dtype=np.bool_)
+    warm = np.array([wx, wy, 0.0])
+    s = 0.0
+    travel = 0.0
+    changes = 0
+    peak = 0.0
+    theta_ref, travel_ref = theta_i, 0.0
+    status, reason = OK, JAM_NONE
+    if record:
+        traj[0] = (0.0, 0.0, 0.0, theta_i)
+        n_traj = 1
+    separated = False
+    while True:
+        st, mode, fx, fy = _derivative(model, verts, quad, area, m_max, mu_c, kind, idx,
+                                       vpwx, vpwy, y, warm, k1)
+        if separated:
+            # A located separation ends just before n . v_p crosses zero.
+            st, mode, separated = TWIST_OK, SEPARATE, False
+        if st != TWIST_OK:
+            status, reason = JAMMED, JAM_NO_PUSH
+            break
+        cs, sn = math.cos(y[0]), math.sin(y[0])
+        fwx, fwy = cs * fx - sn * fy, sn * fx + cs * fy
+        if mode == SEPARATE:
+            fwx, fwy = 0.0, 0.0
+        peak = max(peak, math.hypot(fwx, fwy))
+        if record:
+            force = _grow(force, n_force)
+            force[n_force] = (s * a, -fwx, -fwy)
+            n_force += 1
+        if mode == SEPARATE:
+            # The pin moves away: the part rests while the pin travels on; a
+            # non-convex part may be caught again further along the path.
+            wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
+            sigma, kind, idx = _ray_first_contact(verts, y[1], y[2], wx, wy, rp, 1e-9)
+            if not math.isfinite(sigma):
+                break
+            if s + sigma >= s_cap:
+                status = TRUNCATED
+                break
+            y[1] += sigma * wx
+            y[2] += sigma * wy
+            s += sigma
+            changes += 1
+            continue
+        if s >= s_cap:
+            status = TRUNCATED
+            break
+        h = ds_max
+        if abs(k1[0]) * h > dtheta_max:
+            h = dtheta_max / abs(k1[0])
+        h = min(h, s_cap - s)
+        ok = _rk4(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy, y, k1, h,
+                  y_new, stage, tmp, warm)
+        halvings = 0
+        while not ok and halvings < 40:
+            h *= 0.5
+            halvings += 1
+            ok = _rk4(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy, y, k1,
+                      h, y_new, stage, tmp, warm)
+        if not ok:
+            status, reason = JAMMED, JAM_NO_PUSH
+            break
+        _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_new, g_end)
+        ev = _first_event(g_end, _EVENT_TOL)
+        frac = 1.0
+        if ev >= 0:
+            frac, ev = _locate(model, verts, quad, area, m_max, mu_c, convex, kind, idx, rp,
+                               vpwx, vpwy, y, k1, h, g_end, y_new, stage, tmp, warm, g_work,
+                               mask)
+        for i in range(5):
+            y[i] = y_new[i]
+        s += frac * h
+        travel += frac * h
+        if record:
+            traj = _grow(traj, n_traj)
+            traj[n_traj] = (s * a, (y[3]) * a, (y[4] + d) * a, y[0])
+            n_traj += 1
+        if abs(y[0] - theta_ref) >= _JAM_ANGLE:
+            theta_ref, travel_ref = y[0], travel
+        elif travel - travel_ref > _JAM_TRAVEL:
+            status, reason = JAMMED, JAM_NO_ROTATION
+            break
+        if travel > _MAX_TRAVEL:
+            status, reason = JAMMED, JAM_TRAVEL
+            break
+        if ev == 3:
+            status, reason = JAMMED, JAM_NOTCH
+            break
+        if ev == 0 or ev == 1:
+            changes += 1
+            if changes > _MAX_CHANGES:
+                status, reason = JAMMED, JAM_CHATTER
+                break
+            n = verts.shape[0]
+            if kind == EDGE:
+                kind, idx = VERTEX, (idx if ev == 0 else (idx + 1) % n)
+            else:
+                kind, idx = EDGE, ((idx - 1 + n) % n if ev == 0 else idx)
+            _project(verts, kind, idx, rp, y)
+        separated = ev == 2
+    if record:
+        force = _grow(force, n_force)
+        force[n_force] = (s * a, 0.0, 0.0)
+        n_force += 1
+    if status == OK and travel == 0.0:
+        status = MISS
+    return (status, reason, y[0] % two_pi, (y[4] + d) * a, travel * a, changes, peak,
+            traj[:n_traj].copy(), force[:n_force].copy())
