@@ -15,7 +15,7 @@ from .rollout import _rollout
 
 @jit_parallel
 def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
-                  max_travel, ds_max, dtheta_max):
+                  max_travel, ds_max, tol):
     """Rollouts over the outer product ``d x theta_i`` (radians for theta_i).
 
     Returns arrays of shape ``(len(d), len(theta_i))``: ``status``,
@@ -38,7 +38,7 @@ def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         for flat in range(start, stop):
             i, j = flat // nt, flat % nt
             res = _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin,
-                           theta_i[j], d[i], v_pin, max_travel, ds_max, dtheta_max, False)
+                           theta_i[j], d[i], v_pin, max_travel, ds_max, tol, False)
             status[i, j] = res[0]
             reason[i, j] = res[1]
             theta_f[i, j] = res[2]

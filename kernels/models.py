@@ -102,6 +102,14 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
         if dec <= 1e-28 * (p + 1e-300):
             converged = True
             break
+        if dec <= 1e-18 * p:
+            # Quadratic convergence: this step lands at rounding level, so
+            # take it without paying for a confirming evaluation. The force
+            # returned is from the previous iterate (relative error ~1e-9).
+            y1 += d1
+            y2 += d2
+            converged = True
+            break
         t = 1.0
         accepted = False
         while t > 1e-12:
@@ -188,7 +196,28 @@ def _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom):
 
 
 @jit
-def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom):
+def _slip_opposes_friction(vx, vy, om, cx, cy, nx, ny, vpx, vpy, side):
+    """True if the part slips past the pin against the friction of cone side
+    ``side`` (tangential slip of the part relative to the pin along ``-side t``)."""
+    ut = -(vx - om * cy - vpx) * ny + (vy + om * cx - vpy) * nx
+    return side * ut <= 0.0
+
+
+@jit
+def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint):
+    if mu > 0.0 and (hint == SLIDE_POS or hint == SLIDE_NEG):
+        # Shortcut while sliding: the spec's rule (solve sticking, slide on the
+        # side its force leaves the cone) has a unique consistent answer, so a
+        # sliding solution on the previous side whose slip opposes friction is
+        # that answer. Otherwise fall through to the full rule.
+        ex, ey = _cone_edge(nx, ny, mu, hint)
+        vx, vy, om, fx, fy, conv = _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx,
+                                                   wvy, wom)
+        scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
+        if scale > 0.0:
+            vx, vy, om = scale * vx, scale * vy, scale * om
+            if _slip_opposes_friction(vx, vy, om, cx, cy, nx, ny, vpx, vpy, hint):
+                return TWIST_OK, vx, vy, om, fx, fy, hint
     if mu > 0.0:
         vx, vy, om, fx, fy, conv = _minpower_stick(verts, quad, area, cx, cy, vpx, vpy, wom)
         side = _cone_side(fx, fy, nx, ny, mu)
@@ -307,17 +336,19 @@ def _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max):
 
 @jit
 def _contact_twist(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
-                   wvx, wvy, wom):
+                   wvx, wvy, wom, hint):
     """Twist and pin force for one contact under ``model`` (see module doc).
 
-    ``(wvx, wvy, wom)`` is the previous twist, used to warm-start minpower.
+    ``(wvx, wvy, wom)`` is the previous twist and ``hint`` the previous mode,
+    used to warm-start minpower (the answer does not depend on them).
     A pin moving away from the part (``n . v_p <= 0``) exerts no force and the
     part stays at rest: mode ``SEPARATE``.
     """
     if vpx * nx + vpy * ny <= 0.0:
         return TWIST_OK, 0.0, 0.0, 0.0, 0.0, 0.0, SEPARATE
     if model == MINPOWER:
-        return _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom)
+        return _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom,
+                               hint)
     if model == TIP:
         return _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu)
     return _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max)

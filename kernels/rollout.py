@@ -14,11 +14,13 @@ from ``models._contact_twist``::
     d X / ds     = R(theta) v
 
 Within one contact feature (an edge or a vertex) the right-hand side is
-smooth, so a classical Runge-Kutta step is accurate to O(ds^4); the pin is
-projected back to distance ``r_pin`` after every step to stop drift. Feature
+smooth, and an embedded Runge-Kutta pair (Cash-Karp 5(4)) with local error
+control takes large steps where the motion is slow and small ones where it
+is not (on a vertex the geometry varies on the scale of ``r_pin``, not a).
+The pin is projected back to distance ``r_pin`` after every step to stop
+drift. Feature
 changes, separation and second contacts are events located by the Illinois
-method on the step fraction, so the step never straddles one. The step is
-capped by ``ds_max`` and by a rotation of ``dtheta_max`` per step.
+method on the step fraction, so the step never straddles one.
 """
 import math
 
@@ -52,8 +54,9 @@ _JAM_TRAVEL = 3.0  # units of a
 _MAX_TRAVEL = 50.0  # units of a
 _MAX_CHANGES = 10000
 
-DEFAULT_DS_MAX = 0.04  # units of a
-DEFAULT_DTHETA_MAX = 0.05  # radians
+DEFAULT_DS_MAX = 0.1  # units of a
+DEFAULT_TOL = 1e-7  # local error per step, units of a and radians
+_DTHETA_CAP = 0.2  # radians of contact-normal turn per step
 
 
 @jit
@@ -113,9 +116,9 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, w
     vpy = -sn * vpwx + cs * vpwy
     st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
                                                   nx, ny, vpx, vpy, mu, warm[0], warm[1],
-                                                  warm[2])
+                                                  warm[2], int(warm[3]))
     if st == TWIST_OK and mode != SEPARATE:
-        warm[0], warm[1], warm[2] = vx, vy, om
+        warm[0], warm[1], warm[2], warm[3] = vx, vy, om, mode
     out[0] = om
     out[1] = vpx - (vx - om * y[2])
     out[2] = vpy - (vy + om * y[1])
@@ -143,30 +146,53 @@ def _project(verts, kind, idx, rp, y):
         y[2] = verts[idx, 1] + rp * oy / dist
 
 
+# Cash-Karp embedded Runge-Kutta 5(4) tableau.
+_CK_C = np.array([0.0, 0.2, 0.3, 0.6, 1.0, 0.875])
+_CK_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [0.2, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0],
+    [0.3, -0.9, 1.2, 0.0, 0.0],
+    [-11.0 / 54.0, 2.5, -70.0 / 27.0, 35.0 / 27.0, 0.0],
+    [1631.0 / 55296.0, 175.0 / 512.0, 575.0 / 13824.0, 44275.0 / 110592.0, 253.0 / 4096.0],
+])
+_CK_B5 = np.array([37.0 / 378.0, 0.0, 250.0 / 621.0, 125.0 / 594.0, 0.0, 512.0 / 1771.0])
+_CK_B4 = np.array([2825.0 / 27648.0, 0.0, 18575.0 / 48384.0, 13525.0 / 55296.0,
+                   277.0 / 14336.0, 0.25])
+
+
 @jit
-def _rk4(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1, h, y1,
-         stage, tmp, warm):
-    """One classical Runge-Kutta step of size ``h`` from ``y0`` (slope ``k1``
-    given) into ``y1``. Returns False if a stage found no pushing solution."""
+def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1, h, y1,
+          ks, tmp, warm):
+    """One Cash-Karp step of size ``h`` from ``y0`` (slope ``k1`` given) into
+    ``y1`` (5th-order solution, projected back onto the contact).
+
+    Returns ``(ok, err)``: ``ok`` is False if a stage found no pushing
+    solution; ``err`` is the max-norm of the embedded error estimate.
+    """
     for i in range(5):
-        tmp[i] = y0[i] + 0.5 * h * k1[i]
-        y1[i] = k1[i]
-    st = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp, warm,
-                     stage)[0]
+        ks[0, i] = k1[i]
+    ok = True
+    for st in range(1, 6):
+        for i in range(5):
+            acc = 0.0
+            for j in range(st):
+                acc += _CK_A[st, j] * ks[j, i]
+            tmp[i] = y0[i] + h * acc
+        res = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp,
+                          warm, ks[st])
+        ok = ok and res[0] == TWIST_OK
+    err = 0.0
     for i in range(5):
-        y1[i] += 2.0 * stage[i]
-        tmp[i] = y0[i] + 0.5 * h * stage[i]
-    st2 = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp, warm,
-                      stage)[0]
-    for i in range(5):
-        y1[i] += 2.0 * stage[i]
-        tmp[i] = y0[i] + h * stage[i]
-    st3 = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp, warm,
-                      stage)[0]
-    for i in range(5):
-        y1[i] = y0[i] + h / 6.0 * (y1[i] + stage[i])
+        acc5 = 0.0
+        acc4 = 0.0
+        for j in range(6):
+            acc5 += _CK_B5[j] * ks[j, i]
+            acc4 += _CK_B4[j] * ks[j, i]
+        y1[i] = y0[i] + h * acc5
+        err = max(err, abs(h * (acc5 - acc4)))
     _project(verts, kind, idx, rp, y1)
-    return st == TWIST_OK and st2 == TWIST_OK and st3 == TWIST_OK
+    return ok, err
 
 
 @jit
@@ -204,50 +230,95 @@ def _min_over(g, mask):
 
 
 @jit
+def _hermite(y0, k0, y1, k1, h, alpha, out):
+    """Cubic Hermite dense output of a step at fraction ``alpha`` (first 3 components)."""
+    a2 = alpha * alpha
+    a3 = a2 * alpha
+    h00 = 2.0 * a3 - 3.0 * a2 + 1.0
+    h10 = a3 - 2.0 * a2 + alpha
+    h01 = -2.0 * a3 + 3.0 * a2
+    h11 = a3 - a2
+    for i in range(3):
+        out[i] = h00 * y0[i] + h10 * h * k0[i] + h01 * y1[i] + h11 * h * k1[i]
+
+
+@jit
 def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vpwy, y0, k1, h,
-            g1, y_out, stage, tmp, warm, g, mask):
-    """Shrink the step from ``y0`` to end on the first event crossed by a full
-    step of size ``h`` (event values ``g1`` at its end). The state just before
-    the crossing goes to ``y_out``. Returns ``(fraction, event)``."""
+            y1, k_end, g1, y_out, ks, tmp, warm, g, mask):
+    """Shrink the step from ``y0`` to end on the first event crossed by the
+    full step of size ``h`` to ``y1`` (slope ``k_end``, event values ``g1``).
+
+    The crossing is first found on the step's Hermite interpolant (no contact
+    solves), then refined with real steps by safeguarded secant iterations.
+    The state just before the crossing goes to ``y_out``.
+    Returns ``(fraction, event)``.
+    """
     for j in range(4):
         mask[j] = g1[j] < -_EVENT_TOL
     _events(verts, convex, kind, idx, rp, vpwx, vpwy, y0, g)
-    lo, hi = 0.0, 1.0
-    f_lo = _min_over(g, mask)
-    f_hi = _min_over(g1, mask)
-    side = 0
+    f0 = _min_over(g, mask)
+    f1 = _min_over(g1, mask)
+    # 1. Root of the event function along the interpolant (Illinois).
+    yi = np.empty(5)
     for i in range(5):
-        y_out[i] = y0[i]
-    y_try = np.empty(5)
-    for _ in range(80):
-        if f_hi < f_lo and f_lo - f_hi > 0.0:
-            alpha = hi - f_hi * (hi - lo) / (f_hi - f_lo)
-        else:
-            alpha = 0.5 * (lo + hi)
+        yi[i] = y0[i]
+    lo, hi, f_lo, f_hi, side = 0.0, 1.0, f0, f1, 0
+    alpha = 0.5
+    for _ in range(60):
+        alpha = hi - f_hi * (hi - lo) / (f_hi - f_lo) if f_lo > f_hi else 0.5 * (lo + hi)
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
-        _rk4(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1,
-             alpha * h, y_try, stage, tmp, warm)
-        _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_try, g)
-        for j in range(4):
-            if not mask[j] and g[j] < -_EVENT_TOL:
-                mask[j] = True  # an earlier event than the ones seen so far
-                side = 0
+        _hermite(y0, k1, y1, k_end, h, alpha, yi)
+        _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
         f = _min_over(g, mask)
         if f < 0.0:
             hi, f_hi = alpha, f
             if side == -1:
-                f_lo *= 0.5  # Illinois modification
+                f_lo *= 0.5
             side = -1
+        else:
+            lo, f_lo = alpha, f
+            if side == 1:
+                f_hi *= 0.5
+            side = 1
+        if abs(f) < 1e-14 or hi - lo < 1e-14:
+            break
+    # 2. Refine with real steps: secant from the interpolant's root, kept
+    #    inside the bracket of real evaluations.
+    for i in range(5):
+        y_out[i] = y0[i]
+    y_try = np.empty(5)
+    lo, hi, f_lo = 0.0, 1.0, f0
+    prev_alpha, prev_f = -1.0, 0.0
+    for it in range(60):
+        if not (lo < alpha < hi):
+            alpha = 0.5 * (lo + hi)
+        _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1,
+              alpha * h, y_try, ks, tmp, warm)
+        _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_try, g)
+        for j in range(4):
+            if not mask[j] and g[j] < -_EVENT_TOL:
+                mask[j] = True  # an earlier event than the ones seen so far
+        f = _min_over(g, mask)
+        if f < 0.0:
+            hi = alpha
         else:
             lo, f_lo = alpha, f
             for i in range(5):
                 y_out[i] = y_try[i]
-            if side == 1:
-                f_hi *= 0.5
-            side = 1
-        if (f >= 0.0 and f < 1e-13) or (hi - lo) * h < 1e-15:
+        if (f >= 0.0 and f < 1e-12) or (hi - lo) * h < 1e-15:
             break
+        if prev_alpha >= 0.0 and f != prev_f and it < 8:
+            nxt = alpha - f * (alpha - prev_alpha) / (f - prev_f)
+        else:
+            # First refinement: the interpolant's slope at the guess.
+            _hermite(y0, k1, y1, k_end, h, alpha + 1e-7, yi)
+            _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
+            slope = (_min_over(g, mask) - f) / 1e-7 if it < 8 else 0.0
+            nxt = alpha - f / slope if slope < 0.0 else 0.5 * (lo + hi)
+        prev_alpha, prev_f = alpha, f
+        # Aim slightly early so the kept state lies before the crossing.
+        alpha = nxt - 1e-13 / h
     _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_out, g)
     ev = 0
     best = np.inf
@@ -268,7 +339,7 @@ def _grow(buf, m):
 
 @jit
 def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
-             max_travel, ds_max, dtheta_max, record):
+             max_travel, ds_max, tol, record):
     """Roll a prepared part (see ``_prepare``) past one pin.
 
     Parameters
@@ -282,7 +353,8 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         passes the centroid's starting station.
     v_pin : pin speed across the belt in units of the belt speed (0: static).
     max_travel : stop after this belt travel since first contact (inf: never).
-    ds_max, dtheta_max : step caps (units of a, radians).
+    ds_max : largest step (units of a).
+    tol : local error tolerance per step (units of a and radians).
     record : keep the trajectory and force history.
 
     Returns
@@ -316,14 +388,17 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
     y = np.array([theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d])
     y_new = np.empty(5)
     k1 = np.empty(5)
-    stage = np.empty(5)
+    k_end = np.empty(5)
+    y_located = np.empty(5)
+    ks = np.empty((6, 5))
     tmp = np.empty(5)
     g = np.empty(4)
     g_end = np.empty(4)
     g_work = np.empty(4)
     mask = np.zeros(4, dtype=np.bool_)
-    warm = np.array([wx, wy, 0.0])
+    warm = np.array([wx, wy, 0.0, 0.0])  # previous twist and contact mode
     s = 0.0
+    h_next = ds_max
     travel = 0.0
     changes = 0
     peak = 0.0
@@ -333,9 +408,12 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         traj[0] = (0.0, 0.0, 0.0, theta_i)
         n_traj = 1
     separated = False
+    have_k1 = False
     while True:
-        st, mode, fx, fy = _derivative(model, verts, quad, area, m_max, mu_c, kind, idx,
-                                       vpwx, vpwy, y, warm, k1)
+        if not have_k1:
+            st, mode, fx, fy = _derivative(model, verts, quad, area, m_max, mu_c, kind, idx,
+                                           vpwx, vpwy, y, warm, k1)
+        have_k1 = False
         if separated:
             # A located separation ends just before n . v_p crosses zero.
             st, mode, separated = TWIST_OK, SEPARATE, False
@@ -369,28 +447,50 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         if s >= s_cap:
             status = TRUNCATED
             break
-        h = ds_max
-        if abs(k1[0]) * h > dtheta_max:
-            h = dtheta_max / abs(k1[0])
-        h = min(h, s_cap - s)
-        ok = _rk4(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy, y, k1, h,
-                  y_new, stage, tmp, warm)
-        halvings = 0
-        while not ok and halvings < 40:
-            h *= 0.5
-            halvings += 1
-            ok = _rk4(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy, y, k1,
-                      h, y_new, stage, tmp, warm)
+        # Adaptive step: error control, plus caps on the turn of the contact
+        # normal (with the part on an edge, around the vertex on a vertex) so
+        # no event function can cross zero twice within one step.
+        h = min(h_next, s_cap - s)
+        if abs(k1[0]) * h > _DTHETA_CAP:
+            h = _DTHETA_CAP / abs(k1[0])
+        if kind == VERTEX:
+            turn = math.hypot(k1[1], k1[2]) / rp
+            if turn * h > _DTHETA_CAP:
+                h = _DTHETA_CAP / turn
+        while True:
+            ok, err = _step(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy,
+                            y, k1, h, y_new, ks, tmp, warm)
+            if h < 1e-12:
+                break
+            if not ok:
+                h *= 0.5
+            elif err > tol:
+                h *= max(0.2, 0.9 * (tol / err) ** 0.2)
+            else:
+                break
         if not ok:
             status, reason = JAMMED, JAM_NO_PUSH
             break
+        grow = 5.0 if err <= 0.0 else min(5.0, 0.9 * (tol / err) ** 0.2)
+        h_next = min(ds_max, h * grow)
+        # Slope at the step's end: the next step's first stage when no event
+        # intervenes, and the end slope of the dense output otherwise.
+        st_e, mode_e, fx_e, fy_e = _derivative(model, verts, quad, area, m_max, mu_c, kind,
+                                               idx, vpwx, vpwy, y_new, warm, k_end)
         _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_new, g_end)
         ev = _first_event(g_end, _EVENT_TOL)
         frac = 1.0
         if ev >= 0:
             frac, ev = _locate(model, verts, quad, area, m_max, mu_c, convex, kind, idx, rp,
-                               vpwx, vpwy, y, k1, h, g_end, y_new, stage, tmp, warm, g_work,
-                               mask)
+                               vpwx, vpwy, y, k1, h, y_new, k_end, g_end, y_located, ks, tmp,
+                               warm, g_work, mask)
+            for i in range(5):
+                y_new[i] = y_located[i]
+        else:
+            for i in range(5):
+                k1[i] = k_end[i]
+            st, mode, fx, fy = st_e, mode_e, fx_e, fy_e
+            have_k1 = True
         for i in range(5):
             y[i] = y_new[i]
         s += frac * h

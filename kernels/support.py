@@ -40,7 +40,7 @@ from ._numba import jit
 # Centre-of-rotation distance (in units of a) beyond which the power uses the
 # smooth quadrature instead of the closed forms (see module notes).
 _R_FAR = 8.0
-_GL_N = 10
+_GL_N = 6
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(_GL_N)
 _GL_X = 0.5 * (_GL_X + 1.0)
 _GL_W = 0.5 * _GL_W
