@@ -7,7 +7,7 @@ blocks), so each thread reuses its own buffers and the result does not depend
 on the thread count: every rollout is computed independently.
 """
 import numpy as np
-from numba import get_num_threads, prange
+from numba import prange
 
 from ._numba import jit_parallel
 from .rollout import _rollout
@@ -15,10 +15,11 @@ from .rollout import _rollout
 
 @jit_parallel
 def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
-                  max_travel, ds_max, tol):
+                  max_travel, ds_max, tol, n_blocks):
     """Rollouts over the outer product ``d x theta_i`` (radians for theta_i).
 
-    Returns arrays of shape ``(len(d), len(theta_i))``: ``status``,
+    ``n_blocks`` is the number of contiguous blocks the grid is cut into
+    (use the thread count). Returns arrays of shape ``(len(d), len(theta_i))``: ``status``,
     ``jam_reason`` (int8), ``theta_f`` (radians), ``dy``, ``contact_travel``,
     ``feature_changes`` (int32) and ``peak_force``.
     """
@@ -31,7 +32,7 @@ def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     travel = np.empty((nd, nt))
     changes = np.empty((nd, nt), dtype=np.int32)
     peak = np.empty((nd, nt))
-    n_blocks = min(get_num_threads(), total) if total > 0 else 0
+    n_blocks = max(1, min(n_blocks, total))
     for b in prange(n_blocks):
         start = b * total // n_blocks
         stop = (b + 1) * total // n_blocks

@@ -1,0 +1,203 @@
+"""Public wrappers around the rollout kernels: validate, call, pack into xarray.
+
+Angles a person reads or writes are degrees; lengths are in the part's unit
+(``length_unit``, millimetres by default); forces in units of ``mu_s m g``.
+
+``d`` for a moving pin (``v_pin != 0``) is the pin's offset as it passes the
+centroid's starting station along the belt (for a static pin, simply its
+offset).
+"""
+from __future__ import annotations
+
+import math
+from contextlib import contextmanager
+
+import numba
+import numpy as np
+import xarray as xr
+
+from kernels.batch import _rollout_grid
+from kernels.models import MODEL_NAMES
+from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
+                             _rollout)
+
+from . import __version__
+from .errors import PinfeedError
+from .parts import Part
+
+MODELS = MODEL_NAMES
+STATUSES = STATUS_NAMES
+
+STATUS_ATTRS = {
+    "long_name": "rollout status",
+    "flag_values": np.arange(len(STATUS_NAMES), dtype=np.int8),
+    "flag_meanings": " ".join(STATUS_NAMES),
+}
+JAM_ATTRS = {
+    "long_name": "why a jammed rollout was declared jammed",
+    "flag_values": np.arange(len(JAM_REASONS), dtype=np.int8),
+    "flag_meanings": " ".join(["none"] + [r.replace(" ", "_") for r in JAM_REASONS[1:]]),
+}
+
+
+def check_parameters(mu_c, pin_radius, model="minpower", v_pin=0.0, max_travel=None):
+    """Raise :class:`PinfeedError` with a clear message for bad physical parameters."""
+    if not (isinstance(mu_c, (int, float, np.floating, np.integer)) and math.isfinite(mu_c)) or mu_c < 0:
+        raise PinfeedError(f"contact friction mu_c must be a finite number >= 0, got {mu_c!r}")
+    if not (isinstance(pin_radius, (int, float, np.floating, np.integer)) and math.isfinite(pin_radius)) \
+            or pin_radius <= 0:
+        raise PinfeedError(f"pin radius must be a finite number > 0, got {pin_radius!r}")
+    if model not in MODELS:
+        raise PinfeedError(f"unknown model {model!r}; choose one of {', '.join(MODELS)}")
+    if not math.isfinite(v_pin):
+        raise PinfeedError(f"pin speed ratio v_pin must be finite, got {v_pin!r}")
+    if max_travel is not None and not (max_travel > 0):
+        raise PinfeedError(f"max travel must be > 0, got {max_travel!r}")
+
+
+def _angles(values, what) -> np.ndarray:
+    arr = np.atleast_1d(np.asarray(values, dtype=np.float64))
+    if arr.ndim != 1 or not np.all(np.isfinite(arr)):
+        raise PinfeedError(f"{what} must be finite numbers, got {values!r}")
+    return arr
+
+
+@contextmanager
+def _threads(n):
+    if n is None:
+        yield numba.get_num_threads()
+        return
+    old = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
+    try:
+        yield numba.get_num_threads()
+    finally:
+        numba.set_num_threads(old)
+
+
+def _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, length_unit):
+    return {
+        "part_name": part.name,
+        "part_id": part.id,
+        "part_vertices": np.asarray(part.vertices).ravel(),
+        "part_a": part.a,
+        "model": model,
+        "mu_c": float(mu_c),
+        "pin_radius": float(pin_radius),
+        "v_pin": float(v_pin),
+        "length_unit": length_unit,
+        "kernel_ds_max": float(ds_max),
+        "kernel_tol": float(tol),
+        "pinfeed_version": __version__,
+    }
+
+
+def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float,
+            model: str = "minpower", v_pin: float = 0.0, max_travel: float | None = None,
+            trajectory: bool = False, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
+            length_unit: str = "mm") -> xr.Dataset:
+    """One passage of ``part`` past one pin (spec section 4).
+
+    Parameters
+    ----------
+    theta_i : initial orientation, degrees.
+    d : contact parameter ``(y_pin - y_com) / a``.
+    mu_c : pin-part friction coefficient (>= 0).
+    pin_radius : pin radius, in the part's length unit (> 0).
+    model : ``"minpower"`` (default), ``"tip"`` or ``"ellipsoid"``.
+    v_pin : pin speed across the belt over belt speed (0 for a static pin).
+    max_travel : stop after this belt travel since first contact (status
+        ``truncated``); ``None`` runs to the end.
+    trajectory : also return the trajectory (dim ``step``: ``s``, ``x``,
+        ``y``, ``theta``) and the force on the pin (dim ``sample``).
+
+    Returns
+    -------
+    xarray.Dataset
+        Scalars ``status`` (a string), ``theta_f`` (degrees, [0, 360)),
+        ``dy``, ``contact_travel``, ``feature_changes``, ``peak_force``,
+        ``jam_reason``.
+    """
+    check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
+    theta = float(_angles(theta_i, "theta_i")[0])
+    dd = float(_angles(d, "d")[0])
+    cap = np.inf if max_travel is None else float(max_travel)
+    res = _rollout(*part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
+                   math.radians(theta), dd, float(v_pin), cap, float(ds_max), float(tol),
+                   bool(trajectory))
+    status, reason, theta_f, dy, travel, changes, peak, traj, force = res
+    unit = length_unit
+    ds = xr.Dataset(
+        {
+            "status": ((), STATUS_NAMES[status], {"long_name": "rollout status"}),
+            "jam_reason": ((), JAM_REASONS[reason] or "none", {"long_name": "why jammed"}),
+            "theta_f": ((), _wrap_deg(math.degrees(theta_f)),
+                        {"units": "degree", "long_name": "final orientation"}),
+            "dy": ((), dy, {"units": unit, "long_name": "centroid displacement across the belt"}),
+            "contact_travel": ((), travel, {"units": unit, "long_name": "pin travel in contact"}),
+            "feature_changes": ((), int(changes), {"long_name": "contact feature changes"}),
+            "peak_force": ((), peak, {"units": "mu_s m g", "long_name": "peak force on the pin"}),
+        },
+        coords={"theta_i": ((), theta, {"units": "degree", "long_name": "initial orientation"}),
+                "d": ((), dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"})},
+        attrs=_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit),
+    )
+    if trajectory:
+        ds["traj_s"] = ("step", traj[:, 0], {"units": unit, "long_name": "belt travel since first contact"})
+        ds["traj_x"] = ("step", traj[:, 1], {"units": unit, "long_name": "centroid displacement along the belt"})
+        ds["traj_y"] = ("step", traj[:, 2], {"units": unit, "long_name": "centroid displacement across the belt"})
+        ds["traj_theta"] = ("step", np.degrees(traj[:, 3]), {"units": "degree", "long_name": "orientation (unwrapped)"})
+        ds["force_s"] = ("sample", force[:, 0], {"units": unit, "long_name": "belt travel since first contact"})
+        ds["force_x"] = ("sample", force[:, 1], {"units": "mu_s m g", "long_name": "force on the pin along the belt"})
+        ds["force_y"] = ("sample", force[:, 2], {"units": "mu_s m g", "long_name": "force on the pin across the belt"})
+    return ds
+
+
+def _wrap_deg(x):
+    """Wrap degrees to [0, 360) without returning 360.0 for tiny negatives."""
+    w = np.mod(x, 360.0)
+    return np.where(w >= 360.0, 0.0, w) if np.ndim(w) else (0.0 if w >= 360.0 else float(w))
+
+
+def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "minpower",
+        v_pin: float = 0.0, max_travel: float | None = None, threads: int | None = None,
+        ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
+        length_unit: str = "mm") -> xr.Dataset:
+    """Configuration map set: rollouts over ``d x theta_i`` (paper eq. 2).
+
+    Runs in parallel on ``threads`` Numba threads (default: all Numba has).
+    Returns a Dataset with dims ``(d, theta_i)`` and variables ``theta_f``,
+    ``dy``, ``status`` (int8 flags, see its ``flag_meanings``), ``jam_reason``,
+    ``contact_travel``, ``feature_changes`` and ``peak_force``.
+    """
+    check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
+    th = _angles(theta_i, "theta_i")
+    dd = _angles(d, "d")
+    cap = np.inf if max_travel is None else float(max_travel)
+    with _threads(threads) as n:
+        status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
+            *part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
+            np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol), n)
+    unit = length_unit
+    return xr.Dataset(
+        {
+            "theta_f": (("d", "theta_i"), _wrap_deg(np.degrees(theta_f)),
+                        {"units": "degree", "long_name": "final orientation"}),
+            "dy": (("d", "theta_i"), dy, {"units": unit, "long_name": "centroid displacement across the belt"}),
+            "status": (("d", "theta_i"), status, dict(STATUS_ATTRS)),
+            "jam_reason": (("d", "theta_i"), reason, dict(JAM_ATTRS)),
+            "contact_travel": (("d", "theta_i"), travel, {"units": unit, "long_name": "pin travel in contact"}),
+            "feature_changes": (("d", "theta_i"), changes, {"long_name": "contact feature changes"}),
+            "peak_force": (("d", "theta_i"), peak, {"units": "mu_s m g", "long_name": "peak force on the pin"}),
+        },
+        coords={
+            "d": ("d", dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"}),
+            "theta_i": ("theta_i", th, {"units": "degree", "long_name": "initial orientation"}),
+        },
+        attrs=_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit),
+    )
+
+
+def status_names(codes) -> np.ndarray:
+    """Decode int8 status flags to their names."""
+    return np.asarray(STATUS_NAMES, dtype=object)[np.asarray(codes, dtype=int)]
