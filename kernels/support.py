@@ -12,8 +12,8 @@ Each integral is a signed sum over edges of the triangle (r, p, q). In the
 edge's own frame (unit direction ``e``, outward normal ``m = (e_y, -e_x)``,
 signed height ``h = cross(p - r, e)``, positions ``t`` of the edge ends along
 ``e`` from the foot of the perpendicular, ``R = sqrt(h^2 + t^2)``) polar
-integration about r gives, with ``S = asinh(t / |h|)`` and ``[.]`` the
-difference between the two ends::
+integration about r gives, with ``S = asinh(t / |h|) = log((t + R) / |h|)``
+and ``[.]`` the difference between the two ends::
 
     E_edge = h/6 [t R] + h^3/6 [S]
     G_edge = h/2 (e [R] + h m [S])
@@ -47,8 +47,9 @@ _GL_W = 0.5 * _GL_W
 
 
 @jit
-def _edge_support(px, py, qx, qy):
-    """Signed E, G, N of the triangle (0, p, q); coordinates relative to r.
+def _edge_support(px, py, r1, qx, qy, r2):
+    """Signed E, G, N of the triangle (0, p, q); coordinates relative to r,
+    ``r1 = |p|`` and ``r2 = |q|`` (shared with the neighbouring edges).
 
     Returns ``(E, Gx, Gy, Nxx, Nxy, Nyy)``.
     """
@@ -58,23 +59,25 @@ def _edge_support(px, py, qx, qy):
     ey /= length
     mx, my = ey, -ex
     h = px * ey - py * ex
-    r1 = math.hypot(px, py)
-    r2 = math.hypot(qx, qy)
     if abs(h) <= 1e-15 * (r1 + r2):
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     t1 = px * ex + py * ey
     t2 = qx * ex + qy * ey
-    ah = abs(h)
-    ds = math.asinh(t2 / ah) - math.asinh(t1 / ah)
+    # [asinh(t/|h|)] = log of (t2 + R2)/(t1 + R1), each written without
+    # cancellation: t + R = h^2 / (R - t) when t < 0.
+    hh = h * h
+    p1 = t1 + r1 if t1 >= 0.0 else hh / (r1 - t1)
+    p2 = t2 + r2 if t2 >= 0.0 else hh / (r2 - t2)
+    ds = math.log(p2 / p1)
     dtr = t2 * r2 - t1 * r1
     dr = r2 - r1
     dtor = t2 / r2 - t1 / r1
     dinv = 1.0 / r2 - 1.0 / r1
-    e_val = h * dtr / 6.0 + h * h * h * ds / 6.0
+    e_val = h * dtr / 6.0 + hh * h * ds / 6.0
     gx = 0.5 * h * (ex * dr + h * mx * ds)
     gy = 0.5 * h * (ey * dr + h * my * ds)
     cee = h * (ds - dtor)
-    cem = -h * h * dinv
+    cem = -hh * dinv
     cmm = h * dtor
     nxx = cee * ex * ex + 2.0 * cem * ex * mx + cmm * mx * mx
     nxy = cee * ex * ey + cem * (ex * my + mx * ey) + cmm * mx * my
@@ -90,16 +93,24 @@ def _support(verts, rx, ry):
     """
     n = verts.shape[0]
     e_val = gx = gy = nxx = nxy = nyy = 0.0
+    px, py = verts[0, 0] - rx, verts[0, 1] - ry
+    r_first = math.hypot(px, py)
+    r1 = r_first
     for j in range(n):
-        k = (j + 1) % n
-        a0, a1, a2, a3, a4, a5 = _edge_support(verts[j, 0] - rx, verts[j, 1] - ry,
-                                               verts[k, 0] - rx, verts[k, 1] - ry)
+        if j + 1 < n:
+            qx, qy = verts[j + 1, 0] - rx, verts[j + 1, 1] - ry
+            r2 = math.hypot(qx, qy)
+        else:
+            qx, qy = verts[0, 0] - rx, verts[0, 1] - ry
+            r2 = r_first
+        a0, a1, a2, a3, a4, a5 = _edge_support(px, py, r1, qx, qy, r2)
         e_val += a0
         gx += a1
         gy += a2
         nxx += a3
         nxy += a4
         nyy += a5
+        px, py, r1 = qx, qy, r2
     return e_val, gx, gy, nxx, nxy, nyy
 
 

@@ -17,6 +17,12 @@ from .errors import PinfeedError
 MAP_VARIABLES = ("theta_f", "dy", "status")
 
 
+def _umask_mode() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def write_atomic(ds: xr.Dataset, path, encoding=None) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -24,6 +30,7 @@ def write_atomic(ds: xr.Dataset, path, encoding=None) -> Path:
     os.close(fd)
     try:
         ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding, invalid_netcdf=True)
+        os.chmod(tmp, _umask_mode())  # mkstemp creates 0600
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -1,0 +1,250 @@
+"""The map database: an index of every shard under ``catalog/``, checked against disk.
+
+The index (``catalog/index.json``) is rebuilt from the shards' own
+attributes, never edited by hand, and written atomically. Opening a catalog
+checks each entry against its file: entries whose files are gone or changed
+are reported in :attr:`Catalog.problems` and never served; a re-index drops
+them. Foreign or corrupt ``.h5`` files are reported by name.
+
+Queries return lazy (dask-backed) xarray objects::
+
+    cat = Catalog.open("catalog")
+    ds = cat.query(part="asym_triangle", model="minpower", mu_c=0.2, d=0.3)
+    ds.attrs["selection"]   # e.g. "mu_c 0.2 -> nearest stored 0.15; d 0.3 -> 0.3"
+    cube = cat.cube("paper_triangles")   # dims (part, model, mu_c, d, theta_i)
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .errors import PinfeedError
+
+INDEX_NAME = "index.json"
+INDEX_VERSION = 1
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _entry_from_file(root: Path, path: Path) -> dict:
+    """Index entry from a shard's own attributes; raises PinfeedError for foreign/corrupt files."""
+    try:
+        with xr.open_dataset(path, engine="h5netcdf") as ds:
+            attrs = dict(ds.attrs)
+            d = [float(x) for x in ds["d"].values]
+            n_theta = int(ds.sizes["theta_i"])
+    except Exception as exc:
+        raise PinfeedError(f"{path}: cannot read as HDF5 (corrupt or not a map file): "
+                           f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+    if "catalog_schema_version" not in attrs or "part_id" not in attrs:
+        raise PinfeedError(f"{path}: foreign file, not a pinfeed shard (no catalog attributes)")
+    verts = np.asarray(attrs["part_vertices"], float).reshape(-1, 2).tolist()
+    return {
+        "file": path.relative_to(root).as_posix(),
+        "sha256": _sha256(path),
+        "size": path.stat().st_size,
+        "family": str(attrs["family"]),
+        "part_id": str(attrs["part_id"]),
+        "part_name": str(attrs["part_name"]),
+        "part_vertices": verts,
+        "model": str(attrs["model"]),
+        "mu_c": float(attrs["mu_c"]),
+        "pin_radius": float(attrs["pin_radius"]),
+        "v_pin": float(attrs.get("v_pin", 0.0)),
+        "d": d,
+        "theta_step": float(attrs["theta_step"]),
+        "n_theta": n_theta,
+        "config_hash": str(attrs["config_hash"]),
+        "pinfeed_version": str(attrs["pinfeed_version"]),
+        "git_commit": str(attrs.get("git_commit", "unknown")),
+        "created": str(attrs.get("created", "")),
+        "schema_version": int(attrs["catalog_schema_version"]),
+    }
+
+
+def _write_json_atomic(obj, path: Path):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(obj, fh, indent=1, sort_keys=True)
+            fh.write("\n")
+        from .io import _umask_mode
+        os.chmod(tmp, _umask_mode())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+class Catalog:
+    """An opened catalog: verified entries plus the problems found on disk."""
+
+    def __init__(self, root: Path, entries: list[dict], problems: list[str]):
+        self.root = Path(root)
+        self.entries = entries
+        self.problems = problems
+
+    # ------------------------------------------------------------------ building
+
+    @classmethod
+    def rebuild(cls, root="catalog") -> "Catalog":
+        """Scan every shard under ``root``, write a fresh index atomically."""
+        root = Path(root)
+        if not root.is_dir():
+            raise PinfeedError(f"no catalog folder at {root}; run the workflow ('make run') first")
+        entries, problems = [], []
+        for path in sorted(root.rglob("*.h5")):
+            if path.name.startswith("."):
+                continue  # an unfinished atomic write
+            try:
+                entries.append(_entry_from_file(root, path))
+            except PinfeedError as exc:
+                problems.append(str(exc))
+        _write_json_atomic({"index_version": INDEX_VERSION, "entries": entries,
+                            "problems": problems}, root / INDEX_NAME)
+        return cls(root, entries, problems)
+
+    @classmethod
+    def open(cls, root="catalog") -> "Catalog":
+        """Read the index and check it against the files on disk (size and presence;
+        contents are checksummed when an entry is served)."""
+        root = Path(root)
+        index = root / INDEX_NAME
+        if not index.is_file():
+            raise PinfeedError(f"no catalog index at {index}; run the workflow ('make run') "
+                               f"or 'pinfeed catalog index --catalog {root}'")
+        try:
+            with open(index) as fh:
+                data = json.load(fh)
+            raw = data["entries"]
+        except (json.JSONDecodeError, KeyError, TypeError):
+            raise PinfeedError(f"{index} is corrupt; rebuild it with 'pinfeed catalog index "
+                               f"--catalog {root}'") from None
+        entries, problems = [], list(data.get("problems", []))
+        for e in raw:
+            path = root / e["file"]
+            if not path.is_file():
+                problems.append(f"{path}: listed in the index but gone from disk")
+            elif path.stat().st_size != e["size"]:
+                problems.append(f"{path}: changed since it was indexed")
+            else:
+                entries.append(e)
+        return cls(root, entries, problems)
+
+    # ------------------------------------------------------------------ queries
+
+    def parts(self) -> list[dict]:
+        """One row per part: family, id, name, models and frictions stored."""
+        rows = {}
+        for e in self.entries:
+            r = rows.setdefault(e["part_id"], {"family": e["family"], "part_id": e["part_id"],
+                                               "part_name": e["part_name"], "n_vertices": len(e["part_vertices"]),
+                                               "models": set(), "mu_c": set(), "n_d": len(e["d"]),
+                                               "n_theta": e["n_theta"]})
+            r["models"].add(e["model"])
+            r["mu_c"].add(e["mu_c"])
+        return [dict(r, models=sorted(r["models"]), mu_c=sorted(r["mu_c"])) for r in rows.values()]
+
+    def _entries_for(self, part: str) -> list[dict]:
+        found = [e for e in self.entries if part in (e["part_id"], e["part_name"])]
+        if not found:
+            known = sorted({e["part_name"] for e in self.entries})
+            raise PinfeedError(f"unknown part {part!r}; known parts: {', '.join(known) or 'none'} "
+                               f"('pinfeed catalog list' shows them)")
+        ids = sorted({e["part_id"] for e in found})
+        if len(ids) > 1:
+            raise PinfeedError(f"part name {part!r} matches several parts ({', '.join(ids)}); give the id")
+        return found
+
+    def _open_entry(self, e: dict) -> xr.Dataset:
+        path = self.root / e["file"]
+        if not path.is_file():
+            raise PinfeedError(f"{path} is gone from disk; re-run the workflow to recompute it")
+        if _sha256(path) != e["sha256"]:
+            raise PinfeedError(f"{path} changed since it was indexed; re-run the workflow or "
+                               f"'pinfeed catalog index'")
+        return xr.open_dataset(path, engine="h5netcdf", chunks={})
+
+    def query(self, part: str, model: str = "minpower", mu_c=None, d=None,
+              method: str = "nearest") -> xr.Dataset:
+        """Maps of one part and model, lazily.
+
+        ``mu_c`` and ``d`` select stored values: ``method="nearest"`` takes the
+        nearest stored value, ``"bracket"`` the stored values on either side (or
+        the exact one). ``None`` keeps all. ``attrs["selection"]`` says what was
+        chosen. Returns dims ``(mu_c, d, theta_i)``.
+        """
+        if method not in ("nearest", "bracket"):
+            raise PinfeedError(f"unknown selection method {method!r}; use nearest or bracket")
+        found = [e for e in self._entries_for(part) if e["model"] == model]
+        if not found:
+            models = sorted({e["model"] for e in self._entries_for(part)})
+            raise PinfeedError(f"part {part!r} has no {model} maps; stored models: {', '.join(models)}")
+        notes = []
+        stored_mu = sorted({e["mu_c"] for e in found})
+        if mu_c is not None:
+            chosen = _select(stored_mu, float(mu_c), method)
+            notes.append(f"mu_c {float(mu_c):g} -> {_describe(chosen, float(mu_c), method)}")
+            found = [e for e in found if e["mu_c"] in chosen]
+        found.sort(key=lambda e: e["mu_c"])
+        parts = [self._open_entry(e).expand_dims(mu_c=[e["mu_c"]]) for e in found]
+        ds = xr.concat(parts, dim="mu_c", combine_attrs="drop_conflicts")
+        ds["mu_c"].attrs.update(units="1", long_name="pin-part friction coefficient")
+        if d is not None:
+            stored_d = [float(x) for x in ds["d"].values]
+            picks = []
+            for want in np.atleast_1d(d):
+                chosen = _select(stored_d, float(want), method)
+                notes.append(f"d {float(want):g} -> {_describe(chosen, float(want), method)}")
+                picks.extend(c for c in chosen if c not in picks)
+            ds = ds.sel(d=picks)
+        ds.attrs["selection"] = "; ".join(notes) if notes else "all stored mu_c and d"
+        return ds
+
+    def cube(self, family: str) -> xr.Dataset:
+        """All maps of a family as one lazy cube (part, model, mu_c, d, theta_i)."""
+        found = [e for e in self.entries if e["family"] == family]
+        if not found:
+            fams = sorted({e["family"] for e in self.entries})
+            raise PinfeedError(f"unknown family {family!r}; known families: {', '.join(fams) or 'none'}")
+        pieces = []
+        for e in found:
+            ds = self._open_entry(e)
+            ds = ds.drop_attrs() if hasattr(ds, "drop_attrs") else ds.assign_attrs({})
+            pieces.append(ds.expand_dims(part=[e["part_id"]], model=[e["model"]], mu_c=[e["mu_c"]]))
+        cube = xr.combine_by_coords(pieces, combine_attrs="drop")
+        cube.attrs.update(family=family, title=f"pinfeed map cube of family {family}")
+        return cube
+
+
+def _select(stored: list[float], want: float, method: str) -> list[float]:
+    stored = sorted(stored)
+    if method == "nearest" or want in stored:
+        return [min(stored, key=lambda s: (abs(s - want), s))]
+    below = [s for s in stored if s < want]
+    above = [s for s in stored if s > want]
+    if not below or not above:
+        return [below[-1] if below else above[0]]  # outside the stored range: the end
+    return [below[-1], above[0]]
+
+
+def _describe(chosen, want, method) -> str:
+    if len(chosen) == 1 and chosen[0] == want:
+        return "stored exactly"
+    if len(chosen) == 1:
+        how = "nearest stored" if method == "nearest" else "outside the stored range, end"
+        return f"{how} {chosen[0]:g}"
+    return f"bracketed by {chosen[0]:g} and {chosen[1]:g}"

@@ -1,0 +1,102 @@
+"""Load and validate a workflow config before any work starts.
+
+Validation is the JSON schema in ``config/schema.yaml`` (a description for
+every key) with its defaults filled in, then the checks a schema cannot
+express: every part is a simple polygon, 360 is a multiple of theta_step.
+The Snakefile and the CLI both call :func:`load_config`, so a bad config
+fails with one clear message before any work starts.
+"""
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+from pathlib import Path
+
+import jsonschema
+import yaml
+
+from .errors import PinfeedError
+from .families import family_parts
+
+SCHEMA_PATH = Path(__file__).resolve().parent.parent / "config" / "schema.yaml"
+DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config" / "config.yaml"
+
+
+def _schema():
+    with open(SCHEMA_PATH) as fh:
+        return yaml.safe_load(fh)
+
+
+def _fill_defaults(validator_cls):
+    validate_props = validator_cls.VALIDATORS["properties"]
+
+    def set_defaults(validator, properties, instance, schema):
+        if isinstance(instance, dict):
+            for prop, sub in properties.items():
+                if "default" in sub and prop not in instance:
+                    instance[prop] = copy.deepcopy(sub["default"])
+        yield from validate_props(validator, properties, instance, schema)
+
+    return jsonschema.validators.extend(validator_cls, {"properties": set_defaults})
+
+
+def _where(err) -> str:
+    path = "/".join(str(p) for p in err.absolute_path)
+    return path or "(top level)"
+
+
+def validate_config(config: dict) -> dict:
+    """Return a validated copy of ``config`` with defaults filled in."""
+    cfg = copy.deepcopy(config)
+    schema = _schema()
+    validator = _fill_defaults(jsonschema.Draft202012Validator)(schema)
+    errors = sorted(validator.iter_errors(cfg), key=lambda e: list(e.absolute_path))
+    if errors:
+        err = errors[0]
+        raise PinfeedError(f"config error at {_where(err)}: {err.message}")
+    # Defaults of nested objects that were themselves defaulted.
+    validator.validate(cfg)
+    steps = 360.0 / cfg["sweep"]["theta_step"]
+    if abs(steps - round(steps)) > 1e-9:
+        raise PinfeedError(f"config error at sweep/theta_step: 360 is not a multiple of "
+                           f"{cfg['sweep']['theta_step']}")
+    for name, spec in cfg["families"].items():
+        family_parts(name, spec)  # raises on a bad outline, naming the part
+    return cfg
+
+
+def load_config(path=None) -> dict:
+    """Read a YAML config (default: the embedded ``config/config.yaml``) and validate it."""
+    path = Path(path) if path else DEFAULT_CONFIG
+    if not path.is_file():
+        raise PinfeedError(f"no config file at {path}; pass an existing YAML file")
+    try:
+        with open(path) as fh:
+            config = yaml.safe_load(fh)
+    except yaml.YAMLError as exc:
+        raise PinfeedError(f"{path} is not valid YAML: {exc}".splitlines()[0]) from None
+    if not isinstance(config, dict):
+        raise PinfeedError(f"{path} must hold a YAML mapping of settings")
+    return validate_config(config)
+
+
+def config_hash(config: dict) -> str:
+    """Hash of the validated config (canonical JSON), recorded in stored files."""
+    blob = json.dumps(config, sort_keys=True, separators=(",", ":"), default=float)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def theta_grid(config: dict):
+    import numpy as np
+    step = config["sweep"]["theta_step"]
+    return np.round(np.arange(int(round(360.0 / step))) * step, 10)
+
+
+def mu_label(mu: float) -> str:
+    """File-name form of a friction value: 0.15 -> '0.15' (round-trips through float)."""
+    text = repr(float(mu))
+    if not math.isclose(float(text), mu):
+        raise PinfeedError(f"mu_c {mu} cannot be written exactly")
+    return text

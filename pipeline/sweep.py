@@ -1,0 +1,132 @@
+"""The sweep: one shard per (family, part, model, mu_c), each a map set over (d, theta_i).
+
+A shard is an HDF5 file (xarray, h5netcdf engine) that describes itself:
+CF-style variable attributes, the part's outline, every sweep parameter, the
+pinfeed version and git commit, the config hash and the creation time. Data
+is gzip-compressed and chunked so one map (one d) is one chunk.
+
+``run_sweep`` computes whatever shards are missing, locally or on a
+dask.distributed cluster (``scheduler`` address), then rebuilds the index.
+The Snakemake workflow calls :func:`write_shard` once per job instead.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import simulate
+from .config import config_hash, mu_label, theta_grid
+from .families import family_parts
+from .io import write_atomic
+from .parts import Part
+from .provenance import provenance_attrs
+
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True)
+class ShardJob:
+    family: str
+    part: Part
+    model: str
+    mu_c: float
+
+    def path(self, catalog_dir) -> Path:
+        return shard_path(catalog_dir, self.family, self.part.id, self.model, self.mu_c)
+
+
+def shard_path(catalog_dir, family, part_id, model, mu_c) -> Path:
+    return Path(catalog_dir) / family / part_id / model / f"mu_c={mu_label(mu_c)}.h5"
+
+
+def shard_jobs(config) -> list[ShardJob]:
+    """Every shard the config asks for, in a stable order."""
+    jobs = []
+    for family, spec in config["families"].items():
+        for part in family_parts(family, spec):
+            for model in config["sweep"]["models"]:
+                for mu in config["sweep"]["mu_c"]:
+                    jobs.append(ShardJob(family, part, model, float(mu)))
+    return jobs
+
+
+def find_job(config, family, part_id, model, mu_c) -> ShardJob:
+    for job in shard_jobs(config):
+        if (job.family, job.part.id, job.model) == (family, part_id, model) and job.mu_c == float(mu_c):
+            return job
+    from .errors import PinfeedError
+    raise PinfeedError(f"the config has no shard {family}/{part_id}/{model}/mu_c={mu_c}")
+
+
+def compute_shard(config, job: ShardJob, threads=None):
+    """The map set of one shard as a self-describing Dataset."""
+    sweep = config["sweep"]
+    kernel = sweep.get("kernel", {})
+    ds = simulate.map(job.part, theta_grid(config), np.asarray(sweep["d"], float), job.mu_c,
+                      sweep["pin_radius"], model=job.model, threads=threads,
+                      ds_max=kernel.get("ds_max", 0.1), tol=kernel.get("tol", 1e-7))
+    ds.attrs.update(provenance_attrs())
+    ds.attrs.update({
+        "title": f"pinfeed configuration maps: {job.part.id}, {job.model}, mu_c={job.mu_c:g}",
+        "family": job.family,
+        "theta_step": float(sweep["theta_step"]),
+        "config_hash": config_hash(config),
+        "catalog_schema_version": SCHEMA_VERSION,
+        "Conventions": "CF-1.10",
+    })
+    return ds
+
+
+def _encoding(ds):
+    nt = ds.sizes["theta_i"]
+    enc = {}
+    for name, var in ds.data_vars.items():
+        if var.dims == ("d", "theta_i"):
+            enc[name] = {"compression": "gzip", "compression_opts": 4, "shuffle": True,
+                         "chunksizes": (1, nt)}
+    return enc
+
+
+def write_shard(config, job: ShardJob, out=None, threads=None) -> Path:
+    """Compute one shard and write it atomically (to ``out`` or its catalog path)."""
+    out = Path(out) if out else job.path(config["catalog_dir"])
+    ds = compute_shard(config, job, threads=threads)
+    return write_atomic(ds, out, encoding=_encoding(ds))
+
+
+def _write_job(config, job, threads):
+    return str(write_shard(config, job, threads=threads))
+
+
+def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
+              progress: bool = True) -> list[Path]:
+    """Compute every missing shard, then rebuild the catalog index.
+
+    With ``scheduler`` (a dask.distributed address such as ``tcp://host:8786``)
+    the shards run as tasks on that cluster; otherwise here, one after
+    another, each on ``threads`` Numba threads.
+    """
+    from .catalog import Catalog
+    root = Path(config["catalog_dir"])
+    todo = [j for j in shard_jobs(config) if not j.path(root).is_file()]
+    written = []
+    if scheduler:
+        from distributed import Client, as_completed
+        with Client(scheduler) as client:
+            futures = [client.submit(_write_job, config, j, threads, pure=False) for j in todo]
+            for fut in _progress(as_completed(futures), len(futures), progress):
+                written.append(Path(fut.result()))
+    else:
+        for job in _progress(todo, len(todo), progress):
+            written.append(write_shard(config, job, threads=threads))
+    Catalog.rebuild(root)
+    return written
+
+
+def _progress(it, total, enabled):
+    if not enabled or total == 0:
+        return it
+    from tqdm import tqdm
+    return tqdm(it, total=total, desc="shards", unit="shard")
