@@ -127,6 +127,108 @@ def cmd_demo(args):
     print(f"wrote {out / 'map.h5'} and {out / 'map.png'}")
 
 
+def _catalog(args):
+    from .catalog import Catalog
+    cat = Catalog.open(args.catalog)
+    for problem in cat.problems:
+        print(f"pinfeed: warning: {problem} (not served)", file=sys.stderr)
+    return cat
+
+
+def cmd_catalog_index(args):
+    from .catalog import Catalog
+    cat = Catalog.rebuild(args.catalog)
+    print(f"indexed {len(cat.entries)} shards under {args.catalog}")
+    for problem in cat.problems:
+        print(f"pinfeed: warning: {problem}", file=sys.stderr)
+
+
+def cmd_catalog_list(args):
+    rows = _catalog(args).parts()
+    if args.json:
+        json.dump(rows, sys.stdout, indent=1)
+        sys.stdout.write("\n")
+        return
+    print(f"{'family':<18} {'part':<28} {'models':<22} {'mu_c':<18} {'d x theta_i'}")
+    for r in rows:
+        print(f"{r['family']:<18} {r['part_id']:<28} {','.join(r['models']):<22} "
+              f"{','.join(f'{m:g}' for m in r['mu_c']):<18} {r['n_d']} x {r['n_theta']}")
+
+
+def cmd_catalog_show(args):
+    cat = _catalog(args)
+    entries = cat._entries_for(args.part)
+    e0 = entries[0]
+    info = {k: e0[k] for k in ("family", "part_id", "part_name", "part_vertices", "pin_radius",
+                               "d", "theta_step", "config_hash", "pinfeed_version", "git_commit")}
+    info["shards"] = [{k: e[k] for k in ("model", "mu_c", "file", "sha256", "created")}
+                      for e in sorted(entries, key=lambda e: (e["model"], e["mu_c"]))]
+    if args.json:
+        json.dump(info, sys.stdout, indent=1)
+        sys.stdout.write("\n")
+        return
+    print(f"part {info['part_id']} (family {info['family']})")
+    print("vertices (body frame, mm): " + " ".join(f"{x:.3f},{y:.3f}" for x, y in info["part_vertices"]))
+    print(f"pin radius {info['pin_radius']:g} mm; theta step {info['theta_step']:g} deg; "
+          f"d = {', '.join(f'{d:g}' for d in info['d'])}")
+    print(f"made by pinfeed {info['pinfeed_version']} ({info['git_commit']}), config {info['config_hash']}")
+    for sh in info["shards"]:
+        print(f"  {sh['model']:<10} mu_c={sh['mu_c']:<6g} {sh['file']}  {sh['created']}")
+
+
+def _query(args):
+    cat = _catalog(args)
+    d = parse_values(args.d, "--d") if args.d is not None else None
+    ds = cat.query(args.part, model=args.model, mu_c=args.mu_c, d=d, method=args.method)
+    if getattr(args, "theta_i", None) is not None:
+        ds = ds.sel(theta_i=parse_values(args.theta_i, "--theta-i"), method="nearest")
+    return ds
+
+
+def cmd_catalog_query(args):
+    from .simulate import status_names
+    ds = _query(args).load()
+    rows = []
+    for mu in ds["mu_c"].values:
+        for d in ds["d"].values:
+            sub = ds.sel(mu_c=mu, d=d)
+            for k, th in enumerate(sub["theta_i"].values):
+                rows.append({"mu_c": float(mu), "d": float(d), "theta_i": float(th),
+                             "status": str(status_names(sub["status"].values[k])),
+                             "theta_f": float(sub["theta_f"].values[k]), "dy": float(sub["dy"].values[k])})
+    if args.json:
+        json.dump({"part": ds.attrs.get("part_id"), "model": args.model,
+                   "selection": ds.attrs["selection"], "rows": rows}, sys.stdout)
+        sys.stdout.write("\n")
+        return
+    print(f"selection: {ds.attrs['selection']}")
+    print(f"{'mu_c':>6} {'d':>6} {'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9}")
+    for r in rows:
+        print(f"{r['mu_c']:6g} {r['d']:6g} {r['theta_i']:8.2f} {r['status']:>9} {r['theta_f']:9.3f} {r['dy']:9.3f}")
+
+
+def cmd_catalog_plot(args):
+    from .figures.maps import plot_map
+    ds = _query(args)
+    if ds.sizes["mu_c"] != 1:
+        raise PinfeedError("plot one friction at a time: give --mu-c")
+    sub = ds.isel(mu_c=0).load()
+    sub.attrs["mu_c"] = float(ds["mu_c"].values[0])
+    print(f"selection: {ds.attrs['selection']}")
+    print(f"wrote {plot_map(sub, args.out)}")
+
+
+def cmd_sweep(args):
+    from .config import load_config
+    from .sweep import run_sweep
+    config = load_config(args.config)
+    if args.catalog:
+        config["catalog_dir"] = args.catalog
+    written = run_sweep(config, scheduler=args.scheduler, threads=args.threads,
+                        progress=not args.quiet)
+    print(f"computed {len(written)} shards; catalog index at {config['catalog_dir']}/index.json")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="pinfeed", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -153,6 +255,45 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("map", help="map file written by 'pinfeed map'")
     p.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
     p.set_defaults(func=cmd_plot_map)
+
+    p = sub.add_parser("sweep", help="compute missing catalog shards of a config (locally or on dask)")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's catalog_dir)")
+    p.add_argument("--scheduler", default=None, help="dask.distributed scheduler address, e.g. tcp://host:8786")
+    p.add_argument("--threads", type=int, default=None, help="Numba threads per shard")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_sweep)
+
+    cat = sub.add_parser("catalog", help="the map database: list, show, query, plot, index")
+    csub = cat.add_subparsers(dest="catalog_command", required=True)
+
+    def catalog_parser(name, help_text, func):
+        q = csub.add_parser(name, help=help_text)
+        q.add_argument("--catalog", default="catalog", help="catalog folder (default: catalog)")
+        q.set_defaults(func=func)
+        return q
+
+    catalog_parser("index", "rebuild the index from the shards on disk", cmd_catalog_index)
+    q = catalog_parser("list", "list the parts stored", cmd_catalog_list)
+    q.add_argument("--json", action="store_true")
+    q = catalog_parser("show", "everything stored about one part", cmd_catalog_show)
+    q.add_argument("part", help="part name or id")
+    q.add_argument("--json", action="store_true")
+    for name, func, help_text in (("query", cmd_catalog_query, "maps of one part, model, friction, d"),
+                                  ("plot", cmd_catalog_plot, "draw stored maps like the paper's Table 1")):
+        q = catalog_parser(name, help_text, func)
+        q.add_argument("--part", required=True, help="part name or id")
+        q.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"])
+        q.add_argument("--mu-c", type=float, default=None, help="friction (nearest/bracketing stored value)")
+        q.add_argument("--d", default=None, help="contact parameter(s): 'a,b' or 'start:stop:step'")
+        q.add_argument("--method", default="nearest", choices=["nearest", "bracket"],
+                       help="how to pick stored mu_c and d values (default nearest)")
+        if name == "query":
+            q.add_argument("--theta-i", default=None,
+                           help="only these initial orientations (nearest stored)")
+            q.add_argument("--json", action="store_true")
+        else:
+            q.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
 
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")

@@ -1,0 +1,36 @@
+# pinfeed workflow: sweep part families x models x friction into map shards,
+# then index them into the catalog. Downstream stages add rules by include.
+#
+#   snakemake --cores all                       # default config (the paper's set-up)
+#   snakemake --cores 16 --configfile config/workstation.yaml
+import os
+
+from snakemake.utils import min_version
+
+from pipeline.config import validate_config
+
+min_version("8.0")
+
+
+# The embedded default, unless --configfile gave a whole config (Snakemake
+# would otherwise merge the two family lists).
+if not {"families", "sweep"} & set(config):
+
+    configfile: os.path.join(workflow.basedir, "config", "config.yaml")
+
+
+
+# Schema validation (descriptions in config/schema.yaml), defaults filled in,
+# part outlines checked: a bad config stops here, before any job runs.
+config.update(validate_config(config))
+
+
+include: "rules/common.smk"
+include: "rules/sweep.smk"
+include: "rules/catalog.smk"
+
+
+rule all:
+    input:
+        rules.catalog_index.output.index,
+    default_target: True

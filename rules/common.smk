@@ -1,0 +1,26 @@
+# Shared helpers: the shard list and per-shard parameters, from the config.
+from pipeline.sweep import shard_jobs
+
+CATALOG = config["catalog_dir"]
+JOBS = {str(job.path(CATALOG)): job for job in shard_jobs(config)}
+
+
+wildcard_constraints:
+    family="[A-Za-z0-9_]+",
+    part="[A-Za-z0-9_]+-[0-9a-f]{10}",
+    model="minpower|tip|ellipsoid",
+    mu="[0-9.eE+-]+",
+
+
+def shard_params(wildcards):
+    """Everything a shard's content depends on: changing any of it reruns the shard."""
+    path = f"{CATALOG}/{wildcards.family}/{wildcards.part}/{wildcards.model}/mu_c={wildcards.mu}.h5"
+    job = JOBS[path]
+    sweep = config["sweep"]
+    return {
+        "vertices": job.part.vertices.round(12).tolist(),
+        "d": sweep["d"],
+        "theta_step": sweep["theta_step"],
+        "pin_radius": sweep["pin_radius"],
+        "kernel": sweep["kernel"],
+    }

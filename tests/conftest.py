@@ -1,0 +1,94 @@
+"""Shared fixtures and Hypothesis settings for the pinfeed test suite.
+
+Hypothesis profiles
+-------------------
+``ci`` (default): few examples, no deadline (the first call of a Numba kernel
+compiles, which would trip any per-example deadline), derandomized so that a
+CI run is reproducible. ``dev``: more examples, random seeds, for local
+bug hunting. Select with ``HYPOTHESIS_PROFILE=dev``.
+
+Nothing here reads ``/work/shared``: reference data the tests need is copied
+under ``tests/data``.
+"""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, settings
+
+settings.register_profile(
+    "ci",
+    deadline=None,
+    max_examples=15,
+    derandomize=True,
+    print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
+settings.register_profile(
+    "dev",
+    deadline=None,
+    max_examples=100,
+    print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+DATA_DIR = Path(__file__).parent / "data"
+
+# Outlines (drawing frame, mm) used across test files.
+TRIANGLE = [(0.0, 0.0), (60.0, 0.0), (15.0, 35.0)]  # the CLI's default triangle
+QUAD = [(0.0, 0.0), (50.0, 0.0), (60.0, 30.0), (10.0, 25.0)]  # irregular convex quad
+RECTANGLE = [(0.0, 0.0), (60.0, 0.0), (60.0, 20.0), (0.0, 20.0)]  # 60 x 20
+# A 60 x 30 block with a V-notch cut into its +x face (apex 20 mm deep).
+V_NOTCH = [(0.0, 0.0), (60.0, 0.0), (40.0, 15.0), (60.0, 30.0), (0.0, 30.0)]
+
+
+def circular_diff(a, b):
+    """Signed difference ``a - b`` of angles in degrees, wrapped to [-180, 180)."""
+    return (np.asarray(a, dtype=float) - np.asarray(b, dtype=float) + 180.0) % 360.0 - 180.0
+
+
+@pytest.fixture(scope="session")
+def rollout_vectors():
+    """Reference rollouts from the independent brute-force implementation."""
+    with open(DATA_DIR / "rollouts.json") as fh:
+        return json.load(fh)
+
+
+@pytest.fixture(scope="session")
+def triangle():
+    from pipeline.parts import Part
+    return Part.from_vertices(TRIANGLE, name="triangle")
+
+
+@pytest.fixture(scope="session")
+def quad():
+    from pipeline.parts import Part
+    return Part.from_vertices(QUAD, name="quad")
+
+
+@pytest.fixture(scope="session")
+def rectangle():
+    from pipeline.parts import Part
+    return Part.from_vertices(RECTANGLE, name="rectangle")
+
+
+@pytest.fixture(scope="session")
+def v_notch():
+    from pipeline.parts import Part
+    return Part.from_vertices(V_NOTCH, name="v-notch")
+
+
+@pytest.fixture(scope="session")
+def warm_kernels(triangle):
+    """Compile (or load from cache) the rollout and grid kernels once, so that
+    tests timing a single rollout do not measure the JIT compilation."""
+    from pipeline import simulate
+    simulate.rollout(triangle, 30.0, 0.3, 0.2, 3.0)
+    simulate.rollout(triangle, 30.0, 0.3, 0.2, 3.0, trajectory=True)
+    simulate.map(triangle, [0.0], [0.3], 0.2, 3.0)
+    return True
