@@ -41,15 +41,17 @@ def _sha256(path: Path) -> str:
 def _entry_from_file(root: Path, path: Path) -> dict:
     """Index entry from a shard's own attributes; raises PinfeedError for foreign/corrupt files."""
     try:
-        with xr.open_dataset(path, engine="h5netcdf") as ds:
-            attrs = dict(ds.attrs)
-            d = [float(x) for x in ds["d"].values]
-            n_theta = int(ds.sizes["theta_i"])
+        ds = xr.open_dataset(path, engine="h5netcdf", phony_dims="sort")
     except Exception as exc:
         raise PinfeedError(f"{path}: cannot read as HDF5 (corrupt or not a map file): "
                            f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
-    if "catalog_schema_version" not in attrs or "part_id" not in attrs:
-        raise PinfeedError(f"{path}: foreign file, not a pinfeed shard (no catalog attributes)")
+    with ds:
+        attrs = dict(ds.attrs)
+        if ("catalog_schema_version" not in attrs or "part_id" not in attrs
+                or "d" not in ds.coords or "theta_i" not in ds.coords):
+            raise PinfeedError(f"{path}: foreign file, not a pinfeed shard (no catalog attributes)")
+        d = [float(x) for x in ds["d"].values]
+        n_theta = int(ds.sizes["theta_i"])
     verts = np.asarray(attrs["part_vertices"], float).reshape(-1, 2).tolist()
     return {
         "file": path.relative_to(root).as_posix(),
