@@ -1,5 +1,5 @@
 # pinfeed workflow: sweep part families x models x friction into map shards,
-# then index them into the catalog. Downstream stages add rules by include.
+# index them into the catalog, then bands, plans, verification, figures, report.
 #
 #   snakemake --cores all                       # default config (the paper's set-up)
 #   snakemake --cores 16 --configfile config/workstation.yaml
@@ -28,9 +28,13 @@ config.update(validate_config(config))
 include: "rules/common.smk"
 include: "rules/sweep.smk"
 include: "rules/catalog.smk"
+include: "rules/plan.smk"
+include: "rules/report.smk"
 
 
 rule all:
     input:
         rules.catalog_index.output.index,
+        BAND_FILES,
+        rules.report.output.report,
     default_target: True

@@ -62,8 +62,13 @@ def validate_config(config: dict) -> dict:
     if abs(steps - round(steps)) > 1e-9:
         raise PinfeedError(f"config error at sweep/theta_step: 360 is not a multiple of "
                            f"{cfg['sweep']['theta_step']}")
+    names = set()
     for name, spec in cfg["families"].items():
-        family_parts(name, spec)  # raises on a bad outline, naming the part
+        names.update(p.name for p in family_parts(name, spec))  # raises on a bad outline
+    unknown = [p for p in cfg["planner"]["parts"] if p not in names]
+    if unknown:
+        raise PinfeedError(f"config error at planner/parts: {', '.join(unknown)} not in any family; "
+                           f"known parts: {', '.join(sorted(names))}")
     return cfg
 
 

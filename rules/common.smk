@@ -24,3 +24,10 @@ def shard_params(wildcards):
         "pin_radius": sweep["pin_radius"],
         "kernel": sweep["kernel"],
     }
+
+
+RESULTS = config["results_dir"]
+PLANNED = config["planner"]["parts"]
+BAND_FILES = [
+    p.replace(f"{CATALOG}/", f"{CATALOG}/bands/", 1).replace(".h5", ".json") for p in JOBS
+]

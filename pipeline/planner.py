@@ -1,0 +1,287 @@
+"""The fixed-pins planner (spec section 6; the paper's section II.D).
+
+An uncertain state is an arc of orientations and an interval of centroid
+heights ``y_c`` above the fence. A global pin at height ``y_k`` meets it over
+the contact-parameter range ``d = (y_k - y_c) / a``; it is allowed only if the
+whole range keeps ``d_min <= |d| <= d_max`` on one side (no metastable
+contacts) and lies within the stored maps. The maps used are every stored d
+in the range plus the stored values bracketing it; the orientations used are
+the theta_i grid points covering the arc plus one grid step either side. Each
+point's outcome is the adjusted band its theta_f falls in (children: the
+adjusted-band arcs hit, merged where they overlap, each with the union of
+the COM intervals of the bands behind it); a ``miss`` leaves the state as it
+was; a ``jammed`` outcome forbids the pin.
+
+The search is complete up to ``depth``: every pin sequence is tried, and
+sequences that reach a joint state (the states of all initial states) already
+reached are merged. Plans are ranked by the number of final orientation sets
+(clusters of overlapping final arcs over all branches of all initial
+states), then by the safety margin (the smallest distance of any d from the
+forbidden ranges), then by fewest pins, then by the total width of the final
+sets.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from kernels.rollout import JAMMED, MISS, OK, TRUNCATED
+
+from .bands import band_lookup, extract_bands, in_arc
+from .errors import PinfeedError
+from .parts import Part
+
+
+@dataclass(frozen=True)
+class Step:
+    pin: str
+    y_pin: float
+    d_lo: float
+    d_hi: float
+    arc: tuple  # (start, width) of the orientation set reached, degrees
+    y_lo: float
+    y_hi: float
+
+
+@dataclass(frozen=True)
+class State:
+    arc: tuple  # (start, width), degrees
+    y_lo: float
+    y_hi: float
+    history: tuple = field(default=(), compare=False, hash=False)
+
+    def key(self):
+        return (round(self.arc[0], 6), round(self.arc[1], 6), round(self.y_lo, 6), round(self.y_hi, 6))
+
+
+@dataclass
+class MapData:
+    """One stored map (one d) with its bands, as the planner needs it."""
+    d: float
+    theta_i: np.ndarray
+    theta_f: np.ndarray
+    status: np.ndarray
+    dy: np.ndarray
+    bands: list
+    lookup: np.ndarray
+
+
+@dataclass
+class Plan:
+    pins: tuple  # labels in order
+    n_sets: int
+    final_sets: list  # [(start, width)] merged final arcs
+    margin: float
+    branches: dict  # initial-state label -> list of step lists (one per branch)
+
+    def rank_key(self):
+        return (self.n_sets, -round(self.margin, 9), len(self.pins),
+                round(sum(w for _, w in self.final_sets), 6))
+
+    def to_dict(self) -> dict:
+        return {
+            "pins": list(self.pins), "n_final_sets": self.n_sets,
+            "final_sets": [{"start": s, "width": w} for s, w in self.final_sets],
+            "margin": self.margin,
+            "initial_states": {
+                label: [[{"pin": st.pin, "y_pin": st.y_pin, "d_range": [st.d_lo, st.d_hi],
+                          "band": {"start": st.arc[0], "width": st.arc[1]},
+                          "com_interval": [st.y_lo, st.y_hi]} for st in branch]
+                        for branch in branches]
+                for label, branches in self.branches.items()},
+        }
+
+
+def load_maps(ds, threshold_T: float, factor_c: float) -> list[MapData]:
+    """MapData for every d of a map set (dims ``(d, theta_i)``), sorted by d."""
+    out = []
+    theta_i = np.asarray(ds["theta_i"].values, float)
+    for d in sorted(float(x) for x in ds["d"].values):
+        sub = ds.sel(d=d)
+        tf, dy, st = sub["theta_f"].values, sub["dy"].values, sub["status"].values
+        bands = extract_bands(theta_i, tf, dy, st, threshold_T, factor_c)
+        out.append(MapData(d, theta_i, np.asarray(tf), np.asarray(st), np.asarray(dy), bands,
+                           band_lookup(bands, theta_i.size)))
+    return out
+
+
+def merge_arcs(arcs) -> list[tuple[float, float]]:
+    """Union of circular arcs ``(start, width)``; overlapping or touching arcs merge."""
+    arcs = [(s % 360.0, w) for s, w in arcs]
+    if any(w >= 360.0 for _, w in arcs):
+        return [(0.0, 360.0)]
+    if not arcs:
+        return []
+    arcs.sort()
+    merged = [list(arcs[0])]
+    for s, w in arcs[1:]:
+        ms, mw = merged[-1]
+        if s <= ms + mw + 1e-9:
+            merged[-1][1] = max(mw, s + w - ms)
+        else:
+            merged.append([s, w])
+    if len(merged) > 1:  # join the last with the first across 360
+        ls, lw = merged[-1]
+        fs, fw = merged[0]
+        if ls + lw >= fs + 360.0 - 1e-9:
+            merged[0] = [ls, max(lw, fs + 360.0 + fw - ls)]
+            merged.pop()
+    return [(float(s), float(min(w, 360.0))) for s, w in merged]
+
+
+class Planner:
+    """Fixed global pins for one part, from its stored maps."""
+
+    def __init__(self, part: Part, maps: list[MapData], pins: dict, d_min: float, d_max: float,
+                 com: str = "covered", coverage: str = "bracket"):
+        if not maps:
+            raise PinfeedError("the planner needs at least one stored map")
+        self.part = part
+        self.maps = maps
+        self.d_values = np.array([m.d for m in maps])
+        self.pins = dict(pins)
+        self.d_min, self.d_max = d_min, d_max
+        self.com = com
+        if coverage not in ("bracket", "nearest"):
+            raise PinfeedError(f"unknown coverage {coverage!r}; use bracket or nearest")
+        self.coverage = coverage
+        self._cache = {}
+
+    def initial_states(self) -> dict:
+        """Resting states against the fence: label -> State (exact theta and y_c)."""
+        states = {}
+        for k, (theta, yc) in enumerate(self.part.stable_states(), start=1):
+            states[f"state {k}"] = State((float(theta), 0.0), float(yc), float(yc))
+        return states
+
+    def _maps_for(self, d_lo, d_hi):
+        if d_lo < self.d_values[0] - 1e-9 or d_hi > self.d_values[-1] + 1e-9:
+            return None
+        if self.coverage == "nearest":
+            lo = int(np.argmin(np.abs(self.d_values - d_lo)))
+            hi = int(np.argmin(np.abs(self.d_values - d_hi)))
+        else:
+            lo = np.flatnonzero(self.d_values <= d_lo + 1e-9).max()
+            hi = np.flatnonzero(self.d_values >= d_hi - 1e-9).min()
+        return self.maps[lo: hi + 1]
+
+    def transition(self, state: State, label: str):
+        """Children of ``state`` at pin ``label`` and the step's margin, or None if forbidden."""
+        key = (state.key(), label)
+        if key not in self._cache:
+            self._cache[key] = self._transition(state, label)
+        result = self._cache[key]
+        if result is None:
+            return None
+        children, margin, d_lo, d_hi = result
+        y_pin = self.pins[label]
+        out = [State(arc, ylo, yhi, state.history + (Step(label, y_pin, d_lo, d_hi, arc, ylo, yhi),))
+               for arc, ylo, yhi in children]
+        return out, margin
+
+    def _transition(self, state: State, label: str):
+        a = self.part.a
+        y_pin = self.pins[label]
+        d_lo, d_hi = (y_pin - state.y_hi) / a, (y_pin - state.y_lo) / a
+        if d_lo < 0.0 < d_hi or min(abs(d_lo), abs(d_hi)) < self.d_min - 1e-12 \
+                or max(abs(d_lo), abs(d_hi)) > self.d_max + 1e-12:
+            return None
+        maps = self._maps_for(d_lo, d_hi)
+        if maps is None:
+            return None
+        margin = min(min(abs(d_lo), abs(d_hi)) - self.d_min, self.d_max - max(abs(d_lo), abs(d_hi)))
+        hits = []  # (arc, com_min, com_max)
+        dy_of = {}
+        for m in maps:
+            step = float(np.median(np.diff(m.theta_i))) if m.theta_i.size > 1 else 360.0
+            s, w = state.arc
+            pad = step if self.coverage == "bracket" else 0.5 * step
+            cover = np.flatnonzero(in_arc(m.theta_i, (s - pad) % 360.0, min(360.0, w + 2 * pad)))
+            for i in cover:
+                st = m.status[i]
+                if st == JAMMED or st == TRUNCATED:
+                    return None
+                if st == MISS:
+                    hits.append((state.arc, 0.0, 0.0))
+                    continue
+                b = m.bands[m.lookup[i]]
+                if self.com == "kernel":
+                    hits.append(((b.adj_start, b.adj_width), b.com_min, b.com_max))
+                else:
+                    hits.append(((b.adj_start, b.adj_width), m.dy[i], m.dy[i]))
+        children = []
+        for arc in merge_arcs([h[0] for h in hits]):
+            inside = [h for h in hits if _arc_within(h[0], arc)]
+            children.append((arc, state.y_lo + min(h[1] for h in inside),
+                             state.y_hi + max(h[2] for h in inside)))
+        return children, margin, d_lo, d_hi
+
+    def search(self, depth: int, keep: int = 10) -> list[Plan]:
+        """Every pin sequence up to ``depth``; the ``keep`` best plans, best first."""
+        starts = self.initial_states()
+        labels = list(starts)
+        frontier = [((), tuple((starts[l],) for l in labels), math.inf)]
+        seen = {self._joint_key(frontier[0][1])}
+        plans = []
+        for _ in range(depth):
+            nxt = []
+            for seq, joint, margin in frontier:
+                for pin in self.pins:
+                    new_joint, new_margin = [], margin
+                    for branch_states in joint:
+                        children = []
+                        for st in branch_states:
+                            res = self.transition(st, pin)
+                            if res is None:
+                                break
+                            children.extend(res[0])
+                            new_margin = min(new_margin, res[1])
+                        else:
+                            new_joint.append(_dedupe(children))
+                            continue
+                        break
+                    if len(new_joint) != len(joint):
+                        continue  # the pin is forbidden for some branch
+                    key = self._joint_key(new_joint)
+                    if key in seen:
+                        continue
+                    seen.add(key)
+                    new_seq = seq + (pin,)
+                    nxt.append((new_seq, tuple(new_joint), new_margin))
+                    plans.append(self._plan(new_seq, labels, new_joint, new_margin))
+            frontier = nxt
+        plans.sort(key=Plan.rank_key)
+        return plans[:keep]
+
+    @staticmethod
+    def _joint_key(joint):
+        return tuple(tuple(sorted(st.key() for st in states)) for states in joint)
+
+    @staticmethod
+    def _plan(seq, labels, joint, margin) -> Plan:
+        finals = merge_arcs([st.arc for states in joint for st in states])
+        branches = {label: [list(st.history) for st in states] for label, states in zip(labels, joint)}
+        return Plan(seq, len(finals), finals, float(margin), branches)
+
+
+def _arc_within(inner, outer) -> bool:
+    s, w = inner
+    if outer[1] >= 360.0:
+        return True
+    return bool(in_arc(s, outer[0], outer[1], 1e-6)) and (s - outer[0]) % 360.0 + w <= outer[1] + 1e-6
+
+
+def _dedupe(states):
+    out, keys = [], set()
+    for st in states:
+        if st.key() not in keys:
+            keys.add(st.key())
+            out.append(st)
+    return out
+
+
+def pins_from_config(values) -> dict:
+    """Global pin labels ``P1, P2, ...`` for the configured heights (mm above the fence)."""
+    return {f"P{k}": float(y) for k, y in enumerate(values, start=1)}

@@ -1,0 +1,65 @@
+"""One HTML page that links every result: maps, plans, sequence diagrams, verification."""
+from __future__ import annotations
+
+import html
+import os
+from pathlib import Path
+
+from . import __version__
+from .config import config_hash
+from .figures.tables import HEADER, verification_rows
+from .provenance import creation_time, git_commit
+
+
+def _rel(path, base):
+    return html.escape(os.path.relpath(path, base))
+
+
+def write_report(config, plans: dict, verifications: dict, figures: dict, out) -> Path:
+    """``plans``/``verifications``: part -> result dict; ``figures``: part -> {kind: path}
+    plus key ``"verification"``. Writes ``out`` (HTML)."""
+    out = Path(out)
+    base = out.parent
+    p = ['<!doctype html><html><head><meta charset="utf-8"><title>pinfeed results</title>',
+         "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto}"
+         "img{max-width:100%}table{border-collapse:collapse}td,th{border:1px solid #ccc;"
+         "padding:3px 8px;font-size:90%}</style></head><body>",
+         "<h1>pinfeed results</h1>",
+         f"<p>pinfeed {html.escape(__version__)} ({html.escape(git_commit())}), config "
+         f"{config_hash(config)}, made {creation_time()}. Planner: model "
+         f"{html.escape(config['planner']['model'])}, mu_c {config['planner']['mu_c']:g}, depth "
+         f"{config['planner']['depth']}, d in [{config['planner']['d_min']:g}, "
+         f"{config['planner']['d_max']:g}], T = {config['bands']['threshold_T']:g} deg, "
+         f"c = {config['bands']['factor_c']:g}.</p>"]
+    if "verification" in figures:
+        p.append("<h2>Verification (full rollouts, perturbed)</h2>")
+        p.append(f'<img src="{_rel(figures["verification"], base)}" alt="verification table">')
+    for name, res in plans.items():
+        p.append(f"<h2>{html.escape(name)}</h2>")
+        p.append(f"<p>maps: {html.escape(res['selection'])}; initial states: " + ", ".join(
+            f"{html.escape(k)}: θ = {v['theta']:.1f}°, y_c = {v['y_c']:.2f} mm"
+            for k, v in res["initial_states"].items()) + "</p>")
+        figs = figures.get(name, {})
+        if "maps" in figs:
+            p.append(f'<h3>Configuration maps with bands</h3><img src="{_rel(figs["maps"], base)}">')
+        p.append("<h3>Best plans</h3><table><tr><th>rank</th><th>pins</th><th>heights (mm)</th>"
+                 "<th>final sets</th><th>orientation sets (deg)</th><th>margin in d</th></tr>")
+        for k, plan in enumerate(res["plans"], start=1):
+            sets = ", ".join(f"[{s['start']:.0f}, {s['start'] + s['width']:.0f}]" for s in plan["final_sets"])
+            heights = ", ".join(f"{res['pins'][q]:g}" for q in plan["pins"])
+            p.append(f"<tr><td>{k}</td><td>{' → '.join(plan['pins'])}</td><td>{heights}</td>"
+                     f"<td>{plan['n_final_sets']}</td><td>{sets}</td><td>{plan['margin']:.3f}</td></tr>")
+        p.append("</table>")
+        if "sequence" in figs:
+            p.append(f'<h3>Pin sequence</h3><img src="{_rel(figs["sequence"], base)}">')
+        if name in verifications:
+            rows = verification_rows({name: verifications[name]})
+            p.append("<table><tr>" + "".join(f"<th>{h}</th>" for h in HEADER) + "</tr>")
+            p += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows]
+            p.append("</table>")
+    p.append("</body></html>")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.tmp")
+    tmp.write_text("\n".join(p))
+    os.replace(tmp, out)
+    return out

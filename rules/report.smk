@@ -1,0 +1,36 @@
+# Stage 6: figures and the page that links every result.
+
+
+rule figures:
+    input:
+        index=rules.catalog_index.output.index,
+        plans=expand(f"{CATALOG}/plans/{{name}}.json", name=PLANNED),
+        verify=expand(f"{CATALOG}/verify/{{name}}.json", name=PLANNED),
+    output:
+        maps=expand(f"{RESULTS}/figures/maps_{{name}}.png", name=PLANNED),
+        sequence=expand(f"{RESULTS}/figures/sequence_{{name}}.png", name=PLANNED),
+        verification=f"{RESULTS}/figures/verification.png",
+        table=f"{RESULTS}/verification.md",
+    params:
+        settings=config["figures"],
+    log:
+        "logs/figures.log",
+    conda:
+        "envs/pinfeed.yaml"
+    script:
+        "scripts/figures.py"
+
+
+rule report:
+    input:
+        rules.figures.output,
+        plans=rules.figures.input.plans,
+        verify=rules.figures.input.verify,
+    output:
+        report=f"{RESULTS}/report.html",
+    log:
+        "logs/report.log",
+    conda:
+        "envs/pinfeed.yaml"
+    script:
+        "scripts/report.py"
