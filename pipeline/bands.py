@@ -60,9 +60,11 @@ def in_arc(x, start, width, tol=1e-9):
 def circular_mean_std(deg) -> tuple[float, float]:
     rad = np.radians(np.asarray(deg, float))
     c, s = np.cos(rad).mean(), np.sin(rad).mean()
-    r = min(1.0, math.hypot(c, s))
+    r = math.hypot(c, s)
     mean = math.degrees(math.atan2(s, c)) % 360.0
-    sigma = math.degrees(math.sqrt(max(0.0, -2.0 * math.log(r)))) if r > 0 else 180.0
+    if r >= 1.0 - 4.0 * np.finfo(float).eps * max(1, len(rad)):
+        return mean, 0.0  # identical angles: R is 1 up to rounding
+    sigma = math.degrees(math.sqrt(-2.0 * math.log(r))) if r > 0 else 180.0
     return mean, sigma
 
 

@@ -229,6 +229,63 @@ def cmd_sweep(args):
     print(f"computed {len(written)} shards; catalog index at {config['catalog_dir']}/index.json")
 
 
+
+def cmd_plan(args):
+    from .config import load_config
+    from .families import family_parts
+    from .parts import Part, parse_vertices
+    from .stages import ensure_maps, plan_part, write_json
+    config = load_config(args.config)
+    if args.catalog:
+        config["catalog_dir"] = args.catalog
+    for key in ("mu_c", "model", "depth", "coverage"):
+        if getattr(args, key) is not None:
+            config["planner"][key] = getattr(args, key)
+    if args.pins:
+        config["planner"]["pins"] = [float(x) for x in parse_values(args.pins, "--pins")]
+    if args.vertices:
+        part = Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
+    elif args.part:
+        found = [p for fam, spec in config["families"].items() for p in family_parts(fam, spec)
+                 if args.part in (p.name, p.id)]
+        if not found:
+            from .catalog import Catalog
+            cat = Catalog.open(config["catalog_dir"])
+            e = cat._entries_for(args.part)[0]  # raises 'unknown part' with the known names
+            found = [Part.from_vertices(e["part_vertices"], name=e["part_name"])]
+        part = found[0]
+    else:
+        raise PinfeedError("give --part NAME or --vertices \"x0,y0 x1,y1 ...\"")
+    cat = ensure_maps(config, part)
+    result = plan_part(cat, part.id, config)
+    if args.out:
+        write_json(result, args.out)
+    if args.json:
+        json.dump(result, sys.stdout, default=float)
+        sys.stdout.write("\n")
+        return
+    pc = config["planner"]
+    print(f"part {part.id}: model {pc['model']}, {result['selection']}, depth {pc['depth']}, "
+          f"{len(result['pins'])} candidate pins, coverage {result['coverage']}")
+    for label, s in result["initial_states"].items():
+        print(f"  {label}: resting on the fence at theta = {s['theta']:.1f} deg, y_c = {s['y_c']:.2f} mm")
+    if not result["plans"]:
+        print("no allowed pin sequence within the depth (every pin meets some state metastably, "
+              "outside |d| <= d_max, or jams it)")
+        return
+    for k, plan in enumerate(result["plans"], start=1):
+        sets = ", ".join(f"[{s['start']:.1f}, {s['start'] + s['width']:.1f}] deg" for s in plan["final_sets"])
+        heights = ", ".join(f"{q}@{result['pins'][q]:g} mm" for q in plan["pins"])
+        print(f"#{k}: {heights} -> {plan['n_final_sets']} final set(s): {sets}; margin in d {plan['margin']:.3f}")
+        if k == 1:
+            for label, branches in plan["initial_states"].items():
+                for branch in branches:
+                    steps = "; ".join(f"{st['pin']} d [{st['d_range'][0]:+.2f}, {st['d_range'][1]:+.2f}] -> "
+                                      f"[{st['band']['start']:.0f}+{st['band']['width']:.0f}] deg, y_c "
+                                      f"[{st['com_interval'][0]:.1f}, {st['com_interval'][1]:.1f}]" for st in branch)
+                    print(f"    {label}: {steps}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="pinfeed", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -263,6 +320,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--threads", type=int, default=None, help="Numba threads per shard")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_sweep)
+
+    p = sub.add_parser("plan", help="plan fixed pins for a part (computes missing maps)")
+    p.add_argument("--part", default=None, help="part name or id from the config or catalog")
+    p.add_argument("--vertices", default=None, help='or a new outline "x0,y0 x1,y1 ..." (mm)')
+    p.add_argument("--name", default=None, help="name for --vertices (default part)")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    p.add_argument("--mu-c", dest="mu_c", type=float, default=None, help="friction the plan assumes")
+    p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"])
+    p.add_argument("--depth", type=int, default=None, help="largest number of pins")
+    p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step' "
+                   "(write --pins=-10:45:2.5 when the first value is negative)")
+    p.add_argument("--coverage", default=None, choices=["bracket", "nearest"])
+    p.add_argument("--out", default=None, help="also write the result JSON here")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_plan)
 
     cat = sub.add_parser("catalog", help="the map database: list, show, query, plot, index")
     csub = cat.add_subparsers(dest="catalog_command", required=True)

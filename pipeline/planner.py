@@ -128,7 +128,7 @@ def merge_arcs(arcs) -> list[tuple[float, float]]:
         if ls + lw >= fs + 360.0 - 1e-9:
             merged[0] = [ls, max(lw, fs + 360.0 + fw - ls)]
             merged.pop()
-    return [(float(s), float(min(w, 360.0))) for s, w in merged]
+    return sorted((float(s), float(min(w, 360.0))) for s, w in merged)
 
 
 class Planner:

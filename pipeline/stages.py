@@ -191,3 +191,21 @@ def make_report(config, plan_paths, verify_paths, out):
         verifications[name] = read_json(verify_path)
         figures[name] = {"maps": results / f"maps_{name}.png", "sequence": results / f"sequence_{name}.png"}
     return write_report(config, plans, verifications, figures, out)
+
+
+def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:
+    """Make sure the catalog holds the maps the planner needs for ``part``:
+    the planner's model at its mu_c over the sweep's d grid. Missing ones are
+    computed with the sweep settings, stored atomically and indexed."""
+    from .sweep import ShardJob, write_shard
+    root = Path(config["catalog_dir"])
+    pc = config["planner"]
+    cat = Catalog.open(root) if (root / "index.json").is_file() else None
+    have = cat is not None and any(
+        e["part_id"] == part.id and e["model"] == pc["model"] and e["mu_c"] == float(pc["mu_c"])
+        for e in cat.entries)
+    if not have:
+        fam = next((e["family"] for e in (cat.entries if cat else []) if e["part_id"] == part.id), family)
+        write_shard(config, ShardJob(fam, part, pc["model"], float(pc["mu_c"])))
+        cat = Catalog.rebuild(root)
+    return cat
