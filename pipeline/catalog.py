@@ -17,14 +17,13 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from .errors import PinfeedError
+from .io import write_json
 
 INDEX_NAME = "index.json"
 INDEX_VERSION = 1
@@ -76,21 +75,6 @@ def _entry_from_file(root: Path, path: Path) -> dict:
     }
 
 
-def _write_json_atomic(obj, path: Path):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(obj, fh, indent=1, sort_keys=True)
-            fh.write("\n")
-        from .io import _umask_mode
-        os.chmod(tmp, _umask_mode())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 class Catalog:
     """An opened catalog: verified entries plus the problems found on disk."""
 
@@ -115,8 +99,8 @@ class Catalog:
                 entries.append(_entry_from_file(root, path))
             except PinfeedError as exc:
                 problems.append(str(exc))
-        _write_json_atomic({"index_version": INDEX_VERSION, "entries": entries,
-                            "problems": problems}, root / INDEX_NAME)
+        write_json({"index_version": INDEX_VERSION, "entries": entries, "problems": problems},
+                   root / INDEX_NAME)
         return cls(root, entries, problems)
 
     @classmethod

@@ -6,8 +6,10 @@ half-written file under the real name.
 """
 from __future__ import annotations
 
+import json
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import xarray as xr
@@ -23,19 +25,37 @@ def _umask_mode() -> int:
     return 0o666 & ~mask
 
 
-def write_atomic(ds: xr.Dataset, path, encoding=None) -> Path:
+@contextmanager
+def atomic_target(path):
+    """Yield a temporary path beside ``path``; on success it is renamed onto
+    ``path`` (with the umask's permissions), on any error it is removed."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
-        ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding, invalid_netcdf=True)
+        yield tmp
         os.chmod(tmp, _umask_mode())  # mkstemp creates 0600
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
+
+
+def write_atomic(ds: xr.Dataset, path, encoding=None) -> Path:
+    with atomic_target(path) as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding, invalid_netcdf=True)
+    return Path(path)
+
+
+def write_text_atomic(text: str, path) -> Path:
+    with atomic_target(path) as tmp:
+        Path(tmp).write_text(text)
+    return Path(path)
+
+
+def write_json(obj, path) -> Path:
+    return write_text_atomic(json.dumps(obj, indent=1, sort_keys=True, default=float) + "\n", path)
 
 
 def read_map(path) -> xr.Dataset:

@@ -8,9 +8,13 @@ contacts) and lies within the stored maps. The maps used are every stored d
 in the range plus the stored values bracketing it; the orientations used are
 the theta_i grid points covering the arc plus one grid step either side. Each
 point's outcome is the adjusted band its theta_f falls in (children: the
-adjusted-band arcs hit, merged where they overlap, each with the union of
-the COM intervals of the bands behind it); a ``miss`` leaves the state as it
-was; a ``jammed`` outcome forbids the pin.
+adjusted-band arcs hit, merged where they overlap); a ``miss`` leaves the
+state as it was; a ``jammed`` outcome forbids the pin. A child's centroid
+interval adds the range of dy over the grid points the state covers
+(``com="covered"``, default) or, literally as spec section 6 says, the COM
+interval of the whole kernel of each band hit (``com="kernel"``); the kernel
+often spans 100+ degrees of theta_i whose dy spread tens of millimetres, so
+the literal rule makes nearly every second pin metastable.
 
 The search is complete up to ``depth``: every pin sequence is tried, and
 sequences that reach a joint state (the states of all initial states) already
@@ -27,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kernels.rollout import JAMMED, MISS, OK, TRUNCATED
+from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from .bands import band_lookup, extract_bands, in_arc
 from .errors import PinfeedError
@@ -193,7 +197,6 @@ class Planner:
             return None
         margin = min(min(abs(d_lo), abs(d_hi)) - self.d_min, self.d_max - max(abs(d_lo), abs(d_hi)))
         hits = []  # (arc, com_min, com_max)
-        dy_of = {}
         for m in maps:
             step = float(np.median(np.diff(m.theta_i))) if m.theta_i.size > 1 else 360.0
             s, w = state.arc

@@ -8,6 +8,7 @@ from pathlib import Path
 from . import __version__
 from .config import config_hash
 from .figures.tables import HEADER, verification_rows
+from .io import write_text_atomic
 from .provenance import creation_time, git_commit
 
 
@@ -58,8 +59,4 @@ def write_report(config, plans: dict, verifications: dict, figures: dict, out) -
             p += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows]
             p.append("</table>")
     p.append("</body></html>")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text("\n".join(p))
-    os.replace(tmp, out)
-    return out
+    return write_text_atomic("\n".join(p), out)

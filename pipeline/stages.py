@@ -9,36 +9,15 @@ All JSON is written atomically.
 from __future__ import annotations
 
 import json
-import math
-import os
-import tempfile
 from pathlib import Path
-
-import numpy as np
 
 from .bands import map_bands
 from .catalog import Catalog
 from .errors import PinfeedError
-from .io import _umask_mode, read_map
+from .io import read_map, write_json  # noqa: F401 (write_json is part of this module's API)
 from .parts import Part
 from .planner import Planner, load_maps, pins_from_config
 from .provenance import provenance_attrs
-
-
-def write_json(obj, path) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(obj, fh, indent=1, default=float)
-            fh.write("\n")
-        os.chmod(tmp, _umask_mode())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
 
 
 def read_json(path) -> dict:

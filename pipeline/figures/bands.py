@@ -4,11 +4,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-import numpy as np
 
 from kernels.rollout import OK
 
 from ..bands import extract_bands
+from . import circle_axes
 
 
 def _shade(ax, start, width, **kw):
@@ -36,11 +36,7 @@ def plot_band_maps(maps_by_model: dict, d_values, threshold_T, factor_c, title, 
             ax.scatter(ti[ok], tf[ok], s=2, color="tab:blue", label="θ_f (ok)")
             ax.scatter(ti[~ok], tf[~ok], s=2, color="0.6", label="miss / jammed")
             ax.set_title(f"{model}, d = {float(sub['d']):+.1f}", fontsize=9)
-            ax.set_xlim(0, 360)
-            ax.set_ylim(0, 360)
-            ax.set_xticks([0, 90, 180, 270, 360])
-            ax.set_yticks([0, 90, 180, 270, 360])
-            ax.tick_params(labelsize=7)
+            circle_axes(ax)
             if r == len(models) - 1:
                 ax.set_xlabel(r"$\theta_i$ (deg)", fontsize=8)
             if c == 0:

@@ -10,6 +10,8 @@ import xarray as xr
 
 from kernels.rollout import JAMMED, MISS, OK, TRUNCATED
 
+from . import circle_axes
+
 _STYLE = {
     OK: dict(marker=".", s=4, color="tab:blue", label="ok"),
     MISS: dict(marker=".", s=4, color="0.7", label="miss (no contact)"),
@@ -40,11 +42,7 @@ def plot_map(ds: xr.Dataset, out, ncols: int = 6) -> Path:
                 ax.scatter(theta_i[sel], sub["theta_f"].values[sel], marker=style["marker"],
                            s=style["s"], color=style["color"], label=label, linewidths=0.8)
         ax.set_title(f"d = {d:+.2f}", fontsize=9)
-        ax.set_xlim(0, 360)
-        ax.set_ylim(0, 360)
-        ax.set_xticks([0, 90, 180, 270, 360])
-        ax.set_yticks([0, 90, 180, 270, 360])
-        ax.tick_params(labelsize=7)
+        circle_axes(ax)
         ax.set_aspect("equal")
         ax.grid(True, lw=0.3, alpha=0.5)
     for k in range(n, nrows * ncols):
