@@ -72,6 +72,20 @@ def _polygon_problem(xy):
         for k in range(j + 1, n):
             if xy[j, 0] == xy[k, 0] and xy[j, 1] == xy[k, 1]:
                 return POLY_REPEATED, j, k
+    scale = 0.0
+    for j in range(n):
+        scale = max(scale, abs(xy[j, 0]), abs(xy[j, 1]))
+    # All vertices on one line: zero area (before the crossing tests, which
+    # would call the overlapping edges of such a sliver "crossing").
+    collinear = True
+    for j in range(2, n):
+        cr = ((xy[1, 0] - xy[0, 0]) * (xy[j, 1] - xy[0, 1])
+              - (xy[1, 1] - xy[0, 1]) * (xy[j, 0] - xy[0, 0]))
+        if abs(cr) > 1e-12 * scale * scale:
+            collinear = False
+            break
+    if collinear:
+        return POLY_ZERO_AREA, -1, -1
     # Non-adjacent edges must not meet (O(n^2): parts have few vertices).
     for j in range(n):
         j1 = (j + 1) % n
@@ -90,9 +104,6 @@ def _polygon_problem(xy):
         vx, vy = xy[k, 0] - xy[j, 0], xy[k, 1] - xy[j, 1]
         if ux * vy - uy * vx == 0.0 and ux * vx + uy * vy > 0.0:
             return POLY_SELF_INTERSECTING, i, j
-    scale = 0.0
-    for j in range(n):
-        scale = max(scale, abs(xy[j, 0]), abs(xy[j, 1]))
     if abs(_signed_area(xy)) <= 1e-12 * scale * scale:
         return POLY_ZERO_AREA, -1, -1
     return POLY_OK, -1, -1

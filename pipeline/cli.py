@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 
 import numpy as np
@@ -286,8 +287,33 @@ def cmd_plan(args):
                     print(f"    {label}: {steps}")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with the project's error contract: one line, exit status 2."""
+
+    def error(self, message):
+        self.exit(2, f"pinfeed: error: {message} (see '{self.prog} --help')\n")
+
+
+# Options whose values may start with '-' (negative numbers, ranges such as
+# -0.9:0.9:0.1) that argparse would otherwise take for an option.
+_SIGNED_VALUE_OPTIONS = {"--d", "--theta-i", "--pins", "--v-pin"}
+
+
+def _join_signed_values(argv):
+    out, i = [], 0
+    while i < len(argv):
+        tok = argv[i]
+        if tok in _SIGNED_VALUE_OPTIONS and i + 1 < len(argv) and re.match(r"^-[\d.]", argv[i + 1]):
+            out.append(f"{tok}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(tok)
+            i += 1
+    return out
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="pinfeed", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="pinfeed", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("rollout", help="roll a part past one pin for some initial orientations")
@@ -330,8 +356,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--mu-c", dest="mu_c", type=float, default=None, help="friction the plan assumes")
     p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"])
     p.add_argument("--depth", type=int, default=None, help="largest number of pins")
-    p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step' "
-                   "(write --pins=-10:45:2.5 when the first value is negative)")
+    p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step'")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"])
     p.add_argument("--out", default=None, help="also write the result JSON here")
     p.add_argument("--json", action="store_true")
@@ -376,7 +401,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_join_signed_values(sys.argv[1:] if argv is None else list(argv)))
     try:
         args.func(args)
     except PinfeedError as exc:

@@ -64,7 +64,7 @@ def read_map(path) -> xr.Dataset:
     if not path.is_file():
         raise PinfeedError(f"no map file at {path}; create one with 'pinfeed map ... --out {path}'")
     try:
-        ds = xr.open_dataset(path, engine="h5netcdf")
+        ds = xr.open_dataset(path, engine="h5netcdf", phony_dims="sort")
         ds.load()
     except Exception as exc:  # h5py/h5netcdf raise several types for bad files
         raise PinfeedError(f"cannot read {path} as a pinfeed map (corrupt or not HDF5): {exc}") from None
