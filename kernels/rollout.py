@@ -392,7 +392,6 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
     y_located = np.empty(5)
     ks = np.empty((6, 5))
     tmp = np.empty(5)
-    g = np.empty(4)
     g_end = np.empty(4)
     g_work = np.empty(4)
     mask = np.zeros(4, dtype=np.bool_)
