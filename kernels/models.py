@@ -119,7 +119,10 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
             vy = x1 + ty1 * b1 + ty2 * c1
             om = x2 + ty1 * b2 + ty2 * c2
             res = _power(verts, quad, area, vx, vy, om)
-            if res[0] <= p - 1e-4 * t * dec + 4e-16 * p:
+            # The slack is above the rounding noise of P (sums of closed forms
+            # with cancellation, ~1e-14 relative): near the minimum the Armijo
+            # decrease is unmeasurable and must not block the last Newton step.
+            if res[0] <= p - 1e-4 * t * dec + 1e-12 * p:
                 accepted = True
                 break
             t *= 0.5
@@ -172,6 +175,9 @@ def _minpower_stick(verts, quad, area, cx, cy, vpx, vpy, om_warm):
     """Sticking: minimise P over twists with ``u(c) = v_p`` (1 unknown, omega)."""
     p, om, _, fx, fy, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
                                        0.0, 0.0, 0.0, 1, om_warm, 0.0)
+    if not conv and om_warm != 0.0:  # a poor warm start: solve again from translation
+        p, om, _, fx, fy, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
+                                           0.0, 0.0, 0.0, 1, 0.0, 0.0)
     return vpx + om * cy, vpy - om * cx, om, fx, fy, conv
 
 
@@ -181,8 +187,11 @@ def _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom):
 
     ``(wvx, wvy, wom)`` is a warm-start twist of any scale."""
     ke = cx * ey - cy * ex  # e . (z x c)
-    ue = (wvx - wom * cy) * ex + (wvy + wom * cx) * ey
-    if ue > 0.0:
+    uwx, uwy = wvx - wom * cy, wvy + wom * cx
+    ue = uwx * ex + uwy * ey
+    # Rescaling a warm start whose contact velocity is nearly tangent to e
+    # would throw it far away: start from translation along e instead.
+    if ue > 1e-3 * math.hypot(uwx, uwy):
         y1 = (-wvx * ey + wvy * ex) / ue
         y2 = wom / ue
     else:
@@ -190,6 +199,9 @@ def _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom):
         y2 = 0.0
     p, y1, y2, fx, fy, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
                                         -ke * ex, -ke * ey, 1.0, 2, y1, y2)
+    if not conv and (y1 != 0.0 or y2 != 0.0):
+        p, y1, y2, fx, fy, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
+                                            -ke * ex, -ke * ey, 1.0, 2, 0.0, 0.0)
     vx = ex - y1 * ey - y2 * ke * ex
     vy = ey + y1 * ex - y2 * ke * ey
     return vx, vy, y2, fx, fy, conv

@@ -80,7 +80,9 @@ def _v_rule(p, q, nv):
     brk = [0.0, 1.0]
     if eps < 1.0:
         brk.append(v0)
-        s = eps
+        # Below ~1e-16 of the parameter range the integrand is not resolved
+        # anyway, and those panels contribute below rounding.
+        s = max(eps, 1e-16)
         while s < 4.0:
             brk.extend((v0 - s, v0 + s))
             s *= 2.0
@@ -93,10 +95,13 @@ def _v_rule(p, q, nv):
 
 
 def fan_integrate(verts, centre, func, nu=8, nv=20):
-    """Integral over the CCW polygon ``verts`` of ``func(wx, wy)``.
+    """Integral over the CCW polygon ``verts`` of ``func(wx, wy, dx, dy)``.
 
-    ``func`` takes two flat arrays of points and returns an array whose last
-    axis runs over the points; the result has the remaining shape.
+    ``func`` takes flat arrays of the points ``w`` and of their offsets
+    ``d = w - centre`` (computed directly as ``u (p - o + v (q - p))``, so they
+    stay accurate, and non-zero, right next to the centre) and returns an
+    array whose last axis runs over the points; the result has the remaining
+    shape.
     """
     verts = np.asarray(verts, dtype=float)
     o = np.asarray(centre, dtype=float)
@@ -114,9 +119,8 @@ def fan_integrate(verts, centre, func, nu=8, nv=20):
         wt = (np.outer(wu, wv) * uu * cr).ravel()
         dx = p[0] + vv * (q[0] - p[0])
         dy = p[1] + vv * (q[1] - p[1])
-        wx = (o[0] + uu * dx).ravel()
-        wy = (o[1] + uu * dy).ravel()
-        vals = np.asarray(func(wx, wy)) @ wt
+        ox_, oy_ = (uu * dx).ravel(), (uu * dy).ravel()
+        vals = np.asarray(func(o[0] + ox_, o[1] + oy_, ox_, oy_)) @ wt
         total = vals if total is None else total + vals
     return total
 
@@ -128,17 +132,20 @@ def support_ref(verts, r):
     """``(E, Gx, Gy, Nxx, Nxy, Nyy)`` about ``r`` by brute-force quadrature."""
     rx, ry = float(r[0]), float(r[1])
 
-    def f(wx, wy):
-        dx, dy = wx - rx, wy - ry
+    def f(wx, wy, dx, dy):
         rho = np.hypot(dx, dy)
+        # A node can land within rounding of r when r is on an edge's line (in
+        # floating point); its weight is ~1e-16 of the panel, so drop it.
+        rho = np.where(rho > 0.0, rho, np.inf)
         hx, hy = dx / rho, dy / rho
-        return np.array([rho, hx, hy, hx * hx / rho, hx * hy / rho, hy * hy / rho])
+        return np.array([np.where(np.isfinite(rho), rho, 0.0), hx, hy, hx * hx / rho,
+                         hx * hy / rho, hy * hy / rho])
 
     return fan_integrate(verts, (rx, ry), f)
 
 
 def area_ref(verts):
-    return float(fan_integrate(verts, (0.0, 0.0), lambda wx, wy: np.ones((1, wx.size)))[0])
+    return float(fan_integrate(verts, (0.0, 0.0), lambda wx, wy, dx, dy: np.ones((1, wx.size)))[0])
 
 
 def regular_ngon_moment(n, radius):
@@ -170,17 +177,20 @@ def power_ref(verts, vx, vy, om, derivatives=False):
     area = signed_area(verts)
     scale = float(np.max(np.hypot(verts[:, 0], verts[:, 1])))
     speed = math.hypot(vx, vy)
-    if om != 0.0 and speed <= 20.0 * scale * abs(om):
-        centre = (-vy / om, vx / om)
-    else:
-        centre = (0.0, 0.0)
+    at_cor = om != 0.0 and speed <= 20.0 * scale * abs(om)
+    centre = (-vy / om, vx / om) if at_cor else (0.0, 0.0)
 
-    def f(wx, wy):
-        ux = vx - om * wy
-        uy = vy + om * wx
+    def f(wx, wy, dx, dy):
+        if at_cor:  # u(w) = om z x (w - r)
+            ux, uy = -om * dy, om * dx
+        else:
+            ux, uy = vx - om * wy, vy + om * wx
         nu = np.hypot(ux, uy)
         if not derivatives:
             return nu[None, :]
+        # A node within rounding of the COR (COR on an edge's line) carries a
+        # weight ~1e-16 of its panel: drop it rather than divide by zero.
+        nu = np.where(nu > 0.0, nu, np.inf)
         hx, hy = ux / nu, uy / nu
         # J(w) = [[1, 0, -w_y], [0, 1, w_x]]; grad = J^T u_hat
         g = np.array([hx, hy, wx * hy - wy * hx])
@@ -190,7 +200,7 @@ def power_ref(verts, vx, vy, om, derivatives=False):
         c = 1.0 / nu
         hs = np.array([c * ax * ax, c * ax * ay, c * ax * aw, c * ay * ay, c * ay * aw,
                        c * aw * aw])
-        return np.concatenate([nu[None, :], g, hs])
+        return np.concatenate([np.where(np.isfinite(nu), nu, 0.0)[None, :], g, hs])
 
     res = fan_integrate(verts, centre, f) / area
     if not derivatives:

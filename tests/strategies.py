@@ -116,3 +116,52 @@ def point_near_edge(draw, xy):
     expo = draw(_floats(-12.0, -2.0))
     sign = draw(st.sampled_from([-1.0, 1.0]))
     return c + sign * 10.0 ** expo * m
+
+
+# --------------------------------------------------------------------------- contacts
+
+
+def inward_normal(verts, j):
+    """Inward unit normal of edge j (from vertex j to j + 1) of a CCW polygon."""
+    n = len(verts)
+    e = verts[(j + 1) % n] - verts[j]
+    e = e / math.hypot(*e)
+    return np.array([-e[1], e[0]])
+
+
+@st.composite
+def contact_on(draw, verts, allow_vertex=True):
+    """A pin contact on the CCW polygon ``verts``: ``(c, n, kind)``.
+
+    Edge contact: c inside edge j, n its inward normal. Vertex contact (convex
+    vertices only, where a round pin can touch): n anywhere in the vertex's
+    normal cone, between the inward normals of the two adjacent edges.
+    """
+    n_v = len(verts)
+    kinds = ["edge", "vertex"] if allow_vertex else ["edge"]
+    kind = draw(st.sampled_from(kinds))
+    if kind == "vertex":
+        convex = []
+        for j in range(n_v):
+            a, b, c = verts[j - 1], verts[j], verts[(j + 1) % n_v]
+            if (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) > 1e-9:
+                convex.append(j)
+        j = draw(st.sampled_from(convex))
+        s = draw(_floats(0.0, 1.0))
+        nv = (1.0 - s) * inward_normal(verts, (j - 1) % n_v) + s * inward_normal(verts, j)
+        return verts[j].copy(), nv / math.hypot(*nv), kind
+    j = draw(st.integers(0, n_v - 1))
+    t = draw(_floats(0.02, 0.98))
+    p, q = verts[j], verts[(j + 1) % n_v]
+    return p + t * (q - p), inward_normal(verts, j), kind
+
+
+@st.composite
+def pin_velocity(draw, n, max_angle=1.45, min_angle=0.0):
+    """Pin velocity relative to the belt, moving into the part (n . v_p > 0):
+    at angle alpha from n, min_angle <= |alpha| <= max_angle < pi/2,
+    magnitude in [0.5, 2]."""
+    alpha = draw(_floats(min_angle, max_angle)) * draw(st.sampled_from([-1.0, 1.0]))
+    speed = draw(_floats(0.5, 2.0))
+    t = np.array([-n[1], n[0]])
+    return speed * (math.cos(alpha) * n + math.sin(alpha) * t)

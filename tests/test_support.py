@@ -5,6 +5,7 @@ Gauss-Legendre, no closed forms), which is itself cross-checked here against
 scipy's adaptive ``dblquad`` and against analytic results (square, regular
 n-gon, disc).
 """
+import itertools
 import math
 import os
 import sys
@@ -16,14 +17,14 @@ from hypothesis import strategies as st
 from scipy import integrate
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import reference as ref  # noqa: E402
-import strategies as sts  # noqa: E402
+import reference as ref
+import strategies as sts
 
-from kernels.rollout import _prepare  # noqa: E402
-from kernels.support import _fan_quadrature, _max_moment, _power, _support  # noqa: E402
+from kernels.rollout import _prepare
+from kernels.support import _R_FAR, _max_moment, _power, _support
 
-SETTINGS = dict(deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                      HealthCheck.filter_too_much])
+SETTINGS = {"deadline": None,
+            "suppress_health_check": [HealthCheck.too_slow, HealthCheck.filter_too_much]}
 
 
 def kernel_support(verts, r):
@@ -74,7 +75,9 @@ def _convex_slices(verts):
 
 def _dblquad_support(verts, r, parts):
     lim = _convex_slices(verts)
-    xs = np.sort(np.unique(np.concatenate([verts[:, 0], [r[0]]])))
+    xs = np.unique(verts[:, 0])
+    if xs[0] < r[0] < xs[-1]:
+        xs = np.unique(np.append(xs, r[0]))  # the integrand's kink line
     out = []
     funcs = {
         "E": lambda y, x: math.hypot(x - r[0], y - r[1]),
@@ -86,7 +89,7 @@ def _dblquad_support(verts, r, parts):
     }
     for name in parts:
         total = 0.0
-        for x0, x1 in zip(xs[:-1], xs[1:]):
+        for x0, x1 in itertools.pairwise(xs):
             if x1 - x0 < 1e-14:
                 continue
             val, _ = integrate.dblquad(funcs[name], x0, x1, lambda x: lim(x)[0],
@@ -137,7 +140,9 @@ def test_reference_n_is_gradient_of_g():
         for k in range(2):
             dr = np.zeros(2)
             dr[k] = h
-            jac[:, k] = (ref.support_ref(verts, r + dr)[1:3] - ref.support_ref(verts, r - dr)[1:3]) / (2 * h)
+            g_plus = ref.support_ref(verts, r + dr)[1:3]
+            g_minus = ref.support_ref(verts, r - dr)[1:3]
+            jac[:, k] = (g_plus - g_minus) / (2 * h)
         np.testing.assert_allclose(jac, nmat - np.trace(nmat) * np.eye(2), atol=1e-7)
 
 
@@ -267,7 +272,10 @@ def test_fan_quadrature_exact_for_low_degree_polynomials(xy):
     assert w.sum() == pytest.approx(area, rel=1e-13)
     assert abs((w * x).sum()) <= 1e-13 and abs((w * y).sum()) <= 1e-13  # centroid
     for i, j in [(2, 0), (1, 1), (0, 2), (3, 4), (7, 3), (0, 10)]:
-        want = ref.fan_integrate(verts, (0.0, 0.0), lambda px, py: (px ** i * py ** j)[None])[0]
+        def mono(px, py, dx, dy, i=i, j=j):
+            return (px ** i * py ** j)[None]
+
+        want = ref.fan_integrate(verts, (0.0, 0.0), mono)[0]
         assert (w * x ** i * y ** j).sum() == pytest.approx(want, rel=1e-11, abs=1e-13)
 
 
@@ -289,7 +297,7 @@ def twist_with_cor(r, om):
 @st.composite
 def prepared_and_twist(draw, regime):
     xy = draw(sts.polygons())
-    verts, area, a, quad, m_max, convex = _prepare(xy)
+    verts, area, _, quad, _, _ = _prepare(xy)
     om = draw(st.floats(0.2, 3.0)) * draw(st.sampled_from([-1.0, 1.0]))
     ang = draw(st.floats(0.0, 2 * math.pi))
     u = np.array([math.cos(ang), math.sin(ang)])
@@ -298,13 +306,13 @@ def prepared_and_twist(draw, regime):
         if kind == "inside":
             r = draw(sts.point_inside_star(verts))
         else:
-            r = draw(st.floats(1.05, 7.5)) * u
+            r = draw(st.floats(1.05, 0.95 * _R_FAR)) * u
         assume(boundary_distance(verts, r) > 0.03)
         xi = twist_with_cor(r, om)
     else:
         kind = draw(st.sampled_from(["far", "translation"]))
         if kind == "far":
-            xi = twist_with_cor(draw(st.floats(8.5, 200.0)) * u, om)
+            xi = twist_with_cor(draw(st.floats(1.05 * _R_FAR, 25.0 * _R_FAR)) * u, om)
         else:
             xi = np.array([u[0], u[1], 0.0]) * abs(om)
     return verts, area, quad, xi
@@ -365,13 +373,14 @@ def test_power_derivatives_finite_differences_far(case):
 @settings(max_examples=40, **SETTINGS)
 @given(sts.polygons(), st.floats(0.0, 2 * math.pi), st.floats(0.3, 3.0))
 def test_power_continuous_across_regime_switch(xy, ang, om):
-    """P, grad P and Hess P agree on both sides of |COR| = 8 (closed forms
-    inside, quadrature outside), and with the reference there."""
+    """P, grad P and Hess P agree on both sides of the switch at |COR| =
+    _R_FAR (8 a: closed forms inside, quadrature outside), and with the
+    reference there."""
     verts, area, _, quad, _, _ = _prepare(xy)
     u = np.array([math.cos(ang), math.sin(ang)])
-    lo = kernel_power(verts, quad, area, twist_with_cor(8.0 * (1 - 1e-12) * u, om))
-    hi = kernel_power(verts, quad, area, twist_with_cor(8.0 * (1 + 1e-12) * u, om))
-    pr, gr, hr = ref.power_ref(verts, *twist_with_cor(8.0 * u, om), derivatives=True)
+    lo = kernel_power(verts, quad, area, twist_with_cor(_R_FAR * (1 - 1e-12) * u, om))
+    hi = kernel_power(verts, quad, area, twist_with_cor(_R_FAR * (1 + 1e-12) * u, om))
+    pr, gr, hr = ref.power_ref(verts, *twist_with_cor(_R_FAR * u, om), derivatives=True)
     for p, g, h in (lo, hi):
         assert p == pytest.approx(pr, rel=1e-10)
         np.testing.assert_allclose(g, gr, rtol=0, atol=1e-9 * np.abs(gr).max())
@@ -387,10 +396,15 @@ def test_power_special_twists():
     p, g, _ = kernel_power(verts, quad, area, np.array([0.6, -0.8, 0.0]) * 2.0)
     assert p == pytest.approx(2.0, rel=1e-13)
     np.testing.assert_allclose(g, [0.6, -0.8, 0.0], atol=1e-13)
-    m_ref = ref.support_ref(verts, (0.0, 0.0))[0] / ref.signed_area(verts)
+    s0 = ref.support_ref(verts, (0.0, 0.0))
+    m_ref = s0[0] / ref.signed_area(verts)
     for om in (1.5, -0.5):
         p, g, _ = kernel_power(verts, quad, area, np.array([0.0, 0.0, om]))
         assert p == pytest.approx(abs(om) * m_ref, rel=1e-12)
         assert g[2] == pytest.approx(math.copysign(m_ref, om), rel=1e-12)
-        np.testing.assert_allclose(g[:2], 0.0, atol=1e-12)
+        # Net force of a spin about the centroid: (s/A) z x G(0) (not zero for
+        # an asymmetric part: only int w dA vanishes, not int w/|w| dA).
+        want = math.copysign(1.0, om) / ref.signed_area(verts) * np.array([-s0[2], s0[1]])
+        assert np.abs(want).max() > 0.01
+        np.testing.assert_allclose(g[:2], want, atol=1e-12)
     assert m_max == pytest.approx(m_ref, rel=1e-12)
