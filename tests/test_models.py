@@ -75,6 +75,19 @@ def cone_edge(n, mu, side):
     return e / np.linalg.norm(e)
 
 
+
+def assert_contact_consistent(xi, f, c, n, vp, mu, mode):
+    """Sticking: u(c) = v_p with f in the cone; sliding: f along the cone edge and no penetration."""
+    uc = u_at(xi, c)
+    if mode == STICK:
+        np.testing.assert_allclose(uc, vp, atol=1e-10 * np.linalg.norm(vp))
+        assert f @ n > 0 and abs(f @ tangent(n)) <= mu * (f @ n) * (1 + 1e-9)
+    else:
+        e = cone_edge(n, mu, mode)
+        assert abs(cross(f, e)) <= 1e-9 * np.linalg.norm(f) and f @ e > 0
+        assert n @ uc == pytest.approx(n @ vp, rel=1e-10)
+    return uc
+
 def cross(a, b):
     return a[0] * b[1] - a[1] * b[0]
 
@@ -440,14 +453,7 @@ def test_tip_cor_is_tip_of_cor_locus(case):
     part, c, n, vp, mu = case
     status, xi, f, mode = solve(TIP, part, c, n, vp, mu)
     assert status == TWIST_OK
-    uc = u_at(xi, c)
-    if mode == STICK:
-        np.testing.assert_allclose(uc, vp, atol=1e-10 * np.linalg.norm(vp))
-        assert f @ n > 0 and abs(f @ tangent(n)) <= mu * (f @ n) * (1 + 1e-9)
-    else:
-        e = cone_edge(n, mu, mode)
-        assert abs(cross(f, e)) <= 1e-9 * np.linalg.norm(f) and f @ e > 0
-        assert n @ uc == pytest.approx(n @ vp, rel=1e-10)
+    uc = assert_contact_consistent(xi, f, c, n, vp, mu, mode)
     fh = f / np.linalg.norm(f)
     foot = c - (c @ fh) * fh  # foot of the perpendicular from the centroid
     rho = np.linalg.norm(foot)
@@ -482,14 +488,7 @@ def test_ellipsoid_twist_along_limit_surface_normal(case):
     assert cos == pytest.approx(1.0, abs=1e-12)
     # The wrench lies on the limit surface H = 1 (f_max = 1).
     assert f @ f + mom ** 2 / m_max ** 2 == pytest.approx(1.0, rel=1e-10)
-    uc = u_at(xi, c)
-    if mode == STICK:
-        np.testing.assert_allclose(uc, vp, atol=1e-10 * np.linalg.norm(vp))
-        assert f @ n > 0 and abs(f @ tangent(n)) <= mu * (f @ n) * (1 + 1e-9)
-    else:
-        e = cone_edge(n, mu, mode)
-        assert abs(cross(f, e)) <= 1e-9 * np.linalg.norm(f) and f @ e > 0
-        assert n @ uc == pytest.approx(n @ vp, rel=1e-10)
+    uc = assert_contact_consistent(xi, f, c, n, vp, mu, mode)
 
 
 # --------------------------------------------------------------------------- invariances

@@ -18,21 +18,8 @@ from scipy.spatial import ConvexHull
 from conftest import QUAD, RECTANGLE, TRIANGLE, V_NOTCH, circular_diff
 from pipeline.errors import PinfeedError
 from pipeline.parts import Part, PolygonError, parse_vertices
-
-
-def shoelace(xy):
-    xy = np.asarray(xy, dtype=float)
-    x, y = xy[:, 0], xy[:, 1]
-    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-
-
-def centroid(xy):
-    """Area centroid by the standard polygon formula (independent of the code)."""
-    xy = np.asarray(xy, dtype=float)
-    x, y = xy[:, 0], xy[:, 1]
-    cr = x * np.roll(y, -1) - np.roll(x, -1) * y
-    a = 0.5 * cr.sum()
-    return np.array([((x + np.roll(x, -1)) * cr).sum(), ((y + np.roll(y, -1)) * cr).sum()]) / (6 * a)
+from reference import centroid
+from reference import signed_area as shoelace
 
 
 def same_point_set(a, b, tol=1e-9):
