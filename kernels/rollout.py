@@ -57,6 +57,7 @@ _MAX_CHANGES = 10000
 DEFAULT_DS_MAX = 0.1  # units of a
 DEFAULT_TOL = 1e-7  # local error per step, units of a and radians
 _DTHETA_CAP = 0.2  # radians of contact-normal turn per step
+_GROW_MAX = 2.0  # largest step growth between accepted steps
 
 
 @jit
@@ -289,6 +290,7 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
         y_out[i] = y0[i]
     y_try = np.empty(5)
     lo, hi, f_lo = 0.0, 1.0, f0
+    frac = 0.0
     prev_alpha, prev_f = -1.0, 0.0
     for it in range(60):
         if not (lo < alpha < hi):
@@ -300,13 +302,18 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
             if not mask[j] and g[j] < -_EVENT_TOL:
                 mask[j] = True  # an earlier event than the ones seen so far
         f = _min_over(g, mask)
+        # Close enough when within the integrator's own event tolerance; a
+        # state a hair past the crossing (f >= -_EVENT_TOL / 10) is kept too.
+        close = -0.1 * _EVENT_TOL <= f <= _EVENT_TOL
         if f < 0.0:
             hi = alpha
         else:
             lo, f_lo = alpha, f
+        if f >= 0.0 or close:
+            frac = alpha
             for i in range(5):
                 y_out[i] = y_try[i]
-        if (f >= 0.0 and f < 1e-12) or (hi - lo) * h < 1e-15:
+        if close or (hi - lo) * h < 1e-15:
             break
         if prev_alpha >= 0.0 and f != prev_f and it < 8:
             nxt = alpha - f * (alpha - prev_alpha) / (f - prev_f)
@@ -325,7 +332,7 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
     for j in range(4):
         if mask[j] and g[j] < best:
             best, ev = g[j], j
-    return lo, ev
+    return frac, ev
 
 
 @jit
@@ -456,6 +463,7 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
             turn = math.hypot(k1[1], k1[2]) / rp
             if turn * h > _DTHETA_CAP:
                 h = _DTHETA_CAP / turn
+        rejected = False
         while True:
             ok, err = _step(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy,
                             y, k1, h, y_new, ks, tmp, warm)
@@ -464,13 +472,18 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
             if not ok:
                 h *= 0.5
             elif err > tol:
-                h *= max(0.2, 0.9 * (tol / err) ** 0.2)
+                h *= max(0.2, 0.8 * (tol / err) ** 0.2)
             else:
                 break
+            rejected = True
         if not ok:
             status, reason = JAMMED, JAM_NO_PUSH
             break
-        grow = 5.0 if err <= 0.0 else min(5.0, 0.9 * (tol / err) ** 0.2)
+        # Grow gently, and not at all right after a rejection: rejected
+        # steps cost five contact solves each.
+        grow = _GROW_MAX if err <= 0.0 else min(_GROW_MAX, 0.8 * (tol / err) ** 0.2)
+        if rejected:
+            grow = min(grow, 1.0)
         h_next = min(ds_max, h * grow)
         # Slope at the step's end: the next step's first stage when no event
         # intervenes, and the end slope of the dense output otherwise.
