@@ -45,11 +45,6 @@ class Band:
         return asdict(self)
 
 
-def circ_dist(a, b):
-    """Absolute circular distance in degrees."""
-    return np.abs((np.asarray(a) - np.asarray(b) + 180.0) % 360.0 - 180.0)
-
-
 def in_arc(x, start, width, tol=1e-9):
     """True where angle ``x`` lies in the arc ``start + [0, width]``."""
     if width >= 360.0:

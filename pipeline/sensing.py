@@ -241,21 +241,3 @@ def read_profile_csv(path) -> Profile:
     if np.any(np.diff(arr[:, 0]) <= 0):
         raise PinfeedError(f"{path}: time must increase from row to row")
     return Profile(arr[:, 0] - arr[0, 0], arr[:, 1], arr[:, 2])
-
-
-def resample(profile: Profile, sensor: Sensor) -> Profile:
-    """Put a measured profile on the sensor's time grid (for the smoothing window)."""
-    t_end = profile.t[-1]
-    n = max(2, int(math.floor(t_end * sensor.rate_hz)) + 1)
-    t = np.arange(n) / sensor.rate_hz
-    return Profile(t, np.interp(t, profile.t, profile.fx), np.interp(t, profile.t, profile.fy))
-
-
-def write_profile_csv(profile: Profile, path):
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["time_s", "F_x", "F_y"])
-        for row in zip(profile.t, profile.fx, profile.fy):
-            w.writerow([f"{v:.6g}" for v in row])

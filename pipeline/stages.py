@@ -152,11 +152,12 @@ def make_figures(config, plan_paths, verify_paths, out_maps, out_sequence, out_v
 
 def _placeholder(path, text):
     import matplotlib.pyplot as plt
+
+    from .figures import save_figure
     fig, ax = plt.subplots(figsize=(6, 1.5))
     ax.axis("off")
     ax.text(0.5, 0.5, text, ha="center", va="center")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path, dpi=100)
 
 
 def make_report(config, plan_paths, verify_paths, out):

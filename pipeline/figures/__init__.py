@@ -1,8 +1,20 @@
 """Figures, one module per kind. All use the paper's conventions: theta_i on
 the x axis, theta_f on the y axis, degrees."""
+from pathlib import Path
+
 import matplotlib
 
 matplotlib.use("Agg")  # files only: no display needed
+import matplotlib.pyplot as plt  # noqa: E402 (after choosing the backend)
+
+
+def save_figure(fig, out, dpi=130, **kwargs) -> Path:
+    """Write ``fig`` to ``out`` (making its folder) and free it."""
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=dpi, **kwargs)
+    plt.close(fig)
+    return out
 
 
 def circle_axes(ax):

@@ -8,7 +8,7 @@ import matplotlib.pyplot as plt
 from kernels.rollout import OK
 
 from ..bands import extract_bands
-from . import circle_axes
+from . import circle_axes, save_figure
 
 
 def _shade(ax, start, width, **kw):
@@ -48,8 +48,4 @@ def plot_band_maps(maps_by_model: dict, d_values, threshold_T, factor_c, title, 
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout(rect=(0, 0.05, 1, 0.95))
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=130)
-    plt.close(fig)
-    return out
+    return save_figure(fig, out)

@@ -10,7 +10,7 @@ import xarray as xr
 
 from kernels.rollout import JAMMED, MISS, OK, TRUNCATED
 
-from . import circle_axes
+from . import circle_axes, save_figure
 
 _STYLE = {
     OK: dict(marker=".", s=4, color="tab:blue", label="ok"),
@@ -58,8 +58,4 @@ def plot_map(ds: xr.Dataset, out, ncols: int = 6) -> Path:
                  f"{attrs.get('pin_radius', float('nan')):g} {unit}", fontsize=10)
     fig.legend(loc="upper right", fontsize=7, markerscale=2, frameon=False)
     fig.tight_layout(rect=(0, 0.02, 1, 0.95))
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=130)
-    plt.close(fig)
-    return out
+    return save_figure(fig, out)

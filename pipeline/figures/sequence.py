@@ -8,6 +8,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle, Polygon
 
+from . import save_figure
+
 
 def _pose(vertices, theta_deg, x, y):
     c, s = math.cos(math.radians(theta_deg)), math.sin(math.radians(theta_deg))
@@ -52,8 +54,4 @@ def plot_sequence(part, plan_dict, pins: dict, paths: dict, pin_radius, title, o
     fig.suptitle(f"{title}\npins {' → '.join(plan_dict['pins'])}; final orientation set(s): {sets}",
                  fontsize=9)
     fig.tight_layout()
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=130)
-    plt.close(fig)
-    return out
+    return save_figure(fig, out)

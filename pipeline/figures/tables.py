@@ -5,6 +5,8 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
+from . import save_figure
+
 
 def verification_rows(results: dict) -> list[list[str]]:
     """Rows (part, plan, state, trials, successes, failures, reasons) from verify results by part."""
@@ -34,8 +36,4 @@ def plot_table(rows, title, out, header=HEADER) -> Path:
     table.set_fontsize(8)
     table.auto_set_column_width(list(range(len(header))))
     ax.set_title(title, fontsize=10)
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=130, bbox_inches="tight")
-    plt.close(fig)
-    return out
+    return save_figure(fig, out, bbox_inches="tight")
