@@ -39,6 +39,17 @@ def run(capsys, argv):
     return code, out, err
 
 
+def with_options(pairs):
+    """BASE plus ``--theta-i 0`` with ``pairs`` (flag, value, ...) replacing or adding options."""
+    argv = list(BASE) + ["--theta-i", "0"]
+    for flag, value in zip(pairs[::2], pairs[1::2]):
+        if flag in argv:
+            argv[argv.index(flag) + 1] = value
+        else:
+            argv += [flag, value]
+    return argv
+
+
 def run_script(args, cwd):
     env = {k: v for k, v in os.environ.items() if k != "PYTHONWARNINGS"}
     return subprocess.run([str(PINFEED), *args], capture_output=True, text=True, cwd=cwd,
@@ -157,13 +168,7 @@ def test_rollout_table_shows_jams(capsys):
     (["--max-travel", "0"], ["travel"]),
 ])
 def test_rollout_bad_input_one_line_exit_2(capsys, args, words):
-    argv = list(BASE) + ["--theta-i", "0"]
-    for flag, value in zip(args[::2], args[1::2]):
-        if flag in argv:
-            argv[argv.index(flag) + 1] = value
-        else:
-            argv += [flag, value]
-    code, out, err = run(capsys, argv)
+    code, out, err = run(capsys, with_options(args))
     assert_one_line_error(code, err)
     assert out == ""
     for w in words:
@@ -182,13 +187,7 @@ def test_unknown_model_exits_2(capsys):
 def test_argparse_errors_follow_the_one_line_contract(capsys, extra):
     # cli.py promises: every error a user can cause prints one line
     # "pinfeed: error: ..." on stderr and exits with status 2.
-    argv = list(BASE) + ["--theta-i", "0"]
-    for flag, value in zip(extra[::2], extra[1::2]):
-        if flag in argv:
-            argv[argv.index(flag) + 1] = value
-        else:
-            argv += [flag, value]
-    code, out, err = run(capsys, argv)
+    code, out, err = run(capsys, with_options(extra))
     assert_one_line_error(code, err)
 
 

@@ -363,3 +363,16 @@ def test_bad_parameters_raise(triangle, kwargs):
     margs = dict(args, theta_i=[args["theta_i"], 10.0], d=[args["d"]])
     with pytest.raises(PinfeedError):
         simulate.map(triangle, **margs)
+
+
+def test_closest_feature_of_a_pin():
+    """Edge interior, vertex, and the contact normal pointing into the part."""
+    from kernels.geometry import EDGE, VERTEX, _closest_feature
+    square = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])  # CCW
+    kind, idx, dist, cx, cy, nx, ny = _closest_feature(square, 0.3, -1.5)
+    assert (kind, idx) == (EDGE, 0) and dist == pytest.approx(0.5)
+    assert (cx, cy) == pytest.approx((0.3, -1.0)) and (nx, ny) == pytest.approx((0.0, 1.0))
+    kind, idx, dist, cx, cy, nx, ny = _closest_feature(square, 2.0, 2.0)
+    assert (kind, idx) == (VERTEX, 2) and dist == pytest.approx(np.sqrt(2.0))
+    assert (cx, cy) == pytest.approx((1.0, 1.0))
+    assert (nx, ny) == pytest.approx((-np.sqrt(0.5), -np.sqrt(0.5)))

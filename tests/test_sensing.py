@@ -71,3 +71,28 @@ def test_measured_profile_csv(tmp_path):
             read_profile_csv(bad)
     with pytest.raises(PinfeedError, match="no profile file"):
         read_profile_csv(tmp_path / "missing.csv")
+
+
+def test_moments_at_the_sensor():
+    p = _profile([1.0, 2.0], [0.5, -1.0])
+    mx, my = p.moments(30.0)
+    # M = r x F with the contact 30 mm below the sensor: r = (0, 0, -30).
+    assert mx.tolist() == [15.0, -30.0] and my.tolist() == [-30.0, -60.0]
+
+
+def test_score_table_groups_a_state_that_touches_apart_from_ones_that_miss():
+    # A pin high above the asymmetric triangle's first two resting states misses
+    # them (an all-zero sign matrix) and pushes the third: noise-free and
+    # unperturbed, the sensor must tell the third apart and only the third.
+    from pipeline.parts import Part
+    from pipeline.sensing import score_table
+    part = Part.from_vertices([(0, 0), (60, 0), (15, 35)], name="asym")
+    states = {f"state {k}": {"theta": th, "y_c": y}
+              for k, (th, y) in enumerate(part.stable_states(), start=1)}
+    quiet = Sensor(noise_sigma=0.0, bias_x=0.0, bias_y=0.0)
+    still = {"theta_sigma": 0.0, "y_halfwidth": 0.0, "mu_sigma": 0.0, "pin_halfwidth": 0.0}
+    tab = score_table(part, states, 42.5, 0.15, 3.0, "minpower", quiet, trials=2, perturb=still)
+    assert sorted(map(sorted, tab["groups"])) == [["state 1", "state 2"], ["state 3"]]
+    assert tab["mean_scores"]["state 3"]["state 3"] == 40
+    assert tab["mean_scores"]["state 1"]["state 2"] == 40  # two misses look the same
+    assert tab["mean_scores"]["state 1"]["state 3"] < 40 - quiet.margin
