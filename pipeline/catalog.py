@@ -11,7 +11,11 @@ Queries return lazy (dask-backed) xarray objects::
     cat = Catalog.open("catalog")
     ds = cat.query(part="asym_triangle", model="minpower", mu_c=0.2, d=0.3)
     ds.attrs["selection"]   # e.g. "mu_c 0.2 -> nearest stored 0.15; d 0.3 -> 0.3"
-    cube = cat.cube("paper_triangles")   # dims (part, model, mu_c, d, theta_i)
+    moving = cat.query("asym_triangle", mu_c=0.15, v_pin=-2)   # a dynamic pin's maps
+    cube = cat.cube("paper_triangles")   # dims (part, model, mu_c, v_pin, d, theta_i)
+
+Shards written before dynamic pins existed have no ``v_pin`` attribute and
+count as static pins (v_pin = 0).
 """
 from __future__ import annotations
 
@@ -138,11 +142,13 @@ class Catalog:
         for e in self.entries:
             r = rows.setdefault(e["part_id"], {"family": e["family"], "part_id": e["part_id"],
                                                "part_name": e["part_name"], "n_vertices": len(e["part_vertices"]),
-                                               "models": set(), "mu_c": set(), "n_d": len(e["d"]),
-                                               "n_theta": e["n_theta"]})
+                                               "models": set(), "mu_c": set(), "v_pin": set(),
+                                               "n_d": len(e["d"]), "n_theta": e["n_theta"]})
             r["models"].add(e["model"])
             r["mu_c"].add(e["mu_c"])
-        return [dict(r, models=sorted(r["models"]), mu_c=sorted(r["mu_c"])) for r in rows.values()]
+            r["v_pin"].add(e.get("v_pin", 0.0))
+        return [dict(r, models=sorted(r["models"]), mu_c=sorted(r["mu_c"]), v_pin=sorted(r["v_pin"]))
+                for r in rows.values()]
 
     def _entries_for(self, part: str) -> list[dict]:
         found = [e for e in self.entries if part in (e["part_id"], e["part_name"])]
@@ -165,12 +171,14 @@ class Catalog:
         return xr.open_dataset(path, engine="h5netcdf", chunks={})
 
     def query(self, part: str, model: str = "minpower", mu_c=None, d=None,
-              method: str = "nearest") -> xr.Dataset:
-        """Maps of one part and model, lazily.
+              method: str = "nearest", v_pin: float = 0.0) -> xr.Dataset:
+        """Maps of one part, model and pin speed, lazily.
 
         ``mu_c`` and ``d`` select stored values: ``method="nearest"`` takes the
         nearest stored value, ``"bracket"`` the stored values on either side (or
-        the exact one). ``None`` keeps all. ``attrs["selection"]`` says what was
+        the exact one). ``None`` keeps all. ``v_pin`` (speed ratio v_pin / v_b,
+        default 0: static pins) must be stored exactly, since maps of different
+        speeds are not interpolated. ``attrs["selection"]`` says what was
         chosen. Returns dims ``(mu_c, d, theta_i)``.
         """
         if method not in ("nearest", "bracket"):
@@ -179,7 +187,12 @@ class Catalog:
         if not found:
             models = sorted({e["model"] for e in self._entries_for(part)})
             raise PinfeedError(f"part {part!r} has no {model} maps; stored models: {', '.join(models)}")
-        notes = []
+        speeds = sorted({e.get("v_pin", 0.0) for e in found})
+        found = [e for e in found if e.get("v_pin", 0.0) == float(v_pin)]
+        if not found:
+            raise PinfeedError(f"part {part!r} has no {model} maps at v_pin/v_b = {float(v_pin):g}; "
+                               f"stored speeds: {', '.join(f'{v:g}' for v in speeds)} (add it to sweep.v_pin)")
+        notes = [] if float(v_pin) == 0.0 else [f"v_pin {float(v_pin):g} stored exactly"]
         stored_mu = sorted({e["mu_c"] for e in found})
         if mu_c is not None:
             chosen = _select(stored_mu, float(mu_c), method)
@@ -201,7 +214,7 @@ class Catalog:
         return ds
 
     def cube(self, family: str) -> xr.Dataset:
-        """All maps of a family as one lazy cube (part, model, mu_c, d, theta_i)."""
+        """All maps of a family as one lazy cube (part, model, mu_c, v_pin, d, theta_i)."""
         found = [e for e in self.entries if e["family"] == family]
         if not found:
             fams = sorted({e["family"] for e in self.entries})
@@ -210,9 +223,11 @@ class Catalog:
         for e in found:
             ds = self._open_entry(e)
             ds = ds.drop_attrs() if hasattr(ds, "drop_attrs") else ds.assign_attrs({})
-            pieces.append(ds.expand_dims(part=[e["part_id"]], model=[e["model"]], mu_c=[e["mu_c"]]))
-        cube = xr.combine_by_coords(pieces, combine_attrs="drop")
+            pieces.append(ds.expand_dims(part=[e["part_id"]], model=[e["model"]], mu_c=[e["mu_c"]],
+                                         v_pin=[e.get("v_pin", 0.0)]))
+        cube = xr.combine_by_coords(pieces, combine_attrs="drop", join="outer")  # missing speeds: NaN
         cube.attrs.update(family=family, title=f"pinfeed map cube of family {family}")
+        cube["v_pin"].attrs.update(units="1", long_name="pin speed across the belt over belt speed")
         return cube
 
 

@@ -150,10 +150,11 @@ def cmd_catalog_list(args):
         json.dump(rows, sys.stdout, indent=1)
         sys.stdout.write("\n")
         return
-    print(f"{'family':<18} {'part':<28} {'models':<22} {'mu_c':<18} {'d x theta_i'}")
+    print(f"{'family':<18} {'part':<28} {'models':<22} {'mu_c':<18} {'v_pin/v_b':<16} {'d x theta_i'}")
     for r in rows:
         print(f"{r['family']:<18} {r['part_id']:<28} {','.join(r['models']):<22} "
-              f"{','.join(f'{m:g}' for m in r['mu_c']):<18} {r['n_d']} x {r['n_theta']}")
+              f"{','.join(f'{m:g}' for m in r['mu_c']):<18} "
+              f"{','.join(f'{v:g}' for v in r['v_pin']):<16} {r['n_d']} x {r['n_theta']}")
 
 
 def cmd_catalog_show(args):
@@ -162,8 +163,9 @@ def cmd_catalog_show(args):
     e0 = entries[0]
     info = {k: e0[k] for k in ("family", "part_id", "part_name", "part_vertices", "pin_radius",
                                "d", "theta_step", "config_hash", "pinfeed_version", "git_commit")}
-    info["shards"] = [{k: e[k] for k in ("model", "mu_c", "file", "sha256", "created")}
-                      for e in sorted(entries, key=lambda e: (e["model"], e["mu_c"]))]
+    info["shards"] = [dict({k: e[k] for k in ("model", "mu_c", "file", "sha256", "created")},
+                           v_pin=e.get("v_pin", 0.0))
+                      for e in sorted(entries, key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0)))]
     if args.json:
         json.dump(info, sys.stdout, indent=1)
         sys.stdout.write("\n")
@@ -174,13 +176,15 @@ def cmd_catalog_show(args):
           f"d = {', '.join(f'{d:g}' for d in info['d'])}")
     print(f"made by pinfeed {info['pinfeed_version']} ({info['git_commit']}), config {info['config_hash']}")
     for sh in info["shards"]:
-        print(f"  {sh['model']:<10} mu_c={sh['mu_c']:<6g} {sh['file']}  {sh['created']}")
+        print(f"  {sh['model']:<10} mu_c={sh['mu_c']:<6g} v_pin/v_b={sh['v_pin']:<5g} {sh['file']}  "
+              f"{sh['created']}")
 
 
 def _query(args):
     cat = _catalog(args)
     d = parse_values(args.d, "--d") if args.d is not None else None
-    ds = cat.query(args.part, model=args.model, mu_c=args.mu_c, d=d, method=args.method)
+    ds = cat.query(args.part, model=args.model, mu_c=args.mu_c, d=d, method=args.method,
+                   v_pin=args.v_pin)
     if getattr(args, "theta_i", None) is not None:
         ds = ds.sel(theta_i=parse_values(args.theta_i, "--theta-i"), method="nearest")
     return ds
@@ -198,7 +202,7 @@ def cmd_catalog_query(args):
                              "status": str(status_names(sub["status"].values[k])),
                              "theta_f": float(sub["theta_f"].values[k]), "dy": float(sub["dy"].values[k])})
     if args.json:
-        json.dump({"part": ds.attrs.get("part_id"), "model": args.model,
+        json.dump({"part": ds.attrs.get("part_id"), "model": args.model, "v_pin": args.v_pin,
                    "selection": ds.attrs["selection"], "rows": rows}, sys.stdout)
         sys.stdout.write("\n")
         return
@@ -242,6 +246,17 @@ def cmd_plan(args):
     for key in ("mu_c", "model", "depth", "coverage"):
         if getattr(args, key) is not None:
             config["planner"][key] = getattr(args, key)
+    dynamic = config["planner"]["dynamic"]
+    if args.speeds is not None:
+        dynamic["speeds"] = [float(v) for v in parse_values(args.speeds, "--speeds")] if args.speeds else []
+        if any(v == 0.0 for v in dynamic["speeds"]):
+            raise PinfeedError("--speeds lists moving pins: drop 0 (static pins are always candidates)")
+    if args.dynamic_depth is not None:
+        if args.dynamic_depth < 0:
+            raise PinfeedError("--dynamic-depth must be 0 (fixed pins only) or more")
+        dynamic["depth"] = args.dynamic_depth
+    if dynamic["depth"] == 0:
+        dynamic["speeds"] = []
     if args.pins:
         config["planner"]["pins"] = [float(x) for x in parse_values(args.pins, "--pins")]
     if args.vertices:
@@ -274,10 +289,14 @@ def cmd_plan(args):
         print("no allowed pin sequence within the depth (every pin meets some state metastably, "
               "outside |d| <= d_max, or jams it)")
         return
+    speeds = result["pin_speeds"]
     for k, plan in enumerate(result["plans"], start=1):
         sets = ", ".join(f"[{s['start']:.1f}, {s['start'] + s['width']:.1f}] deg" for s in plan["final_sets"])
-        heights = ", ".join(f"{q}@{result['pins'][q]:g} mm" for q in plan["pins"])
-        print(f"#{k}: {heights} -> {plan['n_final_sets']} final set(s): {sets}; margin in d {plan['margin']:.3f}")
+        heights = ", ".join(f"{q}@{result['pins'][q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
+                            for q in plan["pins"])
+        after = " -> ".join(str(n) for n in plan["sets_after_each_pin"])
+        print(f"#{k}: {heights} -> {plan['n_final_sets']} final set(s): {sets}; margin in d "
+              f"{plan['margin']:.3f}; sets after each pin {after}")
         if k == 1:
             for label, branches in plan["initial_states"].items():
                 for branch in branches:
@@ -296,7 +315,7 @@ class _Parser(argparse.ArgumentParser):
 
 # Options whose values may start with '-' (negative numbers, ranges such as
 # -0.9:0.9:0.1) that argparse would otherwise take for an option.
-_SIGNED_VALUE_OPTIONS = {"--d", "--theta-i", "--pins", "--v-pin"}
+_SIGNED_VALUE_OPTIONS = {"--d", "--theta-i", "--pins", "--v-pin", "--speeds"}
 
 
 def _join_signed_values(argv):
@@ -358,6 +377,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--depth", type=int, default=None, help="largest number of pins")
     p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step'")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"])
+    p.add_argument("--speeds", default=None,
+                   help="dynamic pin speeds v_pin/v_b after the static pins: 'a,b' ('' for none)")
+    p.add_argument("--dynamic-depth", dest="dynamic_depth", type=int, default=None,
+                   help="largest number of dynamic pins (0: fixed pins only)")
     p.add_argument("--out", default=None, help="also write the result JSON here")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plan)
@@ -386,6 +409,8 @@ def build_parser() -> argparse.ArgumentParser:
         q.add_argument("--d", default=None, help="contact parameter(s): 'a,b' or 'start:stop:step'")
         q.add_argument("--method", default="nearest", choices=["nearest", "bracket"],
                        help="how to pick stored mu_c and d values (default nearest)")
+        q.add_argument("--v-pin", dest="v_pin", type=float, default=0.0,
+                       help="pin speed ratio v_pin/v_b of the maps (stored exactly; default 0, static)")
         if name == "query":
             q.add_argument("--theta-i", default=None,
                            help="only these initial orientations (nearest stored)")

@@ -69,6 +69,12 @@ def validate_config(config: dict) -> dict:
     if unknown:
         raise PinfeedError(f"config error at planner/parts: {', '.join(unknown)} not in any family; "
                            f"known parts: {', '.join(sorted(names))}")
+    speeds = cfg["planner"]["dynamic"]["speeds"]
+    bad = [v for v in speeds if v == 0 or v not in cfg["sweep"]["v_pin"]]
+    if bad:
+        raise PinfeedError(f"config error at planner/dynamic/speeds: {', '.join(f'{v:g}' for v in bad)} "
+                           f"must be non-zero and listed in sweep/v_pin "
+                           f"({', '.join(f'{v:g}' for v in cfg['sweep']['v_pin'])})")
     return cfg
 
 

@@ -47,6 +47,7 @@ class Step:
     arc: tuple  # (start, width) of the orientation set reached, degrees
     y_lo: float
     y_hi: float
+    v_pin: float = 0.0  # speed ratio v_pin / v_b of a dynamic pin
 
 
 @dataclass(frozen=True)
@@ -79,6 +80,8 @@ class Plan:
     final_sets: list  # [(start, width)] merged final arcs
     margin: float
     branches: dict  # initial-state label -> list of step lists (one per branch)
+    sets_after: tuple = ()  # number of orientation sets after each pin (what each pin adds)
+    n_dynamic: int = 0  # how many of the pins (the last ones) move
 
     def rank_key(self):
         return (self.n_sets, -round(self.margin, 9), len(self.pins),
@@ -89,8 +92,11 @@ class Plan:
             "pins": list(self.pins), "n_final_sets": self.n_sets,
             "final_sets": [{"start": s, "width": w} for s, w in self.final_sets],
             "margin": self.margin,
+            "sets_after_each_pin": list(self.sets_after),
+            "n_dynamic_pins": self.n_dynamic,
             "initial_states": {
-                label: [[{"pin": st.pin, "y_pin": st.y_pin, "d_range": [st.d_lo, st.d_hi],
+                label: [[{"pin": st.pin, "y_pin": st.y_pin, "v_pin": st.v_pin,
+                          "d_range": [st.d_lo, st.d_hi],
                           "band": {"start": st.arc[0], "width": st.arc[1]},
                           "com_interval": [st.y_lo, st.y_hi]} for st in branch]
                         for branch in branches]
@@ -136,22 +142,49 @@ def merge_arcs(arcs) -> list[tuple[float, float]]:
 
 
 class Planner:
-    """Fixed global pins for one part, from its stored maps."""
+    """Global pins for one part, from its stored maps.
+
+    ``pins`` maps labels to heights (mm above the fence) of static pins.
+    ``dynamic`` optionally adds moving pins: a dict ``label -> (y, v_pin)``
+    (``y`` the pin's height when the part's centroid reaches the pin's
+    station, ``v_pin`` the speed ratio v_pin / v_b) with ``dynamic_maps``
+    ``{v_pin: [MapData]}`` the maps stored at each speed.
+    """
 
     def __init__(self, part: Part, maps: list[MapData], pins: dict, d_min: float, d_max: float,
-                 com: str = "covered", coverage: str = "bracket"):
+                 com: str = "covered", coverage: str = "bracket", dynamic: dict | None = None,
+                 dynamic_maps: dict | None = None):
         if not maps:
             raise PinfeedError("the planner needs at least one stored map")
         self.part = part
-        self.maps = maps
-        self.d_values = np.array([m.d for m in maps])
+        self.maps = {0.0: maps}
+        self.d_values = {0.0: np.array([m.d for m in maps])}
         self.pins = dict(pins)
+        self.speeds = {label: 0.0 for label in self.pins}
+        for label, (y, v) in (dynamic or {}).items():
+            v = float(v)
+            if v not in (dynamic_maps or {}):
+                raise PinfeedError(f"dynamic pin {label} moves at v_pin/v_b = {v:g} but no maps "
+                                   f"are stored at that speed; add it to sweep.v_pin")
+            self.pins[label] = float(y)
+            self.speeds[label] = v
+        for v, vmaps in (dynamic_maps or {}).items():
+            self.maps[float(v)] = vmaps
+            self.d_values[float(v)] = np.array([m.d for m in vmaps])
         self.d_min, self.d_max = d_min, d_max
         self.com = com
         if coverage not in ("bracket", "nearest"):
             raise PinfeedError(f"unknown coverage {coverage!r}; use bracket or nearest")
         self.coverage = coverage
         self._cache = {}
+
+    @property
+    def static_labels(self) -> list[str]:
+        return [k for k, v in self.speeds.items() if v == 0.0]
+
+    @property
+    def dynamic_labels(self) -> list[str]:
+        return [k for k, v in self.speeds.items() if v != 0.0]
 
     def initial_states(self) -> dict:
         """Resting states against the fence: label -> State (exact theta and y_c)."""
@@ -160,16 +193,17 @@ class Planner:
             states[f"state {k}"] = State((float(theta), 0.0), float(yc), float(yc))
         return states
 
-    def _maps_for(self, d_lo, d_hi):
-        if d_lo < self.d_values[0] - 1e-9 or d_hi > self.d_values[-1] + 1e-9:
+    def _maps_for(self, d_lo, d_hi, v_pin=0.0):
+        d_values, maps = self.d_values[v_pin], self.maps[v_pin]
+        if d_lo < d_values[0] - 1e-9 or d_hi > d_values[-1] + 1e-9:
             return None
         if self.coverage == "nearest":
-            lo = int(np.argmin(np.abs(self.d_values - d_lo)))
-            hi = int(np.argmin(np.abs(self.d_values - d_hi)))
+            lo = int(np.argmin(np.abs(d_values - d_lo)))
+            hi = int(np.argmin(np.abs(d_values - d_hi)))
         else:
-            lo = np.flatnonzero(self.d_values <= d_lo + 1e-9).max()
-            hi = np.flatnonzero(self.d_values >= d_hi - 1e-9).min()
-        return self.maps[lo: hi + 1]
+            lo = np.flatnonzero(d_values <= d_lo + 1e-9).max()
+            hi = np.flatnonzero(d_values >= d_hi - 1e-9).min()
+        return maps[lo: hi + 1]
 
     def transition(self, state: State, label: str):
         """Children of ``state`` at pin ``label`` and the step's margin, or None if forbidden."""
@@ -180,8 +214,9 @@ class Planner:
         if result is None:
             return None
         children, margin, d_lo, d_hi = result
-        y_pin = self.pins[label]
-        out = [State(arc, ylo, yhi, state.history + (Step(label, y_pin, d_lo, d_hi, arc, ylo, yhi),))
+        y_pin, v_pin = self.pins[label], self.speeds[label]
+        out = [State(arc, ylo, yhi,
+                     state.history + (Step(label, y_pin, d_lo, d_hi, arc, ylo, yhi, v_pin),))
                for arc, ylo, yhi in children]
         return out, margin
 
@@ -192,7 +227,7 @@ class Planner:
         if d_lo < 0.0 < d_hi or min(abs(d_lo), abs(d_hi)) < self.d_min - 1e-12 \
                 or max(abs(d_lo), abs(d_hi)) > self.d_max + 1e-12:
             return None
-        maps = self._maps_for(d_lo, d_hi)
+        maps = self._maps_for(d_lo, d_hi, self.speeds[label])
         if maps is None:
             return None
         margin = min(min(abs(d_lo), abs(d_hi)) - self.d_min, self.d_max - max(abs(d_lo), abs(d_hi)))
@@ -221,52 +256,79 @@ class Planner:
                              state.y_hi + max(h[2] for h in inside)))
         return children, margin, d_lo, d_hi
 
-    def search(self, depth: int, keep: int = 10) -> list[Plan]:
-        """Every pin sequence up to ``depth``; the ``keep`` best plans, best first."""
+    def search(self, depth: int, keep: int = 10, dynamic_depth: int = 0,
+               dynamic_beam: int = 50) -> list[Plan]:
+        """The ``keep`` best plans, best first.
+
+        Static pins: every sequence up to ``depth`` (complete; sequences that
+        reach a joint state already reached are merged). Dynamic pins come
+        after the static ones: up to ``dynamic_depth`` of them, appended to
+        the ``dynamic_beam`` best plans of the previous level (a beam search:
+        complete for one dynamic pin after the beam's plans, not beyond).
+        """
         starts = self.initial_states()
         labels = list(starts)
-        frontier = [((), tuple((starts[l],) for l in labels), math.inf)]
-        seen = {self._joint_key(frontier[0][1])}
-        plans = []
+        root = ((), tuple((starts[lab],) for lab in labels), math.inf, ())
+        seen = {self._joint_key(root[1])}
+        nodes, frontier = [], [root]
         for _ in range(depth):
-            nxt = []
-            for seq, joint, margin in frontier:
-                for pin in self.pins:
-                    new_joint, new_margin = [], margin
-                    for branch_states in joint:
-                        children = []
-                        for st in branch_states:
-                            res = self.transition(st, pin)
-                            if res is None:
-                                break
-                            children.extend(res[0])
-                            new_margin = min(new_margin, res[1])
-                        else:
-                            new_joint.append(_dedupe(children))
-                            continue
-                        break
-                    if len(new_joint) != len(joint):
-                        continue  # the pin is forbidden for some branch
-                    key = self._joint_key(new_joint)
-                    if key in seen:
-                        continue
-                    seen.add(key)
-                    new_seq = seq + (pin,)
-                    nxt.append((new_seq, tuple(new_joint), new_margin))
-                    plans.append(self._plan(new_seq, labels, new_joint, new_margin))
-            frontier = nxt
+            frontier = self._expand(frontier, self.static_labels, seen)
+            nodes.extend(frontier)
+        if dynamic_depth and self.dynamic_labels:
+            beam = [root] + nodes
+            for _ in range(dynamic_depth):
+                beam.sort(key=lambda node: self._node_rank(node))
+                grown = self._expand(beam[:dynamic_beam], self.dynamic_labels, seen)
+                nodes.extend(grown)
+                beam = grown
+        plans = [self._plan(node, labels) for node in nodes]
         plans.sort(key=Plan.rank_key)
         return plans[:keep]
+
+    def _expand(self, frontier, pin_labels, seen):
+        """Every node of ``frontier`` followed by every pin in ``pin_labels``."""
+        out = []
+        for seq, joint, margin, sets_after in frontier:
+            for pin in pin_labels:
+                new_joint, new_margin = [], margin
+                for branch_states in joint:
+                    children = []
+                    for st in branch_states:
+                        res = self.transition(st, pin)
+                        if res is None:
+                            break
+                        children.extend(res[0])
+                        new_margin = min(new_margin, res[1])
+                    else:
+                        new_joint.append(_dedupe(children))
+                        continue
+                    break
+                if len(new_joint) != len(joint):
+                    continue  # the pin is forbidden for some branch
+                key = self._joint_key(new_joint)
+                if key in seen:
+                    continue
+                seen.add(key)
+                n_sets = len(merge_arcs([st.arc for states in new_joint for st in states]))
+                out.append((seq + (pin,), tuple(new_joint), new_margin, sets_after + (n_sets,)))
+        return out
+
+    @staticmethod
+    def _node_rank(node):
+        seq, joint, margin, sets_after = node
+        n_sets = sets_after[-1] if sets_after else len(joint)
+        return (n_sets, -round(margin, 9) if math.isfinite(margin) else 0.0, len(seq))
 
     @staticmethod
     def _joint_key(joint):
         return tuple(tuple(sorted(st.key() for st in states)) for states in joint)
 
-    @staticmethod
-    def _plan(seq, labels, joint, margin) -> Plan:
+    def _plan(self, node, labels) -> Plan:
+        seq, joint, margin, sets_after = node
         finals = merge_arcs([st.arc for states in joint for st in states])
         branches = {label: [list(st.history) for st in states] for label, states in zip(labels, joint)}
-        return Plan(seq, len(finals), finals, float(margin), branches)
+        n_dynamic = sum(1 for p in seq if self.speeds[p] != 0.0)
+        return Plan(seq, len(finals), finals, float(margin), branches, sets_after, n_dynamic)
 
 
 def _arc_within(inner, outer) -> bool:

@@ -43,16 +43,26 @@ def write_report(config, plans: dict, verifications: dict, figures: dict, out) -
         figs = figures.get(name, {})
         if "maps" in figs:
             p.append(f'<h3>Configuration maps with bands</h3><img src="{_rel(figs["maps"], base)}">')
-        p.append("<h3>Best plans</h3><table><tr><th>rank</th><th>pins</th><th>heights (mm)</th>"
+        if "speeds" in figs:
+            p.append(f'<h3>Maps by pin speed (dynamic pins)</h3><img src="{_rel(figs["speeds"], base)}">')
+        p.append("<h3>Best plans</h3><table><tr><th>rank</th><th>pins</th>"
+                 "<th>heights (mm) @ speed (v_pin/v_b)</th><th>sets after each pin</th>"
                  "<th>final sets</th><th>orientation sets (deg)</th><th>margin in d</th></tr>")
+        speeds = res.get("pin_speeds", {})
         for k, plan in enumerate(res["plans"], start=1):
             sets = ", ".join(f"[{s['start']:.0f}, {s['start'] + s['width']:.0f}]" for s in plan["final_sets"])
-            heights = ", ".join(f"{res['pins'][q]:g}" for q in plan["pins"])
+            heights = ", ".join(f"{res['pins'][q]:g}" + (f" @ {speeds[q]:+g}" if q in speeds else "")
+                                for q in plan["pins"])
+            after = " → ".join(str(n) for n in plan.get("sets_after_each_pin", []))
             p.append(f"<tr><td>{k}</td><td>{' → '.join(plan['pins'])}</td><td>{heights}</td>"
-                     f"<td>{plan['n_final_sets']}</td><td>{sets}</td><td>{plan['margin']:.3f}</td></tr>")
+                     f"<td>{after}</td><td>{plan['n_final_sets']}</td><td>{sets}</td>"
+                     f"<td>{plan['margin']:.3f}</td></tr>")
         p.append("</table>")
         if "sequence" in figs:
-            p.append(f'<h3>Pin sequence</h3><img src="{_rel(figs["sequence"], base)}">')
+            p.append(f'<h3>Pin sequence: fixed pins</h3><img src="{_rel(figs["sequence"], base)}">')
+        if "sequence_dynamic" in figs:
+            p.append(f'<h3>Pin sequence: with dynamic pins</h3>'
+                     f'<img src="{_rel(figs["sequence_dynamic"], base)}">')
         if name in verifications:
             rows = verification_rows({name: verifications[name]})
             p.append("<table><tr>" + "".join(f"<th>{h}</th>" for h in HEADER) + "</tr>")

@@ -37,6 +37,7 @@ def shard_bands(shard, threshold_T, factor_c) -> dict:
     ds = read_map(shard)
     bands = map_bands(ds, threshold_T, factor_c)
     return {"part_id": ds.attrs["part_id"], "model": ds.attrs["model"], "mu_c": ds.attrs["mu_c"],
+            "v_pin": float(ds.attrs.get("v_pin", 0.0)),
             "threshold_T": threshold_T, "factor_c": factor_c, "shard": str(shard),
             "maps": {f"{d:g}": [b.to_dict() for b in bs] for d, bs in bands.items()},
             **provenance_attrs()}
@@ -51,26 +52,50 @@ def catalog_part(cat: Catalog, name: str) -> Part:
 
 
 def build_planner(cat: Catalog, name: str, config: dict):
+    """The planner of one catalog part: static maps at the planner's mu_c, plus
+    the maps of every dynamic speed the config allows (``planner.dynamic``)."""
     pc, bc = config["planner"], config["bands"]
     part = catalog_part(cat, name)
     ds = cat.query(name, model=pc["model"], mu_c=pc["mu_c"])
     selection = ds.attrs["selection"]
-    ds = ds.isel(mu_c=0).load()
-    maps = load_maps(ds, bc["threshold_T"], bc["factor_c"])
-    planner = Planner(part, maps, pins_from_config(pc["pins"]), pc["d_min"], pc["d_max"],
-                      coverage=pc.get("coverage", "bracket"))
-    return part, planner, float(ds["mu_c"]), selection
+    mu_used = float(ds["mu_c"][0])
+    maps = load_maps(ds.isel(mu_c=0).load(), bc["threshold_T"], bc["factor_c"])
+    static = pins_from_config(pc["pins"])
+    speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])]
+    dynamic_maps = {}
+    for v in speeds:
+        dv = cat.query(name, model=pc["model"], mu_c=mu_used, v_pin=v).isel(mu_c=0).load()
+        dynamic_maps[v] = load_maps(dv, bc["threshold_T"], bc["factor_c"])
+    dynamic = {dynamic_label(label, v): (y, v) for label, y in static.items() for v in speeds}
+    planner = Planner(part, maps, static, pc["d_min"], pc["d_max"],
+                      coverage=pc.get("coverage", "bracket"), dynamic=dynamic,
+                      dynamic_maps=dynamic_maps)
+    return part, planner, mu_used, selection
+
+
+def dynamic_label(static_label: str, v_pin: float) -> str:
+    """Label of a moving pin: its static label and speed ratio, e.g. ``P23v-2``."""
+    return f"{static_label}v{v_pin:+g}"
 
 
 def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5) -> dict:
     pc = config["planner"]
     part, planner, mu_used, selection = build_planner(cat, name, config)
-    plans = planner.search(pc["depth"], keep=keep)
+    dyn = pc.get("dynamic", {})
+    plans = planner.search(pc["depth"], keep=keep, dynamic_depth=dyn.get("depth", 0),
+                           dynamic_beam=dyn.get("beam", 50))
     states = planner.initial_states()
+    static_only = [p for p in plans if p.n_dynamic == 0]
+    if planner.dynamic_labels and not static_only:
+        static_only = [p for p in planner.search(pc["depth"], keep=1) if p.n_dynamic == 0]
     return {
         "part": part.to_dict(), "model": pc["model"], "mu_c": mu_used, "selection": selection,
-        "pins": planner.pins, "depth": pc["depth"], "d_min": pc["d_min"], "d_max": pc["d_max"],
+        "pins": planner.pins,
+        "pin_speeds": {k: v for k, v in planner.speeds.items() if v != 0.0},
+        "depth": pc["depth"], "dynamic_depth": dyn.get("depth", 0) if planner.dynamic_labels else 0,
+        "d_min": pc["d_min"], "d_max": pc["d_max"],
         "coverage": planner.coverage,
+        "best_static": static_only[0].to_dict() if static_only else None,
         "initial_states": {k: {"theta": s.arc[0], "y_c": s.y_lo} for k, s in states.items()},
         "plans": [p.to_dict() for p in plans],
         "found": bool(plans),
@@ -81,28 +106,51 @@ def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5) -> dict:
 # ---------------------------------------------------------------------- verify
 
 
+def plans_to_check(plan_result: dict) -> dict:
+    """The plans the verify stage replays and the figures draw: ``"fixed pins"``
+    (the best plan of static pins only) and, when the best plan moves a pin,
+    ``"with dynamic pins"`` (the best plan overall)."""
+    plans = plan_result["plans"]
+    if not plans:
+        return {}
+    best = plans[0]
+    static = plan_result.get("best_static")
+    if static is None and not best.get("n_dynamic_pins", 0):
+        static = best
+    out = {"fixed pins": static} if static else {}
+    if best.get("n_dynamic_pins", 0):
+        out["with dynamic pins"] = best
+    return out
+
+
 def verify_part(plan_result: dict, config: dict) -> dict:
+    """Perturbed full rollouts of the best fixed-pin plan and of the best plan
+    with dynamic pins (if any): ``{"part", "checks": [verify_plan result + "kind"]}``."""
     from .planner import State
     from .verify import verify_plan
-    if not plan_result["plans"]:
-        return {"part": plan_result["part"]["name"], "plan": [], "rows": [], "trials": [],
-                "note": "no allowed plan within the depth"}
-    part = Part.from_vertices(plan_result["part"]["vertices"], name=plan_result["part"]["name"])
+    name = plan_result["part"]["name"]
+    out = {"part": name, "checks": [], **provenance_attrs()}
+    to_check = plans_to_check(plan_result)
+    if not to_check:
+        out["note"] = "no allowed plan within the depth"
+        return out
+    part = Part.from_vertices(plan_result["part"]["vertices"], name=name)
     states = {k: State((v["theta"], 0.0), v["y_c"], v["y_c"])
               for k, v in plan_result["initial_states"].items()}
-    res = verify_plan(part, plan_result["plans"][0], plan_result["pins"], states,
-                      plan_result["mu_c"], config["sweep"]["pin_radius"], plan_result["model"],
-                      config.get("verify", {}))
-    res["part"] = part.name
-    res.update(provenance_attrs())
-    return res
+    for kind, plan in to_check.items():
+        res = verify_plan(part, plan, plan_result["pins"], states,
+                          plan_result["mu_c"], config["sweep"]["pin_radius"], plan_result["model"],
+                          config.get("verify", {}), speeds=plan_result.get("pin_speeds", {}))
+        out["checks"].append({"kind": kind, **res})
+    return out
 
 
-def nominal_paths(plan_result: dict, config: dict) -> dict:
-    """Unperturbed rollouts of the best plan: (theta, y_c) before and after each pin."""
+def nominal_paths(plan_result: dict, config: dict, plan: dict | None = None) -> dict:
+    """Unperturbed rollouts of a plan (default: the best): (theta, y_c) before and after each pin."""
     from . import simulate
     part = Part.from_vertices(plan_result["part"]["vertices"], name=plan_result["part"]["name"])
-    best = plan_result["plans"][0]
+    best = plan or plan_result["plans"][0]
+    speeds = plan_result.get("pin_speeds", {})
     paths = {}
     for label, s in plan_result["initial_states"].items():
         theta, y = s["theta"], s["y_c"]
@@ -110,7 +158,7 @@ def nominal_paths(plan_result: dict, config: dict) -> dict:
         for pin in best["pins"]:
             r = simulate.rollout(part, theta, (plan_result["pins"][pin] - y) / part.a,
                                  plan_result["mu_c"], config["sweep"]["pin_radius"],
-                                 model=plan_result["model"])
+                                 model=plan_result["model"], v_pin=speeds.get(pin, 0.0))
             theta, y = float(r.theta_f), y + float(r.dy)
             path.append((theta, y))
         paths[label] = path
@@ -120,34 +168,51 @@ def nominal_paths(plan_result: dict, config: dict) -> dict:
 # ---------------------------------------------------------------------- figures, report
 
 
-def make_figures(config, plan_paths, verify_paths, out_maps, out_sequence, out_verification,
-                 out_table):
+def make_figures(config, plan_paths, verify_paths, out: dict):
+    """Every figure of the planned parts. ``out`` holds lists (one path per
+    part, in plan order) under ``maps`` (models side by side), ``speeds``
+    (the planner's model at each pin speed), ``sequence`` (best fixed-pin
+    plan), ``sequence_dynamic`` (best plan with dynamic pins), and single
+    paths ``verification`` (PNG) and ``table`` (Markdown)."""
     from .figures.bands import plot_band_maps
-    from .figures.sequence import plot_sequence
     from .figures.tables import markdown_table, plot_table, verification_rows
     cat = Catalog.open(config["catalog_dir"])
+    bc, fc = config["bands"], config["figures"]
     verifications = {}
-    for plan_path, verify_path, maps_png, seq_png in zip(plan_paths, verify_paths, out_maps,
-                                                          out_sequence):
+    for k, (plan_path, verify_path) in enumerate(zip(plan_paths, verify_paths)):
         res = read_json(plan_path)
         name = res["part"]["name"]
-        maps = {}
-        for model in config["sweep"]["models"]:
-            ds = cat.query(name, model=model, mu_c=res["mu_c"])
-            maps[model] = ds.isel(mu_c=0).load()
-        plot_band_maps(maps, config["figures"]["d"], config["bands"]["threshold_T"],
-                       config["bands"]["factor_c"],
-                       f"{name}: configuration maps, mu_c = {res['mu_c']:g} (rows: models)", maps_png)
-        if res["plans"]:
-            part = Part.from_vertices(res["part"]["vertices"], name=name)
-            plot_sequence(part, res["plans"][0], res["pins"], nominal_paths(res, config),
-                          config["sweep"]["pin_radius"], f"{name}: best fixed-pin plan", seq_png)
-        else:
-            _placeholder(seq_png, f"{name}: no allowed plan within depth {res['depth']}")
+        maps = {model: cat.query(name, model=model, mu_c=res["mu_c"]).isel(mu_c=0).load()
+                for model in config["sweep"]["models"]}
+        plot_band_maps(maps, fc["d"], bc["threshold_T"], bc["factor_c"],
+                       f"{name}: configuration maps, mu_c = {res['mu_c']:g} (rows: models)", out["maps"][k])
+        speeds = {f"v_pin/v_b = {v:+g}": cat.query(name, model=res["model"], mu_c=res["mu_c"], v_pin=v)
+                  .isel(mu_c=0).load() for v in sorted(config["sweep"]["v_pin"])}
+        plot_band_maps(speeds, fc["d"], bc["threshold_T"], bc["factor_c"],
+                       f"{name}: {res['model']} maps by pin speed, mu_c = {res['mu_c']:g} "
+                       f"(d at the centroid's station)", out["speeds"][k])
+        to_draw = plans_to_check(res)
+        _sequence_figure(config, res, to_draw.get("fixed pins"), "best fixed-pin plan", out["sequence"][k])
+        _sequence_figure(config, res, to_draw.get("with dynamic pins"), "best plan with dynamic pins",
+                         out["sequence_dynamic"][k])
         verifications[name] = read_json(verify_path)
     rows = verification_rows(verifications)
-    plot_table(rows, "Verification of the best plans by perturbed full rollouts", out_verification)
-    Path(out_table).write_text(markdown_table(rows))
+    plot_table(rows, "Verification of the best plans by perturbed full rollouts", out["verification"])
+    Path(out["table"]).write_text(markdown_table(rows))
+
+
+def _sequence_figure(config, res, plan, what, path):
+    from .figures.sequence import plot_sequence
+    name = res["part"]["name"]
+    if plan is None:
+        why = (f"no allowed plan within depth {res['depth']}" if not res["plans"] else
+               "no plan with dynamic pins beats the fixed pins (or none allowed)")
+        _placeholder(path, f"{name}, {what}: {why}")
+        return
+    part = Part.from_vertices(res["part"]["vertices"], name=name)
+    plot_sequence(part, plan, res["pins"], nominal_paths(res, config, plan),
+                  config["sweep"]["pin_radius"], f"{name}: {what}", path,
+                  speeds=res.get("pin_speeds", {}))
 
 
 def _placeholder(path, text):
@@ -169,23 +234,29 @@ def make_report(config, plan_paths, verify_paths, out):
         name = res["part"]["name"]
         plans[name] = res
         verifications[name] = read_json(verify_path)
-        figures[name] = {"maps": results / f"maps_{name}.png", "sequence": results / f"sequence_{name}.png"}
+        figures[name] = {kind: results / f"{kind}_{name}.png"
+                         for kind in ("maps", "speeds", "sequence", "sequence_dynamic")}
     return write_report(config, plans, verifications, figures, out)
 
 
 def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:
     """Make sure the catalog holds the maps the planner needs for ``part``:
-    the planner's model at its mu_c over the sweep's d grid. Missing ones are
+    the planner's model at its mu_c over the sweep's d grid, for a static pin
+    and for every dynamic speed the planner may use. Missing ones are
     computed with the sweep settings, stored atomically and indexed."""
     from .sweep import ShardJob, write_shard
     root = Path(config["catalog_dir"])
     pc = config["planner"]
     cat = Catalog.open(root) if (root / "index.json").is_file() else None
-    have = cat is not None and any(
-        e["part_id"] == part.id and e["model"] == pc["model"] and e["mu_c"] == float(pc["mu_c"])
-        for e in cat.entries)
-    if not have:
-        fam = next((e["family"] for e in (cat.entries if cat else []) if e["part_id"] == part.id), family)
-        write_shard(config, ShardJob(fam, part, pc["model"], float(pc["mu_c"])))
+    entries = cat.entries if cat else []
+    fam = next((e["family"] for e in entries if e["part_id"] == part.id), family)
+    wrote = False
+    for v in [0.0] + [float(x) for x in pc.get("dynamic", {}).get("speeds", [])]:
+        have = any(e["part_id"] == part.id and e["model"] == pc["model"]
+                   and e["mu_c"] == float(pc["mu_c"]) and e.get("v_pin", 0.0) == v for e in entries)
+        if not have:
+            write_shard(config, ShardJob(fam, part, pc["model"], float(pc["mu_c"]), v))
+            wrote = True
+    if wrote:
         cat = Catalog.rebuild(root)
     return cat

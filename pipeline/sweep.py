@@ -1,4 +1,8 @@
-"""The sweep: one shard per (family, part, model, mu_c), each a map set over (d, theta_i).
+"""The sweep: one shard per (family, part, model, mu_c, v_pin), each a map set over (d, theta_i).
+
+Static pins (v_pin = 0) keep the file name ``mu_c=MU.h5``, so catalogs
+written before dynamic pins existed stay valid; a moving pin's shard is
+``mu_c=MU_v_pin=V.h5`` (V the speed ratio v_pin / v_b).
 
 A shard is an HDF5 file (xarray, h5netcdf engine) that describes itself:
 CF-style variable attributes, the part's outline, every sweep parameter, the
@@ -32,13 +36,20 @@ class ShardJob:
     part: Part
     model: str
     mu_c: float
+    v_pin: float = 0.0
 
     def path(self, catalog_dir) -> Path:
-        return shard_path(catalog_dir, self.family, self.part.id, self.model, self.mu_c)
+        return shard_path(catalog_dir, self.family, self.part.id, self.model, self.mu_c, self.v_pin)
 
 
-def shard_path(catalog_dir, family, part_id, model, mu_c) -> Path:
-    return Path(catalog_dir) / family / part_id / model / f"mu_c={mu_label(mu_c)}.h5"
+def shard_tag(mu_c, v_pin=0.0) -> str:
+    """File stem of a shard: ``mu_c=0.15`` (static pin) or ``mu_c=0.15_v_pin=-2.0``."""
+    tag = f"mu_c={mu_label(mu_c)}"
+    return tag if float(v_pin) == 0.0 else f"{tag}_v_pin={mu_label(v_pin)}"
+
+
+def shard_path(catalog_dir, family, part_id, model, mu_c, v_pin=0.0) -> Path:
+    return Path(catalog_dir) / family / part_id / model / f"{shard_tag(mu_c, v_pin)}.h5"
 
 
 def shard_jobs(config) -> list[ShardJob]:
@@ -48,16 +59,19 @@ def shard_jobs(config) -> list[ShardJob]:
         for part in family_parts(family, spec):
             for model in config["sweep"]["models"]:
                 for mu in config["sweep"]["mu_c"]:
-                    jobs.append(ShardJob(family, part, model, float(mu)))
+                    for v in config["sweep"]["v_pin"]:
+                        jobs.append(ShardJob(family, part, model, float(mu), float(v)))
     return jobs
 
 
-def find_job(config, family, part_id, model, mu_c) -> ShardJob:
+def find_job(config, family, part_id, model, tag) -> ShardJob:
+    """The job of a shard named by its folder parts and file stem (``shard_tag``)."""
     for job in shard_jobs(config):
-        if (job.family, job.part.id, job.model) == (family, part_id, model) and job.mu_c == float(mu_c):
+        if (job.family, job.part.id, job.model) == (family, part_id, model) \
+                and shard_tag(job.mu_c, job.v_pin) == tag:
             return job
     from .errors import PinfeedError
-    raise PinfeedError(f"the config has no shard {family}/{part_id}/{model}/mu_c={mu_c}")
+    raise PinfeedError(f"the config has no shard {family}/{part_id}/{model}/{tag}")
 
 
 def compute_shard(config, job: ShardJob, threads=None):
@@ -65,11 +79,12 @@ def compute_shard(config, job: ShardJob, threads=None):
     sweep = config["sweep"]
     kernel = sweep.get("kernel", {})
     ds = simulate.map(job.part, theta_grid(config), np.asarray(sweep["d"], float), job.mu_c,
-                      sweep["pin_radius"], model=job.model, threads=threads,
+                      sweep["pin_radius"], model=job.model, v_pin=job.v_pin, threads=threads,
                       ds_max=kernel.get("ds_max", 0.1), tol=kernel.get("tol", 1e-7))
     ds.attrs.update(provenance_attrs())
     ds.attrs.update({
-        "title": f"pinfeed configuration maps: {job.part.id}, {job.model}, mu_c={job.mu_c:g}",
+        "title": f"pinfeed configuration maps: {job.part.id}, {job.model}, mu_c={job.mu_c:g}, "
+                 f"v_pin/v_b={job.v_pin:g}",
         "family": job.family,
         "theta_step": float(sweep["theta_step"]),
         "config_hash": config_hash(config),

@@ -44,9 +44,13 @@ def _expects_contact(plan: dict, label: str, k: int, start_arc) -> bool:
 
 
 def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c: float,
-                pin_radius: float, model: str = "minpower", settings: dict | None = None) -> dict:
+                pin_radius: float, model: str = "minpower", settings: dict | None = None,
+                speeds: dict | None = None) -> dict:
     """Run the trials for a plan (as stored: ``Plan.to_dict()``); returns per-state
-    counts and every trial's outcome."""
+    counts and every trial's outcome. ``speeds`` gives the speed ratio
+    v_pin / v_b of each dynamic pin's label (absent: a static pin); the
+    perturbation of a dynamic pin's position shifts its whole path."""
+    speeds = speeds or {}
     cfg = dict(DEFAULTS, **(settings or {}))
     rng = np.random.default_rng(cfg["seed"])
     prep = part.prepared()
@@ -63,7 +67,8 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c: 
             reason, path = None, [(theta % 360.0, y_c)]
             for k, (pin, off) in enumerate(zip(plan["pins"], offsets)):
                 d = (pins[pin] + off - y_c) / part.a
-                res = _rollout(*prep, model_code, mu, pin_radius, math.radians(theta), d, 0.0,
+                res = _rollout(*prep, model_code, mu, pin_radius, math.radians(theta), d,
+                               float(speeds.get(pin, 0.0)),
                                np.inf, DEFAULT_DS_MAX, DEFAULT_TOL, False)
                 status, why = res[0], res[1]
                 if status == JAMMED:

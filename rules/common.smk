@@ -9,12 +9,12 @@ wildcard_constraints:
     family="[A-Za-z0-9_]+",
     part="[A-Za-z0-9_]+-[0-9a-f]{10}",
     model="minpower|tip|ellipsoid",
-    mu="[0-9.eE+-]+",
+    tag="mu_c=[0-9.eE+-]+(_v_pin=[0-9.eE+-]+)?",
 
 
 def shard_params(wildcards):
     """Everything a shard's content depends on: changing any of it reruns the shard."""
-    path = f"{CATALOG}/{wildcards.family}/{wildcards.part}/{wildcards.model}/mu_c={wildcards.mu}.h5"
+    path = f"{CATALOG}/{wildcards.family}/{wildcards.part}/{wildcards.model}/{wildcards.tag}.h5"
     job = JOBS[path]
     sweep = config["sweep"]
     return {

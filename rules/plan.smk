@@ -3,13 +3,13 @@
 
 rule bands:
     input:
-        shard=f"{CATALOG}/{{family}}/{{part}}/{{model}}/mu_c={{mu}}.h5",
+        shard=f"{CATALOG}/{{family}}/{{part}}/{{model}}/{{tag}}.h5",
     output:
-        bands=f"{CATALOG}/bands/{{family}}/{{part}}/{{model}}/mu_c={{mu}}.json",
+        bands=f"{CATALOG}/bands/{{family}}/{{part}}/{{model}}/{{tag}}.json",
     params:
         bands=config["bands"],
     log:
-        "logs/bands/{family}/{part}/{model}/mu_c={mu}.log",
+        "logs/bands/{family}/{part}/{model}/{tag}.log",
     conda:
         "envs/pinfeed.yaml"
     script:

@@ -8,7 +8,9 @@ rule figures:
         verify=expand(f"{CATALOG}/verify/{{name}}.json", name=PLANNED),
     output:
         maps=expand(f"{RESULTS}/figures/maps_{{name}}.png", name=PLANNED),
+        speeds=expand(f"{RESULTS}/figures/speeds_{{name}}.png", name=PLANNED),
         sequence=expand(f"{RESULTS}/figures/sequence_{{name}}.png", name=PLANNED),
+        sequence_dynamic=expand(f"{RESULTS}/figures/sequence_dynamic_{{name}}.png", name=PLANNED),
         verification=f"{RESULTS}/figures/verification.png",
         table=f"{RESULTS}/verification.md",
     params:

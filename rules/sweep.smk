@@ -1,13 +1,13 @@
-# Stage 1: one map shard per (family, part, model, mu_c).
+# Stage 1: one map shard per (family, part, model, mu_c, v_pin).
 
 
 rule sweep_shard:
     output:
-        shard=f"{CATALOG}/{{family}}/{{part}}/{{model}}/mu_c={{mu}}.h5",
+        shard=f"{CATALOG}/{{family}}/{{part}}/{{model}}/{{tag}}.h5",
     params:
         spec=shard_params,
     log:
-        "logs/sweep/{family}/{part}/{model}/mu_c={mu}.log",
+        "logs/sweep/{family}/{part}/{model}/{tag}.log",
     threads: 2
     resources:
         mem_mb=1000,

@@ -76,10 +76,44 @@ def test_queries_are_lazy_and_cube_has_all_dims(swept):
     q = cat.query("tri")
     assert q["theta_f"].chunks is not None  # dask-backed
     cube = cat.cube("fam")
-    assert cube["theta_f"].dims == ("part", "model", "mu_c", "d", "theta_i")
-    assert cube.sizes == {"part": 2, "model": 2, "mu_c": 2, "d": 2, "theta_i": 8}
+    assert cube["theta_f"].dims == ("part", "model", "mu_c", "v_pin", "d", "theta_i")
+    assert cube.sizes == {"part": 2, "model": 2, "mu_c": 2, "v_pin": 1, "d": 2, "theta_i": 8}
     one = cube["theta_f"].sel(model="minpower", mu_c=0.2, d=0.3).isel(part=0).compute()
     assert np.all((one >= 0) & (one < 360))
+
+
+def test_dynamic_pin_speeds_are_a_catalog_dimension(tmp_path):
+    cfg = validate_config(dict(TINY, catalog_dir=str(tmp_path / "catalog"),
+                               sweep=dict(TINY["sweep"], models=["ellipsoid"], mu_c=[0.2],
+                                          v_pin=[0.0, -1.5])))
+    run_sweep(cfg, progress=False)
+    cat = Catalog.open(cfg["catalog_dir"])
+    names = sorted(Path(e["file"]).name for e in cat.entries if e["part_name"] == "tri")
+    assert names == ["mu_c=0.2.h5", "mu_c=0.2_v_pin=-1.5.h5"]  # static shards keep their names
+    part = Part.from_vertices(TINY["families"]["fam"]["parts"][0]["vertices"], name="tri")
+    moving = cat.query("tri", model="ellipsoid", mu_c=0.2, v_pin=-1.5).load()
+    direct = simulate.map(part, np.arange(0, 360, 45.0), [-0.4, 0.3], 0.2, 3.0, model="ellipsoid",
+                          v_pin=-1.5)
+    np.testing.assert_array_equal(moving["theta_f"].values[0], direct["theta_f"].values)
+    static = cat.query("tri", model="ellipsoid", mu_c=0.2).load()
+    assert not np.array_equal(static["theta_f"].values, moving["theta_f"].values)
+    with pytest.raises(PinfeedError, match="no ellipsoid maps at v_pin/v_b = 2; stored speeds: -1.5, 0"):
+        cat.query("tri", model="ellipsoid", v_pin=2.0)
+    cube = cat.cube("fam")
+    assert cube.sizes["v_pin"] == 2 and cube["v_pin"].values.tolist() == [-1.5, 0.0]
+    assert [r["v_pin"] for r in cat.parts()] == [[-1.5, 0.0]] * 2
+
+
+def test_catalog_from_before_dynamic_pins_stays_readable(swept):
+    """Shards written before v_pin existed have no v_pin attribute: they are static maps."""
+    root = Path(swept["catalog_dir"])
+    for path in root.rglob("*.h5"):
+        with h5py.File(path, "r+") as f:
+            del f.attrs["v_pin"]
+    cat = Catalog.rebuild(root)
+    assert not cat.problems and all(e["v_pin"] == 0.0 for e in cat.entries)
+    q = cat.query("tri", model="minpower", mu_c=0.2, d=0.3).load()
+    assert q.sizes["theta_i"] == 8 and "v_pin" not in q.attrs["selection"]
 
 
 def test_unknown_part_and_model_are_clear_errors(swept):

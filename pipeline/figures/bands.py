@@ -19,7 +19,8 @@ def _shade(ax, start, width, **kw):
 
 
 def plot_band_maps(maps_by_model: dict, d_values, threshold_T, factor_c, title, out) -> Path:
-    """``maps_by_model``: model -> Dataset with dims (d, theta_i). Rows: models; columns: d."""
+    """``maps_by_model``: row label (a model, or a pin speed) -> Dataset with dims
+    (d, theta_i). Rows: those labels; columns: d."""
     models = list(maps_by_model)
     fig, axes = plt.subplots(len(models), len(d_values), figsize=(2.7 * len(d_values) + 0.5,
                              2.7 * len(models) + 0.8), sharex=True, sharey=True, squeeze=False)

@@ -17,15 +17,21 @@ def _pose(vertices, theta_deg, x, y):
 
 
 def plot_sequence(part, plan_dict, pins: dict, paths: dict, pin_radius, title, out,
-                  spacing=None) -> Path:
+                  spacing=None, speeds: dict | None = None) -> Path:
     """``paths``: initial-state label -> [(theta_deg, y_c)] before and after each pin
-    (nominal rollouts). Pins are drawn at their heights, one station per pin."""
+    (nominal rollouts). Pins are drawn at their heights, one station per pin.
+    A dynamic pin (``speeds``: label -> v_pin / v_b) is drawn at its height when
+    the centroid reaches its station, with an arrow along its path while the
+    belt carries the part over ``+- a/2`` around that station."""
+    speeds = speeds or {}
     labels = list(paths)
     n_pins = len(plan_dict["pins"])
     spacing = spacing or 3.2 * part.a
     fig, axes = plt.subplots(len(labels), 1, figsize=(2.2 + 1.9 * (n_pins + 1), 2.3 * len(labels) + 0.6),
                              squeeze=False)
     ys = [y for p in paths.values() for _, y in p] + [pins[p] for p in plan_dict["pins"]]
+    ys += [pins[p] + sgn * 0.5 * speeds[p] * part.a for p in plan_dict["pins"] if p in speeds
+           for sgn in (-1, 1)]
     lo, hi = min(ys + [0.0]) - 1.2 * part.a, max(ys) + 1.2 * part.a
     for ax, label in zip(axes[:, 0], labels):
         ax.axhline(0.0, xmin=0.0, xmax=0.12, color="k", lw=2)
@@ -38,8 +44,15 @@ def plot_sequence(part, plan_dict, pins: dict, paths: dict, pin_radius, title, o
             ax.text(x, y - 1.05 * part.a, f"{theta:.0f}°", ha="center", fontsize=7)
         for k, pin in enumerate(plan_dict["pins"]):
             x = (k + 0.5) * spacing
-            ax.add_patch(Circle((x, pins[pin]), max(pin_radius, 0.04 * part.a), color="tab:red"))
-            ax.text(x, pins[pin] + 0.12 * part.a, pin, color="tab:red", ha="center", fontsize=8)
+            color = "tab:purple" if pin in speeds else "tab:red"
+            if pin in speeds:
+                half = 0.5 * speeds[pin] * part.a
+                ax.annotate("", xy=(x, pins[pin] + half), xytext=(x, pins[pin] - half),
+                            arrowprops=dict(arrowstyle="->", color=color, ls="--", lw=1.2))
+            ax.add_patch(Circle((x, pins[pin]), max(pin_radius, 0.04 * part.a), color=color))
+            text = pin if pin not in speeds else f"{pin}\n(v = {speeds[pin]:+g} v_b)"
+            ax.text(x + 0.08 * part.a, pins[pin] + 0.12 * part.a, text, color=color, ha="left",
+                    fontsize=7)
         ax.annotate("", xy=(n_pins * spacing + 0.8 * part.a, lo + 0.1 * part.a),
                     xytext=(n_pins * spacing - 0.8 * part.a, lo + 0.1 * part.a),
                     arrowprops=dict(arrowstyle="->"))

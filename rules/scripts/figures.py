@@ -11,4 +11,5 @@ from pipeline.stages import make_figures
 with log_to(snakemake.log[0]):  # noqa: F821
     out = snakemake.output  # noqa: F821
     make_figures(snakemake.config, snakemake.input.plans, snakemake.input.verify,  # noqa: F821
-                 out.maps, out.sequence, out.verification, out.table)
+                 {key: getattr(out, key) for key in
+                  ("maps", "speeds", "sequence", "sequence_dynamic", "verification", "table")})

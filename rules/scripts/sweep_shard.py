@@ -10,7 +10,7 @@ from pipeline.sweep import find_job, write_shard
 
 w = snakemake.wildcards  # noqa: F821 (injected by Snakemake)
 with log_to(snakemake.log[0]):  # noqa: F821
-    job = find_job(snakemake.config, w.family, w.part, w.model, float(w.mu))  # noqa: F821
+    job = find_job(snakemake.config, w.family, w.part, w.model, w.tag)  # noqa: F821
     path = write_shard(snakemake.config, job, out=snakemake.output.shard,  # noqa: F821
                        threads=snakemake.threads)  # noqa: F821
     print(f"wrote {path}")

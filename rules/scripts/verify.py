@@ -1,4 +1,4 @@
-"""Snakemake script: replay the best plan of one part with perturbed full rollouts."""
+"""Snakemake script: replay the best plans of one part with perturbed full rollouts."""
 import sys
 from pathlib import Path
 
@@ -11,5 +11,6 @@ from pipeline.stages import read_json, verify_part, write_json
 with log_to(snakemake.log[0]):  # noqa: F821
     result = verify_part(read_json(snakemake.input.plan), snakemake.config)  # noqa: F821
     write_json(result, snakemake.output.verify)  # noqa: F821
-    for row in result["rows"]:
-        print(row)
+    for check in result["checks"]:
+        for row in check["rows"]:
+            print(check["kind"], check["plan"], row)
