@@ -46,6 +46,18 @@ def shard_bands(shard, threshold_T, factor_c) -> dict:
 # ---------------------------------------------------------------------- plan
 
 
+def config_part_id(config: dict, name: str) -> str:
+    """The id of the config's part called ``name`` (the catalog may also hold
+    older outlines under the same name), or ``name`` itself if the config
+    has no such part."""
+    from .families import family_parts
+    for family, spec in config.get("families", {}).items():
+        for part in family_parts(family, spec):
+            if name in (part.name, part.id):
+                return part.id
+    return name
+
+
 def catalog_part(cat: Catalog, name: str) -> Part:
     e = cat._entries_for(name)[0]
     return Part.from_vertices(e["part_vertices"], name=e["part_name"])
@@ -55,6 +67,7 @@ def build_planner(cat: Catalog, name: str, config: dict):
     """The planner of one catalog part: static maps at the planner's mu_c, plus
     the maps of every dynamic speed the config allows (``planner.dynamic``)."""
     pc, bc = config["planner"], config["bands"]
+    name = config_part_id(config, name)
     part = catalog_part(cat, name)
     ds = cat.query(name, model=pc["model"], mu_c=pc["mu_c"])
     selection = ds.attrs["selection"]
@@ -181,12 +194,12 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
     verifications = {}
     for k, (plan_path, verify_path) in enumerate(zip(plan_paths, verify_paths)):
         res = read_json(plan_path)
-        name = res["part"]["name"]
-        maps = {model: cat.query(name, model=model, mu_c=res["mu_c"]).isel(mu_c=0).load()
+        name, part_id = res["part"]["name"], res["part"]["id"]
+        maps = {model: cat.query(part_id, model=model, mu_c=res["mu_c"]).isel(mu_c=0).load()
                 for model in config["sweep"]["models"]}
         plot_band_maps(maps, fc["d"], bc["threshold_T"], bc["factor_c"],
                        f"{name}: configuration maps, mu_c = {res['mu_c']:g} (rows: models)", out["maps"][k])
-        speeds = {f"v_pin/v_b = {v:+g}": cat.query(name, model=res["model"], mu_c=res["mu_c"], v_pin=v)
+        speeds = {f"v_pin/v_b = {v:+g}": cat.query(part_id, model=res["model"], mu_c=res["mu_c"], v_pin=v)
                   .isel(mu_c=0).load() for v in sorted(config["sweep"]["v_pin"])}
         plot_band_maps(speeds, fc["d"], bc["threshold_T"], bc["factor_c"],
                        f"{name}: {res['model']} maps by pin speed, mu_c = {res['mu_c']:g} "
