@@ -16,6 +16,7 @@ different pin path and different integration steps.
 """
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -152,3 +153,39 @@ def test_dynamic_pins_bring_default_triangles_to_one_orientation(default_planner
                       settings=dict(cfg["verify"], trials=30), speeds=planner.speeds)
     for row in res["rows"]:
         assert row["trials"] == 30 and row["successes"] >= 28, row
+
+
+# ------------------------------------------------------------------ command line
+
+def test_cli_plan_with_a_moving_pin_stores_its_maps(tmp_path, capsys):
+    from pipeline.catalog import Catalog
+    from pipeline.cli import main
+    cat = tmp_path / "cat"
+    base = ["plan", "--vertices", "0,0 40,0 40,20 0,20", "--name", "rect", "--catalog", str(cat),
+            "--depth", "1", "--pins=-5,5,15,25,35"]
+    assert main(base + ["--speeds", "-1.5", "--dynamic-depth", "1", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["pin_speeds"] and set(res["pin_speeds"].values()) == {-1.5}
+    assert all(label.endswith("v-1.5") for label in res["pin_speeds"])
+    speeds = {e["v_pin"] for e in Catalog.open(cat).entries}
+    assert speeds == {0.0, -1.5}  # the moving pin's maps were computed and indexed
+    assert main(["catalog", "query", "--catalog", str(cat), "--part", "rect", "--mu-c", "0.15",
+                 "--d", "0.3", "--theta-i", "0", "--v-pin", "-1.5", "--json"]) == 0
+    q = json.loads(capsys.readouterr().out)
+    assert q["v_pin"] == -1.5 and len(q["rows"]) == 1
+    assert main(["catalog", "query", "--catalog", str(cat), "--part", "rect", "--v-pin", "3"]) == 2
+    assert "no minpower maps at v_pin/v_b = 3" in capsys.readouterr().err
+    assert main(base + ["--speeds", "0"]) == 2
+    assert main(base + ["--dynamic-depth", "-1"]) == 2
+
+
+def test_config_speeds_must_be_swept():
+    from pipeline.config import validate_config
+    from pipeline.errors import PinfeedError
+    cfg = _default_config()
+    cfg["planner"]["dynamic"]["speeds"] = [-2.0, 3.0]
+    with pytest.raises(PinfeedError, match="planner/dynamic/speeds: 3 must be non-zero and listed in sweep/v_pin"):
+        validate_config(cfg)
+    cfg["planner"]["dynamic"]["speeds"] = [0.0]
+    with pytest.raises(PinfeedError, match="planner/dynamic/speeds: 0 must be non-zero"):
+        validate_config(cfg)
