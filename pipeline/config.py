@@ -2,7 +2,8 @@
 
 Validation is the JSON schema in ``config/schema.yaml`` (a description for
 every key) with its defaults filled in, then the checks a schema cannot
-express: every part is a simple polygon, 360 is a multiple of theta_step.
+express: every part is a simple polygon, 360 is a multiple of theta_step,
+planned parts exist, sensing parts are planned (default: the planned parts).
 The Snakefile and the CLI both call :func:`load_config`, so a bad config
 fails with one clear message before any work starts.
 """
@@ -69,6 +70,13 @@ def validate_config(config: dict) -> dict:
     if unknown:
         raise PinfeedError(f"config error at planner/parts: {', '.join(unknown)} not in any family; "
                            f"known parts: {', '.join(sorted(names))}")
+    sensing = cfg["sensing"]
+    sensing.setdefault("parts", list(cfg["planner"]["parts"]))
+    unplanned = [p for p in sensing["parts"] if p not in cfg["planner"]["parts"]]
+    if unplanned:
+        raise PinfeedError(f"config error at sensing/parts: {', '.join(unplanned)} not in planner/parts "
+                           f"(the sensor plans on the planner's maps); planned parts: "
+                           f"{', '.join(cfg['planner']['parts']) or 'none'}")
     return cfg
 
 

@@ -112,9 +112,17 @@ def smooth(values, window: int) -> np.ndarray:
     return uniform_filter1d(values, size=min(window, values.size), mode="nearest")
 
 
+def effective_window(n: int, sensor: Sensor) -> int:
+    """The moving-average window for a profile of ``n`` samples: ``sensor.window``,
+    but never wider than one region (``n // regions``), so that a short contact
+    is not smoothed across the regions its sign matrix resolves."""
+    return max(1, min(sensor.window, n // max(1, sensor.regions)))
+
+
 def processed(profile: Profile, sensor: Sensor) -> dict:
-    """Smoothed forces and their time gradients."""
-    fx, fy = smooth(profile.fx, sensor.window), smooth(profile.fy, sensor.window)
+    """Smoothed forces (window: :func:`effective_window`) and their time gradients."""
+    w = effective_window(np.asarray(profile.t).size, sensor)
+    fx, fy = smooth(profile.fx, w), smooth(profile.fy, w)
     t = np.asarray(profile.t, float)
     gx = np.gradient(fx, t) if fx.size > 1 else np.zeros_like(fx)
     gy = np.gradient(fy, t) if fy.size > 1 else np.zeros_like(fy)
