@@ -488,7 +488,7 @@ def test_ellipsoid_twist_along_limit_surface_normal(case):
     assert cos == pytest.approx(1.0, abs=1e-12)
     # The wrench lies on the limit surface H = 1 (f_max = 1).
     assert f @ f + mom ** 2 / m_max ** 2 == pytest.approx(1.0, rel=1e-10)
-    uc = assert_contact_consistent(xi, f, c, n, vp, mu, mode)
+    assert_contact_consistent(xi, f, c, n, vp, mu, mode)
 
 
 # --------------------------------------------------------------------------- invariances

@@ -15,7 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
-from conftest import QUAD, RECTANGLE, TRIANGLE, V_NOTCH, circular_diff
+from conftest import QUAD, TRIANGLE, circular_diff
 from pipeline.errors import PinfeedError
 from pipeline.parts import Part, PolygonError, parse_vertices
 from reference import centroid
