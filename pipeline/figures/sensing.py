@@ -80,10 +80,10 @@ def plot_scores(table: dict, title, out) -> Path:
     ax.set_xlabel("measured (synthetic) initial state", fontsize=8)
     ax.set_ylabel("simulated initial state", fontsize=8)
     fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04, label="mean score (equal elements)")
-    groups = " | ".join(", ".join(g) for g in table["groups"])
+    groups = " ".join("{" + ", ".join(g) + "}" for g in table["groups"])
     ax.set_title(f"{title}\naccuracy {100 * table['accuracy']:.0f} %, wrong "
                  f"{100 * table['wrong']:.0f} % ({table['trials']} trials per state)\n"
-                 f"groups: {groups}", fontsize=8)
+                 f"states the sensor cannot tell apart: {groups}", fontsize=8)
     fig.tight_layout()
     return save_figure(fig, out)
 
