@@ -423,3 +423,11 @@ def test_cli_module_entry_point():
     run = subprocess.run([sys.executable, "-m", "pipeline.cli", "sense", "classify", "--help"], cwd=root,
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and "time (s), F_x, F_y" in run.stdout
+
+
+def test_sensing_figures_are_written(sym_catalog, tmp_path):
+    from pipeline.figures.sensing import sensing_figures
+    _, _, res = sym_catalog
+    prof, scores = sensing_figures(res, tmp_path / "profiles.png", tmp_path / "scores.png")
+    for path in (prof, scores):
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
