@@ -29,6 +29,7 @@ include: "rules/common.smk"
 include: "rules/sweep.smk"
 include: "rules/catalog.smk"
 include: "rules/plan.smk"
+include: "rules/sense.smk"
 include: "rules/report.smk"
 
 

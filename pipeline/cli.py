@@ -306,6 +306,108 @@ def cmd_plan(args):
                     print(f"    {label}: {steps}")
 
 
+PROFILE_FORMAT = """\
+A measured profile is a CSV file with three columns: time (s), F_x, F_y (the
+force on the pin along and across the belt, any one force unit: the sign
+matrix does not depend on it). A header row is optional (a first row that is
+not numbers is skipped); further columns are ignored; time must increase.
+The rows should cover the contact, from first touch to separation. The
+profile is resampled to the sensor rate of the stored sensor plan (or of the
+config) before it is smoothed."""
+
+
+def cmd_sense_classify(args):
+    from pathlib import Path
+
+    from .catalog import Catalog
+    from .config import load_config
+    from .parts import Part
+    from .sensing import (Sensor, classify, read_profile_csv, reference_profiles, resample,
+                          sign_matrix)
+    from .sensor_plan import describe_sets, final_for_verdict, stored_sensor_plan
+    from .stages import read_json
+    config = load_config(args.config)
+    root = Path(args.catalog or config["catalog_dir"])
+    cat = Catalog.open(root)
+    entry = cat._entries_for(args.part)[0]  # unknown part: says how to list the parts
+    part = Part.from_vertices(entry["part_vertices"], name=entry["part_name"])
+    name = part.name
+    stored = stored_sensor_plan(root, name)
+    if stored is not None and not stored.get("found"):
+        stored = None
+    plan_path = root / "plans" / f"{name}.json"
+    plan = read_json(plan_path) if plan_path.is_file() else None
+    first_pin = None
+    if args.y_pin is not None:
+        if not math.isfinite(args.y_pin):
+            raise PinfeedError(f"--y-pin must be a finite height in mm, got {args.y_pin}")
+        y_pin, source = float(args.y_pin), "--y-pin"
+    elif stored is not None:
+        first_pin, y_pin = stored["first_pin"], float(stored["y_pin"])
+        source = f"sensor plan {root / 'sensing' / (name + '.json')}"
+    elif plan is not None and plan["plans"]:
+        first_pin = plan["plans"][0]["pins"][0]
+        y_pin, source = float(plan["pins"][first_pin]), f"first pin of the best plan {plan_path}"
+    else:
+        raise PinfeedError(f"no stored sensor plan or plan for {name} under {root}; run the workflow "
+                           f"('make run') or give the sensor pin's height with --y-pin MM")
+    if stored is not None:
+        sensor = Sensor.from_config(stored["sensor"])
+        mu_c, model = float(stored["mu_c"]), stored["model"]
+    else:
+        sensor = Sensor.from_config(config["sensing"]["sensor"])
+        mu_c = float(plan["mu_c"]) if plan else float(config["planner"]["mu_c"])
+        model = plan["model"] if plan else config["planner"]["model"]
+    pin_radius = float(entry["pin_radius"])
+    measured = resample(read_profile_csv(args.profile), sensor.rate_hz)
+    if measured.t.size < sensor.regions:
+        raise PinfeedError(f"{args.profile}: the profile spans {measured.t[-1]:.3g} s, fewer than "
+                           f"{sensor.regions} samples at {sensor.rate_hz:g} Hz; give the whole contact")
+    states = {f"state {k}": {"theta": float(th), "y_c": float(y)}
+              for k, (th, y) in enumerate(part.stable_states(), start=1)}
+    refs = {k: sign_matrix(p, sensor) for k, p in
+            reference_profiles(part, states, y_pin, mu_c, pin_radius, model, sensor).items()}
+    signs = sign_matrix(measured, sensor)
+    verdict = classify(signs, refs, sensor.margin)
+    on_plan = stored is not None and abs(y_pin - float(stored["y_pin"])) < 1e-9
+    final = final_for_verdict(stored, verdict["candidates"]) if on_plan else None
+    result = {"part": name, "part_id": part.id, "profile": str(args.profile), "y_pin": y_pin,
+              "y_pin_source": source, "first_pin": first_pin if args.y_pin is None else None,
+              "model": model, "mu_c": mu_c, "pin_radius": pin_radius, "sensor": sensor.to_dict(),
+              "samples": int(measured.t.size), "duration": float(measured.t[-1]),
+              "elements": int(signs.size), "margin": sensor.margin, "scores": verdict["scores"],
+              "best": verdict["best"], "candidates": verdict["candidates"],
+              "decided": verdict["decided"], "measured_signs": signs.tolist(),
+              "sensor_plan": stored["plan"]["pins"] if on_plan else None,
+              "final_sets": final, "final_known": (len(final) == 1) if final is not None else None}
+    if args.json:
+        json.dump(result, sys.stdout)
+        sys.stdout.write("\n")
+        return
+    print(f"part {part.id}: sensor pin at y = {y_pin:g} mm ({source}); model {model}, "
+          f"mu_c {mu_c:g}, pin radius {pin_radius:g} mm")
+    print(f"profile {args.profile}: {measured.t.size} samples over {measured.t[-1]:.3f} s at "
+          f"{sensor.rate_hz:g} Hz")
+    if verdict["decided"]:
+        print(f"verdict: {verdict['best']} (decided: every other state scores at least "
+              f"{sensor.margin} elements lower)")
+    else:
+        print(f"verdict: undecided between {', '.join(verdict['candidates'])} (scores within "
+              f"{sensor.margin} elements of the best)")
+    print(f"scores (equal elements of {signs.size}):")
+    for k, v in verdict["scores"].items():
+        print(f"  {k}: {v}" + ("  <- best" if k == verdict["best"] else ""))
+    if final is None and stored is None:
+        print("final orientation: unknown (no sensor plan stored; the workflow's sense stage makes one)")
+    elif final is None:
+        print(f"final orientation: unknown (the stored sensor plan reads pin {stored['first_pin']} "
+              f"at y = {stored['y_pin']:g} mm, not this one)")
+    elif len(final) == 1:
+        print(f"final orientation: {describe_sets(final)} (sensor plan {' -> '.join(stored['plan']['pins'])})")
+    else:
+        print(f"final orientation: one of {describe_sets(final)} (the verdict does not decide it)")
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with the project's error contract: one line, exit status 2."""
 
@@ -315,7 +417,7 @@ class _Parser(argparse.ArgumentParser):
 
 # Options whose values may start with '-' (negative numbers, ranges such as
 # -0.9:0.9:0.1) that argparse would otherwise take for an option.
-_SIGNED_VALUE_OPTIONS = {"--d", "--theta-i", "--pins", "--v-pin", "--speeds"}
+_SIGNED_VALUE_OPTIONS = {"--d", "--theta-i", "--pins", "--v-pin", "--speeds", "--y-pin"}
 
 
 def _join_signed_values(argv):
@@ -417,6 +519,24 @@ def build_parser() -> argparse.ArgumentParser:
             q.add_argument("--json", action="store_true")
         else:
             q.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
+
+    sense = sub.add_parser("sense", help="force/torque sensor on the first pin: classify a measured profile")
+    ssub = sense.add_subparsers(dest="sense_command", required=True)
+    q = ssub.add_parser("classify", help="which initial state a measured force profile comes from",
+                        description="Score a measured force profile against the simulated profile\n"
+                        "of every initial state of a part at the sensor pin (the paper's sign\n"
+                        "matrix) and print the verdict, the scores and, if a sensor plan is\n"
+                        "stored, the final orientation that results.", epilog=PROFILE_FORMAT,
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
+    q.add_argument("--part", required=True, help="part name or id in the catalog")
+    q.add_argument("--profile", required=True, help="measured profile: CSV time (s), F_x, F_y (see below)")
+    q.add_argument("--y-pin", dest="y_pin", type=float, default=None,
+                   help="height of the sensor pin, mm (default: the stored sensor plan's first pin, "
+                   "else the stored plan's)")
+    q.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    q.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    q.add_argument("--json", action="store_true", help="print JSON instead of text")
+    q.set_defaults(func=cmd_sense_classify)
 
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")

@@ -2,7 +2,8 @@
 
 Validation is the JSON schema in ``config/schema.yaml`` (a description for
 every key) with its defaults filled in, then the checks a schema cannot
-express: every part is a simple polygon, 360 is a multiple of theta_step.
+express: every part is a simple polygon, 360 is a multiple of theta_step,
+planned parts exist, sensing parts are planned (default: the planned parts).
 The Snakefile and the CLI both call :func:`load_config`, so a bad config
 fails with one clear message before any work starts.
 """
@@ -75,6 +76,13 @@ def validate_config(config: dict) -> dict:
         raise PinfeedError(f"config error at planner/dynamic/speeds: {', '.join(f'{v:g}' for v in bad)} "
                            f"must be non-zero and listed in sweep/v_pin "
                            f"({', '.join(f'{v:g}' for v in cfg['sweep']['v_pin'])})")
+    sensing = cfg["sensing"]
+    sensing.setdefault("parts", list(cfg["planner"]["parts"]))
+    unplanned = [p for p in sensing["parts"] if p not in cfg["planner"]["parts"]]
+    if unplanned:
+        raise PinfeedError(f"config error at sensing/parts: {', '.join(unplanned)} not in planner/parts "
+                           f"(the sensor plans on the planner's maps); planned parts: "
+                           f"{', '.join(cfg['planner']['parts']) or 'none'}")
     return cfg
 
 

@@ -16,9 +16,11 @@ def _rel(path, base):
     return html.escape(os.path.relpath(path, base))
 
 
-def write_report(config, plans: dict, verifications: dict, figures: dict, out) -> Path:
-    """``plans``/``verifications``: part -> result dict; ``figures``: part -> {kind: path}
-    plus key ``"verification"``. Writes ``out`` (HTML)."""
+def write_report(config, plans: dict, verifications: dict, figures: dict, out,
+                 sensing: dict | None = None) -> Path:
+    """``plans``/``verifications``/``sensing``: part -> result dict; ``figures``: part ->
+    {kind: path} plus key ``"verification"``. Writes ``out`` (HTML)."""
+    sensing = sensing or {}
     out = Path(out)
     base = out.parent
     p = ['<!doctype html><html><head><meta charset="utf-8"><title>pinfeed results</title>',
@@ -68,5 +70,45 @@ def write_report(config, plans: dict, verifications: dict, figures: dict, out) -
             p.append("<table><tr>" + "".join(f"<th>{h}</th>" for h in HEADER) + "</tr>")
             p += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows]
             p.append("</table>")
+        if name in sensing:
+            p += _sensing_section(sensing[name], figs, base)
     p.append("</body></html>")
     return write_text_atomic("\n".join(p), out)
+
+
+def _sets(sets) -> str:
+    return ", ".join(f"[{s['start']:.0f}, {s['start'] + s['width']:.0f}]" for s in sets)
+
+
+def _sensing_section(res: dict, figs: dict, base) -> list[str]:
+    """Force/torque sensor on the first pin: the verdict table and the two figures."""
+    p = ["<h3>Force/torque sensor on the first pin</h3>"]
+    if not res.get("found"):
+        return p + ["<p>No allowed plan within the depth: no sensor plan.</p>"]
+    t = res["score_table"]
+    known = ("a known final orientation for every initial state" if res["known_for_every_state"]
+             else f"up to {res['worst_sets']} final orientation sets for one verdict")
+    p.append(f"<p>Sensor on {html.escape(res['first_pin'])} (y = {res['y_pin']:g} mm), plan "
+             f"{html.escape(' → '.join(res['plan']['pins']))}: {known}. Classification accuracy "
+             f"{100 * t['accuracy']:.0f} % (wrong {100 * t['wrong']:.0f} %) over {t['trials']} synthetic "
+             f"measurements per state; fixed pins alone: {res['static_best']['n_final_sets']} sets "
+             f"({html.escape(' → '.join(res['static_best']['pins']))}).</p>")
+    p.append("<table><tr><th>sensor verdict (states it cannot tell apart)</th>"
+             "<th>final orientation set(s) (deg)</th><th>known</th></tr>")
+    for g in res["groups"]:
+        p.append(f"<tr><td>{html.escape(', '.join(g['states']))}</td><td>{_sets(g['final_sets'])}</td>"
+                 f"<td>{'yes' if g['known'] else 'no'}</td></tr>")
+    p.append("</table>")
+    if "verification" in res:
+        p.append("<p>End to end, perturbed full rollouts with the sensor reading the first pin "
+                 "(trials counted by what the verdict said about the final orientation):</p>")
+        p.append("<table><tr><th>initial state</th><th>trials</th><th>one set named, right</th>"
+                 "<th>one set named, wrong</th><th>several sets named</th><th>jammed</th></tr>")
+        for lab, r in res["verification"]["rows"].items():
+            p.append(f"<tr><td>{html.escape(lab)}</td><td>{r['trials']}</td><td>{r['right']}</td>"
+                     f"<td>{r['wrong']}</td><td>{r['ambiguous']}</td><td>{r['jammed']}</td></tr>")
+        p.append("</table>")
+    for kind, alt in (("profiles", "force/torque profiles"), ("scores", "score table")):
+        if kind in figs:
+            p.append(f'<img src="{_rel(figs[kind], base)}" alt="{alt}">')
+    return p

@@ -238,7 +238,7 @@ def _placeholder(path, text):
     save_figure(fig, path, dpi=100)
 
 
-def make_report(config, plan_paths, verify_paths, out):
+def make_report(config, plan_paths, verify_paths, out, sensing_paths=()):
     from .report import write_report
     results = Path(config["results_dir"]) / "figures"
     plans, verifications, figures = {}, {}, {"verification": results / "verification.png"}
@@ -249,7 +249,14 @@ def make_report(config, plan_paths, verify_paths, out):
         verifications[name] = read_json(verify_path)
         figures[name] = {kind: results / f"{kind}_{name}.png"
                          for kind in ("maps", "speeds", "sequence", "sequence_dynamic")}
-    return write_report(config, plans, verifications, figures, out)
+    sensing = {}  # force/torque sensor on the first pin (rules/sense.smk)
+    for path in sensing_paths:
+        res = read_json(path)
+        name = res["part"]["name"]
+        sensing[name] = res
+        figures.setdefault(name, {}).update(profiles=results / f"profiles_{name}.png",
+                                            scores=results / f"scores_{name}.png")
+    return write_report(config, plans, verifications, figures, out, sensing=sensing)
 
 
 def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:

@@ -28,6 +28,10 @@ rule report:
         rules.figures.output,
         plans=rules.figures.input.plans,
         verify=rules.figures.input.verify,
+        # sensing (rules/sense.smk): results and figures of the sensed parts
+        sensing=expand(f"{CATALOG}/sensing/{{name}}.json", name=SENSED),
+        sensing_figures=expand(f"{RESULTS}/figures/{{kind}}_{{name}}.png",
+                               kind=("profiles", "scores"), name=SENSED),
     output:
         report=f"{RESULTS}/report.html",
     log:
