@@ -325,18 +325,21 @@ def cmd_sense_classify(args):
     from .sensing import (Sensor, classify, read_profile_csv, reference_profiles, resample,
                           sign_matrix)
     from .sensor_plan import describe_sets, final_for_verdict, stored_sensor_plan
-    from .stages import read_json
+    from .stages import config_part_id, read_json
     config = load_config(args.config)
     root = Path(args.catalog or config["catalog_dir"])
     cat = Catalog.open(root)
-    entry = cat._entries_for(args.part)[0]  # unknown part: says how to list the parts
+    # The config's outline wins over older ones stored under the same name.
+    entry = cat._entries_for(config_part_id(config, args.part))[0]  # unknown part: says how to list them
     part = Part.from_vertices(entry["part_vertices"], name=entry["part_name"])
     name = part.name
     stored = stored_sensor_plan(root, name)
-    if stored is not None and not stored.get("found"):
-        stored = None
+    if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
+        stored = None  # no sensor plan, or one for another outline of that name
     plan_path = root / "plans" / f"{name}.json"
     plan = read_json(plan_path) if plan_path.is_file() else None
+    if plan is not None and plan["part"].get("id", part.id) != part.id:
+        plan = None
     first_pin = None
     if args.y_pin is not None:
         if not math.isfinite(args.y_pin):
