@@ -281,8 +281,10 @@ def cmd_plan(args):
         sys.stdout.write("\n")
         return
     pc = config["planner"]
+    n_moving = len(result["pin_speeds"])
     print(f"part {part.id}: model {pc['model']}, {result['selection']}, depth {pc['depth']}, "
-          f"{len(result['pins'])} candidate pins, coverage {result['coverage']}")
+          f"{len(result['pins']) - n_moving} fixed + {n_moving} moving candidate pins, "
+          f"coverage {result['coverage']}")
     for label, s in result["initial_states"].items():
         print(f"  {label}: resting on the fence at theta = {s['theta']:.1f} deg, y_c = {s['y_c']:.2f} mm")
     if not result["plans"]:
@@ -316,6 +318,13 @@ profile is resampled to the sensor rate of the stored sensor plan (or of the
 config) before it is smoothed."""
 
 
+def _best_fixed_plan(plan_result: dict):
+    """The best plan of fixed pins only in a stored plan result (None if none)."""
+    if plan_result.get("best_static"):
+        return plan_result["best_static"]
+    return next((p for p in plan_result["plans"] if not p.get("n_dynamic_pins", 0)), None)
+
+
 def cmd_sense_classify(args):
     from pathlib import Path
 
@@ -330,7 +339,10 @@ def cmd_sense_classify(args):
     root = Path(args.catalog or config["catalog_dir"])
     cat = Catalog.open(root)
     # The config's outline wins over older ones stored under the same name.
-    entry = cat._entries_for(config_part_id(config, args.part))[0]  # unknown part: says how to list them
+    wanted = config_part_id(config, args.part)
+    if wanted != args.part and not any(e["part_id"] == wanted for e in cat.entries):
+        wanted = args.part  # the config's outline is not stored: use what the catalog has
+    entry = cat._entries_for(wanted)[0]  # unknown part: says how to list them
     part = Part.from_vertices(entry["part_vertices"], name=entry["part_name"])
     name = part.name
     stored = stored_sensor_plan(root, name)
@@ -348,9 +360,10 @@ def cmd_sense_classify(args):
     elif stored is not None:
         first_pin, y_pin = stored["first_pin"], float(stored["y_pin"])
         source = f"sensor plan {root / 'sensing' / (name + '.json')}"
-    elif plan is not None and plan["plans"]:
-        first_pin = plan["plans"][0]["pins"][0]
-        y_pin, source = float(plan["pins"][first_pin]), f"first pin of the best plan {plan_path}"
+    elif plan is not None and _best_fixed_plan(plan):
+        # The sensor sits on a fixed pin: the first pin of the best fixed-pin plan.
+        first_pin = _best_fixed_plan(plan)["pins"][0]
+        y_pin, source = float(plan["pins"][first_pin]), f"first pin of the best fixed-pin plan {plan_path}"
     else:
         raise PinfeedError(f"no stored sensor plan or plan for {name} under {root}; run the workflow "
                            f"('make run') or give the sensor pin's height with --y-pin MM")
@@ -362,9 +375,10 @@ def cmd_sense_classify(args):
         mu_c = float(plan["mu_c"]) if plan else float(config["planner"]["mu_c"])
         model = plan["model"] if plan else config["planner"]["model"]
     pin_radius = float(entry["pin_radius"])
-    measured = resample(read_profile_csv(args.profile), sensor.rate_hz)
+    raw = read_profile_csv(args.profile)
+    measured = resample(raw, sensor.rate_hz)
     if measured.t.size < sensor.regions:
-        raise PinfeedError(f"{args.profile}: the profile spans {measured.t[-1]:.3g} s, fewer than "
+        raise PinfeedError(f"{args.profile}: the profile spans {raw.t[-1] - raw.t[0]:.3g} s, fewer than "
                            f"{sensor.regions} samples at {sensor.rate_hz:g} Hz; give the whole contact")
     states = {f"state {k}": {"theta": float(th), "y_c": float(y)}
               for k, (th, y) in enumerate(part.stable_states(), start=1)}

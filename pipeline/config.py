@@ -70,6 +70,9 @@ def validate_config(config: dict) -> dict:
     if unknown:
         raise PinfeedError(f"config error at planner/parts: {', '.join(unknown)} not in any family; "
                            f"known parts: {', '.join(sorted(names))}")
+    if cfg["planner"]["parts"] and 0 not in cfg["sweep"]["v_pin"]:
+        raise PinfeedError("config error at sweep/v_pin: the planner needs static maps; add 0 to the "
+                           "speeds (or plan no parts)")
     speeds = cfg["planner"]["dynamic"]["speeds"]
     bad = [v for v in speeds if v == 0 or v not in cfg["sweep"]["v_pin"]]
     if bad:

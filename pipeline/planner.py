@@ -146,9 +146,11 @@ class Planner:
 
     ``pins`` maps labels to heights (mm above the fence) of static pins.
     ``dynamic`` optionally adds moving pins: a dict ``label -> (y, v_pin)``
-    (``y`` the pin's height when the part's centroid reaches the pin's
-    station, ``v_pin`` the speed ratio v_pin / v_b) with ``dynamic_maps``
-    ``{v_pin: [MapData]}`` the maps stored at each speed.
+    (``y`` the pin's height when the part's centroid, had the part not been
+    pushed, would pass the pin's station; ``v_pin`` the speed ratio
+    v_pin / v_b) with ``dynamic_maps`` ``{v_pin: [MapData]}`` the maps stored
+    at each speed. ``d_min``/``d_max`` and the margin apply to the offset of
+    the pin's path from the centroid, ``|d| / sqrt(1 + v^2)`` for a moving pin.
     """
 
     def __init__(self, part: Part, maps: list[MapData], pins: dict, d_min: float, d_max: float,
@@ -222,15 +224,19 @@ class Planner:
 
     def _transition(self, state: State, label: str):
         a = self.part.a
-        y_pin = self.pins[label]
+        y_pin, v_pin = self.pins[label], self.speeds[label]
         d_lo, d_hi = (y_pin - state.y_hi) / a, (y_pin - state.y_lo) / a
-        if d_lo < 0.0 < d_hi or min(abs(d_lo), abs(d_hi)) < self.d_min - 1e-12 \
-                or max(abs(d_lo), abs(d_hi)) > self.d_max + 1e-12:
+        # The limits apply to the offset of the pin's path from the centroid,
+        # perpendicular to the pin's motion relative to the belt (-1, v): for a
+        # moving pin that is d / sqrt(1 + v^2) (see tests/test_dynamic.py).
+        shrink = 1.0 / math.sqrt(1.0 + v_pin * v_pin)
+        near, far = shrink * min(abs(d_lo), abs(d_hi)), shrink * max(abs(d_lo), abs(d_hi))
+        if d_lo < 0.0 < d_hi or near < self.d_min - 1e-12 or far > self.d_max + 1e-12:
             return None
-        maps = self._maps_for(d_lo, d_hi, self.speeds[label])
+        maps = self._maps_for(d_lo, d_hi, v_pin)
         if maps is None:
             return None
-        margin = min(min(abs(d_lo), abs(d_hi)) - self.d_min, self.d_max - max(abs(d_lo), abs(d_hi)))
+        margin = min(near - self.d_min, self.d_max - far)
         hits = []  # (arc, com_min, com_max)
         for m in maps:
             step = float(np.median(np.diff(m.theta_i))) if m.theta_i.size > 1 else 360.0

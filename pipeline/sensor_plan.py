@@ -191,7 +191,7 @@ def sense_part(cat, name: str, config: dict, log=print) -> dict:
     from .provenance import provenance_attrs
     from .stages import build_planner
     sc = config["sensing"]
-    part, planner, mu_used, selection = build_planner(cat, name, config)
+    part, planner, mu_used, selection = build_planner(cat, name, config, dynamic=False)
     sensor = Sensor.from_config(sc["sensor"])
     res = plan_with_sensor(planner, config["planner"]["depth"], mu_used, config["sweep"]["pin_radius"],
                            config["planner"]["model"], sensor, trials=sc["trials"],

@@ -63,9 +63,10 @@ def catalog_part(cat: Catalog, name: str) -> Part:
     return Part.from_vertices(e["part_vertices"], name=e["part_name"])
 
 
-def build_planner(cat: Catalog, name: str, config: dict):
+def build_planner(cat: Catalog, name: str, config: dict, dynamic: bool = True):
     """The planner of one catalog part: static maps at the planner's mu_c, plus
-    the maps of every dynamic speed the config allows (``planner.dynamic``)."""
+    (``dynamic``) the maps of every moving-pin speed the config allows
+    (``planner.dynamic``)."""
     pc, bc = config["planner"], config["bands"]
     name = config_part_id(config, name)
     part = catalog_part(cat, name)
@@ -74,14 +75,18 @@ def build_planner(cat: Catalog, name: str, config: dict):
     mu_used = float(ds["mu_c"][0])
     maps = load_maps(ds.isel(mu_c=0).load(), bc["threshold_T"], bc["factor_c"])
     static = pins_from_config(pc["pins"])
-    speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])]
+    speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if dynamic else []
     dynamic_maps = {}
     for v in speeds:
-        dv = cat.query(name, model=pc["model"], mu_c=mu_used, v_pin=v).isel(mu_c=0).load()
+        dv = cat.query(name, model=pc["model"], mu_c=mu_used, v_pin=v)
+        if float(dv["mu_c"][0]) != mu_used:
+            raise PinfeedError(f"{name}: the maps at v_pin/v_b = {v:g} have no mu_c = {mu_used:g} (the "
+                               f"static maps' friction); add it to the sweep or re-run the workflow")
+        dv = dv.isel(mu_c=0).load()
         dynamic_maps[v] = load_maps(dv, bc["threshold_T"], bc["factor_c"])
-    dynamic = {dynamic_label(label, v): (y, v) for label, y in static.items() for v in speeds}
+    moving = {dynamic_label(label, v): (y, v) for label, y in static.items() for v in speeds}
     planner = Planner(part, maps, static, pc["d_min"], pc["d_max"],
-                      coverage=pc.get("coverage", "bracket"), dynamic=dynamic,
+                      coverage=pc.get("coverage", "bracket"), dynamic=moving,
                       dynamic_maps=dynamic_maps)
     return part, planner, mu_used, selection
 
@@ -218,8 +223,12 @@ def _sequence_figure(config, res, plan, what, path):
     from .figures.sequence import plot_sequence
     name = res["part"]["name"]
     if plan is None:
-        why = (f"no allowed plan within depth {res['depth']}" if not res["plans"] else
-               "no plan with dynamic pins beats the fixed pins (or none allowed)")
+        if not res["plans"]:
+            why = f"no allowed plan within depth {res['depth']}"
+        elif "fixed" in what:
+            why = "no allowed plan of fixed pins only"
+        else:
+            why = "no plan with dynamic pins beats the fixed pins (or none allowed)"
         _placeholder(path, f"{name}, {what}: {why}")
         return
     part = Part.from_vertices(res["part"]["vertices"], name=name)

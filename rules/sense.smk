@@ -10,7 +10,7 @@ rule sense:
     output:
         sensing=f"{CATALOG}/sensing/{{name}}.json",
     params:
-        settings={k: config[k] for k in ("sensing", "planner", "bands")},
+        settings={k: config[k] for k in ("sensing", "planner", "bands", "verify")},
     log:
         "logs/sense/{name}.log",
     conda:

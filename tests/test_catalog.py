@@ -113,6 +113,15 @@ def test_catalog_from_before_dynamic_pins_stays_readable(swept):
     assert not cat.problems and all(e["v_pin"] == 0.0 for e in cat.entries)
     q = cat.query("tri", model="minpower", mu_c=0.2, d=0.3).load()
     assert q.sizes["theta_i"] == 8 and "v_pin" not in q.attrs["selection"]
+    # An index written before v_pin existed (entries without the key) opens and serves.
+    index = root / "index.json"
+    data = json.loads(index.read_text())
+    for e in data["entries"]:
+        e.pop("v_pin")
+    index.write_text(json.dumps(data))
+    cat = Catalog.open(root)
+    assert not cat.problems and cat.query("tri", model="minpower", mu_c=0.2, v_pin=0.0).sizes["d"] == 2
+    assert [r["v_pin"] for r in cat.parts()] == [[0.0]] * 2
 
 
 def test_unknown_part_and_model_are_clear_errors(swept):

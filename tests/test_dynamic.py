@@ -74,6 +74,29 @@ def test_moving_pin_is_a_static_pin_in_a_rotated_frame(part, theta, d, mu_c, mod
     assert_maps_agree(moving, part, mu_c, model, R_PIN, moving.theta_f.values, None, got, v_pin=v)
 
 
+@pytest.mark.parametrize("vertices", [[(0, 0), (60, 0), (15, 35)], [(0, 0), (40, 0), (20, 60)],
+                                      [(0, 0), (40, 0), (40, 10), (10, 10), (10, 30), (0, 30)]])
+def test_moving_pin_displacement_is_the_rotated_static_one(vertices):
+    # The rotated static problem also gives the displacement: the moving pin's dy
+    # is the y part of the static displacement (x, y) turned back by -beta.
+    part = Part.from_vertices(vertices)
+    compared = 0
+    for theta_i in range(0, 360, 40):
+        for d, v in ((0.4, 1.0), (-0.5, -2.0), (0.3, 0.5), (-0.7, 1.5)):
+            beta = math.atan(v)
+            moving = simulate.rollout(part, theta_i, d, 0.15, R_PIN, v_pin=v)
+            static = simulate.rollout(part, theta_i + math.degrees(beta), d / math.sqrt(1 + v * v), 0.15,
+                                      R_PIN, trajectory=True)
+            if moving.status.item() != "ok" or static.status.item() != "ok":
+                continue
+            if abs((float(moving.theta_f) + math.degrees(beta) - float(static.theta_f) + 180) % 360 - 180) > 0.05:
+                continue  # at a band jump the two sides may legitimately differ
+            x, y = float(static.traj_x.values[-1]), float(static.traj_y.values[-1])
+            assert float(moving.dy) == pytest.approx(-math.sin(beta) * x + math.cos(beta) * y, abs=0.02)
+            compared += 1
+    assert compared >= 20
+
+
 def test_moving_pin_changes_the_outcome():
     """The speed is not ignored: the default asymmetric triangle ends elsewhere
     when the pin moves."""
@@ -189,3 +212,45 @@ def test_config_speeds_must_be_swept():
     cfg["planner"]["dynamic"]["speeds"] = [0.0]
     with pytest.raises(PinfeedError, match="planner/dynamic/speeds: 0 must be non-zero"):
         validate_config(cfg)
+    cfg["planner"]["dynamic"]["speeds"] = [-2.0]
+    cfg["sweep"]["v_pin"] = [-2.0]
+    with pytest.raises(PinfeedError, match="sweep/v_pin: the planner needs static maps; add 0"):
+        validate_config(cfg)
+
+
+# ------------------------------------------------------------------ workflow
+
+def test_workflow_plans_verifies_and_draws_moving_pins(tmp_path):
+    """The whole downstream chain on a small sweep with one moving-pin speed:
+    plan, verify (both plans), sensing, figures (maps by speed, both sequence
+    diagrams) and the report."""
+    from test_catalog import _snakemake
+    cfg = {
+        "catalog_dir": "cat", "results_dir": "res",
+        "families": {"fam": {"parts": [{"name": "tri", "vertices": [[0, 0], [60, 0], [15, 35]]}]}},
+        "sweep": {"models": ["ellipsoid"], "mu_c": [0.2], "v_pin": [0.0, -1.5],
+                  "d": [-0.8, -0.6, -0.4, -0.2, 0.2, 0.4, 0.6, 0.8], "theta_step": 10, "pin_radius": 3.0},
+        "planner": {"parts": ["tri"], "model": "ellipsoid", "mu_c": 0.2, "depth": 1,
+                    "pins": [-10, -5, 0, 5, 10, 15, 20, 25, 30, 35, 40],
+                    "dynamic": {"speeds": [-1.5], "depth": 1}},
+        "verify": {"trials": 3}, "sensing": {"trials": 3}, "figures": {"d": [0.4]},
+    }
+    (tmp_path / "cfg.yaml").write_text(yaml.safe_dump(cfg))
+    run = _snakemake(tmp_path, "--configfile", str(tmp_path / "cfg.yaml"))
+    assert run.returncode == 0, run.stderr[-3000:]
+    plan = json.loads((tmp_path / "cat" / "plans" / "tri.json").read_text())
+    assert plan["pin_speeds"] == {f"P{k}v-1.5": -1.5 for k in range(1, 12)}
+    assert plan["best_static"]["n_dynamic_pins"] == 0
+    for p in plan["plans"]:  # what each pin adds, and moving pins only at the end
+        assert len(p["sets_after_each_pin"]) == len(p["pins"]) and p["sets_after_each_pin"][-1] == p["n_final_sets"]
+        kinds = [q in plan["pin_speeds"] for q in p["pins"]]
+        assert kinds == sorted(kinds) and sum(kinds) == p["n_dynamic_pins"]
+    checks = json.loads((tmp_path / "cat" / "verify" / "tri.json").read_text())["checks"]
+    want = ["fixed pins"] + (["with dynamic pins"] if plan["plans"][0]["n_dynamic_pins"] else [])
+    assert [c["kind"] for c in checks] == want
+    assert all(r["trials"] == 3 for c in checks for r in c["rows"])
+    figures = tmp_path / "res" / "figures"
+    for kind in ("maps", "speeds", "sequence", "sequence_dynamic", "profiles", "scores"):
+        assert (figures / f"{kind}_tri.png").stat().st_size > 1000, kind
+    page = (tmp_path / "res" / "report.html").read_text()
+    assert "speeds_tri.png" in page and "sequence_dynamic_tri.png" in page and "sets after each pin" in page

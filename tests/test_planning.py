@@ -1,5 +1,6 @@
 """Bands, the fixed-pins planner and verification (issue: bands, planner, verification)."""
 import json
+import math
 
 import numpy as np
 import pytest
@@ -8,6 +9,7 @@ import xarray as xr
 from kernels.rollout import JAMMED, MISS, OK
 from pipeline import simulate
 from pipeline.bands import circular_mean_std, extract_bands, in_arc
+from pipeline.errors import PinfeedError
 from pipeline.parts import Part
 from pipeline.planner import Planner, State, load_maps, merge_arcs
 from pipeline.verify import verify_plan
@@ -232,3 +234,25 @@ def test_cli_plan_for_new_outline(tmp_path, capsys):
     from pipeline.catalog import Catalog
     assert any(e["part_name"] == "rect" for e in Catalog.open(tmp_path / "cat").entries)
     assert main(["plan", "--catalog", str(tmp_path / "cat"), "--part", "nope"]) == 2
+
+
+def test_moving_pin_limits_apply_to_the_offset_of_its_path():
+    # Same maps for a static pin and one moving at 2 v_b: every orientation goes to
+    # 45 deg. At station offset d = 0.2 the moving pin's path passes the centroid at
+    # 0.2 / sqrt(5) = 0.089 < d_min (metastable: forbidden); at d = 0.5 it is 0.224,
+    # allowed, with that margin; a plan may then end with it after static pins.
+    def rule(th, d):
+        return 45.0, 0.0, OK
+    maps = load_maps(_synthetic_maps(rule), 5.0, 2.0)
+    a = RECT.a
+    dynamic = {"near": (20 + 0.2 * a, 2.0), "far": (20 + 0.5 * a, 2.0)}
+    pl = Planner(RECT, maps, {"static": 20 + 0.2 * a}, 0.1, 0.9, dynamic=dynamic,
+                 dynamic_maps={2.0: maps})
+    state = State((90.0, 0.0), 20.0, 20.0)
+    assert pl.transition(state, "static") is not None
+    assert pl.transition(state, "near") is None
+    children, margin = pl.transition(state, "far")
+    assert margin == pytest.approx(0.5 / math.sqrt(5.0) - 0.1, abs=1e-12)
+    assert children[0].history[-1].v_pin == 2.0
+    with pytest.raises(PinfeedError, match="no maps are stored at that speed"):
+        Planner(RECT, maps, {}, 0.1, 0.9, dynamic={"x": (10.0, -1.0)}, dynamic_maps={2.0: maps})

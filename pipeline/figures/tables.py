@@ -9,19 +9,19 @@ from . import save_figure
 
 
 def verification_rows(results: dict) -> list[list[str]]:
-    """Rows (part, pins, plan, state, trials, successes, failures, reasons) from
+    """Rows (part, plan, kind of pins, state, trials, successes, failures, reasons) from
     verify results by part (each with its ``checks``)."""
     rows = []
     for part, res in results.items():
         for check in res["checks"]:
             for r in check["rows"]:
                 reasons = "; ".join(f"{k}: {v}" for k, v in sorted(r["reasons"].items())) or "n/a"
-                rows.append([part, check["kind"], " ".join(check["plan"]), r["state"], str(r["trials"]),
+                rows.append([part, " ".join(check["plan"]), check["kind"], r["state"], str(r["trials"]),
                              str(r["successes"]), str(r["failures"]), reasons])
     return rows
 
 
-HEADER = ["part", "pins", "plan", "initial state", "trials", "successes", "failures", "reason"]
+HEADER = ["part", "plan", "pins", "initial state", "trials", "successes", "failures", "reason"]
 
 
 def markdown_table(rows, header=HEADER) -> str:
