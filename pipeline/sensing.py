@@ -52,6 +52,7 @@ from scipy.ndimage import uniform_filter1d
 
 from .errors import PinfeedError
 from .parts import Part
+from .verify import PERTURB_DEFAULTS  # one set of perturbation sizes for every check
 
 
 @dataclass
@@ -203,7 +204,6 @@ def reference_profiles(part, states: dict, y_pin, mu_c, pin_radius, model, senso
     return out
 
 
-PERTURB_DEFAULTS = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 
 
 def synthetic_measurement(part, state: dict, y_pin, mu_c, pin_radius, model, sensor: Sensor,

@@ -146,7 +146,7 @@ def verify_sensor_plan(part, result: dict, mu_c: float, pin_radius: float, model
 
     from .sensing import classify, measure, profile_from_rollout, sign_matrix
     from .simulate import rollout
-    from .verify import DEFAULTS
+    from .verify import DEFAULTS, perturbed_inputs
     cfg = dict(DEFAULTS, **(settings or {}))
     rng = np.random.default_rng(cfg["seed"])
     refs = {k: np.asarray(v) for k, v in result["score_table"]["reference_signs"].items()}
@@ -155,10 +155,8 @@ def verify_sensor_plan(part, result: dict, mu_c: float, pin_radius: float, model
     for label, st in result["initial_states"].items():
         row = {"trials": 0, "right": 0, "wrong": 0, "ambiguous": 0, "jammed": 0}
         for _ in range(int(cfg["trials"])):
-            theta = st["theta"] + rng.normal(0.0, cfg["theta_sigma"])
-            y_c = st["y_c"] + rng.uniform(-cfg["y_halfwidth"], cfg["y_halfwidth"])
-            mu = max(0.0, mu_c + rng.normal(0.0, cfg["mu_sigma"]))
-            offsets = rng.uniform(-cfg["pin_halfwidth"], cfg["pin_halfwidth"], len(plan_pins))
+            theta, y_c, mu, offsets = perturbed_inputs(st["theta"], st["y_c"], mu_c, len(plan_pins),
+                                                       cfg, rng)
             row["trials"] += 1
             claimed, jammed = None, False
             for k, (pin, off) in enumerate(zip(plan_pins, offsets)):

@@ -22,8 +22,17 @@ from .bands import in_arc
 from .parts import Part
 from .planner import merge_arcs
 
-DEFAULTS = {"trials": 30, "theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02,
-            "pin_halfwidth": 0.3, "seed": 1}
+PERTURB_DEFAULTS = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
+DEFAULTS = {"trials": 30, **PERTURB_DEFAULTS, "seed": 1}
+
+
+def perturbed_inputs(theta, y_c, mu_c, n_pins, cfg, rng):
+    """One trial's inputs: theta_i (normal), y_c (uniform), mu_c (normal, clipped
+    at 0) and an offset for each of ``n_pins`` pins (uniform), sizes from ``cfg``."""
+    return (theta + rng.normal(0.0, cfg["theta_sigma"]),
+            y_c + rng.uniform(-cfg["y_halfwidth"], cfg["y_halfwidth"]),
+            max(0.0, mu_c + rng.normal(0.0, cfg["mu_sigma"])),
+            rng.uniform(-cfg["pin_halfwidth"], cfg["pin_halfwidth"], n_pins))
 
 
 def _arc(step):
@@ -60,10 +69,8 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c: 
         finals = _predicted_sets(plan, label)
         counts = {"state": label, "trials": 0, "successes": 0, "failures": 0, "reasons": {}}
         for _ in range(int(cfg["trials"])):
-            theta = state.arc[0] + rng.normal(0.0, cfg["theta_sigma"])
-            y_c = state.y_lo + rng.uniform(-cfg["y_halfwidth"], cfg["y_halfwidth"])
-            mu = max(0.0, mu_c + rng.normal(0.0, cfg["mu_sigma"]))
-            offsets = rng.uniform(-cfg["pin_halfwidth"], cfg["pin_halfwidth"], len(plan["pins"]))
+            theta, y_c, mu, offsets = perturbed_inputs(state.arc[0], state.y_lo, mu_c,
+                                                       len(plan["pins"]), cfg, rng)
             reason, path = None, [(theta % 360.0, y_c)]
             for k, (pin, off) in enumerate(zip(plan["pins"], offsets)):
                 d = (pins[pin] + off - y_c) / part.a
