@@ -20,6 +20,12 @@ PAPER_D = [-0.9, -0.8, -0.7, -0.6, -0.5, -0.4, -0.3, -0.2, -0.1,
 DEFAULT_TRIANGLE = "0,0 60,0 15,35"
 
 
+def _print_json(obj, **kw):
+    """One JSON document on stdout, newline-terminated (the ``--json`` outputs)."""
+    json.dump(obj, sys.stdout, **kw)
+    sys.stdout.write("\n")
+
+
 def parse_values(text: str, what: str) -> np.ndarray:
     """``"a,b,c"`` or an inclusive range ``"start:stop:step"``."""
     try:
@@ -70,8 +76,7 @@ def cmd_rollout(args):
             row["force"] = np.column_stack([ds.force_s, ds.force_x, ds.force_y]).tolist()
         rows.append(row)
     if args.json:
-        json.dump(rows, sys.stdout)
-        sys.stdout.write("\n")
+        _print_json(rows)
         return
     print(f"part {part.id}  a = {part.a:.3f} mm  model {args.model}  mu_c = {args.mu_c:g}  "
           f"pin radius {args.pin_radius:g} mm  d = {args.d:+g}")
@@ -147,8 +152,7 @@ def cmd_catalog_index(args):
 def cmd_catalog_list(args):
     rows = _catalog(args).parts()
     if args.json:
-        json.dump(rows, sys.stdout, indent=1)
-        sys.stdout.write("\n")
+        _print_json(rows, indent=1)
         return
     print(f"{'family':<18} {'part':<28} {'models':<22} {'mu_c':<18} {'v_pin/v_b':<16} {'d x theta_i'}")
     for r in rows:
@@ -167,8 +171,7 @@ def cmd_catalog_show(args):
                            v_pin=e.get("v_pin", 0.0))
                       for e in sorted(entries, key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0)))]
     if args.json:
-        json.dump(info, sys.stdout, indent=1)
-        sys.stdout.write("\n")
+        _print_json(info, indent=1)
         return
     print(f"part {info['part_id']} (family {info['family']})")
     print("vertices (body frame, mm): " + " ".join(f"{x:.3f},{y:.3f}" for x, y in info["part_vertices"]))
@@ -202,9 +205,8 @@ def cmd_catalog_query(args):
                              "status": str(status_names(sub["status"].values[k])),
                              "theta_f": float(sub["theta_f"].values[k]), "dy": float(sub["dy"].values[k])})
     if args.json:
-        json.dump({"part": ds.attrs.get("part_id"), "model": args.model, "v_pin": args.v_pin,
-                   "selection": ds.attrs["selection"], "rows": rows}, sys.stdout)
-        sys.stdout.write("\n")
+        _print_json({"part": ds.attrs.get("part_id"), "model": args.model, "v_pin": args.v_pin,
+                   "selection": ds.attrs["selection"], "rows": rows})
         return
     print(f"selection: {ds.attrs['selection']}")
     print(f"{'mu_c':>6} {'d':>6} {'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9}")
@@ -277,8 +279,7 @@ def cmd_plan(args):
     if args.out:
         write_json(result, args.out)
     if args.json:
-        json.dump(result, sys.stdout, default=float)
-        sys.stdout.write("\n")
+        _print_json(result, default=float)
         return
     pc = config["planner"]
     n_moving = len(result["pin_speeds"])
@@ -398,8 +399,7 @@ def cmd_sense_classify(args):
               "sensor_plan": stored["plan"]["pins"] if on_plan else None,
               "final_sets": final, "final_known": (len(final) == 1) if final is not None else None}
     if args.json:
-        json.dump(result, sys.stdout)
-        sys.stdout.write("\n")
+        _print_json(result)
         return
     print(f"part {part.id}: sensor pin at y = {y_pin:g} mm ({source}); model {model}, "
           f"mu_c {mu_c:g}, pin radius {pin_radius:g} mm")
