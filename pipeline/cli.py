@@ -206,7 +206,7 @@ def cmd_catalog_query(args):
                              "theta_f": float(sub["theta_f"].values[k]), "dy": float(sub["dy"].values[k])})
     if args.json:
         _print_json({"part": ds.attrs.get("part_id"), "model": args.model, "v_pin": args.v_pin,
-                   "selection": ds.attrs["selection"], "rows": rows})
+                     "selection": ds.attrs["selection"], "rows": rows})
         return
     print(f"selection: {ds.attrs['selection']}")
     print(f"{'mu_c':>6} {'d':>6} {'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9}")
