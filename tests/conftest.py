@@ -59,28 +59,18 @@ def rollout_vectors():
         return json.load(fh)
 
 
-@pytest.fixture(scope="session")
-def triangle():
-    from pipeline.parts import Part
-    return Part.from_vertices(TRIANGLE, name="triangle")
+def _part_fixture(vertices, name):
+    @pytest.fixture(scope="session")
+    def part():
+        from pipeline.parts import Part
+        return Part.from_vertices(vertices, name=name)
+    return part
 
 
-@pytest.fixture(scope="session")
-def quad():
-    from pipeline.parts import Part
-    return Part.from_vertices(QUAD, name="quad")
-
-
-@pytest.fixture(scope="session")
-def rectangle():
-    from pipeline.parts import Part
-    return Part.from_vertices(RECTANGLE, name="rectangle")
-
-
-@pytest.fixture(scope="session")
-def v_notch():
-    from pipeline.parts import Part
-    return Part.from_vertices(V_NOTCH, name="v-notch")
+triangle = _part_fixture(TRIANGLE, "triangle")
+quad = _part_fixture(QUAD, "quad")
+rectangle = _part_fixture(RECTANGLE, "rectangle")
+v_notch = _part_fixture(V_NOTCH, "v-notch")
 
 
 @pytest.fixture(scope="session")

@@ -14,15 +14,21 @@ def _floats(lo, hi):
     return st.floats(lo, hi, allow_nan=False, allow_infinity=False)
 
 
-@st.composite
-def star_polygons(draw, min_n=3, max_n=11, min_radius=0.25):
-    """Star-shaped (usually non-convex) polygon: sorted random angles, random radii."""
-    n = draw(st.integers(min_n, max_n))
+def _sorted_angles(draw, n):
+    """``n`` increasing angles around a full turn from a random phase, no gap
+    reaching half a turn (so the polygon around the origin is not degenerate)."""
     gaps = np.array(draw(st.lists(_floats(0.15, 1.0), min_size=n, max_size=n)))
     gaps = gaps / gaps.sum() * 2.0 * math.pi
     assume(gaps.max() < 0.95 * math.pi)
     phase = draw(_floats(0.0, 2.0 * math.pi))
-    ang = phase + np.concatenate([[0.0], np.cumsum(gaps[:-1])])
+    return phase + np.concatenate([[0.0], np.cumsum(gaps[:-1])])
+
+
+@st.composite
+def star_polygons(draw, min_n=3, max_n=11, min_radius=0.25):
+    """Star-shaped (usually non-convex) polygon: sorted random angles, random radii."""
+    n = draw(st.integers(min_n, max_n))
+    ang = _sorted_angles(draw, n)
     rad = np.array(draw(st.lists(_floats(min_radius, 1.0), min_size=n, max_size=n)))
     xy = np.column_stack([rad * np.cos(ang), rad * np.sin(ang)])
     return xy
@@ -33,11 +39,7 @@ def convex_polygons(draw, min_n=3, max_n=10):
     """Convex polygon: points at sorted random angles on a circle, then a random
     orientation-preserving affine map (convexity and winding survive)."""
     n = draw(st.integers(min_n, max_n))
-    gaps = np.array(draw(st.lists(_floats(0.15, 1.0), min_size=n, max_size=n)))
-    gaps = gaps / gaps.sum() * 2.0 * math.pi
-    assume(gaps.max() < 0.95 * math.pi)
-    phase = draw(_floats(0.0, 2.0 * math.pi))
-    ang = phase + np.concatenate([[0.0], np.cumsum(gaps[:-1])])
+    ang = _sorted_angles(draw, n)
     xy = np.column_stack([np.cos(ang), np.sin(ang)])
     stretch = draw(_floats(0.35, 1.0))
     rot = draw(_floats(0.0, math.pi))
