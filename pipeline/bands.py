@@ -22,6 +22,8 @@ import numpy as np
 
 from kernels.rollout import OK
 
+from .arcs import in_arc  # noqa: F401 (re-exported for older callers)
+
 
 @dataclass
 class Band:
@@ -43,13 +45,6 @@ class Band:
 
     def to_dict(self) -> dict:
         return asdict(self)
-
-
-def in_arc(x, start, width, tol=1e-9):
-    """True where angle ``x`` lies in the arc ``start + [0, width]``."""
-    if width >= 360.0:
-        return np.ones(np.shape(x), dtype=bool)
-    return (np.asarray(x) - start) % 360.0 <= width + tol
 
 
 def circular_mean_std(deg) -> tuple[float, float]:

@@ -96,15 +96,20 @@ class Catalog:
         if not root.is_dir():
             raise PinfeedError(f"no catalog folder at {root}; run the workflow ('make run') first")
         entries, problems = [], []
+        refinements = []
         for path in sorted(root.rglob("*.h5")):
             if path.name.startswith("."):
                 continue  # an unfinished atomic write
+            if path.relative_to(root).parts[0] == "refine":
+                # the planner's on-demand rollouts (pipeline.lattice_store), not maps
+                refinements.append({"file": path.relative_to(root).as_posix(), "sha256": _sha256(path)})
+                continue
             try:
                 entries.append(_entry_from_file(root, path))
             except PinfeedError as exc:
                 problems.append(str(exc))
-        write_json({"index_version": INDEX_VERSION, "entries": entries, "problems": problems},
-                   root / INDEX_NAME)
+        write_json({"index_version": INDEX_VERSION, "entries": entries, "problems": problems,
+                    "refinements": refinements}, root / INDEX_NAME)
         return cls(root, entries, problems)
 
     @classmethod

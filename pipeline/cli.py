@@ -239,16 +239,48 @@ def cmd_sweep(args):
 
 def cmd_plan(args):
     from .config import load_config
-    from .families import family_parts
-    from .parts import Part, parse_vertices
-    from .stages import ensure_maps, plan_part, write_json
+    from .planning import parse_friction
     config = load_config(args.config)
     if args.catalog:
         config["catalog_dir"] = args.catalog
-    for key in ("mu_c", "model", "depth", "coverage"):
+    pc = config["planner"]
+    if args.mu_c is not None:
+        pc["mu_c"] = args.mu_c
+        pc["frictions"] = []
+    parse_friction(pc["mu_c"])  # a clear error before any work
+    if args.depth is not None and args.depth < 1:
+        raise PinfeedError(f"--depth must be 1 or more, got {args.depth}")
+    for key in ("model", "depth", "coverage"):
         if getattr(args, key) is not None:
-            config["planner"][key] = getattr(args, key)
-    dynamic = config["planner"]["dynamic"]
+            pc[key] = getattr(args, key)
+    _plan_dynamic_args(args, pc["dynamic"])
+    if args.pins:
+        pc["pins"] = [float(x) for x in parse_values(args.pins, "--pins")]
+    part = _plan_part_arg(args, config)
+    if args.mode == "tight":
+        result = _plan_tight_only(part, config, progress=None if args.json else _progress)
+    else:
+        from .stages import ensure_maps, plan_part
+        cat = ensure_maps(config, part)
+        if args.mode == "paper":
+            config = dict(config, planner=dict(pc, mu_c=pc["mu_c"], frictions=[]))
+        result = plan_part(cat, part.id, config, progress=None if args.json else _progress)
+        if args.mode == "paper":
+            result.pop("tight")
+    if args.out:
+        from .stages import write_json
+        write_json(result, args.out)
+    if args.json:
+        _print_json(_plan_json(result, args.mode), default=float)
+        return
+    _print_plan_result(result, part, config, args.mode)
+
+
+def _progress(message):
+    print(f"  ... {message}", flush=True)
+
+
+def _plan_dynamic_args(args, dynamic):
     if args.speeds is not None:
         dynamic["speeds"] = [float(v) for v in parse_values(args.speeds, "--speeds")] if args.speeds else []
         if any(v == 0.0 for v in dynamic["speeds"]):
@@ -259,54 +291,101 @@ def cmd_plan(args):
         dynamic["depth"] = args.dynamic_depth
     if dynamic["depth"] == 0:
         dynamic["speeds"] = []
-    if args.pins:
-        config["planner"]["pins"] = [float(x) for x in parse_values(args.pins, "--pins")]
+
+
+def _plan_part_arg(args, config):
+    from .families import family_parts
+    from .parts import Part, parse_vertices
     if args.vertices:
-        part = Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
-    elif args.part:
-        found = [p for fam, spec in config["families"].items() for p in family_parts(fam, spec)
-                 if args.part in (p.name, p.id)]
-        if not found:
-            from .catalog import Catalog
-            cat = Catalog.open(config["catalog_dir"])
-            e = cat._entries_for(args.part)[0]  # raises 'unknown part' with the known names
-            found = [Part.from_vertices(e["part_vertices"], name=e["part_name"])]
-        part = found[0]
-    else:
+        return Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
+    if not args.part:
         raise PinfeedError("give --part NAME or --vertices \"x0,y0 x1,y1 ...\"")
-    cat = ensure_maps(config, part)
-    result = plan_part(cat, part.id, config)
-    if args.out:
-        write_json(result, args.out)
-    if args.json:
-        _print_json(result, default=float)
-        return
+    found = [p for fam, spec in config["families"].items() for p in family_parts(fam, spec)
+             if args.part in (p.name, p.id)]
+    if found:
+        return found[0]
+    from .catalog import Catalog
+    cat = Catalog.open(config["catalog_dir"])
+    e = cat._entries_for(args.part)[0]  # raises 'unknown part' with the known names
+    return Part.from_vertices(e["part_vertices"], name=e["part_name"])
+
+
+def _plan_tight_only(part, config, progress=None) -> dict:
+    from .stages import plan_tight_all
+    from .provenance import provenance_attrs
+    return {"part": part.to_dict(), "model": config["planner"]["model"],
+            "tight": plan_tight_all(part, config, config["catalog_dir"], progress=progress),
+            **provenance_attrs()}
+
+
+def _verification_counts(plan) -> dict | None:
+    v = plan.get("verification")
+    if not v:
+        return None
+    reasons = {}
+    for row in v.get("rows", []):
+        for k, n in row.get("reasons", {}).items():
+            reasons[k] = reasons.get(k, 0) + n
+    return {"trials": v["trials"], "successes": v["successes"], "failures": v["failures"],
+            "reasons": reasons}
+
+
+def _plan_summary(plan, pins=None) -> dict:
+    heights = plan.get("pin_heights_mm") or [pins[p] for p in plan["pins"]]
+    return {"pins": list(plan["pins"]), "pin_heights_mm": list(heights),
+            "final_sets": plan["final_sets"], "n_final_sets": plan["n_final_sets"],
+            "verification": _verification_counts(plan)}
+
+
+def _plan_json(result, mode) -> dict:
+    out = {"part": result["part"]["name"], "part_id": result["part"]["id"], "mode": mode}
+    tight = result.get("tight")
+    if tight:
+        first = tight[0]
+        out.update(mu_c=first["mu_c"], warning=first["warning"],
+                   plans=[_plan_summary(p) for p in first["plans"]],
+                   rejected=[_plan_summary(p) for p in first["rejected"]],
+                   frictions=[{"mu_c": t["mu_c"], "warning": t["warning"],
+                               "plans": [_plan_summary(p) for p in t["plans"]]} for t in tight])
+    if "plans" in result and mode != "tight":
+        paper = {"mu_c": result["mu_c"], "plans": [_plan_summary(p, result["pins"]) for p in result["plans"]]}
+        if mode == "paper":
+            out.update(paper)
+        else:
+            out["paper"] = paper
+    return out
+
+
+def _print_plan_result(result, part, config, mode):
+    from .arcs import format_arcs
     pc = config["planner"]
-    n_moving = len(result["pin_speeds"])
-    print(f"part {part.id}: model {pc['model']}, {result['selection']}, depth {pc['depth']}, "
-          f"{len(result['pins']) - n_moving} fixed + {n_moving} moving candidate pins, "
-          f"coverage {result['coverage']}")
-    for label, s in result["initial_states"].items():
-        print(f"  {label}: resting on the fence at theta = {s['theta']:.1f} deg, y_c = {s['y_c']:.2f} mm")
-    if not result["plans"]:
-        print("no allowed pin sequence within the depth (every pin meets some state metastably, "
-              "outside |d| <= d_max, or jams it)")
+    print(f"part {part.id}: model {pc['model']}, depth {pc['depth']}")
+    for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
+        print(f"  state {k}: resting on the fence at theta = {theta:.1f} deg, y_c = {y_c:.2f} mm")
+    for t in result.get("tight", []):
+        st = t["stats"]
+        print(f"tight planner, friction {t['friction']}: {st['rollouts']} new rollouts in "
+              f"{st['seconds']:.0f} s, stored under {config['catalog_dir']}/refine/{part.id}/")
+        if t["warning"]:
+            print(f"  WARNING: {t['warning']}")
+        for k, plan in enumerate(t["plans"], start=1):
+            v = plan["verification"]
+            heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
+            print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
+                  f"{format_arcs([(s['start'], s['width']) for s in plan['final_sets']])}; "
+                  f"verified {v['successes']}/{v['trials']} trials; margin in d {plan['margin']:+.3f}")
+    if mode == "tight" or "plans" not in result:
         return
+    print(f"paper-mode planner (adjusted bands), {result['selection']}:")
+    if not result["plans"]:
+        print("  no allowed pin sequence within the depth")
     speeds = result["pin_speeds"]
     for k, plan in enumerate(result["plans"], start=1):
-        sets = ", ".join(f"[{s['start']:.1f}, {s['start'] + s['width']:.1f}] deg" for s in plan["final_sets"])
-        heights = ", ".join(f"{q}@{result['pins'][q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
+        heights = ", ".join(f"{q} at {result['pins'][q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
                             for q in plan["pins"])
-        after = " -> ".join(str(n) for n in plan["sets_after_each_pin"])
-        print(f"#{k}: {heights} -> {plan['n_final_sets']} final set(s): {sets}; margin in d "
-              f"{plan['margin']:.3f}; sets after each pin {after}")
-        if k == 1:
-            for label, branches in plan["initial_states"].items():
-                for branch in branches:
-                    steps = "; ".join(f"{st['pin']} d [{st['d_range'][0]:+.2f}, {st['d_range'][1]:+.2f}] -> "
-                                      f"[{st['band']['start']:.0f}+{st['band']['width']:.0f}] deg, y_c "
-                                      f"[{st['com_interval'][0]:.1f}, {st['com_interval'][1]:.1f}]" for st in branch)
-                    print(f"    {label}: {steps}")
+        print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
+              f"{format_arcs([(s['start'], s['width']) for s in plan['final_sets']])}; "
+              f"margin in d {plan['margin']:.3f}")
 
 
 PROFILE_FORMAT = """\
@@ -491,9 +570,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--name", default=None, help="name for --vertices (default part)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
-    p.add_argument("--mu-c", dest="mu_c", type=float, default=None, help="friction the plan assumes")
+    p.add_argument("--mu-c", dest="mu_c", default=None,
+                   help="friction the plan must work for: a value X or a range LO:HI (default: the config's)")
+    p.add_argument("--mode", default="tight", choices=["tight", "paper", "both"],
+                   help="tight propagation (default), the paper's adjusted bands, or both side by side")
     p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"])
-    p.add_argument("--depth", type=int, default=None, help="largest number of pins")
+    p.add_argument("--depth", type=int, default=None, help="largest number of pins (>= 1)")
     p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step'")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"])
     p.add_argument("--speeds", default=None,

@@ -133,6 +133,21 @@ class Part:
         rows = _geo._stable_edges(np.ascontiguousarray(self.vertices))
         return np.column_stack([np.degrees(rows[:, 2]) % 360.0, rows[:, 3]])
 
+    def symmetry_order(self, tol: float = 1e-6) -> int:
+        """Order k of the part's rotational symmetry about its centroid (1: none):
+        orientations 360/k apart are the same physical orientation."""
+        v = np.asarray(self.vertices)
+        scale = tol * self.a
+        for k in range(v.shape[0], 1, -1):
+            if v.shape[0] % k:
+                continue
+            c, s = math.cos(2 * math.pi / k), math.sin(2 * math.pi / k)
+            turned = v @ np.array([[c, s], [-s, c]])
+            gaps = np.min(np.hypot(*(turned[:, None, :] - v[None, :, :]).transpose(2, 0, 1)), axis=1)
+            if np.all(gaps < scale):
+                return k
+        return 1
+
     def to_dict(self) -> dict:
         return {"name": self.name, "id": self.id, "vertices": self.vertices.tolist(),
                 "area": self.area, "a": self.a}

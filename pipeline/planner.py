@@ -33,7 +33,8 @@ import numpy as np
 
 from kernels.rollout import JAMMED, MISS, TRUNCATED
 
-from .bands import band_lookup, extract_bands, in_arc
+from .arcs import in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
+from .bands import band_lookup, extract_bands
 from .errors import PinfeedError
 from .parts import Part
 
@@ -115,30 +116,6 @@ def load_maps(ds, threshold_T: float, factor_c: float) -> list[MapData]:
         out.append(MapData(d, theta_i, np.asarray(tf), np.asarray(st), np.asarray(dy), bands,
                            band_lookup(bands, theta_i.size)))
     return out
-
-
-def merge_arcs(arcs) -> list[tuple[float, float]]:
-    """Union of circular arcs ``(start, width)``; overlapping or touching arcs merge."""
-    arcs = [(s % 360.0, w) for s, w in arcs]
-    if any(w >= 360.0 for _, w in arcs):
-        return [(0.0, 360.0)]
-    if not arcs:
-        return []
-    arcs.sort()
-    merged = [list(arcs[0])]
-    for s, w in arcs[1:]:
-        ms, mw = merged[-1]
-        if s <= ms + mw + 1e-9:
-            merged[-1][1] = max(mw, s + w - ms)
-        else:
-            merged.append([s, w])
-    if len(merged) > 1:  # join the last with the first across 360
-        ls, lw = merged[-1]
-        fs, fw = merged[0]
-        if ls + lw >= fs + 360.0 - 1e-9:
-            merged[0] = [ls, max(lw, fs + 360.0 + fw - ls)]
-            merged.pop()
-    return sorted((float(s), float(min(w, 360.0))) for s, w in merged)
 
 
 class Planner:

@@ -30,10 +30,11 @@ def write_report(config, plans: dict, verifications: dict, figures: dict, out,
          "<h1>pinfeed results</h1>",
          f"<p>pinfeed {html.escape(__version__)} ({html.escape(git_commit())}), config "
          f"{config_hash(config)}, made {creation_time()}. Planner: model "
-         f"{html.escape(config['planner']['model'])}, mu_c {config['planner']['mu_c']:g}, depth "
+         f"{html.escape(config['planner']['model'])}, mu_c {html.escape(str(config['planner']['mu_c']))}, depth "
          f"{config['planner']['depth']}, d in [{config['planner']['d_min']:g}, "
          f"{config['planner']['d_max']:g}], T = {config['bands']['threshold_T']:g} deg, "
          f"c = {config['bands']['factor_c']:g}.</p>"]
+    p += _warnings(plans, verifications)
     if "verification" in figures:
         p.append("<h2>Verification (full rollouts, perturbed)</h2>")
         p.append(f'<img src="{_rel(figures["verification"], base)}" alt="verification table">')
@@ -47,7 +48,11 @@ def write_report(config, plans: dict, verifications: dict, figures: dict, out,
             p.append(f'<h3>Configuration maps with bands</h3><img src="{_rel(figs["maps"], base)}">')
         if "speeds" in figs:
             p.append(f'<h3>Maps by pin speed (dynamic pins)</h3><img src="{_rel(figs["speeds"], base)}">')
-        p.append("<h3>Best plans</h3><table><tr><th>rank</th><th>pins</th>"
+        p += _side_by_side(res, verifications.get(name))
+        if "carried" in figs:
+            p.append(f'<h3>Carried sets against replayed rollouts (recommended plan)</h3>'
+                     f'<img src="{_rel(figs["carried"], base)}">')
+        p.append("<h3>Paper-mode plans (adjusted bands), best first</h3><table><tr><th>rank</th><th>pins</th>"
                  "<th>heights (mm) @ speed (v_pin/v_b)</th><th>sets after each pin</th>"
                  "<th>final sets</th><th>orientation sets (deg)</th><th>margin in d</th></tr>")
         speeds = res.get("pin_speeds", {})
@@ -74,6 +79,63 @@ def write_report(config, plans: dict, verifications: dict, figures: dict, out,
             p += _sensing_section(sensing[name], figs, base)
     p.append("</body></html>")
     return write_text_atomic("\n".join(p), out)
+
+
+def _warnings(plans: dict, verifications: dict) -> list[str]:
+    """Warnings and failing verification rows, in red, for the top of the page."""
+    items = []
+    for name, res in plans.items():
+        for t in res.get("tight", []):
+            if t.get("warning"):
+                items.append(f"{name}, tight planner at mu_c {t['friction']}: {t['warning']}")
+    for name, ver in verifications.items():
+        for check in ver.get("checks", []):
+            for r in check["rows"]:
+                if r["failures"]:
+                    items.append(f"{name}, {check['kind']} ({' '.join(check['plan'])}), {r['state']}: "
+                                 f"{r['failures']} of {r['trials']} trials failed "
+                                 f"({'; '.join(f'{k}: {v}' for k, v in sorted(r['reasons'].items()))})")
+    if not items:
+        return []
+    return (['<div style="color:#b00"><h2>Warnings</h2><ul>'] +
+            [f"<li>{html.escape(t)}</li>" for t in items] + ["</ul></div>"])
+
+
+def _counts(check) -> str:
+    if check is None:
+        return "not verified"
+    t = sum(r["trials"] for r in check["rows"])
+    ok = sum(r["successes"] for r in check["rows"])
+    return f"{ok}/{t}"
+
+
+def _side_by_side(res: dict, ver: dict | None) -> list[str]:
+    """The paper-mode plan beside the tight planner's, with verification counts."""
+    from .arcs import format_arcs
+    checks = {c["kind"]: c for c in (ver or {}).get("checks", [])}
+    p = ["<h3>Plans: paper mode beside the tight planner</h3><table><tr><th>planner</th>"
+         "<th>friction mu_c</th><th>pins (height, mm)</th><th>final sets</th>"
+         "<th>orientation sets</th><th>verified (successes/trials)</th></tr>"]
+    static = res.get("best_static")
+    if static:
+        pins = ", ".join(f"{q} ({res['pins'][q]:g})" for q in static["pins"])
+        sets = format_arcs([(s["start"], s["width"]) for s in static["final_sets"]])
+        p.append(f"<tr><td>paper mode, fixed pins</td><td>{res['mu_c']:g} (stored maps)</td>"
+                 f"<td>{html.escape(pins)}</td><td>{static['n_final_sets']}</td><td>{sets}</td>"
+                 f"<td>{_counts(checks.get('paper mode, fixed pins'))}</td></tr>")
+    for t in res.get("tight", []):
+        plan = t["recommended"]
+        if plan is None:
+            p.append(f"<tr><td>tight</td><td>{t['friction']}</td><td colspan=4 style='color:#b00'>"
+                     f"{html.escape(t['warning'] or 'no plan')}</td></tr>")
+            continue
+        pins = ", ".join(f"{q} ({y:g})" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
+        sets = format_arcs([(s["start"], s["width"]) for s in plan["final_sets"]])
+        p.append(f"<tr><td>tight</td><td>{t['friction']}</td><td>{html.escape(pins)}</td>"
+                 f"<td>{plan['n_final_sets']}</td><td>{sets}</td>"
+                 f"<td>{_counts(checks.get('tight, mu_c ' + t['friction']))}</td></tr>")
+    p.append("</table>")
+    return p
 
 
 def _sets(sets) -> str:

@@ -17,6 +17,7 @@ import numpy as np
 import xarray as xr
 
 from kernels.batch import _rollout_grid
+from kernels.points import _rollout_points
 from kernels.models import MODEL_NAMES
 from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
                              _rollout)
@@ -196,6 +197,34 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
         },
         attrs=_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit),
     )
+
+
+def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str = "minpower",
+                   v_pin: float = 0.0, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
+                   threads: int | None = None) -> dict:
+    """Final states of independent rollouts at scattered points.
+
+    ``theta_i`` (degrees), ``d`` and ``mu_c`` are equal-length 1-D arrays (or
+    scalars, broadcast). Used by the planner's uncertainty propagation and by
+    verification, where the points are not a grid. Returns a dict of NumPy
+    arrays: ``status`` (int8 codes, see :data:`STATUSES`), ``jam_reason``
+    (int8), ``theta_f`` (degrees, [0, 360)) and ``dy`` (the part's unit).
+    """
+    check_parameters(0.0, pin_radius, model, v_pin)
+    th, dd, mu = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=np.float64))
+                                       for x in (theta_i, d, mu_c)))
+    for arr, what in ((th, "theta_i"), (dd, "d"), (mu, "mu_c")):
+        if arr.ndim != 1 or not np.all(np.isfinite(arr)):
+            raise PinfeedError(f"{what} must be finite numbers")
+    if np.any(mu < 0):
+        raise PinfeedError("contact friction mu_c must be >= 0")
+    with _threads(threads) as n:
+        status, reason, theta_f, dy = _rollout_points(
+            *part.prepared(), MODELS.index(model), np.ascontiguousarray(mu), float(pin_radius),
+            np.radians(th), np.ascontiguousarray(dd), float(v_pin), np.inf, float(ds_max),
+            float(tol), n)
+    return {"status": status, "jam_reason": reason,
+            "theta_f": _wrap_deg(np.degrees(theta_f)), "dy": dy}
 
 
 def status_names(codes) -> np.ndarray:

@@ -70,7 +70,8 @@ def build_planner(cat: Catalog, name: str, config: dict, dynamic: bool = True):
     pc, bc = config["planner"], config["bands"]
     name = config_part_id(config, name)
     part = catalog_part(cat, name)
-    ds = cat.query(name, model=pc["model"], mu_c=pc["mu_c"])
+    from .planning import nominal_friction, parse_friction
+    ds = cat.query(name, model=pc["model"], mu_c=nominal_friction(parse_friction(pc["mu_c"])))
     selection = ds.attrs["selection"]
     mu_used = float(ds["mu_c"][0])
     maps = load_maps(ds.isel(mu_c=0).load(), bc["threshold_T"], bc["factor_c"])
@@ -96,7 +97,11 @@ def dynamic_label(static_label: str, v_pin: float) -> str:
     return f"{static_label}v{v_pin:+g}"
 
 
-def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5) -> dict:
+def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=None) -> dict:
+    """Plans for one part: the paper's adjusted-band planner (``plans``,
+    ``best_static``: fixed pins, then moving pins) at the stored friction
+    nearest the planner's, and the tight planner (``tight``) at every
+    friction of :func:`plan_frictions`, each verified by full rollouts."""
     pc = config["planner"]
     part, planner, mu_used, selection = build_planner(cat, name, config)
     dyn = pc.get("dynamic", {})
@@ -117,8 +122,40 @@ def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5) -> dict:
         "initial_states": {k: {"theta": s.arc[0], "y_c": s.y_lo} for k, s in states.items()},
         "plans": [p.to_dict() for p in plans],
         "found": bool(plans),
+        "tight": plan_tight_all(part, config, cat.root, keep=keep, progress=progress),
         **provenance_attrs(),
     }
+
+
+def plan_frictions(config: dict) -> list:
+    """The frictions the workflow plans at: ``planner.mu_c`` (a value or a range
+    ``LO:HI``; the recommended plan) first, then each of ``planner.frictions``."""
+    from .planning import parse_friction
+    pc = config["planner"]
+    out = [parse_friction(pc["mu_c"])]
+    for f in pc.get("frictions", []):
+        f = parse_friction(f)
+        if f not in out:
+            out.append(f)
+    return out
+
+
+def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progress=None) -> list:
+    """Tight plans at every friction of :func:`plan_frictions` (the first is the
+    recommended one); the planner's rollouts are stored in the catalog."""
+    from .lattice_store import load_lattice, save_lattice
+    from .planning import plan_tight
+    sweep, model = config["sweep"], config["planner"]["model"]
+    lattices = {0.0: load_lattice(catalog_root, part, model, 0.0, sweep["pin_radius"],
+                                  sweep.get("kernel"))}
+    out = []
+    for mu_c in plan_frictions(config):
+        res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep, progress=progress)
+        res.pop("lattices")
+        out.append(res)
+    for lattice in lattices.values():
+        save_lattice(catalog_root, lattice)
+    return out
 
 
 # ---------------------------------------------------------------------- verify
@@ -142,24 +179,33 @@ def plans_to_check(plan_result: dict) -> dict:
 
 
 def verify_part(plan_result: dict, config: dict) -> dict:
-    """Perturbed full rollouts of the best fixed-pin plan and of the best plan
-    with dynamic pins (if any): ``{"part", "checks": [verify_plan result + "kind"]}``."""
-    from .planner import State
+    """Perturbed full rollouts of the paper-mode plans (best fixed-pin plan and
+    best plan with dynamic pins, if any) and of the tight planner's
+    recommended plan at every friction: ``{"part", "checks": [verify_plan
+    result + "kind"]}``."""
     from .verify import verify_plan
     name = plan_result["part"]["name"]
     out = {"part": name, "checks": [], **provenance_attrs()}
-    to_check = plans_to_check(plan_result)
-    if not to_check:
-        out["note"] = "no allowed plan within the depth"
-        return out
     part = Part.from_vertices(plan_result["part"]["vertices"], name=name)
-    states = {k: State((v["theta"], 0.0), v["y_c"], v["y_c"])
-              for k, v in plan_result["initial_states"].items()}
-    for kind, plan in to_check.items():
-        res = verify_plan(part, plan, plan_result["pins"], states,
-                          plan_result["mu_c"], config["sweep"]["pin_radius"], plan_result["model"],
-                          config.get("verify", {}), speeds=plan_result.get("pin_speeds", {}))
-        out["checks"].append({"kind": kind, **res})
+    states = {k: (v["theta"], v["y_c"]) for k, v in plan_result["initial_states"].items()}
+    radius, kernel = config["sweep"]["pin_radius"], config["sweep"].get("kernel")
+    for kind, plan in plans_to_check(plan_result).items():
+        res = verify_plan(part, plan, plan_result["pins"], states, plan_result["mu_c"], radius,
+                          plan_result["model"], config.get("verify", {}),
+                          speeds=plan_result.get("pin_speeds", {}), kernel=kernel)
+        res.pop("trials_detail")
+        out["checks"].append({"kind": f"paper mode, {kind}", **res})
+    for tight in plan_result.get("tight", []):
+        plan = tight["recommended"]
+        if plan is None:
+            continue
+        mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
+        res = verify_plan(part, plan, dict(zip(plan["pins"], plan["pin_heights_mm"])), states, mu,
+                          radius, plan_result["model"], config.get("verify", {}), kernel=kernel)
+        res.pop("trials_detail")
+        out["checks"].append({"kind": f"tight, mu_c {tight['friction']}", **res})
+    if not out["checks"]:
+        out["note"] = "no allowed plan within the depth"
     return out
 
 
@@ -279,12 +325,14 @@ def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:
     cat = Catalog.open(root) if (root / "index.json").is_file() else None
     entries = cat.entries if cat else []
     fam = next((e["family"] for e in entries if e["part_id"] == part.id), family)
+    from .planning import nominal_friction, parse_friction
+    mu = nominal_friction(parse_friction(pc["mu_c"]))
     wrote = False
     for v in [0.0] + [float(x) for x in pc.get("dynamic", {}).get("speeds", [])]:
         have = any(e["part_id"] == part.id and e["model"] == pc["model"]
-                   and e["mu_c"] == float(pc["mu_c"]) and e.get("v_pin", 0.0) == v for e in entries)
+                   and e["mu_c"] == mu and e.get("v_pin", 0.0) == v for e in entries)
         if not have:
-            write_shard(config, ShardJob(fam, part, pc["model"], float(pc["mu_c"]), v))
+            write_shard(config, ShardJob(fam, part, pc["model"], mu, v))
             wrote = True
     if wrote:
         cat = Catalog.rebuild(root)

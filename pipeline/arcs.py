@@ -1,0 +1,72 @@
+"""Arcs on the circle of orientations, in degrees: one helper per idea.
+
+An arc is ``(start, width)`` with ``start`` in [0, 360) and ``0 <= width <=
+360``; it covers ``start + [0, width]`` modulo 360.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def in_arc(x, start, width, tol=1e-9):
+    """True where angle ``x`` lies in the arc ``start + [0, width]``."""
+    if width >= 360.0:
+        return np.ones(np.shape(x), dtype=bool)
+    return (np.asarray(x) - start) % 360.0 <= width + tol
+
+
+def arc_within(inner, outer, tol=1e-6) -> bool:
+    """True if arc ``inner`` lies inside arc ``outer``."""
+    if outer[1] >= 360.0:
+        return True
+    return (inner[0] - outer[0]) % 360.0 + inner[1] <= outer[1] + tol
+
+
+def merge_arcs(arcs) -> list[tuple[float, float]]:
+    """Union of circular arcs ``(start, width)``; overlapping or touching arcs merge."""
+    arcs = [(s % 360.0, w) for s, w in arcs]
+    if any(w >= 360.0 for _, w in arcs):
+        return [(0.0, 360.0)]
+    if not arcs:
+        return []
+    arcs.sort()
+    merged = [list(arcs[0])]
+    for s, w in arcs[1:]:
+        ms, mw = merged[-1]
+        if s <= ms + mw + 1e-9:
+            merged[-1][1] = max(mw, s + w - ms)
+        else:
+            merged.append([s, w])
+    if len(merged) > 1:  # join the last with the first across 360
+        ls, lw = merged[-1]
+        fs, fw = merged[0]
+        if ls + lw >= fs + 360.0 - 1e-9:
+            merged[0] = [ls, max(lw, fs + 360.0 + fw - ls)]
+            merged.pop()
+    if len(merged) == 1 and merged[0][1] >= 360.0:
+        return [(0.0, 360.0)]
+    return sorted((float(s), float(min(w, 360.0))) for s, w in merged)
+
+
+def merge_modulo(arcs, order: int) -> list[tuple[float, float]]:
+    """Union of arcs on the circle of a part with ``order``-fold rotational
+    symmetry: orientations ``360 / order`` apart are one physical orientation.
+    Returns arcs in [0, 360 / order) as ``(start, width)`` in degrees."""
+    if order <= 1:
+        return merge_arcs(arcs)
+    period = 360.0 / order
+    scaled = merge_arcs([((s % period) * order, w * order) for s, w in arcs])
+    return [(s / order, w / order) for s, w in scaled]
+
+
+def format_arc(arc) -> str:
+    """``(223.1, 9.1)`` -> ``'223.1-232.2 deg'`` (ends within [0, 360))."""
+    s, w = arc
+    if w >= 360.0:
+        return "0.0-360.0 deg (any orientation)"
+    return f"{s % 360.0:.1f}-{(s + w) % 360.0:.1f} deg"
+
+
+def format_arcs(arcs) -> str:
+    """Several arcs, comma separated."""
+    return ", ".join(format_arc(a) for a in arcs) or "none"

@@ -1,0 +1,129 @@
+"""Plans with tight propagation for one part and one friction, verified.
+
+This is what ``pinfeed plan`` and the workflow's plan stage call: it runs the
+search (``search.TightPlanner``), replays the best candidates by full
+rollouts (``verify.verify_plan``: the configured number of perturbed trials
+per initial state plus every corner of the perturbation box), re-ranks them
+with the verified success and recommends the best plan that fails at most
+``MAX_FAILURE`` of its trials. A plan that fails more is never recommended:
+a warning with the reason is returned instead.
+
+Outcomes computed for the propagation are kept in the catalog under
+``refine/PART_ID/MODEL/v_pin=V.h5`` (see :mod:`pipeline.lattice_store`) and
+reused by later runs.
+"""
+from __future__ import annotations
+
+import math
+
+from .arcs import format_arcs
+from .errors import PinfeedError
+from .parts import Part
+from .propagate import Tolerances, Uncertainty
+from .search import TightPlanner
+from .verify import DEFAULTS as VERIFY_DEFAULTS
+from .verify import verify_plan
+
+MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
+
+
+def parse_friction(value):
+    """``0.15`` -> 0.15; ``"0.1:0.3"`` or ``[0.1, 0.3]`` -> ``(0.1, 0.3)``. Raises
+    :class:`PinfeedError` for negative, non-finite or reversed values."""
+    if isinstance(value, str):
+        parts = value.split(":")
+        try:
+            nums = [float(p) for p in parts]
+        except ValueError:
+            raise PinfeedError(f"friction {value!r} is not a number or a range LO:HI") from None
+    elif isinstance(value, (list, tuple)):
+        nums = [float(v) for v in value]
+    else:
+        nums = [float(value)]
+    if len(nums) not in (1, 2) or not all(math.isfinite(x) and x >= 0 for x in nums):
+        raise PinfeedError(f"friction {value!r} must be a number >= 0 or a range LO:HI of such numbers")
+    if len(nums) == 2:
+        if nums[1] < nums[0]:
+            raise PinfeedError(f"friction range {value!r} has LO > HI; write it as LO:HI")
+        return (nums[0], nums[1]) if nums[1] > nums[0] else nums[0]
+    return nums[0]
+
+
+def friction_label(mu_c) -> str:
+    """``0.15`` -> ``'0.15'``; ``(0.1, 0.3)`` -> ``'0.1:0.3'``."""
+    if isinstance(mu_c, tuple):
+        return f"{mu_c[0]:g}:{mu_c[1]:g}"
+    return f"{mu_c:g}"
+
+
+def nominal_friction(mu_c) -> float:
+    """One friction value to draw nominal paths with: the value or the range's middle."""
+    return 0.5 * (mu_c[0] + mu_c[1]) if isinstance(mu_c, tuple) else float(mu_c)
+
+
+def planner_for(part: Part, config: dict, mu_c, lattices=None) -> TightPlanner:
+    """A :class:`TightPlanner` with the config's pins, limits, model and sizes."""
+    from .planner import pins_from_config
+    pc, sweep = config["planner"], config["sweep"]
+    verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
+    tol = Tolerances(**pc.get("tolerances", {}))
+    return TightPlanner(part, pins_from_config(pc["pins"]), pc["d_min"], pc["d_max"], mu_c,
+                        sweep["pin_radius"], pc["model"], Uncertainty.from_verify(verify_cfg), tol,
+                        lattices=lattices, kernel=sweep.get("kernel"),
+                        max_branches=pc.get("max_branches", 4),
+                        hard_limits=pc.get("hard_d_limits", False))
+
+
+def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None = None,
+               keep: int = 5, progress=None) -> dict:
+    """Search, verify and rank plans for ``part`` at friction ``mu_c`` (a value
+    or a range); returns a JSON-ready dict (``plans`` best first, each with
+    its ``verification``; ``recommended``; ``warning``; search statistics)."""
+    pc = config["planner"]
+    depth = int(depth if depth is not None else pc["depth"])
+    planner = planner_for(part, config, mu_c, lattices)
+    candidates = planner.search(depth, keep=int(pc.get("candidates", 12)),
+                                complete_depth=int(pc.get("complete_depth", 2)),
+                                static_beam=int(pc.get("beam", 30)), progress=progress)
+    verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
+    states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
+    for plan in candidates:
+        res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
+                          config["sweep"]["pin_radius"], pc["model"], verify_cfg,
+                          kernel=config["sweep"].get("kernel"))
+        plan.verification = {"trials": res["trials"], "successes": res["successes"],
+                             "failures": res["failures"], "rows": res["rows"]}
+        if progress:
+            progress(f"verified {' '.join(plan.pins)}: {res['successes']}/{res['trials']} trials")
+    candidates.sort(key=lambda p: p.rank_key())
+    good = [p for p in candidates if p.verification["failures"] <= MAX_FAILURE * p.verification["trials"]]
+    warning = None
+    if not candidates:
+        warning = f"no allowed pin sequence within depth {depth}"
+    elif not good:
+        best = candidates[0]
+        warning = (f"no plan passed verification: the best prediction, {' '.join(best.pins)} "
+                   f"({format_arcs(best.final_sets)}), failed {best.verification['failures']} of "
+                   f"{best.verification['trials']} trials")
+    recommended = good[0] if good else None
+    return {
+        "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c,
+        "friction": friction_label(mu_c),
+        "symmetry_order": planner.order,
+        "depth": depth, "complete_depth": int(pc.get("complete_depth", 2)),
+        "beam": int(pc.get("beam", 30)),
+        "plans": [p.to_dict() for p in good[:keep]],
+        "rejected": [p.to_dict() for p in candidates if p not in good][:keep],
+        "recommended": recommended.to_dict() if recommended else None,
+        "warning": warning,
+        "stats": {"transitions": planner.stats.transitions, "rollouts": planner.stats.rollouts,
+                  "joint_states": planner.stats.nodes, "seconds": round(planner.stats.seconds, 2),
+                  "pruned_branching": planner.stats.pruned_branching,
+                  "per_level": planner.stats.per_level},
+        "initial_states": {k: {"theta": t, "y_c": y} for k, (t, y) in states.items()},
+        "lattices": planner.lattices,
+    }
+
+
+def planner_pin_heights(planner: TightPlanner) -> dict:
+    return {label: pin.y for label, pin in planner.pins.items()}
