@@ -264,7 +264,8 @@ def cmd_plan(args):
         cat = ensure_maps(config, part)
         if args.mode == "paper":
             config = dict(config, planner=dict(pc, mu_c=pc["mu_c"], frictions=[]))
-        result = plan_part(cat, part.id, config, progress=None if args.json else _progress)
+        result = plan_part(cat, part.id, config, progress=None if args.json else _progress,
+                           tight=args.mode == "both")
         if args.mode == "paper":
             result.pop("tight")
     if args.out:
@@ -373,7 +374,7 @@ def _print_plan_result(result, part, config, mode):
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
             print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
                   f"{format_arcs([(s['start'], s['width']) for s in plan['final_sets']])}; "
-                  f"verified {v['successes']}/{v['trials']} trials; margin in d {plan['margin']:+.3f}")
+                  f"verified {v['successes']}/{v['trials']} trials; margin in d " + (f"{plan['margin']:+.3f}" if plan['margin'] is not None else "n/a (touches nothing)"))
     if mode == "tight" or "plans" not in result:
         return
     print(f"paper-mode planner (adjusted bands), {result['selection']}:")

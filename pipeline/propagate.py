@@ -44,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kernels.rollout import JAMMED, TRUNCATED
+from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from .arcs import merge_arcs
 from .parts import Part
@@ -187,6 +187,7 @@ class Transition:
     d_lo: float
     d_hi: float
     jump: bool  # the box straddles a jump (the state branched or a piece is a corner value)
+    touched: bool = True  # some outcome in the box is a contact (not a miss)
 
 
 def _cells_covering(lo, hi):
@@ -246,12 +247,13 @@ def propagate(state: StateSet, y_pin: float, part: Part, lattice: OutcomeLattice
     lo = (state.start / UNITS[0], d_lo / UNITS[1], state.mu_lo / UNITS[2])
     hi = ((state.start + state.width) / UNITS[0], d_hi / UNITS[1], state.mu_hi / UNITS[2])
     cells = _cells_covering(lo, hi)
-    pieces = []  # (start, width, dy_lo, dy_hi, d_lo, d_hi)
-    jump = False
+    pieces = []  # (start, width, dy_lo, dy_hi, g_lo, g_hi, d_lo, d_hi)
+    jump = touched = False
     while cells:
         lattice.ensure([k for c in cells for k in _corners(c) + [_centre(c)]])
         refine = []
         for cell in cells:
+            touched = touched or any(lattice.known[k][0] != MISS for k in _corners(cell) + [_centre(cell)])
             outcome = _cell_outcome(cell, lattice, tol, a, lo, hi)
             if outcome == "jam":
                 if _is_finest(cell):
@@ -267,7 +269,7 @@ def propagate(state: StateSet, y_pin: float, part: Part, lattice: OutcomeLattice
                 pieces.append(outcome + (cell[1][0] * UNITS[1], cell[1][1] * UNITS[1]))
         cells = refine
     children = _children(pieces, state, y_pin, pin_halfwidth, a, d_lo, d_hi)
-    return Transition(children, d_lo, d_hi, jump or len(children) > 1)
+    return Transition(children, d_lo, d_hi, jump or len(children) > 1, touched)
 
 
 def _cell_outcome(cell, lattice, tol, a, lo, hi):

@@ -18,7 +18,8 @@ ones by a beam search (complete for one moving pin after the beam's plans).
 Plans are ranked by (1) the number of final orientation sets, counted modulo
 the part's rotational symmetry; then, once verified by full rollouts
 (``verify.py``), (2) the fraction of successful trials; (3) fewest pins;
-(4) fewest steps whose box straddles a jump; (5) the safety margin in d;
+(4) fewest steps whose box straddles a jump; (5) the safety margin in d (the smallest distance of any d range that a pin
+touches from ``d_min`` and ``d_max``; negative inside them);
 (6) the total width of the final sets.
 """
 from __future__ import annotations
@@ -101,7 +102,7 @@ class TightPlan:
             "pin_speeds": list(self.pin_speeds),
             "n_final_sets": self.n_sets,
             "final_sets": [{"start": s, "width": w} for s, w in self.final_sets],
-            "margin": self.margin, "jump_steps": self.jumps,
+            "margin": self.margin if math.isfinite(self.margin) else None, "jump_steps": self.jumps,
             "sets_after_each_pin": list(self.sets_after),
             "n_dynamic_pins": self.n_dynamic,
             "initial_sets": {k: v.to_dict() for k, v in self.initial.items()},
@@ -201,7 +202,9 @@ class TightPlanner:
         self.stats.rollouts += lattice.n_computed - before
         if res is None:
             return None
-        return res.children, min(near - self.d_min, self.d_max - far), d_lo, d_hi, res.jump
+        # A pin that misses the whole box is no risk, wherever it stands.
+        margin = min(near - self.d_min, self.d_max - far) if res.touched else math.inf
+        return res.children, margin, d_lo, d_hi, res.jump
 
     # ------------------------------------------------------------------ search
 

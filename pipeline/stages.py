@@ -97,7 +97,8 @@ def dynamic_label(static_label: str, v_pin: float) -> str:
     return f"{static_label}v{v_pin:+g}"
 
 
-def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=None) -> dict:
+def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=None,
+              tight: bool = True) -> dict:
     """Plans for one part: the paper's adjusted-band planner (``plans``,
     ``best_static``: fixed pins, then moving pins) at the stored friction
     nearest the planner's, and the tight planner (``tight``) at every
@@ -122,7 +123,7 @@ def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=Non
         "initial_states": {k: {"theta": s.arc[0], "y_c": s.y_lo} for k, s in states.items()},
         "plans": [p.to_dict() for p in plans],
         "found": bool(plans),
-        "tight": plan_tight_all(part, config, cat.root, keep=keep, progress=progress),
+        "tight": plan_tight_all(part, config, cat.root, keep=keep, progress=progress) if tight else [],
         **provenance_attrs(),
     }
 

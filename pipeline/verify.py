@@ -87,11 +87,12 @@ def predicted_sets(plan: dict, label: str):
     return merge_arcs([_arc(branch[-1]) for branch in plan["initial_states"][label] if branch])
 
 
-def _expects_contact(plan: dict, label: str, k: int) -> bool:
+def _expects_contact(plan: dict, label: str, k: int, start_arc) -> bool:
     # A step whose orientation set differs from the one before it needed the pin to touch.
     for branch in plan["initial_states"][label]:
-        if k < len(branch) and (k == 0 or _arc(branch[k]) != _arc(branch[k - 1])):
-            if k > 0 or "carried" not in branch[0]:
+        if k < len(branch):
+            before = _arc(branch[k - 1]) if k > 0 else start_arc
+            if tuple(_arc(branch[k])) != tuple(before):
                 return True
     return False
 
@@ -164,7 +165,9 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
         tf, yf, jam, missed = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
                                      kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL))
         finals = predicted_sets(plan, label)
-        expected = [_expects_contact(plan, label, k) for k in range(len(labels))]
+        first = plan.get("initial_sets", {}).get(label)
+        start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)
+        expected = [_expects_contact(plan, label, k, start_arc) for k in range(len(labels))]
         counts = {"state": label, "trials": 0, "successes": 0, "failures": 0, "reasons": {}}
         for j in range(tf.size):
             reason = jam[j] or None

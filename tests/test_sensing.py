@@ -255,6 +255,8 @@ def sym_catalog(tmp_path_factory):
                if p["name"] == "sym_triangle")
     cfg["families"] = {"paper_triangles": {"parts": [sym]}}
     cfg["sweep"]["models"] = [cfg["planner"]["model"]]
+    cfg["planner"].update(mu_c=0.15, frictions=[], depth=3)  # the paper-mode planner's friction
+    cfg["verify"]["trials"] = 30
     cfg["sweep"]["mu_c"] = [cfg["planner"]["mu_c"]]
     cfg["sweep"]["v_pin"] = [0.0]  # the sensor plans fixed pins only
     cfg["planner"]["dynamic"]["speeds"] = []
@@ -264,7 +266,7 @@ def sym_catalog(tmp_path_factory):
     cfg = validate_config(dict(cfg, catalog_dir=str(root)))
     run_sweep(cfg, progress=False)
     cat = Catalog.open(root)
-    write_json(plan_part(cat, "sym_triangle", cfg), root / "plans" / "sym_triangle.json")
+    write_json(plan_part(cat, "sym_triangle", cfg, tight=False), root / "plans" / "sym_triangle.json")
     result = sense_part(cat, "sym_triangle", cfg, log=lambda *a: None)
     write_json(result, root / "sensing" / "sym_triangle.json")
     return cfg, cat, result
