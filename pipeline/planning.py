@@ -119,6 +119,7 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
         "stats": {"transitions": planner.stats.transitions, "rollouts": planner.stats.rollouts,
                   "joint_states": planner.stats.nodes, "seconds": round(planner.stats.seconds, 2),
                   "pruned_branching": planner.stats.pruned_branching,
+                  "unresolved": planner.stats.unresolved,
                   "per_level": planner.stats.per_level},
         "initial_states": {k: {"theta": t, "y_c": y} for k, (t, y) in states.items()},
         "lattices": planner.lattices,

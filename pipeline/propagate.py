@@ -20,11 +20,12 @@ stored for reuse, see :class:`OutcomeLattice`):
   multilinear interpolant there). It contributes the hull of its corners and
   centre, padded by twice the centre's deviation plus ``pad_deg`` (``pad_dy``);
 - any other cell is halved along every axis above the finest size
-  (1/4 deg x 0.005 x 0.01), keeping only the halves that meet the box;
+  (1/4 deg x 0.01 x 0.02), keeping only the halves that meet the box;
 - a finest cell that is still not smooth but has no jump between neighbouring
   corners is taken as steep but continuous (hull plus pad); otherwise it
-  straddles a jump (a band boundary, a miss boundary) and each corner
-  contributes its own padded outcome, so the state branches into children.
+  straddles a jump (a band boundary, a miss boundary): the corners on each
+  side of it give their hull, padded by ``pad_jump_deg``, and the state
+  branches into children.
 - a jammed corner inside the box forbids the pin (a jam stops the feeder).
 
 The outcomes are then merged on the circle into child arcs; each child's
@@ -52,7 +53,8 @@ from .parts import Part
 # Lattice units: theta in 1/64 deg, d in 1/3200, mu in 1/1600.
 UNITS = (1.0 / 64.0, 1.0 / 3200.0, 1.0 / 1600.0)
 BASE = (128, 128, 128)  # coarsest cell: 2 deg, 0.04, 0.08
-FINEST = (16, 16, 16)  # finest cell: 1/4 deg, 0.005, 0.01
+FINEST = (16, 32, 32)  # finest cell: 1/4 deg, 0.01, 0.02
+MAX_POINTS = 2000  # lattice points one transition may need; beyond: unresolved
 
 SNAP_DEG = 0.5  # carried arcs are snapped outward to this grid (exact merging of states)
 SNAP_Y = 0.1  # carried y_c intervals likewise (mm)
@@ -81,6 +83,8 @@ class Tolerances:
     jump_deg: float = 5.0  # neighbouring corners further apart than this straddle a jump
     pad_deg: float = 0.1
     pad_dy: float = 0.05
+    pad_jump_deg: float = 1.0  # beside a jump, where outcomes change fast
+    pad_jump_dy: float = 0.25
 
 
 @dataclass(frozen=True, order=True)
@@ -180,6 +184,9 @@ class OutcomeLattice:
             self.known[tuple(int(x) for x in key)] = (int(st), float(tf), float(y))
 
 
+UNRESOLVED = "unresolved"  # propagate's answer when a box needs more than MAX_POINTS
+
+
 @dataclass
 class Transition:
     """The children of a state at one pin, and how the pin met it."""
@@ -239,8 +246,10 @@ def _is_finest(cell) -> bool:
 
 def propagate(state: StateSet, y_pin: float, part: Part, lattice: OutcomeLattice,
               pin_halfwidth: float, tol: Tolerances = Tolerances()) -> Transition | None:
-    """Children of ``state`` at a pin at height ``y_pin`` (mm), or ``None`` if a
-    jam is reachable. The d range is not checked here (see ``search``)."""
+    """Children of ``state`` at a pin at height ``y_pin`` (mm); ``None`` if a
+    jam is reachable; :data:`UNRESOLVED` if the box holds so many jumps that
+    resolving them would take more than ``MAX_POINTS`` lattice points (the
+    search then forbids the pin). The d range is not checked here."""
     a = part.a
     d_lo = (y_pin - pin_halfwidth - state.y_hi) / a
     d_hi = (y_pin + pin_halfwidth - state.y_lo) / a
@@ -249,7 +258,11 @@ def propagate(state: StateSet, y_pin: float, part: Part, lattice: OutcomeLattice
     cells = _cells_covering(lo, hi)
     pieces = []  # (start, width, dy_lo, dy_hi, g_lo, g_hi, d_lo, d_hi)
     jump = touched = False
+    used = 0
     while cells:
+        used += len(cells) * 9
+        if used > MAX_POINTS:
+            return UNRESOLVED
         lattice.ensure([k for c in cells for k in _corners(c) + [_centre(c)]])
         refine = []
         for cell in cells:
@@ -315,15 +328,35 @@ def _trilinear(v, u, w, x):
 
 
 def _corner_pieces(cell, lattice, tol, a):
-    """A finest cell across a jump: every corner's own outcome, padded."""
-    out = []
+    """A finest cell across a jump: corners that agree (neighbours within
+    ``jump_deg``, transitively) form one side of the jump; each side gives
+    the hull of its corners, padded by ``pad_jump_deg`` (outcomes change fast
+    near a jump)."""
+    keys = _corners(cell)
+    vals = [lattice.known[k] for k in keys]
+    group = list(range(8))
+    for i, j in _EDGES:  # union-find over agreeing neighbours
+        if abs(((vals[i][1] - vals[j][1] + 180.0) % 360.0) - 180.0) <= tol.jump_deg:
+            gi, gj = _root(group, i), _root(group, j)
+            group[gi] = gj
     d0, d1 = cell[1][0] * UNITS[1], cell[1][1] * UNITS[1]
-    for key in _corners(cell):
-        _, tf, dy = lattice.known[key]
-        g = dy - key[1] * UNITS[1] * a
-        out.append((tf - tol.pad_deg, 2 * tol.pad_deg, dy - tol.pad_dy, dy + tol.pad_dy,
-                    g - tol.pad_dy, g + tol.pad_dy, d0, d1))
+    out = []
+    for r in {_root(group, i) for i in range(8)}:
+        members = [i for i in range(8) if _root(group, i) == r]
+        ref = vals[members[0]][1]
+        rel = [((vals[i][1] - ref + 180.0) % 360.0) - 180.0 for i in members]
+        dys = [vals[i][2] for i in members]
+        gs = [vals[i][2] - keys[i][1] * UNITS[1] * a for i in members]
+        pad, pad_y = tol.pad_jump_deg, tol.pad_jump_dy
+        out.append(((ref + min(rel) - pad) % 360.0, max(rel) - min(rel) + 2 * pad,
+                    min(dys) - pad_y, max(dys) + pad_y, min(gs) - pad_y, max(gs) + pad_y, d0, d1))
     return out
+
+
+def _root(group, i):
+    while group[i] != i:
+        i = group[i]
+    return i
 
 
 def _children(pieces, state, y_pin, h, a, d_lo, d_hi):

@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 from .arcs import merge_arcs, merge_modulo
 from .errors import PinfeedError
 from .parts import Part
-from .propagate import (OutcomeLattice, StateSet, Tolerances, Uncertainty, initial_state_sets,
-                        propagate)
+from .propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
+                        initial_state_sets, propagate)
 
 
 @dataclass(frozen=True)
@@ -119,6 +119,7 @@ class SearchStats:
     nodes: int = 0
     seconds: float = 0.0
     pruned_branching: int = 0
+    unresolved: int = 0
     per_level: list = field(default_factory=list)
 
 
@@ -200,6 +201,9 @@ class TightPlanner:
         res = propagate(state, pin.y, self.part, lattice, h, self.tol)
         self.stats.transitions += 1
         self.stats.rollouts += lattice.n_computed - before
+        if res is UNRESOLVED:
+            self.stats.unresolved += 1
+            return None
         if res is None:
             return None
         # A pin that misses the whole box is no risk, wherever it stands.

@@ -260,6 +260,8 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
         _sequence_figure(config, res, to_draw.get("fixed pins"), "best fixed-pin plan", out["sequence"][k])
         _sequence_figure(config, res, to_draw.get("with dynamic pins"), "best plan with dynamic pins",
                          out["sequence_dynamic"][k])
+        if "carried" in out:
+            _carried_figure(config, res, out["carried"][k])
         verifications[name] = read_json(verify_path)
     rows = verification_rows(verifications)
     plot_table(rows, "Verification of the best plans by perturbed full rollouts", out["verification"])
@@ -284,6 +286,25 @@ def _sequence_figure(config, res, plan, what, path):
                   speeds=res.get("pin_speeds", {}))
 
 
+def _carried_figure(config, res, path):
+    """The tight planner's recommended plan (first friction): carried sets against replays."""
+    from .figures.carried import plot_carried, replayed_paths
+    name = res["part"]["name"]
+    tight = (res.get("tight") or [None])[0]
+    if not tight or not tight["recommended"]:
+        _placeholder(path, f"{name}: no recommended tight plan" + (f" ({tight['warning']})" if tight else ""))
+        return
+    plan = tight["recommended"]
+    part = Part.from_vertices(res["part"]["vertices"], name=name)
+    mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
+    starts = {k: (v["theta"], v["y_c"]) for k, v in res["initial_states"].items()}
+    replays = replayed_paths(part, plan, starts, mu, config["sweep"]["pin_radius"], res["model"],
+                             config.get("verify", {}), kernel=config["sweep"].get("kernel"))
+    plot_carried(plan, replays, f"{name}: carried sets of plan {' '.join(plan['pins'])} (mu_c "
+                 f"{tight['friction']}) against {len(next(iter(replays.values()))[0])} replayed "
+                 f"rollouts per state", path)
+
+
 def _placeholder(path, text):
     import matplotlib.pyplot as plt
 
@@ -304,7 +325,7 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=()):
         plans[name] = res
         verifications[name] = read_json(verify_path)
         figures[name] = {kind: results / f"{kind}_{name}.png"
-                         for kind in ("maps", "speeds", "sequence", "sequence_dynamic")}
+                         for kind in ("maps", "speeds", "sequence", "sequence_dynamic", "carried")}
     sensing = {}  # force/torque sensor on the first pin (rules/sense.smk)
     for path in sensing_paths:
         res = read_json(path)

@@ -22,7 +22,8 @@ rule plan:
     output:
         plan=f"{CATALOG}/plans/{{name}}.json",
     params:
-        settings={k: config[k] for k in ("planner", "bands")},
+        settings={k: config[k] for k in ("planner", "bands", "verify")},
+        sweep={k: config["sweep"][k] for k in ("pin_radius", "kernel")},
     log:
         "logs/plan/{name}.log",
     conda:

@@ -11,6 +11,7 @@ rule figures:
         speeds=expand(f"{RESULTS}/figures/speeds_{{name}}.png", name=PLANNED),
         sequence=expand(f"{RESULTS}/figures/sequence_{{name}}.png", name=PLANNED),
         sequence_dynamic=expand(f"{RESULTS}/figures/sequence_dynamic_{{name}}.png", name=PLANNED),
+        carried=expand(f"{RESULTS}/figures/carried_{{name}}.png", name=PLANNED),
         verification=f"{RESULTS}/figures/verification.png",
         table=f"{RESULTS}/verification.md",
     params:
