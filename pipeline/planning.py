@@ -61,15 +61,20 @@ def nominal_friction(mu_c) -> float:
     return 0.5 * (mu_c[0] + mu_c[1]) if isinstance(mu_c, tuple) else float(mu_c)
 
 
-def planner_for(part: Part, config: dict, mu_c, lattices=None) -> TightPlanner:
-    """A :class:`TightPlanner` with the config's pins, limits, model and sizes."""
+def planner_for(part: Part, config: dict, mu_c, lattices=None, moving: bool = False) -> TightPlanner:
+    """A :class:`TightPlanner` with the config's pins, limits, model and sizes
+    (and, with ``moving``, every candidate height at every ``planner.dynamic``
+    speed as a moving pin, labelled like ``P23v-2``)."""
     from .planner import pins_from_config
     pc, sweep = config["planner"], config["sweep"]
+    static = pins_from_config(pc["pins"])
+    speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if moving else []
+    moving_pins = {f"{k}v{v:+g}": (y, v) for k, y in static.items() for v in speeds}
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
     tol = Tolerances(**pc.get("tolerances", {}))
-    return TightPlanner(part, pins_from_config(pc["pins"]), pc["d_min"], pc["d_max"], mu_c,
+    return TightPlanner(part, static, pc["d_min"], pc["d_max"], mu_c,
                         sweep["pin_radius"], pc["model"], Uncertainty.from_verify(verify_cfg), tol,
-                        lattices=lattices, kernel=sweep.get("kernel"),
+                        moving=moving_pins, lattices=lattices, kernel=sweep.get("kernel"),
                         max_branches=pc.get("max_branches", 4),
                         hard_limits=pc.get("hard_d_limits", False))
 
@@ -82,14 +87,23 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     pc = config["planner"]
     depth = int(depth if depth is not None else pc["depth"])
     planner = planner_for(part, config, mu_c, lattices)
-    candidates = planner.search(depth, keep=int(pc.get("candidates", 12)),
-                                complete_depth=int(pc.get("complete_depth", 2)),
-                                static_beam=int(pc.get("beam", 30)), progress=progress)
+    search = dict(keep=int(pc.get("candidates", 12)), complete_depth=int(pc.get("complete_depth", 2)),
+                  static_beam=int(pc.get("beam", 30)), progress=progress)
+    candidates = planner.search(depth, **search)
+    dyn = pc.get("dynamic", {})
+    if candidates and candidates[0].n_sets > 1 and dyn.get("depth", 0) and dyn.get("speeds"):
+        # Passive pins are not enough: let moving pins follow the static ones.
+        if progress:
+            progress(f"fixed pins leave {candidates[0].n_sets} sets: adding moving pins")
+        planner = planner_for(part, config, mu_c, planner.lattices, moving=True)
+        candidates = planner.search(depth, dynamic_depth=int(dyn["depth"]),
+                                    beam=int(dyn.get("beam", 30)), **search)
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
     states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
+    speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
     for plan in candidates:
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
-                          config["sweep"]["pin_radius"], pc["model"], verify_cfg,
+                          config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
                           kernel=config["sweep"].get("kernel"))
         plan.verification = {"trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"]}

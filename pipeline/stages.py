@@ -147,8 +147,9 @@ def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progre
     from .lattice_store import load_lattice, save_lattice
     from .planning import plan_tight
     sweep, model = config["sweep"], config["planner"]["model"]
-    lattices = {0.0: load_lattice(catalog_root, part, model, 0.0, sweep["pin_radius"],
-                                  sweep.get("kernel"))}
+    speeds = [0.0] + [float(v) for v in config["planner"].get("dynamic", {}).get("speeds", [])]
+    lattices = {v: load_lattice(catalog_root, part, model, v, sweep["pin_radius"], sweep.get("kernel"))
+                for v in speeds}
     out = []
     for mu_c in plan_frictions(config):
         res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep, progress=progress)
@@ -202,7 +203,8 @@ def verify_part(plan_result: dict, config: dict) -> dict:
             continue
         mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
         res = verify_plan(part, plan, dict(zip(plan["pins"], plan["pin_heights_mm"])), states, mu,
-                          radius, plan_result["model"], config.get("verify", {}), kernel=kernel)
+                          radius, plan_result["model"], config.get("verify", {}), kernel=kernel,
+                          speeds=dict(zip(plan["pins"], plan["pin_speeds"])))
         res.pop("trials_detail")
         out["checks"].append({"kind": f"tight, mu_c {tight['friction']}", **res})
     if not out["checks"]:
