@@ -10,6 +10,7 @@ import json
 import math
 import re
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -42,13 +43,34 @@ def parse_values(text: str, what: str) -> np.ndarray:
 
 
 def _part_from_args(args):
+    """The part of ``--vertices`` or ``--outline`` (saying how many vertices a CAD outline gave)."""
     from .parts import Part, parse_vertices
-    return Part.from_vertices(parse_vertices(args.vertices), name=args.name)
+    if getattr(args, "outline", None):
+        from .outlines import read_outline
+        out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol)
+        print(f"outline {out.describe()}", file=sys.stderr)
+        name = args.name or re.sub(r"[^A-Za-z0-9_]", "_", Path(args.outline).stem) or "part"
+        return Part.from_vertices(out.vertices, name=name)
+    if getattr(args, "layer", None) or getattr(args, "id", None):
+        raise PinfeedError("--layer and --id pick an outline in an --outline file")
+    return Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
+
+
+def _add_outline_args(p, required=True):
+    """``--vertices`` or ``--outline FILE`` (with its choosers), and ``--name``."""
+    g = p.add_mutually_exclusive_group(required=required)
+    g.add_argument("--vertices", help='part outline "x0,y0 x1,y1 ..." (mm)')
+    g.add_argument("--outline", help="or a CAD outline: a .dxf or .svg file holding one closed outline")
+    p.add_argument("--layer", default=None, help="DXF layer of the outline (when the file holds several)")
+    p.add_argument("--id", default=None, help="SVG element id or DXF entity handle of the outline")
+    p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=0.05,
+                   help="chordal tolerance for flattening arcs and curves, mm (default 0.05)")
+    p.add_argument("--name", default=None, help="part name used in outputs (default: part, or the "
+                   "outline file's name)")
 
 
 def _add_physics(p, d_required=True):
-    p.add_argument("--vertices", required=True, help='part outline "x0,y0 x1,y1 ..." (mm)')
-    p.add_argument("--name", default="part", help="part name used in outputs")
+    _add_outline_args(p)
     p.add_argument("--mu-c", type=float, required=True, help="pin-part friction coefficient (>= 0)")
     p.add_argument("--pin-radius", type=float, required=True, help="pin radius (mm, > 0)")
     p.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"],
@@ -240,7 +262,7 @@ def cmd_sweep(args):
 def cmd_plan(args):
     from .config import load_config
     from .families import family_parts
-    from .parts import Part, parse_vertices
+    from .parts import Part
     from .stages import ensure_maps, plan_part, write_json
     config = load_config(args.config)
     if args.catalog:
@@ -261,8 +283,8 @@ def cmd_plan(args):
         dynamic["speeds"] = []
     if args.pins:
         config["planner"]["pins"] = [float(x) for x in parse_values(args.pins, "--pins")]
-    if args.vertices:
-        part = Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
+    if args.vertices or args.outline:
+        part = _part_from_args(args)
     elif args.part:
         found = [p for fam, spec in config["families"].items() for p in family_parts(fam, spec)
                  if args.part in (p.name, p.id)]
@@ -273,7 +295,7 @@ def cmd_plan(args):
             found = [Part.from_vertices(e["part_vertices"], name=e["part_name"])]
         part = found[0]
     else:
-        raise PinfeedError("give --part NAME or --vertices \"x0,y0 x1,y1 ...\"")
+        raise PinfeedError("give --part NAME, --vertices \"x0,y0 x1,y1 ...\" or --outline FILE")
     cat = ensure_maps(config, part)
     result = plan_part(cat, part.id, config)
     if args.out:
@@ -487,8 +509,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("plan", help="plan fixed pins for a part (computes missing maps)")
     p.add_argument("--part", default=None, help="part name or id from the config or catalog")
-    p.add_argument("--vertices", default=None, help='or a new outline "x0,y0 x1,y1 ..." (mm)')
-    p.add_argument("--name", default=None, help="name for --vertices (default part)")
+    _add_outline_args(p, required=False)
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
     p.add_argument("--mu-c", dest="mu_c", type=float, default=None, help="friction the plan assumes")

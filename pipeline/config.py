@@ -48,9 +48,21 @@ def _where(err) -> str:
     return path or "(top level)"
 
 
-def validate_config(config: dict) -> dict:
-    """Return a validated copy of ``config`` with defaults filled in."""
+def resolve_outlines(cfg: dict, base_dir) -> None:
+    """Make every relative ``outline`` path of an explicit part absolute,
+    relative to ``base_dir`` (the config file's folder)."""
+    for spec in (cfg.get("families") or {}).values():
+        for p in (spec.get("parts") or []) if isinstance(spec, dict) else []:
+            if isinstance(p, dict) and isinstance(p.get("outline"), str):
+                p["outline"] = str((Path(base_dir) / p["outline"]).resolve())
+
+
+def validate_config(config: dict, base_dir=None) -> dict:
+    """Return a validated copy of ``config`` with defaults filled in. Relative
+    outline paths are taken relative to ``base_dir`` (default: the working
+    directory)."""
     cfg = copy.deepcopy(config)
+    resolve_outlines(cfg, base_dir or Path.cwd())
     schema = _schema()
     validator = _fill_defaults(jsonschema.Draft202012Validator)(schema)
     errors = sorted(validator.iter_errors(cfg), key=lambda e: list(e.absolute_path))
@@ -101,7 +113,7 @@ def load_config(path=None) -> dict:
         raise PinfeedError(f"{path} is not valid YAML: {exc}".splitlines()[0]) from None
     if not isinstance(config, dict):
         raise PinfeedError(f"{path} must hold a YAML mapping of settings")
-    return validate_config(config)
+    return validate_config(config, base_dir=path.resolve().parent)
 
 
 def config_hash(config: dict) -> str:
