@@ -1,0 +1,89 @@
+"""Figure geometry: band rectangles, labels, legends (artists inspected, not pixels)."""
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+import xarray as xr  # noqa: E402
+
+from kernels.rollout import JAMMED, MISS, OK  # noqa: E402
+from pipeline.figures.bands import MIN_THICKNESS, band_maps_figure, draw_map_panel  # noqa: E402
+
+THETA = np.arange(360.0)
+
+
+def _synthetic_map():
+    """Band A: theta_f 100..106 from theta_i 0..119 and 103 from 260..299 (K_A two
+    arcs); band B: theta_f exactly 300 from 200..259 (zero width); misses and jams."""
+    tf = THETA.copy()
+    st = np.full(360, MISS, dtype=np.int8)
+    a1, b, a2, jam = slice(0, 120), slice(200, 260), slice(260, 300), slice(300, 330)
+    tf[a1], st[a1] = 100 + 0.05 * THETA[a1], OK
+    tf[b], st[b] = 300.0, OK
+    tf[a2], st[a2] = 103.0, OK
+    st[jam] = JAMMED
+    return tf, np.zeros(360), st
+
+
+def _rects(ax, prefix):
+    out = {}
+    for p in ax.patches:
+        gid = p.get_gid() or ""
+        if gid.startswith(prefix):
+            out.setdefault(gid, set()).add(tuple(np.round([p.get_x(), p.get_y(), p.get_width(),
+                                                           p.get_height()], 6)))
+    return out
+
+
+def test_band_rectangles_are_B_times_K():
+    fig, ax = plt.subplots()
+    tf, dy, st = _synthetic_map()
+    bands = draw_map_panel(ax, THETA, tf, dy, st, threshold_T=5.0, factor_c=2.0)
+    assert len(bands) == 2
+    rects = _rects(ax, "band")
+    # Each grid point stands for +-0.5 deg of theta_i; K_A's first arc starts at 0,
+    # so its left half-step wraps to 359.5..360.
+    k_a = [(359.5, 0.5), (-0.0, 119.5), (259.5, 40.0)]
+    assert rects["band 0"] == {(x, 100.0, w, 5.95) for x, w in k_a}
+    # Band B has zero width: drawn MIN_THICKNESS thick about 300.
+    assert rects["band 1"] == {(199.5, 300 - MIN_THICKNESS / 2, 60.0, MIN_THICKNESS)}
+    adjusted = _rects(ax, "adjusted")
+    assert {r[0] for r in adjusted["adjusted 0"]} == {x for x, _ in k_a}
+    for gid, rs in adjusted.items():
+        for x, y, w, h in rs:
+            assert h >= MIN_THICKNESS - 1e-9
+    b = bands[0]
+    (ys,) = {(r[1], r[3]) for r in adjusted["adjusted 0"]}
+    assert ys == pytest.approx((b.adj_start, b.adj_width), abs=1e-6)
+    # Distinguishable: the adjusted band is an unfilled hatched outline, the band filled.
+    band_patch = next(p for p in ax.patches if p.get_gid() == "band 0")
+    adj_patch = next(p for p in ax.patches if p.get_gid() == "adjusted 0")
+    assert adj_patch.get_hatch() and adj_patch.get_facecolor()[3] == 0 and band_patch.get_facecolor()[3] > 0
+    plt.close(fig)
+
+
+def _text_artists(fig):
+    return [t for t in fig.findobj(matplotlib.text.Text) if t.get_visible() and t.get_text()]
+
+
+def test_band_map_figure_labels_legend_and_ticks():
+    tf, dy, st = _synthetic_map()
+    ds = xr.Dataset({"theta_f": (("d", "theta_i"), np.vstack([tf, tf])),
+                     "dy": (("d", "theta_i"), np.vstack([dy, dy])),
+                     "status": (("d", "theta_i"), np.vstack([st, st]))},
+                    coords={"d": [-0.3, 0.3], "theta_i": THETA})
+    fig = band_maps_figure({"minpower": ds, "tip": ds}, [-0.3, 0.3], 5.0, 2.0, r"test, $\mu_c$ = 0.2")
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert labels[:2] == [r"band $B_j \times K_j$", r"adjusted band $m_j \pm 2\sigma_j$"]
+    assert "miss (no contact)" in labels and "jammed" in labels
+    colours = {h.get_label(): h.get_color() for h in fig.legends[0].legend_handles[2:]}
+    assert colours["miss (no contact)"] != colours["jammed"]
+    for t in _text_artists(fig):  # underscores only inside mathtext
+        outside = "".join(t.get_text().split("$")[::2])
+        assert "_" not in outside, t.get_text()
+    for ax in fig.axes:  # every panel row shows its tick labels
+        fig.canvas.draw()
+        assert all(lbl.get_visible() and lbl.get_text() for lbl in ax.get_xticklabels())
+        assert ax.get_xlabel() == r"$\theta_i$ (deg)"
+    plt.close(fig)
