@@ -87,3 +87,46 @@ def test_band_map_figure_labels_legend_and_ticks():
         assert all(lbl.get_visible() and lbl.get_text() for lbl in ax.get_xticklabels())
         assert ax.get_xlabel() == r"$\theta_i$ (deg)"
     plt.close(fig)
+
+
+# ---------------------------------------------------------------- sequence diagrams
+
+from pipeline.figures import text_problems  # noqa: E402
+from pipeline.figures.sequence import sequence_figure  # noqa: E402
+from pipeline.parts import Part  # noqa: E402
+
+
+def _sequence(speeds=None):
+    part = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
+    pins = {"P1": 5.0, "P2": 22.5, "P3": 12.5, "P3v+2": 12.5}
+    seq = ["P1", "P2", "P3v+2"] if speeds else ["P1", "P2", "P3"]
+    states = part.stable_states()
+    paths = {f"state {k}": [(th + 40 * j, y + 3 * j) for j in range(len(seq) + 1)]
+             for k, (th, y) in enumerate(states, start=1)}
+    plan = {"pins": seq, "final_sets": [{"start": 355.0, "width": 10.0}]}
+    return sequence_figure(part, plan, pins, paths, 3.0, "tri: best plan", speeds=speeds), paths
+
+
+@pytest.mark.parametrize("speeds", [None, {"P3v+2": 2.0}])
+def test_sequence_labels_never_overlap_nor_clip(speeds):
+    fig, paths = _sequence(speeds)
+    assert text_problems(fig) == []
+    texts = [t.get_text() for t in fig.findobj(matplotlib.text.Text)]
+    # Every pin labelled with its height in every row; every pose with its orientation.
+    assert texts.count("P2: 22.5 mm") == len(paths)
+    if speeds:
+        assert texts.count("P3v+2: 12.5 mm\n$v_{pin}$ = +2 $v_b$") == len(paths)
+    assert sum(t.startswith(r"$\theta$ = ") for t in texts) == sum(len(p) for p in paths.values())
+    assert "final orientation set(s): 355-5 deg" in fig._suptitle.get_text()
+    plt.close(fig)
+
+
+def test_text_problems_finds_an_overlap_and_a_clip():
+    fig, ax = plt.subplots(figsize=(3, 2))
+    ax.text(0.5, 0.5, "first label", transform=ax.transAxes)
+    ax.text(0.52, 0.5, "second label", transform=ax.transAxes)
+    fig.text(0.98, 0.5, "sticks out of the figure")
+    problems = text_problems(fig)
+    assert "overlap: 'first label' and 'second label'" in problems
+    assert "clipped: 'sticks out of the figure'" in problems
+    plt.close(fig)
