@@ -130,3 +130,22 @@ def test_text_problems_finds_an_overlap_and_a_clip():
     assert "overlap: 'first label' and 'second label'" in problems
     assert "clipped: 'sticks out of the figure'" in problems
     plt.close(fig)
+
+
+def test_sensor_figures_labels_never_overlap_nor_clip(monkeypatch):
+    from pipeline.figures import sensing as fs
+    from pipeline.sensing import Profile, Sensor
+    figs = []
+    monkeypatch.setattr(fs, "save_figure", lambda fig, out, **kw: figs.append(fig))
+    t = np.arange(0, 2, 1 / 200)
+    rng = np.random.default_rng(0)
+    sim = {f"state {k}": Profile(t, np.sin(k * t), np.cos(k * t)) for k in (1, 2, 3)}
+    meas = {k: Profile(t, p.fx + 0.05 * rng.normal(size=t.size), p.fy) for k, p in sim.items()}
+    fs.plot_profiles(sim, meas, Sensor(), "tri: force on the pin, sensor on P1 at y = 5 mm", "x.png")
+    table = {"labels": list(sim), "elements": 40, "accuracy": 0.9, "wrong": 0.1, "trials": 30,
+             "mean_scores": {s: {k: 30.0 if s == k else 20.0 for k in sim} for s in sim},
+             "groups": [["state 1"], ["state 2", "state 3"]]}
+    fs.plot_scores(table, "tri: sign-matrix scores", "y.png")
+    for fig in figs:
+        assert text_problems(fig) == []
+        plt.close(fig)

@@ -33,8 +33,9 @@ def text_problems(fig) -> list[str]:
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     page = fig.bbox
+    hidden = _undrawn_tick_labels(fig)
     texts = [t for t in fig.findobj(Text) if t.get_visible() and t.get_text().strip()
-             and t.figure is not None]
+             and id(t) not in hidden]
     boxes = [(t, t.get_window_extent(renderer)) for t in texts]
     problems = []
     for t, b in boxes:
@@ -50,3 +51,16 @@ def text_problems(fig) -> list[str]:
             if b.x0 + 0.5 < c.x1 and c.x0 + 0.5 < b.x1 and b.y0 + 0.5 < c.y1 and c.y0 + 0.5 < b.y1:
                 problems.append(f"overlap: {t.get_text()!r} and {u.get_text()!r}")
     return problems
+
+
+def _undrawn_tick_labels(fig) -> set:
+    """ids of tick labels matplotlib keeps but does not draw (ticks outside the view)."""
+    out = set()
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            lo, hi = sorted(axis.get_view_interval())
+            eps = 1e-9 * max(1.0, abs(hi - lo))
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                if not lo - eps <= tick.get_loc() <= hi + eps:
+                    out.update({id(tick.label1), id(tick.label2)})
+    return out
