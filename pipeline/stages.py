@@ -214,9 +214,21 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
         _sequence_figure(config, res, to_draw.get("with dynamic pins"), "best plan with dynamic pins",
                          out["sequence_dynamic"][k])
         verifications[name] = read_json(verify_path)
+        if out.get("verification_plans"):  # optional: one figure per part, its plans stacked
+            _verification_figure(verifications[name], out["verification_plans"][k])
     rows = verification_rows(verifications)
     plot_table(rows, "Verification of the best plans by perturbed full rollouts", out["verification"])
     Path(out["table"]).write_text(markdown_table(rows))
+
+
+def _verification_figure(result: dict, path):
+    """The verification figure of a part's first checked plan (``verify_part`` result)."""
+    from .figures.tables import plot_verification
+    if not result["checks"]:
+        _placeholder(path, f"{result['part']}: {result.get('note', 'nothing verified')}")
+        return
+    check = result["checks"][0]
+    plot_verification(check, f"{result['part']}: verification of the {check['kind']} plan", path)
 
 
 def _sequence_figure(config, res, plan, what, path):

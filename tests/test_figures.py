@@ -149,3 +149,28 @@ def test_sensor_figures_labels_never_overlap_nor_clip(monkeypatch):
     for fig in figs:
         assert text_problems(fig) == []
         plt.close(fig)
+
+
+# ---------------------------------------------------------------- verification
+
+
+def test_verification_figure_counts_and_highlights_failures():
+    from pipeline.figures.tables import verification_figure
+    check = {"plan": ["P1", "P4"], "rows": [
+        {"state": "state 1", "trials": 30, "successes": 30, "failures": 0, "reasons": {}},
+        {"state": "state 2", "trials": 30, "successes": 25, "failures": 5,
+         "reasons": {"other band": 3, "jammed (wedged)": 2}}]}
+    fig = verification_figure(check, "tri: best fixed-pin plan")
+    ax = fig.axes[0]
+    # Bar lengths per state: successes, then each reason, stacked to the trials.
+    widths = {}
+    for bar in ax.patches:
+        widths.setdefault(round(bar.get_y() + bar.get_height() / 2), []).append(bar.get_width())
+    assert sorted(widths[1]) == [0, 0, 30] and sorted(widths[0]) == [2, 3, 25]
+    texts = {t.get_text(): t for t in ax.texts}
+    assert texts["25/30"].get_color() == "tab:red" and texts["30/30"].get_color() == "black"
+    assert "5 of 60 trials failed" in ax.get_title()
+    red = {lbl.get_text() for lbl in ax.get_yticklabels() if lbl.get_color() == "tab:red"}
+    assert red == {"state 2"}
+    assert text_problems(fig) == []
+    plt.close(fig)
