@@ -331,6 +331,34 @@ def cmd_plan(args):
                     print(f"    {label}: {steps}")
 
 
+def cmd_animate(args):
+    """Animate a stored plan: every initial state past the pins on the moving belt."""
+    from .animate import animate_plan, plan_inputs
+    from .config import load_config
+    from .parts import Part
+    from .stages import read_json
+    config = load_config(args.config)
+    root = Path(args.catalog or config["catalog_dir"])
+    path = root / "plans" / f"{args.part}.json"
+    if not path.is_file():
+        raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
+                           f"{args.part} --out {path}' or the workflow ('make run') first")
+    result = read_json(path)
+    inputs = plan_inputs(result, args.plan, config)
+    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
+                       for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
+    print(f"animating plan {args.plan} of {part.name}: {pins}; {len(inputs['states'])} initial states",
+          flush=True)
+    done = animate_plan(part, inputs["heights"], inputs["speeds"], inputs["states"], inputs["mu_c"],
+                        inputs["model"], inputs["pin_radius"], args.out, labels=inputs["labels"],
+                        frames=args.frames, fps=args.fps,
+                        title=f"{part.name}: plan {args.plan}, pins {' → '.join(inputs['labels'])}")
+    outcomes = ", ".join(f"{k}: {v}" for k, v in done["outcomes"].items())
+    print(f"wrote {done['out']}: {done['frames']} frames over {done['belt_travel']:.0f} mm of belt "
+          f"travel ({outcomes})")
+
+
 PROFILE_FORMAT = """\
 A measured profile is a CSV file with three columns: time (s), F_x, F_y (the
 force on the pin along and across the belt, any one force unit: the sign
@@ -575,6 +603,16 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
+
+    p = sub.add_parser("animate", help="animate a stored plan: every initial state past the pins")
+    p.add_argument("--part", required=True, help="part name (its plan is CATALOG/plans/NAME.json)")
+    p.add_argument("--plan", type=int, default=1, help="which plan, 1 = the recommended one (default 1)")
+    p.add_argument("--out", required=True, help="animation file: .gif (Pillow) or .mp4 (needs ffmpeg)")
+    p.add_argument("--frames", type=int, default=120, help="number of frames (default 120)")
+    p.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    p.set_defaults(func=cmd_animate)
 
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")
