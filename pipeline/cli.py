@@ -108,6 +108,24 @@ def cmd_rollout(args):
         note = f"  ({r['jam_reason']})" if r["status"] == "jammed" else ""
         print(f"{r['theta_i']:8.2f} {r['status']:>9} {r['theta_f']:9.3f} {r['dy']:9.3f} "
               f"{r['contact_travel']:8.2f} {r['feature_changes']:7d} {r['peak_force']:7.3f}{note}")
+    if args.trajectory:
+        for r in rows:
+            _print_trajectory(r)
+
+
+def _print_trajectory(row, n_rows: int = 11):
+    """A short table of one rollout's trajectory: about ``n_rows`` evenly spaced samples."""
+    traj = np.asarray(row["trajectory"], float).reshape(-1, 4)
+    print(f"\ntrajectory of theta_i = {row['theta_i']:g} deg ({len(traj)} samples; "
+          f"--json gives them all): belt travel since first contact s, centroid displacement x, y, "
+          f"orientation theta")
+    if not len(traj):
+        print("  no contact: the part rides past the pin")
+        return
+    print(f"{'s (mm)':>9} {'x (mm)':>9} {'y (mm)':>9} {'theta (deg)':>12}")
+    for k in np.unique(np.linspace(0, len(traj) - 1, min(n_rows, len(traj))).round().astype(int)):
+        s_, x, y, th = traj[k]
+        print(f"{s_:9.2f} {x:9.3f} {y:9.3f} {th % 360:12.2f}")
 
 
 def cmd_map(args):
@@ -263,6 +281,7 @@ def cmd_plan(args):
     from .config import load_config
     from .families import family_parts
     from .parts import Part
+    from .bands import format_arcs
     from .stages import ensure_maps, plan_part, write_json
     config = load_config(args.config)
     if args.catalog:
@@ -316,7 +335,7 @@ def cmd_plan(args):
         return
     speeds = result["pin_speeds"]
     for k, plan in enumerate(result["plans"], start=1):
-        sets = ", ".join(f"[{s['start']:.1f}, {s['start'] + s['width']:.1f}] deg" for s in plan["final_sets"])
+        sets = format_arcs(plan["final_sets"])
         heights = ", ".join(f"{q}@{result['pins'][q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
                             for q in plan["pins"])
         after = " -> ".join(str(n) for n in plan["sets_after_each_pin"])
@@ -376,6 +395,14 @@ def _best_fixed_plan(plan_result: dict):
     return next((p for p in plan_result["plans"] if not p.get("n_dynamic_pins", 0)), None)
 
 
+def _plan_hint(config: dict, name: str, root) -> str:
+    """How to make the stored plan of ``name``: the workflow plans the config's
+    parts; a part planned from --vertices or --outline needs 'pinfeed plan'."""
+    if name in config["planner"]["parts"]:
+        return "run the workflow ('make run')"
+    return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
+
+
 def cmd_sense_classify(args):
     from pathlib import Path
 
@@ -416,8 +443,8 @@ def cmd_sense_classify(args):
         first_pin = _best_fixed_plan(plan)["pins"][0]
         y_pin, source = float(plan["pins"][first_pin]), f"first pin of the best fixed-pin plan {plan_path}"
     else:
-        raise PinfeedError(f"no stored sensor plan or plan for {name} under {root}; run the workflow "
-                           f"('make run') or give the sensor pin's height with --y-pin MM")
+        raise PinfeedError(f"no stored sensor plan or plan for {name} under {root}; "
+                           f"{_plan_hint(config, name, root)} or give the sensor pin's height with --y-pin MM")
     if stored is not None:
         sensor = Sensor.from_config(stored["sensor"])
         mu_c, model = float(stored["mu_c"]), stored["model"]
@@ -501,7 +528,8 @@ def _join_signed_values(argv):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="pinfeed", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="pinfeed", description="pinfeed: design part feeders that orient flat parts "
+                     "on a conveyor with overhead pins.")
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("rollout", help="roll a part past one pin for some initial orientations")

@@ -220,5 +220,6 @@ def final_for_verdict(sensing: dict, candidates) -> list[dict]:
 
 
 def describe_sets(sets) -> str:
-    return ", ".join(f"[{s['start']:.1f}, {s['start'] + s['width']:.1f}] deg"
-                     for s in sets)
+    """Final sets for people: ``223.1-232.2 deg, ...`` (see ``bands.format_arcs``)."""
+    from .bands import format_arcs
+    return format_arcs(sets)

@@ -21,6 +21,7 @@ from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, JAMMED, MI
 from .bands import in_arc
 from .parts import Part
 from .planner import merge_arcs
+from .progress import progress
 
 PERTURB_DEFAULTS = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 DEFAULTS = {"trials": 30, **PERTURB_DEFAULTS, "seed": 1}
@@ -54,18 +55,21 @@ def _expects_contact(plan: dict, label: str, k: int, start_arc) -> bool:
 
 def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c: float,
                 pin_radius: float, model: str = "minpower", settings: dict | None = None,
-                speeds: dict | None = None) -> dict:
+                speeds: dict | None = None, show_progress: bool = True) -> dict:
     """Run the trials for a plan (as stored: ``Plan.to_dict()``); returns per-state
     counts and every trial's outcome. ``speeds`` gives the speed ratio
     v_pin / v_b of each dynamic pin's label (absent: a static pin); the
-    perturbation of a dynamic pin's position shifts its whole path."""
+    perturbation of a dynamic pin's position shifts its whole path.
+    ``show_progress``: a bar on a terminal, a line per tenth in logs (stderr)."""
     speeds = speeds or {}
     cfg = dict(DEFAULTS, **(settings or {}))
     rng = np.random.default_rng(cfg["seed"])
     prep = part.prepared()
     model_code = MODEL_NAMES.index(model)
     rows, trials = [], []
-    for label, state in initial_states.items():
+    for label, state in progress(initial_states.items(), len(initial_states),
+                                 f"verify {' '.join(plan['pins'])}", unit="initial state",
+                                 enabled=show_progress):
         finals = _predicted_sets(plan, label)
         counts = {"state": label, "trials": 0, "successes": 0, "failures": 0, "reasons": {}}
         for _ in range(int(cfg["trials"])):
