@@ -277,3 +277,17 @@ def plan_inputs(result: dict, plan_index: int, config: dict) -> dict:
     return {"labels": labels, "heights": heights, "speeds": speeds, "states": states,
             "mu_c": float(result["mu_c"]), "model": result["model"],
             "pin_radius": float(result.get("pin_radius", config["sweep"]["pin_radius"]))}
+
+
+def animate_stored(result: dict, config: dict, out, plan_index: int = 1, frames: int = 120,
+                   fps: int = 20) -> dict:
+    """Animate plan ``plan_index`` of a stored plan result (what ``pinfeed animate``
+    and a workflow rule call). Returns :func:`animate_plan`'s summary plus the inputs."""
+    from .parts import Part
+    inputs = plan_inputs(result, plan_index, config)
+    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    done = animate_plan(part, inputs["heights"], inputs["speeds"], inputs["states"], inputs["mu_c"],
+                        inputs["model"], inputs["pin_radius"], out, labels=inputs["labels"],
+                        frames=frames, fps=fps,
+                        title=f"{part.name}: plan {plan_index}, pins {' → '.join(inputs['labels'])}")
+    return {**done, **inputs}

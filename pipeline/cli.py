@@ -352,9 +352,8 @@ def cmd_plan(args):
 
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
-    from .animate import animate_plan, plan_inputs
+    from .animate import animate_stored, plan_inputs
     from .config import load_config
-    from .parts import Part
     from .stages import read_json
     config = load_config(args.config)
     root = Path(args.catalog or config["catalog_dir"])
@@ -363,16 +362,12 @@ def cmd_animate(args):
         raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
                            f"{args.part} --out {path}' or the workflow ('make run') first")
     result = read_json(path)
-    inputs = plan_inputs(result, args.plan, config)
-    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
     pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
                        for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
-    print(f"animating plan {args.plan} of {part.name}: {pins}; {len(inputs['states'])} initial states",
+    print(f"animating plan {args.plan} of {args.part}: {pins}; {len(inputs['states'])} initial states",
           flush=True)
-    done = animate_plan(part, inputs["heights"], inputs["speeds"], inputs["states"], inputs["mu_c"],
-                        inputs["model"], inputs["pin_radius"], args.out, labels=inputs["labels"],
-                        frames=args.frames, fps=args.fps,
-                        title=f"{part.name}: plan {args.plan}, pins {' → '.join(inputs['labels'])}")
+    done = animate_stored(result, config, args.out, args.plan, frames=args.frames, fps=args.fps)
     outcomes = ", ".join(f"{k}: {v}" for k, v in done["outcomes"].items())
     print(f"wrote {done['out']}: {done['frames']} frames over {done['belt_travel']:.0f} mm of belt "
           f"travel ({outcomes})")
