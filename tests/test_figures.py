@@ -86,6 +86,25 @@ def test_band_map_figure_labels_legend_and_ticks():
         fig.canvas.draw()
         assert all(lbl.get_visible() and lbl.get_text() for lbl in ax.get_xticklabels())
         assert ax.get_xlabel() == r"$\theta_i$ (deg)"
+    from pipeline.figures import text_problems
+    assert text_problems(fig) == []
+    plt.close(fig)
+
+
+@pytest.mark.parametrize("n_d, ncols", [(4, 2), (18, 6), (1, 6)])
+def test_map_figure_fits_its_labels(n_d, ncols):
+    from pipeline.figures import text_problems
+    from pipeline.figures.maps import map_figure
+    tf, dy, st = _synthetic_map()
+    ds = xr.Dataset({"theta_f": (("d", "theta_i"), np.tile(tf, (n_d, 1))),
+                     "dy": (("d", "theta_i"), np.tile(dy, (n_d, 1))),
+                     "status": (("d", "theta_i"), np.tile(st, (n_d, 1)))},
+                    coords={"d": np.linspace(-0.9, 0.9, n_d), "theta_i": THETA},
+                    attrs={"part_name": "asym_triangle", "model": "minpower", "mu_c": 0.15,
+                           "pin_radius": 3.0, "length_unit": "mm"})
+    fig = map_figure(ds, ncols, bands=(5.0, 2.0))
+    assert text_problems(fig) == []
+    assert len([ax for ax in fig.axes if ax.get_visible()]) == n_d
     plt.close(fig)
 
 

@@ -9,6 +9,7 @@ degrees thick so that a band of identical theta_f (zero width) still shows.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -93,6 +94,16 @@ def legend_handles(factor_c: float, statuses) -> list:
     return handles
 
 
+def bottom_legend(fig, handles) -> float:
+    """A legend under the panels, wrapped into as many rows as the figure's width
+    needs; returns the fraction of the height it takes (for ``tight_layout``'s rect)."""
+    width = fig.get_size_inches()[0]
+    per_row = max(1, min(len(handles), int(width // 2.3)))
+    rows = math.ceil(len(handles) / per_row)
+    fig.legend(handles=handles, loc="lower center", ncol=per_row, fontsize=8, frameon=False)
+    return (0.28 * rows + 0.1) / fig.get_size_inches()[1]
+
+
 def plot_band_maps(maps_by_model: dict, d_values, threshold_T, factor_c, title, out) -> Path:
     """``maps_by_model``: row label (a model, or a pin speed; mathtext allowed) ->
     Dataset with dims (d, theta_i). Rows: those labels; columns: d."""
@@ -102,8 +113,8 @@ def plot_band_maps(maps_by_model: dict, d_values, threshold_T, factor_c, title, 
 def band_maps_figure(maps_by_model: dict, d_values, threshold_T, factor_c, title):
     """The figure of :func:`plot_band_maps`, unsaved."""
     rows = list(maps_by_model)
-    fig, axes = plt.subplots(len(rows), len(d_values), figsize=(2.5 * len(d_values) + 0.8,
-                             2.6 * len(rows) + 1.2), sharex=True, sharey=True, squeeze=False)
+    fig, axes = plt.subplots(len(rows), len(d_values), figsize=(max(2.5 * len(d_values) + 0.8, 7.0),
+                             2.6 * len(rows) + 1.5), sharex=True, sharey=True, squeeze=False)
     seen = set()
     for r, label in enumerate(rows):
         ds = maps_by_model[label]
@@ -119,8 +130,7 @@ def band_maps_figure(maps_by_model: dict, d_values, threshold_T, factor_c, title
             ax.set_xlabel(r"$\theta_i$ (deg)", fontsize=8)
             if c == 0:
                 ax.set_ylabel(r"$\theta_f$ (deg)", fontsize=8)
-    fig.legend(handles=legend_handles(factor_c, seen), loc="lower center", ncol=6, fontsize=8,
-               frameon=False)
+    bottom = bottom_legend(fig, legend_handles(factor_c, seen))
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout(rect=(0, 0.06, 1, 0.95))
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     return fig

@@ -9,17 +9,22 @@ import numpy as np
 import xarray as xr
 
 from . import circle_axes, save_figure
-from .bands import POINTS, draw_map_panel, legend_handles
+from .bands import POINTS, bottom_legend, draw_map_panel, legend_handles
 
 
 def plot_map(ds: xr.Dataset, out, ncols: int = 6, bands: tuple[float, float] | None = None) -> Path:
     """Draw every ``d`` of a map set and save to ``out`` (PNG, PDF, SVG...).
     ``bands``: ``(threshold_T, factor_c)`` also draws the bands B_j x K_j."""
+    return save_figure(map_figure(ds, ncols, bands), out)
+
+
+def map_figure(ds: xr.Dataset, ncols: int = 6, bands: tuple[float, float] | None = None):
+    """The figure of :func:`plot_map`, unsaved."""
     d_values = np.atleast_1d(ds["d"].values)
     n = d_values.size
     ncols = min(ncols, n)
     nrows = math.ceil(n / ncols)
-    fig, axes = plt.subplots(nrows, ncols, figsize=(2.4 * ncols + 0.6, 2.4 * nrows + 0.9),
+    fig, axes = plt.subplots(nrows, ncols, figsize=(max(2.5 * ncols + 0.7, 7.0), 2.6 * nrows + 1.4),
                              sharex=True, sharey=True, squeeze=False)
     theta_i = ds["theta_i"].values
     seen = set()
@@ -50,9 +55,9 @@ def plot_map(ds: xr.Dataset, out, ncols: int = 6, bands: tuple[float, float] | N
     attrs = ds.attrs
     unit = attrs.get("length_unit", "")
     handles = legend_handles(bands[1], seen) if bands else legend_handles(0, seen)[2:]
-    fig.suptitle(f"Configuration maps: {attrs.get('part_name', 'part')}, model {attrs.get('model', '?')}, "
+    fig.suptitle(f"Configuration maps: {attrs.get('part_name', 'part')}\nmodel {attrs.get('model', '?')}, "
                  f"$\\mu_c$ = {attrs.get('mu_c', float('nan')):g}, pin radius "
                  f"{attrs.get('pin_radius', float('nan')):g} {unit}", fontsize=10)
-    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
-    fig.tight_layout(rect=(0, 0.05, 1, 0.95))
-    return save_figure(fig, out)
+    bottom = bottom_legend(fig, handles)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
+    return fig
