@@ -60,10 +60,10 @@ def _add_outline_args(p, required=True):
     """``--vertices`` or ``--outline FILE`` (with its choosers), and ``--name``."""
     g = p.add_mutually_exclusive_group(required=required)
     g.add_argument("--vertices", help='part outline "x0,y0 x1,y1 ..." (mm)')
-    g.add_argument("--outline", help="or a CAD outline: a .dxf or .svg file holding one closed outline")
-    p.add_argument("--layer", default=None, help="DXF layer of the outline (when the file holds several)")
+    g.add_argument("--outline", metavar="FILE", help="or a CAD outline: a .dxf or .svg file holding one closed outline")
+    p.add_argument("--layer", default=None, metavar="NAME", help="DXF layer of the outline (when the file holds several)")
     p.add_argument("--id", default=None, help="SVG element id or DXF entity handle of the outline")
-    p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=0.05,
+    p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=0.05, metavar="MM",
                    help="chordal tolerance for flattening arcs and curves, mm (default 0.05)")
     p.add_argument("--name", default=None, help="part name used in outputs (default: part, or the "
                    "outline file's name)")
@@ -531,7 +531,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_physics(p)
     p.add_argument("--theta-i", required=True, help="initial orientations, degrees: 'a,b,c' or 'start:stop:step'")
     p.add_argument("--d", type=float, required=True, help="contact parameter (y_pin - y_com)/a")
-    p.add_argument("--trajectory", action="store_true", help="include trajectory and force history")
+    p.add_argument("--trajectory", action="store_true", help="also show the trajectory: a short table, or every sample and the "
+                   "force history with --json")
     p.add_argument("--max-travel", type=float, default=None,
                    help="stop after this belt travel since first contact (mm): status truncated")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
