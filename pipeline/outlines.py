@@ -140,10 +140,10 @@ def _svg_pieces(path: Path, want_id, tol) -> list[_Piece]:
         label = f"<{type(el).__name__.lower()} id={eid!r}>" if eid else f"{type(el).__name__.lower()} #{k}"
         shape = se.Path(el)
         shape.reify()  # bake the transform into the coordinates
-        for sub, closed in _subpaths(shape, tol / mm_per_px):
-            if len(sub) >= 2:
-                pts = np.array(sub, dtype=float) * mm_per_px * np.array([1.0, -1.0])
-                pieces.append(_Piece(pts, label, closed))
+        subs = [(sub, closed) for sub, closed in _subpaths(shape, tol / mm_per_px) if len(sub) >= 2]
+        for i, (sub, closed) in enumerate(subs, start=1):
+            pts = np.array(sub, dtype=float) * mm_per_px * np.array([1.0, -1.0])
+            pieces.append(_Piece(pts, label + (f" subpath {i}" if len(subs) > 1 else ""), closed))
     return pieces
 
 

@@ -222,13 +222,12 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
 
 
 def _verification_figure(result: dict, path):
-    """The verification figure of a part's first checked plan (``verify_part`` result)."""
+    """The verification figure of a part: every checked plan (``verify_part`` result)."""
     from .figures.tables import plot_verification
     if not result["checks"]:
         _placeholder(path, f"{result['part']}: {result.get('note', 'nothing verified')}")
         return
-    check = result["checks"][0]
-    plot_verification(check, f"{result['part']}: verification of the {check['kind']} plan", path)
+    plot_verification(result["checks"], f"{result['part']}: verification by perturbed rollouts", path)
 
 
 def _sequence_figure(config, res, plan, what, path):

@@ -175,12 +175,14 @@ def test_sensor_figures_labels_never_overlap_nor_clip(monkeypatch):
 
 def test_verification_figure_counts_and_highlights_failures():
     from pipeline.figures.tables import verification_figure
-    check = {"plan": ["P1", "P4"], "rows": [
+    ok = {"kind": "fixed pins", "plan": ["P1", "P4"], "rows": [
+        {"state": "state 1", "trials": 30, "successes": 30, "failures": 0, "reasons": {}}]}
+    bad = {"kind": "with dynamic pins", "plan": ["P1", "P4v+2"], "rows": [
         {"state": "state 1", "trials": 30, "successes": 30, "failures": 0, "reasons": {}},
         {"state": "state 2", "trials": 30, "successes": 25, "failures": 5,
          "reasons": {"other band": 3, "jammed (wedged)": 2}}]}
-    fig = verification_figure(check, "tri: best fixed-pin plan")
-    ax = fig.axes[0]
+    fig = verification_figure([ok, bad], "tri: verification")
+    ax_ok, ax = fig.axes
     # Bar lengths per state: successes, then each reason, stacked to the trials.
     widths = {}
     for bar in ax.patches:
@@ -188,8 +190,11 @@ def test_verification_figure_counts_and_highlights_failures():
     assert sorted(widths[1]) == [0, 0, 30] and sorted(widths[0]) == [2, 3, 25]
     texts = {t.get_text(): t for t in ax.texts}
     assert texts["25/30"].get_color() == "tab:red" and texts["30/30"].get_color() == "black"
-    assert "5 of 60 trials failed" in ax.get_title()
+    assert ax.get_title() == "with dynamic pins: pins P1 → P4v+2: 5 of 60 trials failed"
+    assert ax_ok.get_title().endswith("all 30 trials succeeded") and ax_ok.title.get_color() == "black"
     red = {lbl.get_text() for lbl in ax.get_yticklabels() if lbl.get_color() == "tab:red"}
     assert red == {"state 2"}
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert legend == ["success", "failure: jammed (wedged)", "failure: other band"]
     assert text_problems(fig) == []
     plt.close(fig)

@@ -184,3 +184,10 @@ def test_cli_rollout_from_outline(tmp_path, capsys):
     assert main(["rollout", "--outline", str(tmp_path / "nope.svg"), "--mu-c", "0.2",
                  "--pin-radius", "3", "--theta-i", "30", "--d", "0.3"]) == 2
     assert capsys.readouterr().err.startswith("pinfeed: error: no outline file")
+
+
+def test_svg_hole_is_refused_and_named(tmp_path):
+    body = '<path id="ring" fill-rule="evenodd" d="M0,0 H40 V40 H0 Z M10,10 H20 V20 H10 Z"/>'
+    with pytest.raises(OutlineError, match=r"outline <path id='ring'> subpath 1 has 1 hole\(s\) "
+                                           r"\(<path id='ring'> subpath 2\)"):
+        read_outline(_svg(tmp_path / "ring.svg", body))

@@ -54,26 +54,40 @@ SUCCESS_COLOUR = "tab:green"
 REASON_COLOURS = ["tab:red", "tab:orange", "tab:purple", "tab:brown", "tab:pink", "tab:olive"]
 
 
-def verification_figure(check: dict, title: str):
-    """One plan's verification (a ``verify_plan`` result): a bar per initial
-    state split into successes and failures by reason, ``successes/trials``
-    written beside it, failing states' labels in red."""
-    rows = check["rows"]
-    reasons = sorted({k for r in rows for k in r["reasons"]})
+def verification_figure(checks, title: str):
+    """Verification of one or more plans (``verify_plan`` results, each optionally
+    with a ``kind``): per plan, a bar per initial state split into successes and
+    failures by reason, ``successes/trials`` beside it, failing states in red."""
+    checks = [checks] if isinstance(checks, dict) else list(checks)
+    reasons = sorted({k for c in checks for r in c["rows"] for k in r["reasons"]})
     colours = dict(zip(reasons, REASON_COLOURS * (1 + len(reasons) // len(REASON_COLOURS))))
-    fig, ax = plt.subplots(figsize=(7.5, 0.55 * len(rows) + 1.9))
+    heights = [0.5 * len(c["rows"]) + 0.9 for c in checks]
+    fig, axes = plt.subplots(len(checks), 1, figsize=(7.5, sum(heights) + 0.6 + 0.25 * (len(reasons) + 1)),
+                             squeeze=False, gridspec_kw={"height_ratios": heights})
+    for ax, check in zip(axes[:, 0], checks):
+        _verification_bars(ax, check, colours)
+    handles = [plt.Rectangle((0, 0), 1, 1, color=SUCCESS_COLOUR, label="success")]
+    handles += [plt.Rectangle((0, 0), 1, 1, color=colours[r], label=f"failure: {r}") for r in reasons]
+    fig.legend(handles=handles, loc="lower center", ncol=min(3, len(handles)), fontsize=7, frameon=False)
+    fig.suptitle(title, fontsize=10)
+    rows = 1 + len(handles) // 3
+    fig.tight_layout(rect=(0, (0.22 * rows + 0.05) / fig.get_size_inches()[1], 1, 1))
+    return fig
+
+
+def _verification_bars(ax, check: dict, colours: dict):
+    rows = check["rows"]
     y = list(range(len(rows)))[::-1]
-    ax.barh(y, [r["successes"] for r in rows], color=SUCCESS_COLOUR, label="success", height=0.6)
-    left = [r["successes"] for r in rows]
-    for reason in reasons:
-        n = [r["reasons"].get(reason, 0) for r in rows]
-        ax.barh(y, n, left=left, color=colours[reason], label=f"failure: {reason}", height=0.6)
-        left = [a + b for a, b in zip(left, n)]
+    left = [0] * len(rows)
+    for name, colour, counts in [("success", SUCCESS_COLOUR, [r["successes"] for r in rows])] + [
+            (reason, colours[reason], [r["reasons"].get(reason, 0) for r in rows]) for reason in colours]:
+        ax.barh(y, counts, left=left, color=colour, height=0.6)
+        left = [a + b for a, b in zip(left, counts)]
     most = max([r["trials"] for r in rows] + [1])
     for yy, r in zip(y, rows):
+        bad = r["failures"] > 0
         ax.text(r["trials"] + 0.01 * most, yy, f"{r['successes']}/{r['trials']}", va="center", fontsize=8,
-                color="tab:red" if r["failures"] else "black",
-                fontweight="bold" if r["failures"] else "normal")
+                color="tab:red" if bad else "black", fontweight="bold" if bad else "normal")
     ax.set_yticks(y, [r["state"] for r in rows], fontsize=8)
     for lbl, r in zip(ax.get_yticklabels(), rows):
         if r["failures"]:
@@ -84,14 +98,11 @@ def verification_figure(check: dict, title: str):
     failed = sum(r["failures"] for r in rows)
     total = sum(r["trials"] for r in rows)
     verdict = f"{failed} of {total} trials failed" if failed else f"all {total} trials succeeded"
-    ax.set_title(f"{title}\npins {' → '.join(check['plan'])}: {verdict}", fontsize=9,
+    kind = f"{check['kind']}: " if check.get("kind") else ""
+    ax.set_title(f"{kind}pins {' → '.join(check['plan'])}: {verdict}", fontsize=9,
                  color="tab:red" if failed else "black")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.35 if len(rows) < 3 else -0.2), ncol=2,
-              fontsize=7, frameon=False)
-    fig.tight_layout()
-    return fig
 
 
-def plot_verification(check: dict, title: str, out) -> Path:
+def plot_verification(checks, title: str, out) -> Path:
     """Save :func:`verification_figure`."""
-    return save_figure(verification_figure(check, title), out)
+    return save_figure(verification_figure(checks, title), out)
