@@ -152,13 +152,19 @@ def pin_height(lane: Lane, k: int, b: float, h: float, v: float, station: float)
     return h + v * (b + lane.lead[k] - station)
 
 
+DPI = 80
+
+
 def animate_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, out,
                  labels=None, frames: int = 120, fps: int = 20, title: str | None = None) -> dict:
     """Write the animation to ``out`` (.gif through Pillow; .mp4 needs ffmpeg).
-    Returns ``{"out", "frames", "belt_travel"}``."""
+    Returns ``{"out", "frames", "belt_travel", "outcomes"}``.
+
+    The still parts (axes, fence, fixed pins, labels) are drawn once into an
+    image; each frame draws only the moving ones over it, in pixel coordinates
+    taken from the still figure's transforms, so long animations stay quick."""
     import matplotlib.pyplot as plt
     from matplotlib import animation
-    from matplotlib.patches import Circle, Polygon
 
     from .figures import save_figure  # noqa: F401 (selects the Agg backend)
     out = Path(out)
@@ -172,13 +178,32 @@ def animate_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, o
         raise PinfeedError(f"--frames must be at least 2 and --fps at least 1, got {frames} and {fps}")
     labels = labels or [f"P{k + 1}" for k in range(len(heights))]
     lanes, stations, b_end = roll_plan(part, heights, speeds, states, mu_c, model, pin_radius)
+    still, panes = _still_figure(part, lanes, stations, heights, speeds, labels, pin_radius, b_end,
+                                 title or f"{part.name}: pins {' → '.join(labels)}")
+    fig, draw = _moving_figure(part, still, panes, stations, heights, speeds, pin_radius)
+    plt.close(still)
+    B = np.linspace(0.0, b_end, int(frames))
+    anim = animation.FuncAnimation(fig, lambda i: draw(B[i]), frames=len(B), blit=False)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    writer = animation.PillowWriter(fps=fps) if suffix == ".gif" else animation.FFMpegWriter(fps=fps)
+    anim.save(str(out), writer=writer, dpi=DPI)
+    plt.close(fig)
+    return {"out": str(out), "frames": int(len(B)), "belt_travel": float(b_end),
+            "outcomes": {ln.label: ln.outcome for ln in lanes}}
+
+
+def _still_figure(part, lanes, stations, heights, speeds, labels, pin_radius, b_end, title):
+    """The figure without moving parts; returns it and, per lane, ``(lane, axes, y_low)``."""
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle
     a = part.a
     ys = [y for ln in lanes for y in ln.y] + list(heights)
     lo, hi = min(ys + [0.0]) - 1.3 * a, max(ys) + 1.3 * a
     x_lo, x_hi = -1.5 * a, b_end + 1.5 * a
     lane_h = max(1.6, 9.0 * (hi - lo) / (x_hi - x_lo))
-    fig, axes = plt.subplots(len(lanes), 1, figsize=(9.0, lane_h * len(lanes) + 1.0), squeeze=False)
-    artists = []
+    fig, axes = plt.subplots(len(lanes), 1, figsize=(9.0, lane_h * len(lanes) + 1.0), squeeze=False,
+                             dpi=DPI)
+    panes = []
     for ax, lane in zip(axes[:, 0], lanes):
         ax.set_xlim(x_lo, x_hi)
         ax.set_ylim(lo, hi)
@@ -189,52 +214,76 @@ def animate_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, o
         ax.text(x_lo + 0.1 * a, 0.0, "fence", fontsize=7, va="bottom")
         ax.set_ylabel(f"{lane.label}\n$y$ (mm)", fontsize=8)
         ax.tick_params(labelsize=7)
-        marks, = ax.plot([], [], "|", color="0.75", ms=6)  # belt texture: shows it moving
-        pins = []
         for k, (h, v, x) in enumerate(zip(heights, speeds, stations)):
-            c = Circle((x, h), pin_radius, color="tab:purple" if v else "tab:red", zorder=3)
-            ax.add_patch(c)
-            pins.append(c)
+            colour = "tab:purple" if v else "tab:red"
+            if not v:  # moving pins are drawn frame by frame
+                ax.add_patch(Circle((x, h), pin_radius, color=colour, zorder=3))
+            ax.axvline(x, color=colour, lw=0.4, ls=":", zorder=0)
             ax.text(x, 1.02, f"{labels[k]}: {h:g} mm" + (f", $v_{{pin}}$ = {v:+g} $v_b$" if v else ""),
-                    transform=ax.get_xaxis_transform(), ha="center", va="bottom", fontsize=7,
-                    color=c.get_facecolor())
-        body = Polygon(_rotated(part.vertices, lane.theta[0]), closed=True, fc="tab:blue", ec="k",
-                       alpha=0.7, zorder=2)
-        ax.add_patch(body)
-        note = ax.text(0.99, 0.04, "", transform=ax.transAxes, ha="right", fontsize=7)
-        artists.append((lane, body, pins, marks, note))
+                    transform=ax.get_xaxis_transform(), ha="center", va="bottom", fontsize=7, color=colour)
+        panes.append((lane, ax, lo))
     axes[-1, 0].set_xlabel("along the belt $x$ (mm), belt moving to the right", fontsize=8)
-    clock = fig.text(0.01, 0.99, "", ha="left", va="top", fontsize=9, family="monospace")
-    fig.suptitle(title or f"{part.name}: pins {' → '.join(labels)}", fontsize=9)
+    fig.suptitle(title, fontsize=9)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
-    B = np.linspace(0.0, b_end, int(frames))
+    fig.canvas.draw()
+    return fig, panes
 
-    def draw(i):
-        b = B[i]
+
+def _moving_figure(part, still, panes, stations, heights, speeds, pin_radius):
+    """A figure showing the still one as an image, and ``draw(b)`` that poses the
+    moving artists (parts, moving pins, belt marks, notes, clock) at belt travel b."""
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Polygon, Rectangle
+    a = part.a
+    w, h = still.canvas.get_width_height()
+    image = np.asarray(still.canvas.buffer_rgba()).copy()
+    fig = plt.figure(figsize=(w / DPI, h / DPI), dpi=DPI)
+    bg = fig.add_axes((0, 0, 1, 1))
+    bg.imshow(image, extent=(0, w, 0, h), origin="upper", interpolation="nearest")
+    bg.set_xlim(0, w)
+    bg.set_ylim(0, h)
+    bg.axis("off")
+    movers = []
+    for lane, ax, lo in panes:
+        to_px = ax.transData.frozen()  # lane data (mm) -> pixels of the still figure
+        scale = to_px.transform((1.0, 0.0))[0] - to_px.transform((0.0, 0.0))[0]
+        (x0, y0), (x1, y1) = ax.bbox.get_points()
+        clip = Rectangle((x0, y0), x1 - x0, y1 - y0, transform=bg.transData, visible=False)
+        bg.add_patch(clip)
+        body = Polygon(np.zeros((3, 2)), closed=True, fc="tab:blue", ec="k", alpha=0.7, zorder=2)
+        bg.add_patch(body)
+        body.set_clip_path(clip)
+        pins = {}
+        for k, v in enumerate(speeds):
+            if v:
+                pins[k] = Circle((0, 0), pin_radius * scale, color="tab:purple", zorder=3)
+                bg.add_patch(pins[k])
+                pins[k].set_clip_path(clip)
+        marks, = bg.plot([], [], "|", color="0.6", ms=6)
+        marks.set_clip_path(clip)
+        note = bg.text(x1 - 4, y0 + 4, "", ha="right", va="bottom", fontsize=7)
+        x_lo, x_hi = ax.get_xlim()
+        movers.append((lane, to_px, body, pins, marks, note, lo, x_lo, x_hi))
+    clock = fig.text(0.01, 0.99, "", ha="left", va="top", fontsize=9, family="monospace")
+
+    def draw(b):
         clock.set_text(f"belt travel {b:6.1f} mm")
-        changed = [clock]
-        for lane, body, pins, marks, note in artists:
+        for lane, to_px, body, pins, marks, note, lo, x_lo, x_hi in movers:
             x, y, th = lane.pose(b)
-            body.set_xy(_rotated(part.vertices, th) + np.array([x, y]))
-            for k, (pin, h, v, st) in enumerate(zip(pins, heights, speeds, stations)):
-                if v:
-                    pin.center = (st, pin_height(lane, k, b, h, v, st))
-            ticks = np.arange((b % (0.5 * a)) + x_lo, x_hi, 0.5 * a)
-            marks.set_data(ticks, np.full_like(ticks, lo + 0.15 * a))
+            body.set_xy(to_px.transform(_rotated(part.vertices, th) + np.array([x, y])))
+            for k, pin in pins.items():
+                pin.center = tuple(to_px.transform((stations[k], pin_height(
+                    lane, k, b, heights[k], speeds[k], stations[k]))))
+            ticks = np.arange((b % (0.5 * a)) + x_lo, x_hi, 0.5 * a)  # the belt's texture moves with it
+            px = to_px.transform(np.column_stack([ticks, np.full_like(ticks, lo + 0.15 * a)]))
+            marks.set_data(px[:, 0], px[:, 1])
             done = b >= lane.B[-1]
-            note.set_text(lane.outcome if lane.outcome != "ok" and done
-                          else (rf"$\theta$ = {th % 360:.1f}°" if done else ""))
-            note.set_color("tab:red" if lane.outcome != "ok" else "black")
-            changed += [body, marks, note, *pins]
-        return changed
+            jammed = lane.outcome != "ok"
+            note.set_text(lane.outcome if jammed and done else (rf"$\theta$ = {th % 360:.1f}°" if done else ""))
+            note.set_color("tab:red" if jammed else "black")
+        return []
 
-    anim = animation.FuncAnimation(fig, draw, frames=len(B), blit=False)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    writer = animation.PillowWriter(fps=fps) if suffix == ".gif" else animation.FFMpegWriter(fps=fps)
-    anim.save(str(out), writer=writer, dpi=80)
-    plt.close(fig)
-    return {"out": str(out), "frames": int(len(B)), "belt_travel": float(b_end),
-            "outcomes": {ln.label: ln.outcome for ln in lanes}}
+    return fig, draw
 
 
 # ---------------------------------------------------------------- stored plans
