@@ -198,3 +198,18 @@ def test_verification_figure_counts_and_highlights_failures():
     assert legend == ["success", "failure: jammed (wedged)", "failure: other band"]
     assert text_problems(fig) == []
     plt.close(fig)
+
+
+def test_outline_figure_fences_touch_the_part():
+    from pipeline.figures.outline import outline_figure
+    part = Part.from_vertices([[0, 0], [60, 0], [60, 10], [10, 10], [10, 40], [0, 40]], name="bracket")
+    fig = outline_figure(part, "cad/bracket.dxf")
+    fences = {ln.get_gid(): np.transpose(ln.get_data()) for ln in fig.axes[0].lines if ln.get_gid()}
+    assert len(fences) == len(part.stable_states()) == 3
+    for k, (_, y_c) in enumerate(part.stable_states(), start=1):
+        foot = fences[f"fence {k}"].mean(axis=0)
+        n = foot / np.linalg.norm(foot)
+        # The fence is y_c from the centroid and touches the outline without cutting it.
+        assert np.linalg.norm(foot) == pytest.approx(y_c) and (part.vertices @ n).max() == pytest.approx(y_c)
+    assert "6 vertices, non-convex" in fig.axes[0].get_title() and text_problems(fig) == []
+    plt.close(fig)
