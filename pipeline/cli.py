@@ -146,10 +146,21 @@ def cmd_map(args):
           + ", ".join(f"{v} {k}" for k, v in counts.items() if v))
 
 
+def _bands_option(text):
+    """``--bands T,C`` -> (threshold T in deg, factor c), or None."""
+    if text is None:
+        return None
+    vals = parse_values(text, "--bands")
+    if vals.size != 2 or not (vals[0] > 0 and vals[1] >= 0):
+        raise PinfeedError(f"--bands {text!r}: give the band threshold T (deg, > 0) and the factor c "
+                           f"(>= 0), e.g. --bands 5,2")
+    return float(vals[0]), float(vals[1])
+
+
 def cmd_plot_map(args):
     from .figures.maps import plot_map
     from .io import read_map
-    out = plot_map(read_map(args.map), args.out)
+    out = plot_map(read_map(args.map), args.out, bands=_bands_option(args.bands))
     print(f"wrote {out}")
 
 
@@ -262,7 +273,7 @@ def cmd_catalog_plot(args):
     sub = ds.isel(mu_c=0).load()
     sub.attrs["mu_c"] = float(ds["mu_c"].values[0])
     print(f"selection: {ds.attrs['selection']}")
-    print(f"wrote {plot_map(sub, args.out)}")
+    print(f"wrote {plot_map(sub, args.out, bands=_bands_option(args.bands))}")
 
 
 def cmd_sweep(args):
@@ -549,6 +560,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("plot-map", help="draw a map file like the paper's Table 1")
     p.add_argument("map", help="map file written by 'pinfeed map'")
     p.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
+    p.add_argument("--bands", default=None, metavar="T,C",
+                   help="also draw the bands B_j x K_j and adjusted bands: threshold T (deg) and factor c")
     p.set_defaults(func=cmd_plot_map)
 
     p = sub.add_parser("sweep", help="compute missing catalog shards of a config (locally or on dask)")
@@ -609,6 +622,8 @@ def build_parser() -> argparse.ArgumentParser:
             q.add_argument("--json", action="store_true")
         else:
             q.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
+            q.add_argument("--bands", default=None, metavar="T,C",
+                           help="also draw the bands: threshold T (deg) and factor c, e.g. 5,2")
 
     sense = sub.add_parser("sense", help="force/torque sensor on the first pin: classify a measured profile")
     ssub = sense.add_subparsers(dest="sense_command", required=True)
