@@ -50,10 +50,22 @@ def _where(err) -> str:
 
 def resolve_outlines(cfg: dict, base_dir) -> None:
     """Make every relative ``outline`` path of an explicit part absolute,
-    relative to ``base_dir`` (the config file's folder)."""
-    for spec in (cfg.get("families") or {}).values():
-        for p in (spec.get("parts") or []) if isinstance(spec, dict) else []:
-            if isinstance(p, dict) and isinstance(p.get("outline"), str):
+    relative to ``base_dir`` (the config file's folder); say clearly when a
+    part gives both or neither of ``vertices`` and ``outline``."""
+    families = cfg.get("families") if isinstance(cfg.get("families"), dict) else {}
+    for fam, spec in families.items():
+        parts = spec.get("parts") if isinstance(spec, dict) else None
+        for i, p in enumerate(parts if isinstance(parts, list) else []):
+            if not isinstance(p, dict):
+                continue
+            where = f"config error at families/{fam}/parts/{i}"
+            if ("vertices" in p) == ("outline" in p):
+                raise PinfeedError(f"{where}: give either vertices or outline (a DXF or SVG file), "
+                                   f"{'not both' if 'vertices' in p else 'one of them'}")
+            extra = [k for k in ("layer", "id", "flatten_tol") if k in p and "outline" not in p]
+            if extra:
+                raise PinfeedError(f"{where}: {', '.join(extra)} only apply to an outline file")
+            if isinstance(p.get("outline"), str):
                 p["outline"] = str((Path(base_dir) / p["outline"]).resolve())
 
 

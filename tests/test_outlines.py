@@ -1,4 +1,5 @@
 """CAD outlines: DXF and SVG files written here, read back as parts."""
+import json
 import math
 
 import numpy as np
@@ -154,12 +155,12 @@ def test_bad_inputs(tmp_path):
 def test_config_family_outline_relative_to_config_file(tmp_path, monkeypatch):
     import yaml
 
-    from pipeline.config import load_config
+    from pipeline.config import DEFAULT_CONFIG, load_config
     from pipeline.errors import PinfeedError
     from pipeline.families import family_parts
     (tmp_path / "cad").mkdir()
     _dxf(tmp_path / "cad" / "l.dxf", _bracket)
-    cfg = yaml.safe_load((__import__("pipeline.config", fromlist=["x"]).DEFAULT_CONFIG).read_text())
+    cfg = yaml.safe_load(DEFAULT_CONFIG.read_text())
     cfg["families"] = {"cad": {"parts": [{"name": "bracket", "outline": "cad/l.dxf"}]}}
     cfg["planner"]["parts"] = ["bracket"]
     (tmp_path / "c.yaml").write_text(yaml.safe_dump(cfg))
@@ -180,7 +181,7 @@ def test_cli_rollout_from_outline(tmp_path, capsys):
                  "--theta-i", "30", "--d", "0.3", "--json"]) == 0
     cap = capsys.readouterr()
     assert "vertices (chordal tolerance 0.05 mm)" in cap.err
-    assert __import__("json").loads(cap.out)[0]["theta_i"] == 30.0
+    assert json.loads(cap.out)[0]["theta_i"] == 30.0
     assert main(["rollout", "--outline", str(tmp_path / "nope.svg"), "--mu-c", "0.2",
                  "--pin-radius", "3", "--theta-i", "30", "--d", "0.3"]) == 2
     assert capsys.readouterr().err.startswith("pinfeed: error: no outline file")
@@ -191,3 +192,20 @@ def test_svg_hole_is_refused_and_named(tmp_path):
     with pytest.raises(OutlineError, match=r"outline <path id='ring'> subpath 1 has 1 hole\(s\) "
                                            r"\(<path id='ring'> subpath 2\)"):
         read_outline(_svg(tmp_path / "ring.svg", body))
+
+
+@pytest.mark.parametrize("part, message", [
+    ({"name": "x", "vertices": [[0, 0], [1, 0], [0, 1]], "outline": "x.dxf"}, "not both"),
+    ({"name": "x"}, "give either vertices or outline"),
+    ({"name": "x", "vertices": [[0, 0], [1, 0], [0, 1]], "layer": "A"}, "layer only apply to an outline"),
+])
+def test_config_part_needs_vertices_or_outline(part, message):
+    import yaml
+
+    from pipeline.config import DEFAULT_CONFIG, validate_config
+    from pipeline.errors import PinfeedError
+    cfg = yaml.safe_load(DEFAULT_CONFIG.read_text())
+    cfg["families"] = {"cad": {"parts": [part]}}
+    cfg["planner"]["parts"] = []
+    with pytest.raises(PinfeedError, match=f"families/cad/parts/0: .*{message}"):
+        validate_config(cfg)
