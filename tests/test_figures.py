@@ -213,3 +213,16 @@ def test_outline_figure_fences_touch_the_part():
         assert np.linalg.norm(foot) == pytest.approx(y_c) and (part.vertices @ n).max() == pytest.approx(y_c)
     assert "6 vertices, non-convex" in fig.axes[0].get_title() and text_problems(fig) == []
     plt.close(fig)
+
+
+def test_long_dynamic_sequence_labels_fit():
+    part = Part.from_vertices([[0, 0], [60, 0], [60, 10], [10, 10], [10, 40], [0, 40]], name="bracket")
+    pins = {"P1": -7.5, "P12": 22.5, "P13": 25.0, "P3v-2": -5.0, "P23v+1": 45.0}
+    seq = list(pins)
+    paths = {f"state {k}": [(th + 70 * j, y + 5 * j) for j in range(len(seq) + 1)]
+             for k, (th, y) in enumerate(part.stable_states(), start=1)}
+    plan = {"pins": seq, "final_sets": [{"start": 10.0, "width": 5.0}, {"start": 200.0, "width": 1.0}]}
+    fig = sequence_figure(part, plan, pins, paths, 3.0, "bracket: best plan with dynamic pins",
+                          speeds={"P3v-2": -2.0, "P23v+1": 1.0})
+    assert text_problems(fig) == []
+    plt.close(fig)
