@@ -209,3 +209,14 @@ def test_config_part_needs_vertices_or_outline(part, message):
     cfg["planner"]["parts"] = []
     with pytest.raises(PinfeedError, match=f"families/cad/parts/0: .*{message}"):
         validate_config(cfg)
+
+
+def test_validated_config_validates_again(tmp_path):
+    import yaml
+
+    from pipeline.config import DEFAULT_CONFIG, validate_config
+    _dxf(tmp_path / "l.dxf", _bracket)
+    cfg = yaml.safe_load(DEFAULT_CONFIG.read_text())
+    cfg["families"]["cad"] = {"parts": [{"name": "bracket", "outline": str(tmp_path / "l.dxf")}]}
+    once = validate_config(cfg)
+    assert validate_config(once) == once  # the Snakefile and rule scripts validate again
