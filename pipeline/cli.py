@@ -60,8 +60,10 @@ def _add_outline_args(p, required=True):
     """``--vertices`` or ``--outline FILE`` (with its choosers), and ``--name``."""
     g = p.add_mutually_exclusive_group(required=required)
     g.add_argument("--vertices", help='part outline "x0,y0 x1,y1 ..." (mm)')
-    g.add_argument("--outline", metavar="FILE", help="or a CAD outline: a .dxf or .svg file holding one closed outline")
-    p.add_argument("--layer", default=None, metavar="NAME", help="DXF layer of the outline (when the file holds several)")
+    g.add_argument("--outline", metavar="FILE",
+                   help="or a CAD outline: a .dxf or .svg file holding one closed outline")
+    p.add_argument("--layer", default=None, metavar="NAME",
+                   help="DXF layer of the outline (when the file holds several)")
     p.add_argument("--id", default=None, help="SVG element id or DXF entity handle of the outline")
     p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=0.05, metavar="MM",
                    help="chordal tolerance for flattening arcs and curves, mm (default 0.05)")
