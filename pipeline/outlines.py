@@ -104,7 +104,7 @@ def _dxf_pieces(path: Path, layer, handle, tol) -> list[_Piece]:
     scale = units.conversion_factor(code, units.MM) if code else 1.0
     kinds = {"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE"}
     pieces = []
-    for e in doc.modelspace():
+    for e in _dxf_entities(doc.modelspace()):
         kind = e.dxftype()
         if kind not in kinds:
             continue
@@ -118,6 +118,15 @@ def _dxf_pieces(path: Path, layer, handle, tol) -> list[_Piece]:
         closed = bool(getattr(e, "closed", False) or getattr(e, "is_closed", False)) or kind == "CIRCLE"
         pieces.append(_Piece(pts, f"{kind} {e.dxf.handle} on layer {e.dxf.layer}", closed))
     return pieces
+
+
+def _dxf_entities(space):
+    """The entities of a layout, with block references (INSERT) exploded in place."""
+    for e in space:
+        if e.dxftype() == "INSERT":
+            yield from e.virtual_entities()
+        else:
+            yield e
 
 
 # ---------------------------------------------------------------------- SVG
@@ -264,7 +273,12 @@ def _choose(loops: list[_Piece], path: Path) -> _Piece:
         return loops[0]
     loops.sort(key=lambda lp: -abs(_signed_area(lp.points)))
     outer = loops[0]
-    holes = [lp for lp in loops[1:] if _inside(lp.points[0], outer.points)]
+    inside = {id(lp): [_inside(pt, outer.points) for pt in lp.points] for lp in loops[1:]}
+    crossing = [lp for lp in loops[1:] if any(inside[id(lp)]) and not all(inside[id(lp)])]
+    if crossing:
+        raise OutlineError(f"{path}: outlines {outer.name} and {crossing[0].name} cross each other; "
+                           f"draw the part as one closed outline")
+    holes = [lp for lp in loops[1:] if all(inside[id(lp)])]
     if holes:
         raise OutlineError(
             f"{path}: outline {outer.name} has {len(holes)} hole(s) ({', '.join(h.name for h in holes)}); "

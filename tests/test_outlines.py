@@ -220,3 +220,19 @@ def test_validated_config_validates_again(tmp_path):
     cfg["families"]["cad"] = {"parts": [{"name": "bracket", "outline": str(tmp_path / "l.dxf")}]}
     once = validate_config(cfg)
     assert validate_config(once) == once  # the Snakefile and rule scripts validate again
+
+
+def test_crossing_outlines_and_block_references(tmp_path):
+    def crossing(msp):
+        _bracket(msp)
+        msp.add_lwpolyline([(5, 5), (80, 5), (80, 8), (5, 8)], close=True)
+    with pytest.raises(OutlineError, match="cross each other"):
+        read_outline(_dxf(tmp_path / "cross.dxf", crossing))
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4  # mm (ezdxf's new documents default to metres)
+    block = doc.blocks.new(name="BRACKET")
+    _bracket(block)
+    doc.modelspace().add_blockref("BRACKET", (100, 50))
+    doc.saveas(tmp_path / "block.dxf")
+    out = read_outline(tmp_path / "block.dxf")
+    assert out.vertices.min(0) == pytest.approx([100, 50]) and _area(out.vertices) == pytest.approx(900)
