@@ -22,7 +22,10 @@ if not {"families", "sweep"} & set(config):
 
 # Schema validation (descriptions in config/schema.yaml), defaults filled in,
 # part outlines checked: a bad config stops here, before any job runs.
-config.update(validate_config(config))
+# Relative outline paths are relative to the last --configfile's folder.
+_CONFIG_FILES = list(getattr(workflow, "configfiles", None) or [])
+config.update(validate_config(
+    config, base_dir=os.path.dirname(os.path.abspath(_CONFIG_FILES[-1])) if _CONFIG_FILES else None))
 
 
 include: "rules/common.smk"

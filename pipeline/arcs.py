@@ -59,14 +59,21 @@ def merge_modulo(arcs, order: int) -> list[tuple[float, float]]:
     return [(s / order, w / order) for s, w in scaled]
 
 
-def format_arc(arc) -> str:
-    """``(223.1, 9.1)`` -> ``'223.1-232.2 deg'`` (ends within [0, 360))."""
-    s, w = arc
-    if w >= 360.0:
-        return "0.0-360.0 deg (any orientation)"
-    return f"{s % 360.0:.1f}-{(s + w) % 360.0:.1f} deg"
+def format_arc(start: float, width: float, digits: int = 1) -> str:
+    """An arc for people: ``223.1-232.2 deg``; both ends within [0, 360), so an arc
+    through 0 reads ``355.0-5.0 deg``; a single angle reads ``12.0 deg``."""
+    if width >= 360.0:
+        return "any orientation (0-360 deg)"
+
+    def wrap(x):
+        r = round(float(x) % 360.0, digits)
+        return 0.0 if r >= 360.0 else r + 0.0
+
+    lo, hi = wrap(start), wrap(start + width)
+    return f"{lo:.{digits}f} deg" if lo == hi else f"{lo:.{digits}f}-{hi:.{digits}f} deg"
 
 
-def format_arcs(arcs) -> str:
-    """Several arcs, comma separated."""
-    return ", ".join(format_arc(a) for a in arcs) or "none"
+def format_arcs(sets, digits: int = 1) -> str:
+    """Several arcs (``(start, width)`` pairs or ``{"start", "width"}`` dicts), comma-separated."""
+    pairs = [(s["start"], s["width"]) if isinstance(s, dict) else tuple(s) for s in sets]
+    return ", ".join(format_arc(s, w, digits) for s, w in pairs) or "none"

@@ -22,7 +22,7 @@ import numpy as np
 
 from kernels.rollout import OK
 
-from .arcs import in_arc  # noqa: F401 (re-exported for older callers)
+from .arcs import format_arc, format_arcs, in_arc  # noqa: F401 (re-exported for older callers)
 
 
 @dataclass

@@ -10,6 +10,7 @@ import json
 import math
 import re
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -42,13 +43,36 @@ def parse_values(text: str, what: str) -> np.ndarray:
 
 
 def _part_from_args(args):
+    """The part of ``--vertices`` or ``--outline`` (saying how many vertices a CAD outline gave)."""
     from .parts import Part, parse_vertices
-    return Part.from_vertices(parse_vertices(args.vertices), name=args.name)
+    if getattr(args, "outline", None):
+        from .outlines import read_outline
+        out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol)
+        print(f"outline {out.describe()}", file=sys.stderr)
+        name = args.name or re.sub(r"[^A-Za-z0-9_]", "_", Path(args.outline).stem) or "part"
+        return Part.from_vertices(out.vertices, name=name)
+    if getattr(args, "layer", None) or getattr(args, "id", None):
+        raise PinfeedError("--layer and --id pick an outline in an --outline file")
+    return Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
+
+
+def _add_outline_args(p, required=True):
+    """``--vertices`` or ``--outline FILE`` (with its choosers), and ``--name``."""
+    g = p.add_mutually_exclusive_group(required=required)
+    g.add_argument("--vertices", help='part outline "x0,y0 x1,y1 ..." (mm)')
+    g.add_argument("--outline", metavar="FILE",
+                   help="or a CAD outline: a .dxf or .svg file holding one closed outline")
+    p.add_argument("--layer", default=None, metavar="NAME",
+                   help="DXF layer of the outline (when the file holds several)")
+    p.add_argument("--id", default=None, help="SVG element id or DXF entity handle of the outline")
+    p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=0.05, metavar="MM",
+                   help="chordal tolerance for flattening arcs and curves, mm (default 0.05)")
+    p.add_argument("--name", default=None, help="part name used in outputs (default: part, or the "
+                   "outline file's name)")
 
 
 def _add_physics(p, d_required=True):
-    p.add_argument("--vertices", required=True, help='part outline "x0,y0 x1,y1 ..." (mm)')
-    p.add_argument("--name", default="part", help="part name used in outputs")
+    _add_outline_args(p)
     p.add_argument("--mu-c", type=float, required=True, help="pin-part friction coefficient (>= 0)")
     p.add_argument("--pin-radius", type=float, required=True, help="pin radius (mm, > 0)")
     p.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"],
@@ -86,6 +110,24 @@ def cmd_rollout(args):
         note = f"  ({r['jam_reason']})" if r["status"] == "jammed" else ""
         print(f"{r['theta_i']:8.2f} {r['status']:>9} {r['theta_f']:9.3f} {r['dy']:9.3f} "
               f"{r['contact_travel']:8.2f} {r['feature_changes']:7d} {r['peak_force']:7.3f}{note}")
+    if args.trajectory:
+        for r in rows:
+            _print_trajectory(r)
+
+
+def _print_trajectory(row, n_rows: int = 11):
+    """A short table of one rollout's trajectory: about ``n_rows`` evenly spaced samples."""
+    traj = np.asarray(row["trajectory"], float).reshape(-1, 4)
+    print(f"\ntrajectory of theta_i = {row['theta_i']:g} deg ({len(traj)} samples; "
+          f"--json gives them all): belt travel since first contact s, centroid displacement x, y, "
+          f"orientation theta")
+    if not len(traj):
+        print("  no contact: the part rides past the pin")
+        return
+    print(f"{'s (mm)':>9} {'x (mm)':>9} {'y (mm)':>9} {'theta (deg)':>12}")
+    for k in np.unique(np.linspace(0, len(traj) - 1, min(n_rows, len(traj))).round().astype(int)):
+        s_, x, y, th = traj[k]
+        print(f"{s_:9.2f} {x:9.3f} {y:9.3f} {th % 360:12.2f}")
 
 
 def cmd_map(args):
@@ -106,10 +148,21 @@ def cmd_map(args):
           + ", ".join(f"{v} {k}" for k, v in counts.items() if v))
 
 
+def _bands_option(text):
+    """``--bands T,C`` -> (threshold T in deg, factor c), or None."""
+    if text is None:
+        return None
+    vals = parse_values(text, "--bands")
+    if vals.size != 2 or not (vals[0] > 0 and vals[1] >= 0):
+        raise PinfeedError(f"--bands {text!r}: give the band threshold T (deg, > 0) and the factor c "
+                           f"(>= 0), e.g. --bands 5,2")
+    return float(vals[0]), float(vals[1])
+
+
 def cmd_plot_map(args):
     from .figures.maps import plot_map
     from .io import read_map
-    out = plot_map(read_map(args.map), args.out)
+    out = plot_map(read_map(args.map), args.out, bands=_bands_option(args.bands))
     print(f"wrote {out}")
 
 
@@ -222,7 +275,7 @@ def cmd_catalog_plot(args):
     sub = ds.isel(mu_c=0).load()
     sub.attrs["mu_c"] = float(ds["mu_c"].values[0])
     print(f"selection: {ds.attrs['selection']}")
-    print(f"wrote {plot_map(sub, args.out)}")
+    print(f"wrote {plot_map(sub, args.out, bands=_bands_option(args.bands))}")
 
 
 def cmd_sweep(args):
@@ -296,11 +349,11 @@ def _plan_dynamic_args(args, dynamic):
 
 def _plan_part_arg(args, config):
     from .families import family_parts
-    from .parts import Part, parse_vertices
-    if args.vertices:
-        return Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
+    from .parts import Part
+    if args.vertices or args.outline:
+        return _part_from_args(args)
     if not args.part:
-        raise PinfeedError("give --part NAME or --vertices \"x0,y0 x1,y1 ...\"")
+        raise PinfeedError("give --part NAME, --vertices \"x0,y0 x1,y1 ...\" or --outline FILE")
     found = [p for fam, spec in config["families"].items() for p in family_parts(fam, spec)
              if args.part in (p.name, p.id)]
     if found:
@@ -389,6 +442,29 @@ def _print_plan_result(result, part, config, mode):
               f"margin in d {plan['margin']:.3f}")
 
 
+def cmd_animate(args):
+    """Animate a stored plan: every initial state past the pins on the moving belt."""
+    from .animate import animate_stored, plan_inputs
+    from .config import load_config
+    from .stages import read_json
+    config = load_config(args.config)
+    root = Path(args.catalog or config["catalog_dir"])
+    path = root / "plans" / f"{args.part}.json"
+    if not path.is_file():
+        raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
+                           f"{args.part} --out {path}' or the workflow ('make run') first")
+    result = read_json(path)
+    inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
+    pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
+                       for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
+    print(f"animating plan {args.plan} of {args.part}: {pins}; {len(inputs['states'])} initial states",
+          flush=True)
+    done = animate_stored(result, config, args.out, args.plan, frames=args.frames, fps=args.fps)
+    outcomes = ", ".join(f"{k}: {v}" for k, v in done["outcomes"].items())
+    print(f"wrote {done['out']}: {done['frames']} frames over {done['belt_travel']:.0f} mm of belt "
+          f"travel ({outcomes})")
+
+
 PROFILE_FORMAT = """\
 A measured profile is a CSV file with three columns: time (s), F_x, F_y (the
 force on the pin along and across the belt, any one force unit: the sign
@@ -404,6 +480,14 @@ def _best_fixed_plan(plan_result: dict):
     if plan_result.get("best_static"):
         return plan_result["best_static"]
     return next((p for p in plan_result["plans"] if not p.get("n_dynamic_pins", 0)), None)
+
+
+def _plan_hint(config: dict, name: str, root) -> str:
+    """How to make the stored plan of ``name``: the workflow plans the config's
+    parts; a part planned from --vertices or --outline needs 'pinfeed plan'."""
+    if name in config["planner"]["parts"]:
+        return "run the workflow ('make run')"
+    return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
 
 
 def cmd_sense_classify(args):
@@ -446,8 +530,8 @@ def cmd_sense_classify(args):
         first_pin = _best_fixed_plan(plan)["pins"][0]
         y_pin, source = float(plan["pins"][first_pin]), f"first pin of the best fixed-pin plan {plan_path}"
     else:
-        raise PinfeedError(f"no stored sensor plan or plan for {name} under {root}; run the workflow "
-                           f"('make run') or give the sensor pin's height with --y-pin MM")
+        raise PinfeedError(f"no stored sensor plan or plan for {name} under {root}; "
+                           f"{_plan_hint(config, name, root)} or give the sensor pin's height with --y-pin MM")
     if stored is not None:
         sensor = Sensor.from_config(stored["sensor"])
         mu_c, model = float(stored["mu_c"]), stored["model"]
@@ -531,14 +615,16 @@ def _join_signed_values(argv):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="pinfeed", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="pinfeed", description="pinfeed: design part feeders that orient flat parts "
+                     "on a conveyor with overhead pins.")
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("rollout", help="roll a part past one pin for some initial orientations")
     _add_physics(p)
     p.add_argument("--theta-i", required=True, help="initial orientations, degrees: 'a,b,c' or 'start:stop:step'")
     p.add_argument("--d", type=float, required=True, help="contact parameter (y_pin - y_com)/a")
-    p.add_argument("--trajectory", action="store_true", help="include trajectory and force history")
+    p.add_argument("--trajectory", action="store_true", help="also show the trajectory: a short table, or every sample and the "
+                   "force history with --json")
     p.add_argument("--max-travel", type=float, default=None,
                    help="stop after this belt travel since first contact (mm): status truncated")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
@@ -555,6 +641,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("plot-map", help="draw a map file like the paper's Table 1")
     p.add_argument("map", help="map file written by 'pinfeed map'")
     p.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
+    p.add_argument("--bands", default=None, metavar="T,C",
+                   help="also draw the bands B_j x K_j and adjusted bands: threshold T (deg) and factor c")
     p.set_defaults(func=cmd_plot_map)
 
     p = sub.add_parser("sweep", help="compute missing catalog shards of a config (locally or on dask)")
@@ -567,8 +655,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("plan", help="plan fixed pins for a part (computes missing maps)")
     p.add_argument("--part", default=None, help="part name or id from the config or catalog")
-    p.add_argument("--vertices", default=None, help='or a new outline "x0,y0 x1,y1 ..." (mm)')
-    p.add_argument("--name", default=None, help="name for --vertices (default part)")
+    _add_outline_args(p, required=False)
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
     p.add_argument("--mu-c", dest="mu_c", default=None,
@@ -619,6 +706,8 @@ def build_parser() -> argparse.ArgumentParser:
             q.add_argument("--json", action="store_true")
         else:
             q.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
+            q.add_argument("--bands", default=None, metavar="T,C",
+                           help="also draw the bands: threshold T (deg) and factor c, e.g. 5,2")
 
     sense = sub.add_parser("sense", help="force/torque sensor on the first pin: classify a measured profile")
     ssub = sense.add_subparsers(dest="sense_command", required=True)
@@ -637,6 +726,16 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
+
+    p = sub.add_parser("animate", help="animate a stored plan: every initial state past the pins")
+    p.add_argument("--part", required=True, help="part name (its plan is CATALOG/plans/NAME.json)")
+    p.add_argument("--plan", type=int, default=1, help="which plan, 1 = the recommended one (default 1)")
+    p.add_argument("--out", required=True, help="animation file: .gif (Pillow) or .mp4 (needs ffmpeg)")
+    p.add_argument("--frames", type=int, default=120, help="number of frames (default 120)")
+    p.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    p.set_defaults(func=cmd_animate)
 
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")

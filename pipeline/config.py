@@ -48,9 +48,33 @@ def _where(err) -> str:
     return path or "(top level)"
 
 
-def validate_config(config: dict) -> dict:
-    """Return a validated copy of ``config`` with defaults filled in."""
+def resolve_outlines(cfg: dict, base_dir) -> None:
+    """Make every relative ``outline`` path of an explicit part absolute,
+    relative to ``base_dir`` (the config file's folder); say clearly when a
+    part gives both or neither of ``vertices`` and ``outline``."""
+    families = cfg.get("families") if isinstance(cfg.get("families"), dict) else {}
+    for fam, spec in families.items():
+        parts = spec.get("parts") if isinstance(spec, dict) else None
+        for i, p in enumerate(parts if isinstance(parts, list) else []):
+            if not isinstance(p, dict):
+                continue
+            where = f"config error at families/{fam}/parts/{i}"
+            if ("vertices" in p) == ("outline" in p):
+                raise PinfeedError(f"{where}: give either vertices or outline (a DXF or SVG file), "
+                                   f"{'not both' if 'vertices' in p else 'one of them'}")
+            extra = [k for k in ("layer", "id", "flatten_tol") if k in p and "outline" not in p]
+            if extra:
+                raise PinfeedError(f"{where}: {', '.join(extra)} only apply to an outline file")
+            if isinstance(p.get("outline"), str):
+                p["outline"] = str((Path(base_dir) / p["outline"]).resolve())
+
+
+def validate_config(config: dict, base_dir=None) -> dict:
+    """Return a validated copy of ``config`` with defaults filled in. Relative
+    outline paths are taken relative to ``base_dir`` (default: the working
+    directory)."""
     cfg = copy.deepcopy(config)
+    resolve_outlines(cfg, base_dir or Path.cwd())
     schema = _schema()
     validator = _fill_defaults(jsonschema.Draft202012Validator)(schema)
     errors = sorted(validator.iter_errors(cfg), key=lambda e: list(e.absolute_path))
@@ -101,7 +125,7 @@ def load_config(path=None) -> dict:
         raise PinfeedError(f"{path} is not valid YAML: {exc}".splitlines()[0]) from None
     if not isinstance(config, dict):
         raise PinfeedError(f"{path} must hold a YAML mapping of settings")
-    return validate_config(config)
+    return validate_config(config, base_dir=path.resolve().parent)
 
 
 def config_hash(config: dict) -> str:

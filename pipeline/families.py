@@ -47,6 +47,19 @@ def _l_shape(g):
                [(0, 0), (w, 0), (w, t), (t, t), (t, h), (0, h)])
 
 
+def _explicit_vertices(family: str, p: dict):
+    """An explicit part's vertices, or its CAD outline's (``outline: FILE``; the
+    config loader has made a relative path absolute)."""
+    if "outline" not in p:
+        return p["vertices"]
+    from .outlines import read_outline
+    try:
+        return read_outline(p["outline"], layer=p.get("layer"), id=p.get("id"),
+                            flatten_tol=p.get("flatten_tol", 0.05)).vertices
+    except PinfeedError as exc:
+        raise PinfeedError(f"family {family}, part {p['name']}: {exc}") from None
+
+
 GENERATORS = {
     "triangle_apex_grid": (_triangle_apex_grid, ("apex_x", "apex_y")),
     "rectangle": (_rectangle, ("aspect",)),
@@ -57,7 +70,7 @@ GENERATORS = {
 
 def family_parts(name: str, spec: dict) -> list[Part]:
     """All parts of one family, validated; raises :class:`PinfeedError` naming the part."""
-    outlines = [(p["name"], p["vertices"]) for p in spec.get("parts", [])]
+    outlines = [(p["name"], _explicit_vertices(name, p)) for p in spec.get("parts", [])]
     for g in spec.get("generators", []):
         kind = g.get("kind")
         if kind not in GENERATORS:

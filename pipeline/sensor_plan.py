@@ -144,6 +144,7 @@ def verify_sensor_plan(part, result: dict, mu_c: float, pin_radius: float, model
     (the verdict names several sets), ``jammed``."""
     import numpy as np
 
+    from .progress import progress
     from .sensing import classify, measure, profile_from_rollout, sign_matrix
     from .simulate import rollout
     from .verify import DEFAULTS, perturbed_inputs
@@ -152,7 +153,8 @@ def verify_sensor_plan(part, result: dict, mu_c: float, pin_radius: float, model
     refs = {k: np.asarray(v) for k, v in result["score_table"]["reference_signs"].items()}
     plan_pins = result["plan"]["pins"]
     rows = {}
-    for label, st in result["initial_states"].items():
+    states = result["initial_states"]
+    for label, st in progress(states.items(), len(states), "verify sensor plan", unit="initial state"):
         row = {"trials": 0, "right": 0, "wrong": 0, "ambiguous": 0, "jammed": 0}
         for _ in range(int(cfg["trials"])):
             theta, y_c, mu, offsets = perturbed_inputs(st["theta"], st["y_c"], mu_c, len(plan_pins),
@@ -220,5 +222,6 @@ def final_for_verdict(sensing: dict, candidates) -> list[dict]:
 
 
 def describe_sets(sets) -> str:
-    return ", ".join(f"[{s['start']:.1f}, {s['start'] + s['width']:.1f}] deg"
-                     for s in sets)
+    """Final sets for people: ``223.1-232.2 deg, ...`` (see ``bands.format_arcs``)."""
+    from .bands import format_arcs
+    return format_arcs(sets)

@@ -252,11 +252,11 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
         maps = {model: cat.query(part_id, model=model, mu_c=res["mu_c"]).isel(mu_c=0).load()
                 for model in config["sweep"]["models"]}
         plot_band_maps(maps, fc["d"], bc["threshold_T"], bc["factor_c"],
-                       f"{name}: configuration maps, mu_c = {res['mu_c']:g} (rows: models)", out["maps"][k])
-        speeds = {f"v_pin/v_b = {v:+g}": cat.query(part_id, model=res["model"], mu_c=res["mu_c"], v_pin=v)
+                       f"{name}: configuration maps, $\\mu_c$ = {res['mu_c']:g} (rows: models)", out["maps"][k])
+        speeds = {f"$v_{{pin}}/v_b$ = {v:+g}": cat.query(part_id, model=res["model"], mu_c=res["mu_c"], v_pin=v)
                   .isel(mu_c=0).load() for v in sorted(config["sweep"]["v_pin"])}
         plot_band_maps(speeds, fc["d"], bc["threshold_T"], bc["factor_c"],
-                       f"{name}: {res['model']} maps by pin speed, mu_c = {res['mu_c']:g} "
+                       f"{name}: {res['model']} maps by pin speed, $\\mu_c$ = {res['mu_c']:g} "
                        f"(d at the centroid's station)", out["speeds"][k])
         to_draw = plans_to_check(res)
         _sequence_figure(config, res, to_draw.get("fixed pins"), "best fixed-pin plan", out["sequence"][k])
@@ -265,9 +265,20 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
         if "carried" in out:
             _carried_figure(config, res, out["carried"][k])
         verifications[name] = read_json(verify_path)
+        if out.get("verification_plans"):  # optional: one figure per part, its plans stacked
+            _verification_figure(verifications[name], out["verification_plans"][k])
     rows = verification_rows(verifications)
     plot_table(rows, "Verification of the best plans by perturbed full rollouts", out["verification"])
     Path(out["table"]).write_text(markdown_table(rows))
+
+
+def _verification_figure(result: dict, path):
+    """The verification figure of a part: every checked plan (``verify_part`` result)."""
+    from .figures.tables import plot_verification
+    if not result["checks"]:
+        _placeholder(path, f"{result['part']}: {result.get('note', 'nothing verified')}")
+        return
+    plot_verification(result["checks"], f"{result['part']}: verification by perturbed rollouts", path)
 
 
 def _sequence_figure(config, res, plan, what, path):

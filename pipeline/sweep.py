@@ -141,7 +141,5 @@ def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
 
 
 def _progress(it, total, enabled):
-    if not enabled or total == 0:
-        return it
-    from tqdm import tqdm
-    return tqdm(it, total=total, desc="shards", unit="shard")
+    from .progress import progress
+    return progress(it, total, "sweep", unit="shard", enabled=enabled)

@@ -161,7 +161,7 @@ def test_symmetry_counts_sets_modulo_the_part():
     assert rect.symmetry_order() == 2 and ASYM.symmetry_order() == 1
     assert len(merge_modulo([(10.0, 4.0), (190.0, 4.0)], 2)) == 1
     assert len(merge_modulo([(10.0, 4.0), (100.0, 4.0)], 2)) == 2
-    assert format_arc((358.0, 5.0)) == "358.0-3.0 deg"
+    assert format_arc(358.0, 5.0) == "358.0-3.0 deg"
 
 
 def test_friction_parsing():

@@ -48,7 +48,7 @@ def plot_profiles(simulated: dict, measured: dict, sensor: Sensor, title, out) -
                 ax.set_ylabel(ylabel, fontsize=8)
             ax.tick_params(labelsize=7)
             if r == 0:
-                ax.set_title(f"{label}\n\n", fontsize=9)
+                ax.set_title(label, fontsize=9, pad=12)  # room for the signs above the panel
         axes[-1][c].set_xlabel("time since first contact t (s)", fontsize=8)
     handles, names = [], []
     for r in (0, 2):

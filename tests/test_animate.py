@@ -1,0 +1,102 @@
+"""Plans you can watch: kernel trajectories placed on the belt clock, GIFs written."""
+import json
+
+import numpy as np
+import pytest
+
+from pipeline.animate import _gap, _rotated, animate_plan, plan_inputs, roll_plan
+from pipeline.errors import PinfeedError
+from pipeline.parts import Part
+
+PART = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
+STATES = {f"state {k}": (float(th), float(y)) for k, (th, y) in enumerate(PART.stable_states(), 1)}
+HEIGHTS, SPEEDS = [10.0, 25.0], [0.0, 0.0]
+
+
+def test_lanes_follow_the_kernel_and_touch_the_pins():
+    from pipeline import simulate
+    lanes, stations, b_end = roll_plan(PART, HEIGHTS, SPEEDS, STATES, 0.15, "minpower", 3.0)
+    assert len(lanes) == len(STATES) and b_end > stations[-1]
+    for lane in lanes:
+        theta, y = STATES[lane.label]
+        for h in HEIGHTS:  # the chain of nominal rollouts the lane must end in
+            r = simulate.rollout(PART, theta, (h - y) / PART.a, 0.15, 3.0)
+            theta, y = float(r.theta_f), y + float(r.dy)
+        x_end, y_end, th_end = lane.pose(b_end)
+        assert th_end % 360 == pytest.approx(theta, abs=1e-6) and y_end == pytest.approx(y, abs=1e-9)
+        assert lane.contacts
+        for k, b0 in lane.contacts:
+            # At first contact the pin touches the outline; a little earlier it is clear of it.
+            x, yy, th = lane.pose(b0)
+            poly = _rotated(PART.vertices, th) + [x, yy]
+            assert _gap(np.array([stations[k], HEIGHTS[k]]), poly) == pytest.approx(3.0, abs=1e-3)
+            x, yy, th = lane.pose(b0 - 0.5)
+            assert _gap(np.array([stations[k], HEIGHTS[k]]), _rotated(PART.vertices, th) + [x, yy]) > 3.0
+
+
+def test_gif_has_the_frames_asked_for(tmp_path):
+    from PIL import Image
+    out = tmp_path / "plan.gif"
+    res = animate_plan(PART, [10.0], [0.0], STATES, 0.15, "minpower", 3.0, out, frames=4, fps=5)
+    assert res["frames"] == 4
+    with Image.open(out) as im:
+        assert im.format == "GIF" and im.n_frames == 4
+
+
+def test_mp4_without_ffmpeg_and_bad_outputs(tmp_path):
+    from matplotlib import animation
+    if not animation.writers.is_available("ffmpeg"):
+        with pytest.raises(PinfeedError, match="MP4 needs ffmpeg"):
+            animate_plan(PART, [10.0], [0.0], STATES, 0.15, "minpower", 3.0, tmp_path / "p.mp4")
+    with pytest.raises(PinfeedError, match="gif or an .mp4"):
+        animate_plan(PART, [10.0], [0.0], STATES, 0.15, "minpower", 3.0, tmp_path / "p.avi")
+
+
+def _stored(with_heights=False):
+    plan = {"pins": ["P2", "P5v+2"], "final_sets": []}
+    if with_heights:
+        plan["pin_heights_mm"] = [7.0, 11.0]
+    return {"part": PART.to_dict(), "mu_c": 0.15, "model": "minpower", "plans": [plan],
+            "initial_states": {k: {"theta": t, "y_c": y} for k, (t, y) in STATES.items()}}
+
+
+def test_plan_inputs_heights_from_plan_or_config():
+    config = {"planner": {"pins": [0.0, 5.0, 10.0, 15.0, 20.0]}, "sweep": {"pin_radius": 3.0}}
+    got = plan_inputs(_stored(), 1, config)
+    assert got["heights"] == [5.0, 20.0] and got["speeds"] == [0.0, 2.0] and got["pin_radius"] == 3.0
+    assert plan_inputs(_stored(True), 1, config)["heights"] == [7.0, 11.0]
+    with pytest.raises(PinfeedError, match="--plan 2: tri has plans 1 to 1"):
+        plan_inputs(_stored(), 2, config)
+
+
+def test_cli_animate(tmp_path, capsys):
+    from PIL import Image
+
+    from pipeline.cli import main
+    (tmp_path / "plans").mkdir()
+    stored = _stored(True)
+    stored["plans"][0]["pins"] = ["P1"]
+    stored["plans"][0]["pin_heights_mm"] = [10.0]
+    (tmp_path / "plans" / "tri.json").write_text(json.dumps(stored))
+    out = tmp_path / "tri.gif"
+    assert main(["animate", "--part", "tri", "--catalog", str(tmp_path), "--out", str(out),
+                 "--frames", "3"]) == 0
+    assert "wrote" in capsys.readouterr().out
+    with Image.open(out) as im:
+        assert im.n_frames == 3
+    assert main(["animate", "--part", "nope", "--catalog", str(tmp_path), "--out", str(out)]) == 2
+    assert "no stored plan for nope" in capsys.readouterr().err
+
+
+def test_moving_pin_touches_at_its_height_on_the_clock():
+    from pipeline.animate import pin_height
+    speeds = [0.0, 1.0]
+    lanes, stations, _ = roll_plan(PART, HEIGHTS, speeds, STATES, 0.15, "minpower", 3.0)
+    touched = 0
+    for lane in lanes:
+        for k, b0 in lane.contacts:
+            x, y, th = lane.pose(b0)
+            pin = np.array([stations[k], pin_height(lane, k, b0, HEIGHTS[k], speeds[k], stations[k])])
+            assert _gap(pin, _rotated(PART.vertices, th) + [x, y]) == pytest.approx(3.0, abs=1e-3)
+            touched += k == 1
+    assert touched  # the moving pin met some state
