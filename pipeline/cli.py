@@ -27,18 +27,23 @@ def _print_json(obj, **kw):
 
 
 def parse_values(text: str, what: str) -> np.ndarray:
-    """``"a,b,c"`` or an inclusive range ``"start:stop:step"``."""
+    """``"a,b,c"`` or an inclusive range ``"start:stop:step"``: finite, distinct,
+    at most ``checks.MAX_VALUES`` values (refused before anything is allocated)."""
+    from .checks import check_grid_size, check_values, range_size
     try:
         if ":" in text:
             start, stop, step = (float(x) for x in text.split(":"))
-            if step <= 0 or stop < start:
+            if not all(map(math.isfinite, (start, stop, step))) or step <= 0 or stop < start:
                 raise ValueError
-            n = int(math.floor((stop - start) / step + 1e-9)) + 1
+            n = range_size(start, stop, step)
+            check_grid_size(n, f"{what} {text}")
             return np.round(start + step * np.arange(n), 10) + 0.0
-        return np.array([float(x) for x in text.split(",") if x.strip()])
+        values = [float(x) for x in text.split(",") if x.strip()]
     except ValueError:
         raise PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
-                           f"with step > 0") from None
+                           f"of finite numbers with step > 0") from None
+    check_grid_size(len(values), what)
+    return check_values(values, f"{what} {text!r}")
 
 
 def _part_from_args(args):
@@ -90,12 +95,16 @@ def cmd_rollout(args):
 
 def cmd_map(args):
     from . import simulate
+    from .checks import MAP_SUFFIXES, check_grid_size, check_out_path
     from .io import write_atomic
     from .provenance import provenance_attrs
     part = _part_from_args(args)
     d = parse_values(args.d, "--d")
     if not args.theta_step > 0 or args.theta_step > 360:
         raise PinfeedError(f"--theta-step must be in (0, 360] degrees, got {args.theta_step}")
+    check_grid_size(math.ceil(360.0 / args.theta_step), f"--theta-step {args.theta_step:g} (theta_i grid)")
+    check_grid_size(d.size * math.ceil(360.0 / args.theta_step), "the map (d x theta_i)")
+    check_out_path(args.out, MAP_SUFFIXES)
     theta = np.arange(0.0, 360.0 - 1e-9, args.theta_step)
     ds = simulate.map(part, theta, d, args.mu_c, args.pin_radius, model=args.model,
                       v_pin=args.v_pin, threads=args.threads)
@@ -107,8 +116,10 @@ def cmd_map(args):
 
 
 def cmd_plot_map(args):
+    from .checks import IMAGE_SUFFIXES, check_out_path
     from .figures.maps import plot_map
     from .io import read_map
+    check_out_path(args.out, IMAGE_SUFFIXES)
     out = plot_map(read_map(args.map), args.out)
     print(f"wrote {out}")
 
@@ -215,7 +226,9 @@ def cmd_catalog_query(args):
 
 
 def cmd_catalog_plot(args):
+    from .checks import IMAGE_SUFFIXES, check_out_path
     from .figures.maps import plot_map
+    check_out_path(args.out, IMAGE_SUFFIXES)
     ds = _query(args)
     if ds.sizes["mu_c"] != 1:
         raise PinfeedError("plot one friction at a time: give --mu-c")
