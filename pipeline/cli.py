@@ -250,11 +250,20 @@ def cmd_sweep(args):
 
 
 
+def _check_plan_args(args):
+    """The plan command's numbers, before any work: a plan has at least one pin."""
+    if args.depth is not None and args.depth < 1:
+        raise PinfeedError(f"--depth must be at least 1 (the largest number of pins), got {args.depth}")
+    if args.mu_c is not None and not (math.isfinite(args.mu_c) and args.mu_c >= 0):
+        raise PinfeedError(f"--mu-c must be a finite number >= 0, got {args.mu_c}")
+
+
 def cmd_plan(args):
     from .config import load_config
     from .families import family_parts
     from .parts import Part, parse_vertices
     from .stages import ensure_maps, plan_part, write_json
+    _check_plan_args(args)
     config = load_config(args.config)
     if args.catalog:
         config["catalog_dir"] = args.catalog
@@ -347,8 +356,9 @@ def cmd_sense_classify(args):
     from .parts import Part
     from .sensing import (Sensor, classify, read_profile_csv, reference_profiles, resample,
                           sign_matrix)
-    from .sensor_plan import describe_sets, final_for_verdict, stored_sensor_plan
-    from .stages import config_part_id, read_json
+    from .sensor_plan import (PLAN_SCHEMA, describe_sets, final_for_verdict, read_checked_json,
+                              stored_sensor_plan)
+    from .stages import config_part_id
     config = load_config(args.config)
     root = Path(args.catalog or config["catalog_dir"])
     cat = Catalog.open(root)
@@ -363,7 +373,7 @@ def cmd_sense_classify(args):
     if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
         stored = None  # no sensor plan, or one for another outline of that name
     plan_path = root / "plans" / f"{name}.json"
-    plan = read_json(plan_path) if plan_path.is_file() else None
+    plan = read_checked_json(plan_path, PLAN_SCHEMA, "pinfeed plan result") if plan_path.is_file() else None
     if plan is not None and plan["part"].get("id", part.id) != part.id:
         plan = None
     first_pin = None
@@ -418,7 +428,9 @@ def cmd_sense_classify(args):
           f"mu_c {mu_c:g}, pin radius {pin_radius:g} mm")
     print(f"profile {args.profile}: {measured.t.size} samples over {measured.t[-1]:.3f} s at "
           f"{sensor.rate_hz:g} Hz")
-    if verdict["decided"]:
+    if verdict.get("note"):
+        print(f"verdict: undecided ({verdict['note']})")
+    elif verdict["decided"]:
         print(f"verdict: {verdict['best']} (decided: every other state scores at least "
               f"{sensor.margin} elements lower)")
     else:
@@ -578,6 +590,8 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(_join_signed_values(sys.argv[1:] if argv is None else list(argv)))
     try:
+        from .provenance import source_date_epoch
+        source_date_epoch()  # before numpy's f2py reads it (and crashes on a bad value)
         args.func(args)
     except PinfeedError as exc:
         print(f"pinfeed: error: {exc}", file=sys.stderr)

@@ -21,6 +21,7 @@ import yaml
 from .checks import check_finite_tree, check_pin_ratio
 from .errors import PinfeedError
 from .families import family_parts
+from .provenance import source_date_epoch
 
 SCHEMA_PATH = Path(__file__).resolve().parent.parent / "config" / "schema.yaml"
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config" / "config.yaml"
@@ -51,6 +52,7 @@ def _where(err) -> str:
 
 def validate_config(config: dict) -> dict:
     """Return a validated copy of ``config`` with defaults filled in."""
+    source_date_epoch()  # before any kernel import trips over a bad value
     cfg = copy.deepcopy(config)
     for key in ("catalog_dir", "results_dir"):
         if isinstance(cfg.get(key), str) and not cfg[key].strip():
