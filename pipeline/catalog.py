@@ -125,7 +125,7 @@ def _read_index(index: Path, root: Path) -> dict:
         with open(index) as fh:
             data = json.load(fh)
     except (json.JSONDecodeError, UnicodeDecodeError):
-        raise PinfeedError(f"{index} is corrupt (not JSON); {hint}") from None
+        raise PinfeedError(f"{index} is corrupt; {hint}") from None
     except OSError as exc:
         raise PinfeedError(f"cannot read {index}: {exc.strerror}; check its permissions") from None
     err = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(INDEX_SCHEMA).iter_errors(data))
