@@ -30,18 +30,21 @@ def parse_values(text: str, what: str) -> np.ndarray:
     """``"a,b,c"`` or an inclusive range ``"start:stop:step"``: finite, distinct,
     at most ``checks.MAX_VALUES`` values (refused before anything is allocated)."""
     from .checks import check_grid_size, check_values, range_size
+    bad = PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
+                       f"of finite numbers with step > 0")
     try:
         if ":" in text:
             start, stop, step = (float(x) for x in text.split(":"))
-            if not all(map(math.isfinite, (start, stop, step))) or step <= 0 or stop < start:
-                raise ValueError
-            n = range_size(start, stop, step)
-            check_grid_size(n, f"{what} {text}")
-            return np.round(start + step * np.arange(n), 10) + 0.0
-        values = [float(x) for x in text.split(",") if x.strip()]
+        else:
+            values = [float(x) for x in text.split(",") if x.strip()]
     except ValueError:
-        raise PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
-                           f"of finite numbers with step > 0") from None
+        raise bad from None
+    if ":" in text:
+        if not all(map(math.isfinite, (start, stop, step))) or step <= 0 or stop < start:
+            raise bad
+        n = range_size(start, stop, step)
+        check_grid_size(n, f"{what} {text}")
+        return np.round(start + step * np.arange(n), 10) + 0.0
     check_grid_size(len(values), what)
     return check_values(values, f"{what} {text!r}")
 
