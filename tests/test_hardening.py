@@ -388,7 +388,7 @@ def test_killed_runs_leave_a_consistent_catalog_that_resumes(tmp_path):
     rng = random.Random(12)
     for _ in range(3):
         proc = _run_workflow(tmp_path)
-        time.sleep(rng.uniform(1.0, 10.0))
+        time.sleep(rng.uniform(1.0, 7.0))
         os.killpg(proc.pid, signal.SIGKILL)  # the whole run, as kill -9 of make would
         proc.communicate()
         _check_consistent(tmp_path / "cat")
