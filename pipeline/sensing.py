@@ -196,7 +196,9 @@ def classify(measured: np.ndarray, references: dict, margin: int) -> dict:
     if not np.any(measured):
         # No force above the dead zone: no contact, or a dead sensor. The zeros
         # would match whichever state's matrix has most zeros; decide nothing.
-        return {"scores": scores, "best": ranked[0], "candidates": sorted(scores),
+        # It may still be one of the states that miss the pin, if any do.
+        missing = sorted(k for k, s in references.items() if not np.any(s))
+        return {"scores": scores, "best": ranked[0], "candidates": missing or sorted(scores),
                 "decided": False, "note": "no force above the dead zone: undecided"}
     return {"scores": scores, "best": ranked[0], "candidates": tied, "decided": len(tied) == 1}
 

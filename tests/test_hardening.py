@@ -252,6 +252,11 @@ def test_all_zero_profile_is_undecided():
     v = classify(zero, refs, sensor.margin)
     assert not v["decided"] and v["candidates"] == ["state 1", "state 2"]
     assert classify(mostly_zero, refs, sensor.margin)["decided"]  # a real profile still decides
+    # If some states miss the pin (all-zero references), the candidates are those,
+    # still undecided: a dead sensor reads the same.
+    refs["state 3"] = np.zeros((4, sensor.regions), np.int8)
+    v = classify(zero, refs, sensor.margin)
+    assert not v["decided"] and v["candidates"] == ["state 3"]
 
 
 # --------------------------------------------------------------------------- environment
