@@ -5,7 +5,7 @@ The limits keep a valid-looking input from running without end or
 allocating without bound (issue 12, "Hardening"):
 
 * a list or range of numbers holds at most ``MAX_VALUES`` values, all
-  finite and distinct;
+  finite and distinct, and one map at most ``MAX_MAP`` rollouts;
 * the integrator's largest step ``ds_max`` (units of a) lies in
   ``DS_MAX_RANGE`` and its tolerance ``tol`` in ``TOL_RANGE`` (the kernel's
   step count grows as 1/ds_max and as tol^(-1/order));
@@ -25,6 +25,7 @@ import numpy as np
 from .errors import PinfeedError
 
 MAX_VALUES = 100_000
+MAX_MAP = 1_000_000  # rollouts in one map (d x theta_i): about half an hour on one core
 DS_MAX_RANGE = (1e-3, 1.0)
 TOL_RANGE = (1e-12, 1e-3)
 MAX_PIN_RATIO = 10.0

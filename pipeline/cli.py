@@ -98,7 +98,7 @@ def cmd_rollout(args):
 
 def cmd_map(args):
     from . import simulate
-    from .checks import MAP_SUFFIXES, check_grid_size, check_out_path
+    from .checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
     from .io import write_atomic
     from .provenance import provenance_attrs
     part = _part_from_args(args)
@@ -106,7 +106,7 @@ def cmd_map(args):
     if not args.theta_step > 0 or args.theta_step > 360:
         raise PinfeedError(f"--theta-step must be in (0, 360] degrees, got {args.theta_step}")
     check_grid_size(math.ceil(360.0 / args.theta_step), f"--theta-step {args.theta_step:g} (theta_i grid)")
-    check_grid_size(d.size * math.ceil(360.0 / args.theta_step), "the map (d x theta_i)")
+    check_grid_size(d.size * math.ceil(360.0 / args.theta_step), "the map (d x theta_i)", MAX_MAP)
     check_out_path(args.out, MAP_SUFFIXES)
     theta = np.arange(0.0, 360.0 - 1e-9, args.theta_step)
     ds = simulate.map(part, theta, d, args.mu_c, args.pin_radius, model=args.model,

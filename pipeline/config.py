@@ -18,7 +18,7 @@ from pathlib import Path
 import jsonschema
 import yaml
 
-from .checks import check_finite_tree, check_pin_ratio
+from .checks import MAX_MAP, check_finite_tree, check_grid_size, check_pin_ratio
 from .errors import PinfeedError
 from .families import family_parts
 from .provenance import source_date_epoch
@@ -71,6 +71,10 @@ def validate_config(config: dict) -> dict:
     if abs(steps - round(steps)) > 1e-9:
         raise PinfeedError(f"config error at sweep/theta_step: 360 is not a multiple of "
                            f"{cfg['sweep']['theta_step']}")
+    try:
+        check_grid_size(len(cfg["sweep"]["d"]) * round(steps), "one shard (d x theta_i)", MAX_MAP)
+    except PinfeedError as exc:
+        raise PinfeedError(f"config error at sweep/d: {exc}") from None
     names = _part_names(cfg)
     unknown = [p for p in cfg["planner"]["parts"] if p not in names]
     if unknown:

@@ -133,6 +133,8 @@ def test_nan_and_inf_never_reach_the_kernel(capsys):
     one_line_error(capsys, base + ["--d", "inf", "--theta-i", "0"], "finite")
     one_line_error(capsys, MAP + ["--d", "0.3", "--theta-step", "1e-9", "--out", "x.h5"],
                    "360,000,000,000 values")
+    one_line_error(capsys, MAP + ["--d", "0:1:0.01", "--theta-step", "0.01", "--out", "x.h5"],
+                   "the map (d x theta_i) has 3,636,000 values, more than the limit of 1,000,000")
 
 
 # --------------------------------------------------------------------------- config
@@ -154,6 +156,8 @@ def test_nan_and_inf_never_reach_the_kernel(capsys):
     (lambda c: c["sweep"].update(kernel={"tol": 1e-30}), "minimum of 1e-12"),
     (lambda c: c["sweep"].update(pin_radius=1e4), "more than the limit of 10"),
     (lambda c: c["sweep"].update(theta_step=1e-6), "minimum of 0.01"),
+    (lambda c: c["sweep"].update(theta_step=0.01, d=[k / 100 for k in range(1, 40)]),
+     "one shard (d x theta_i) has 1,404,000 values, more than the limit of 1,000,000"),
 ])
 def test_bad_configs_are_refused(mutate, needle):
     cfg = json.loads(json.dumps(TINY))
