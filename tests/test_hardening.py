@@ -326,6 +326,8 @@ def test_part_in_two_families_is_a_clear_error(swept):
 def test_plan_depth_zero_is_refused(capsys):
     one_line_error(capsys, ["plan", "--vertices", "0,0 60,0 15,35", "--depth", "0"],
                    "--depth must be at least 1")
+    one_line_error(capsys, ["plan", "--vertices", "0,0 60,0 15,35", "--mu-c", "nan"],
+                   "--mu-c must be a finite number")
 
 
 # --------------------------------------------------------------------------- workflow faults
