@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: run demo test bench clean
+.PHONY: run unlock demo test bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -14,8 +14,14 @@ $(STAMP): pyproject.toml
 
 # The main job: the Snakemake workflow on the embedded default config
 # (config/config.yaml). Resumes an interrupted run; does nothing if up to date.
+# After a killed run it removes Snakemake's stale lock and temporary files
+# when no other run is alive (pipeline/workflow.py), saying so in one line.
 run: $(STAMP)
-	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/snakemake --cores all --rerun-incomplete
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pipeline.workflow run --cores all --rerun-incomplete
+
+# Remove Snakemake's lock by hand (only when no other run is alive).
+unlock: $(STAMP)
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/snakemake --unlock
 
 demo: $(STAMP)
 	$(BIN)/pinfeed demo --out results/demo

@@ -4,10 +4,12 @@
 #   snakemake --cores all                       # default config (the paper's set-up)
 #   snakemake --cores 16 --configfile config/workstation.yaml
 import os
+import sys
 
 from snakemake.utils import min_version
 
 from pipeline.config import validate_config
+from pipeline.workflow import reconcile_catalog
 
 min_version("8.0")
 
@@ -26,6 +28,14 @@ if not {"families", "sweep"} & set(config):
 _CONFIG_FILES = list(getattr(workflow, "configfiles", None) or [])
 config.update(validate_config(
     config, base_dir=os.path.dirname(os.path.abspath(_CONFIG_FILES[-1])) if _CONFIG_FILES else None))
+
+
+# The catalog against disk, before Snakemake plans its jobs: a deleted or
+# damaged shard removes the stale index, so this run recomputes it
+# (pipeline/workflow.py says why Snakemake would not).
+if workflow.is_main_process:
+    for note in reconcile_catalog(config):
+        print(f"pinfeed: {note}", file=sys.stderr)
 
 
 include: "rules/common.smk"

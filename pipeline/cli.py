@@ -28,18 +28,26 @@ def _print_json(obj, **kw):
 
 
 def parse_values(text: str, what: str) -> np.ndarray:
-    """``"a,b,c"`` or an inclusive range ``"start:stop:step"``."""
+    """``"a,b,c"`` or an inclusive range ``"start:stop:step"``: finite, distinct,
+    at most ``checks.MAX_VALUES`` values (refused before anything is allocated)."""
+    from .checks import check_grid_size, check_values, range_size
+    bad = PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
+                       f"of finite numbers with step > 0")
     try:
         if ":" in text:
             start, stop, step = (float(x) for x in text.split(":"))
-            if step <= 0 or stop < start:
-                raise ValueError
-            n = int(math.floor((stop - start) / step + 1e-9)) + 1
-            return np.round(start + step * np.arange(n), 10) + 0.0
-        return np.array([float(x) for x in text.split(",") if x.strip()])
+        else:
+            values = [float(x) for x in text.split(",") if x.strip()]
     except ValueError:
-        raise PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
-                           f"with step > 0") from None
+        raise bad from None
+    if ":" in text:
+        if not all(map(math.isfinite, (start, stop, step))) or step <= 0 or stop < start:
+            raise bad
+        n = range_size(start, stop, step)
+        check_grid_size(n, f"{what} {text}")
+        return np.round(start + step * np.arange(n), 10) + 0.0
+    check_grid_size(len(values), what)
+    return check_values(values, f"{what} {text!r}")
 
 
 def _part_from_args(args):
@@ -132,12 +140,16 @@ def _print_trajectory(row, n_rows: int = 11):
 
 def cmd_map(args):
     from . import simulate
+    from .checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
     from .io import write_atomic
     from .provenance import provenance_attrs
     part = _part_from_args(args)
     d = parse_values(args.d, "--d")
     if not args.theta_step > 0 or args.theta_step > 360:
         raise PinfeedError(f"--theta-step must be in (0, 360] degrees, got {args.theta_step}")
+    check_grid_size(math.ceil(360.0 / args.theta_step), f"--theta-step {args.theta_step:g} (theta_i grid)")
+    check_grid_size(d.size * math.ceil(360.0 / args.theta_step), "the map (d x theta_i)", MAX_MAP)
+    check_out_path(args.out, MAP_SUFFIXES)
     theta = np.arange(0.0, 360.0 - 1e-9, args.theta_step)
     ds = simulate.map(part, theta, d, args.mu_c, args.pin_radius, model=args.model,
                       v_pin=args.v_pin, threads=args.threads)
@@ -160,8 +172,10 @@ def _bands_option(text):
 
 
 def cmd_plot_map(args):
+    from .checks import IMAGE_SUFFIXES, check_out_path
     from .figures.maps import plot_map
     from .io import read_map
+    check_out_path(args.out, IMAGE_SUFFIXES)
     out = plot_map(read_map(args.map), args.out, bands=_bands_option(args.bands))
     print(f"wrote {out}")
 
@@ -268,7 +282,9 @@ def cmd_catalog_query(args):
 
 
 def cmd_catalog_plot(args):
+    from .checks import IMAGE_SUFFIXES, check_out_path
     from .figures.maps import plot_map
+    check_out_path(args.out, IMAGE_SUFFIXES)
     ds = _query(args)
     if ds.sizes["mu_c"] != 1:
         raise PinfeedError("plot one friction at a time: give --mu-c")
@@ -498,8 +514,9 @@ def cmd_sense_classify(args):
     from .parts import Part
     from .sensing import (Sensor, classify, read_profile_csv, reference_profiles, resample,
                           sign_matrix)
-    from .sensor_plan import describe_sets, final_for_verdict, stored_sensor_plan
-    from .stages import config_part_id, read_json
+    from .sensor_plan import (PLAN_SCHEMA, describe_sets, final_for_verdict, read_checked_json,
+                              stored_sensor_plan)
+    from .stages import config_part_id
     config = load_config(args.config)
     root = Path(args.catalog or config["catalog_dir"])
     cat = Catalog.open(root)
@@ -514,7 +531,7 @@ def cmd_sense_classify(args):
     if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
         stored = None  # no sensor plan, or one for another outline of that name
     plan_path = root / "plans" / f"{name}.json"
-    plan = read_json(plan_path) if plan_path.is_file() else None
+    plan = read_checked_json(plan_path, PLAN_SCHEMA, "pinfeed plan result") if plan_path.is_file() else None
     if plan is not None and plan["part"].get("id", part.id) != part.id:
         plan = None
     first_pin = None
@@ -569,7 +586,9 @@ def cmd_sense_classify(args):
           f"mu_c {mu_c:g}, pin radius {pin_radius:g} mm")
     print(f"profile {args.profile}: {measured.t.size} samples over {measured.t[-1]:.3f} s at "
           f"{sensor.rate_hz:g} Hz")
-    if verdict["decided"]:
+    if verdict.get("note"):
+        print(f"verdict: undecided ({verdict['note']})")
+    elif verdict["decided"]:
         print(f"verdict: {verdict['best']} (decided: every other state scores at least "
               f"{sensor.margin} elements lower)")
     else:
@@ -747,6 +766,8 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(_join_signed_values(sys.argv[1:] if argv is None else list(argv)))
     try:
+        from .provenance import source_date_epoch
+        source_date_epoch()  # before numpy's f2py reads it (and crashes on a bad value)
         args.func(args)
     except PinfeedError as exc:
         print(f"pinfeed: error: {exc}", file=sys.stderr)

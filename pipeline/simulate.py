@@ -23,6 +23,7 @@ from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NA
                              _rollout)
 
 from . import __version__
+from .checks import check_kernel_settings, check_pin_ratio
 from .errors import PinfeedError
 from .parts import Part
 
@@ -120,6 +121,8 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
         ``jam_reason``.
     """
     check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
+    check_pin_ratio(part, pin_radius)
+    check_kernel_settings(ds_max, tol)
     theta = float(_angles(theta_i, "theta_i")[0])
     dd = float(_angles(d, "d")[0])
     cap = np.inf if max_travel is None else float(max_travel)
@@ -172,6 +175,8 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
     ``contact_travel``, ``feature_changes`` and ``peak_force``.
     """
     check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
+    check_pin_ratio(part, pin_radius)
+    check_kernel_settings(ds_max, tol)
     th = _angles(theta_i, "theta_i")
     dd = _angles(d, "d")
     cap = np.inf if max_travel is None else float(max_travel)

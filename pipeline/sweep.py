@@ -128,8 +128,8 @@ def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
     todo = [j for j in shard_jobs(config) if not j.path(root).is_file()]
     written = []
     if scheduler:
-        from distributed import Client, as_completed
-        with Client(scheduler) as client:
+        from distributed import as_completed
+        with _client(scheduler) as client:
             futures = [client.submit(_write_job, config, j, threads, pure=False) for j in todo]
             for fut in _progress(as_completed(futures), len(futures), progress):
                 written.append(Path(fut.result()))
@@ -138,6 +138,23 @@ def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
             written.append(write_shard(config, job, threads=threads))
     Catalog.rebuild(root)
     return written
+
+
+SCHEDULER_TIMEOUT = 10  # seconds to reach a dask scheduler
+
+
+def _client(address: str):
+    """A dask.distributed client, or one clear error if the scheduler cannot be
+    reached within ``SCHEDULER_TIMEOUT`` seconds."""
+    from distributed import Client
+
+    from .errors import PinfeedError
+    try:
+        return Client(address, timeout=SCHEDULER_TIMEOUT)
+    except (OSError, TimeoutError, ValueError) as exc:
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise PinfeedError(f"cannot reach the dask scheduler at {address} within {SCHEDULER_TIMEOUT} s "
+                           f"({reason[:120]}); start it or drop --scheduler to run here") from None
 
 
 def _progress(it, total, enabled):
