@@ -189,11 +189,11 @@ def sense_part(cat, name: str, config: dict, log=print) -> dict:
     """The sensing stage for one planned part: score table at the chosen first
     pin, the sensor plan and its per-verdict final sets, with provenance."""
     from .provenance import provenance_attrs
-    from .stages import build_planner
+    from .stages import build_planner, paper_depth
     sc = config["sensing"]
     part, planner, mu_used, selection = build_planner(cat, name, config, dynamic=False)
     sensor = Sensor.from_config(sc["sensor"])
-    res = plan_with_sensor(planner, config["planner"]["depth"], mu_used, config["sweep"]["pin_radius"],
+    res = plan_with_sensor(planner, paper_depth(config), mu_used, config["sweep"]["pin_radius"],
                            config["planner"]["model"], sensor, trials=sc["trials"],
                            perturb=dict(PERTURB_DEFAULTS, **sc["perturb"]), seed=sc["seed"],
                            apart_fraction=sc["apart_fraction"], max_first_pins=sc["max_first_pins"],
