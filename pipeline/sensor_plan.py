@@ -204,7 +204,7 @@ def sense_part(cat, name: str, config: dict, log=print) -> dict:
     if res["found"]:
         out["verification"] = verify_sensor_plan(part, out, mu_used, config["sweep"]["pin_radius"],
                                                  config["planner"]["model"], sensor,
-                                                 config.get("verify", {}))
+                                                 dict(config.get("verify", {}), trials=sc["trials"]))
     return dict(out, **provenance_attrs())
 
 
