@@ -198,7 +198,8 @@ def _model_xml(pieces, r_pin, mu_c, mass, izz, pin_start, pin_dir):
 
 
 def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0.5, v_pin=0.0,
-                   max_travel=math.inf, trajectory=False, record_every=40):
+                   max_travel=math.inf, trajectory=False, record_every=40,
+                   mass=PART_MASS):
     """One passage in MuJoCo. Lengths in mm, speeds in mm/s, angles in degrees.
 
     Returns ``(status, jam_reason, theta_f_rad, dy_mm, contact_travel_mm,
@@ -218,7 +219,6 @@ def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0
     a = a_mm / 1000.0
     r_pin = r_pin_mm / 1000.0
     vb = belt_speed_mm_s / 1000.0
-    mass = PART_MASS
     izz = mass * jpol / area / 1e6
     # Support grid (body frame), centred on the centroid.
     s = GRID_MM / 1000.0
