@@ -171,7 +171,6 @@ def _model_xml(pieces, r_pin, mu_c, mass, izz, pin_start, pin_dir):
         geoms.append(f'<geom type="mesh" mesh="piece{k}" contype="1" conaffinity="2" '
                      f'condim="{3 if mu_c > 0 else 1}" friction="{mu_c:.9g} 0 0" '
                      f'solref="{SOLREF[0]} {SOLREF[1]}"/>')
-    side = max(izz / mass, 1e-12)
     return f"""
 <mujoco model="pinfeed-rig">
   <compiler inertiafromgeom="false" angle="radian"/>
@@ -183,7 +182,7 @@ def _model_xml(pieces, r_pin, mu_c, mass, izz, pin_start, pin_dir):
       <joint name="px" type="slide" axis="1 0 0" damping="0"/>
       <joint name="py" type="slide" axis="0 1 0" damping="0"/>
       <joint name="pth" type="hinge" axis="0 0 1" damping="0"/>
-      <inertial pos="0 0 0" mass="{mass:.9g}" diaginertia="{mass * side / 2:.9g} {mass * side / 2:.9g} {izz:.9g}"/>
+      <inertial pos="0 0 0" mass="{mass:.9g}" diaginertia="{izz:.9g} {izz:.9g} {izz:.9g}"/>
       {''.join(geoms)}
     </body>
     <body name="pin" pos="{pin_start[0]:.9g} {pin_start[1]:.9g} 0">
