@@ -186,3 +186,28 @@ def test_mujoco_kinematics_do_not_depend_on_mass():
     assert light[0] == heavy[0] == 0
     assert circ(math.degrees(light[2]), math.degrees(heavy[2])) < 0.3
     assert light[3] == pytest.approx(heavy[3], abs=0.1)
+
+
+# ------------------------------------------------------------ speed limit
+
+def test_speed_limit_of_a_small_plan_holds_on_replay():
+    """One fixed pin on the asymmetric triangle's second resting state; the
+    final set is the quasi-static outcome +- 3 deg. The limit is found by
+    bisection to 5 mm/s, the next 5 mm/s fail, and a replay with fresh random
+    draws at the limit holds (99% in-sample; 97% allows for sampling noise)."""
+    from pipeline.speed_limit import _draws, speed_curve, success_fraction
+    theta, yc = ASYM.stable_states()[1]
+    y_pin = yc - 0.3 * ASYM.a
+    ref = qs(ASYM, theta, -0.3, 0.3)
+    arcs = [(float(ref.theta_f) - 3.0, 6.0)]
+    res = speed_curve(ASYM, [y_pin], [0.0], [(theta, yc)], arcs, 0.3, trials=100,
+                      speeds=(10.0, 100.0, 200.0, 300.0))
+    limit = res["speed_limit_mm_s"]
+    curve = dict((v, f) for v, f in res["curve"])
+    assert 100.0 <= limit < 200.0 and limit % 5.0 == 0.0
+    assert curve[10.0] >= 0.99 and curve[limit] >= 0.99
+    assert curve[limit + 5.0] < 0.99
+    fresh = _draws(ASYM, [y_pin], [(theta, yc)], 0.3, {"theta_deg": 1.0, "y_mm": 0.5, "pin_mm": 0.2},
+                   200, seed=7)
+    assert success_fraction(ASYM, [y_pin], [0.0], fresh, arcs, limit) >= 0.97
+    assert success_fraction(ASYM, [y_pin], [0.0], fresh, arcs, 300.0) < 0.9
