@@ -86,7 +86,9 @@ import math
 
 import numpy as np
 
-from ._numba import jit
+from numba import prange
+
+from ._numba import jit, jit_parallel
 from .geometry import _closest_feature, _other_contact_gap, _ray_first_contact
 from .support import _power
 
@@ -384,3 +386,41 @@ def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, f
         status = MISS
     return (status, reason, th % two_pi, Y * a, travel * a, changes, peak,
             traj[:n_rec].copy(), force[:n_rec].copy(), twist[:n_rec].copy())
+
+
+@jit_parallel
+def _dyn_rollout_grid(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, fr,
+                      restitution, eps, h, max_travel, max_steps, n_blocks):
+    """Dynamic rollouts over the outer product ``d x theta_i`` (radians).
+
+    Contiguous blocks per thread as in ``batch._rollout_grid``; every rollout
+    is independent, so the result does not depend on the thread count.
+    Returns ``status``, ``reason`` (int8; ``DYN_REASONS``), ``theta_f``,
+    ``dy``, ``contact_travel``, ``feature_changes`` (int32), ``peak_force``,
+    each of shape ``(len(d), len(theta_i))``.
+    """
+    nd, nt = d.shape[0], theta_i.shape[0]
+    total = nd * nt
+    status = np.empty((nd, nt), dtype=np.int8)
+    reason = np.empty((nd, nt), dtype=np.int8)
+    theta_f = np.empty((nd, nt))
+    dy = np.empty((nd, nt))
+    travel = np.empty((nd, nt))
+    changes = np.empty((nd, nt), dtype=np.int32)
+    peak = np.empty((nd, nt))
+    n_blocks = max(1, min(n_blocks, total))
+    for b in prange(n_blocks):
+        start = b * total // n_blocks
+        stop = (b + 1) * total // n_blocks
+        for flat in range(start, stop):
+            i, j = flat // nt, flat % nt
+            res = _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i[j], d[i],
+                               v_pin, fr, restitution, eps, h, max_travel, max_steps, False)
+            status[i, j] = res[0]
+            reason[i, j] = res[1]
+            theta_f[i, j] = res[2]
+            dy[i, j] = res[3]
+            travel[i, j] = res[4]
+            changes[i, j] = res[5]
+            peak[i, j] = res[6]
+    return status, reason, theta_f, dy, travel, changes, peak

@@ -170,30 +170,58 @@ def _wrap_deg(x):
 def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "minpower",
         v_pin: float = 0.0, max_travel: float | None = None, threads: int | None = None,
         ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
-        length_unit: str = "mm") -> xr.Dataset:
+        length_unit: str = "mm", belt_speed: float | None = None,
+        mu_s: float = 0.5) -> xr.Dataset:
     """Configuration map set: rollouts over ``d x theta_i`` (paper eq. 2).
+
+    ``model="dynamic"`` needs ``belt_speed`` (mm/s; the part in mm) and takes
+    ``mu_s``; its ``jam_reason`` flags add ``step_budget``.
 
     Runs in parallel on ``threads`` Numba threads (default: all Numba has).
     Returns a Dataset with dims ``(d, theta_i)`` and variables ``theta_f``,
     ``dy``, ``status`` (int8 flags, see its ``flag_meanings``), ``jam_reason``,
     ``contact_travel``, ``feature_changes`` and ``peak_force``.
     """
-    check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
+    dynamic = model == "dynamic"
+    if model == "mujoco":
+        raise PinfeedError("the MuJoCo rig is for single passages (seconds each), not maps")
+    if dynamic:
+        if belt_speed is None:
+            raise PinfeedError("model 'dynamic' needs a belt speed (mm/s)")
+        fr = check_belt(part, belt_speed, mu_s)
+    check_parameters(mu_c, pin_radius, "minpower" if dynamic else model, v_pin, max_travel)
     th = _angles(theta_i, "theta_i")
     dd = _angles(d, "d")
     cap = np.inf if max_travel is None else float(max_travel)
     with _threads(threads) as n:
-        status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
-            *part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
-            np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol), n)
+        if dynamic:
+            from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
+                                         _dyn_rollout_grid)
+            verts, area, a, quad, _, convex = part.prepared()
+            status, reason, theta_f, dy, travel, changes, peak = _dyn_rollout_grid(
+                verts, area, a, quad, convex, float(mu_c), float(pin_radius), np.radians(th), dd,
+                float(v_pin), fr, 0.0, DEFAULT_V_REG / float(belt_speed), DEFAULT_H, cap,
+                DEFAULT_MAX_STEPS, n)
+        else:
+            status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
+                *part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
+                np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol), n)
     unit = length_unit
+    jam_attrs = dict(JAM_ATTRS)
+    attrs = _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit)
+    if dynamic:
+        from kernels.dynamic import DYN_REASONS
+        jam_attrs = {"long_name": "why a rollout was declared jammed or truncated",
+                     "flag_values": np.arange(len(DYN_REASONS), dtype=np.int8),
+                     "flag_meanings": " ".join(["none"] + [r.replace(" ", "_") for r in DYN_REASONS[1:]])}
+        attrs.update(belt_speed=float(belt_speed), mu_s=float(mu_s), froude=fr)
     return xr.Dataset(
         {
             "theta_f": (("d", "theta_i"), _wrap_deg(np.degrees(theta_f)),
                         {"units": "degree", "long_name": "final orientation"}),
             "dy": (("d", "theta_i"), dy, {"units": unit, "long_name": "centroid displacement across the belt"}),
             "status": (("d", "theta_i"), status, dict(STATUS_ATTRS)),
-            "jam_reason": (("d", "theta_i"), reason, dict(JAM_ATTRS)),
+            "jam_reason": (("d", "theta_i"), reason, jam_attrs),
             "contact_travel": (("d", "theta_i"), travel, {"units": unit, "long_name": "pin travel in contact"}),
             "feature_changes": (("d", "theta_i"), changes, {"long_name": "contact feature changes"}),
             "peak_force": (("d", "theta_i"), peak, {"units": "mu_s m g", "long_name": "peak force on the pin"}),
@@ -202,7 +230,7 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
             "d": ("d", dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"}),
             "theta_i": ("theta_i", th, {"units": "degree", "long_name": "initial orientation"}),
         },
-        attrs=_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit),
+        attrs=attrs,
     )
 
 

@@ -211,3 +211,16 @@ def test_speed_limit_of_a_small_plan_holds_on_replay():
                    200, seed=7)
     assert success_fraction(ASYM, [y_pin], [0.0], fresh, arcs, limit) >= 0.97
     assert success_fraction(ASYM, [y_pin], [0.0], fresh, arcs, 300.0) < 0.9
+
+
+def test_dynamic_map_matches_single_rollouts_for_any_thread_count():
+    th, d = [10.0, 100.0, 200.0, 300.0], [-0.5, 0.3]
+    maps = [simulate.map(ASYM, th, d, 0.3, R_PIN, model="dynamic", belt_speed=200.0, threads=t)
+            for t in (1, 2)]
+    for name in ("theta_f", "dy", "status", "peak_force"):
+        np.testing.assert_array_equal(maps[0][name].values, maps[1][name].values)
+    for i, dd in enumerate(d):
+        for j, t in enumerate(th):
+            one = dyn(ASYM, t, dd, 0.3, 200.0)
+            assert float(one.theta_f) == float(maps[0].theta_f.values[i, j])
+            assert float(one.dy) == float(maps[0].dy.values[i, j])
