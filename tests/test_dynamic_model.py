@@ -224,3 +224,29 @@ def test_dynamic_map_matches_single_rollouts_for_any_thread_count():
             one = dyn(ASYM, t, dd, 0.3, 200.0)
             assert float(one.theta_f) == float(maps[0].theta_f.values[i, j])
             assert float(one.dy) == float(maps[0].dy.values[i, j])
+
+
+def test_belt_speed_is_a_catalog_dimension(tmp_path):
+    from pathlib import Path
+
+    from pipeline.catalog import Catalog
+    from pipeline.config import validate_config
+    from pipeline.sweep import run_sweep
+    cfg = validate_config({
+        "families": {"fam": {"parts": [{"name": "tri", "vertices": [[0, 0], [60, 0], [15, 35]]}]}},
+        "sweep": {"models": ["minpower"], "mu_c": [0.2], "d": [-0.4, 0.3], "theta_step": 45,
+                  "pin_radius": 1.0, "belt_speed": [0.0, 250.0], "mu_s": 0.4},
+        "catalog_dir": str(tmp_path / "catalog")})
+    run_sweep(cfg, progress=False)
+    cat = Catalog.open(cfg["catalog_dir"])
+    names = sorted(Path(e["file"]).as_posix().split("/", 2)[-1] for e in cat.entries)
+    assert names == ["dynamic/mu_c=0.2_belt=250.0_mu_s=0.4.h5", "minpower/mu_c=0.2.h5"]
+    fast = cat.query("tri", mu_c=0.2, belt_speed=250.0).load()
+    direct = simulate.map(ASYM, np.arange(0, 360, 45.0), [-0.4, 0.3], 0.2, 1.0, model="dynamic",
+                          belt_speed=250.0, mu_s=0.4)
+    np.testing.assert_array_equal(fast["theta_f"].values[0], direct["theta_f"].values)
+    slow = cat.query("tri", mu_c=0.2).load()
+    assert slow.attrs["model"] == "minpower"
+    with pytest.raises(PinfeedError, match="belt speed 100 mm/s; stored belt speeds: 250"):
+        cat.query("tri", belt_speed=100.0)
+    assert "dynamic" not in cat.cube("fam")["model"].values.tolist()
