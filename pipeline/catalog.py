@@ -107,6 +107,8 @@ def _entry_from_file(root: Path, path: Path) -> dict:
         "mu_c": float(attrs["mu_c"]),
         "pin_radius": float(attrs["pin_radius"]),
         "v_pin": float(attrs.get("v_pin", 0.0)),
+        "belt_speed": float(attrs.get("belt_speed", 0.0)),
+        "mu_s": float(attrs.get("mu_s", 0.5)),
         "d": d,
         "theta_step": float(attrs["theta_step"]),
         "n_theta": n_theta,
@@ -245,7 +247,8 @@ class Catalog:
         return xr.open_dataset(path, engine="h5netcdf", chunks={})
 
     def query(self, part: str, model: str = "minpower", mu_c=None, d=None,
-              method: str = "nearest", v_pin: float = 0.0) -> xr.Dataset:
+              method: str = "nearest", v_pin: float = 0.0,
+              belt_speed: float = 0.0) -> xr.Dataset:
         """Maps of one part, model and pin speed, lazily.
 
         ``mu_c`` and ``d`` select stored values: ``method="nearest"`` takes the
@@ -253,8 +256,12 @@ class Catalog:
         the exact one). ``None`` keeps all. ``v_pin`` (speed ratio v_pin / v_b,
         default 0: static pins) must be stored exactly, since maps of different
         speeds are not interpolated. ``attrs["selection"]`` says what was
-        chosen. Returns dims ``(mu_c, d, theta_i)``.
+        chosen. ``belt_speed`` (mm/s, default 0: quasi-static) selects the
+        dynamic model's maps at that speed, stored exactly (``model`` is then
+        ``"dynamic"``). Returns dims ``(mu_c, d, theta_i)``.
         """
+        if float(belt_speed) > 0.0:
+            model = "dynamic"
         if method not in ("nearest", "bracket"):
             raise PinfeedError(f"unknown selection method {method!r}; use nearest or bracket")
         _check_finite(mu_c=mu_c, d=d, v_pin=v_pin)
@@ -262,6 +269,12 @@ class Catalog:
         if not found:
             models = sorted({e["model"] for e in self._entries_for(part)})
             raise PinfeedError(f"part {part!r} has no {model} maps; stored models: {', '.join(models)}")
+        belts = sorted({e.get("belt_speed", 0.0) for e in found})
+        found = [e for e in found if e.get("belt_speed", 0.0) == float(belt_speed)]
+        if not found:
+            raise PinfeedError(f"part {part!r} has no {model} maps at belt speed {float(belt_speed):g} mm/s; "
+                               f"stored belt speeds: {', '.join(f'{v:g}' for v in belts)} "
+                               f"(add it to sweep.belt_speed)")
         speeds = sorted({e.get("v_pin", 0.0) for e in found})
         found = [e for e in found if e.get("v_pin", 0.0) == float(v_pin)]
         if not found:
@@ -290,7 +303,9 @@ class Catalog:
 
     def cube(self, family: str) -> xr.Dataset:
         """All maps of a family as one lazy cube (part, model, mu_c, v_pin, d, theta_i)."""
-        found = [e for e in self.entries if e["family"] == family]
+        # Quasi-static maps only: dynamic maps at belt speed > 0 are queried
+        # one speed at a time (``query(..., belt_speed=...)``).
+        found = [e for e in self.entries if e["family"] == family and not e.get("belt_speed", 0.0)]
         if not found:
             fams = sorted({e["family"] for e in self.entries})
             raise PinfeedError(f"unknown family {family!r}; known families: {', '.join(fams) or 'none'}")

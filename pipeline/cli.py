@@ -79,12 +79,21 @@ def _add_outline_args(p, required=True):
                    "outline file's name)")
 
 
-def _add_physics(p, d_required=True):
+def _add_physics(p, d_required=True, belt=False):
     _add_outline_args(p)
     p.add_argument("--mu-c", type=float, required=True, help="pin-part friction coefficient (>= 0)")
     p.add_argument("--pin-radius", type=float, required=True, help="pin radius (mm, > 0)")
-    p.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"],
-                   help="contact model (default minpower)")
+    if belt:
+        p.add_argument("--model", default="minpower",
+                       choices=["minpower", "tip", "ellipsoid", "dynamic", "mujoco"],
+                       help="contact model (default minpower); dynamic and mujoco need --belt-speed")
+        p.add_argument("--belt-speed", dest="belt_speed", type=float, default=None,
+                       help="belt speed, mm/s (models dynamic and mujoco)")
+        p.add_argument("--mu-s", dest="mu_s", type=float, default=0.5,
+                       help="belt-part friction coefficient (models dynamic and mujoco; default 0.5)")
+    else:
+        p.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"],
+                       help="contact model (default minpower)")
     p.add_argument("--v-pin", type=float, default=0.0,
                    help="pin speed across the belt / belt speed (default 0: static pin)")
 
@@ -92,11 +101,20 @@ def _add_physics(p, d_required=True):
 def cmd_rollout(args):
     from . import simulate
     part = _part_from_args(args)
+    belt = {}
+    if args.model in simulate.BELT_MODELS:
+        if args.belt_speed is None:
+            raise PinfeedError(f"--model {args.model} needs --belt-speed MM_S")
+        simulate.check_belt(part, args.belt_speed, args.mu_s)
+        belt = dict(belt_speed=args.belt_speed, mu_s=args.mu_s)
+    elif args.belt_speed is not None:
+        raise PinfeedError(f"--belt-speed is for --model dynamic or mujoco, not {args.model} "
+                           f"(quasi-static: no belt speed)")
     rows = []
     for theta in parse_values(args.theta_i, "--theta-i"):
         ds = simulate.rollout(part, theta, args.d, args.mu_c, args.pin_radius, model=args.model,
                               v_pin=args.v_pin, max_travel=args.max_travel,
-                              trajectory=args.trajectory)
+                              trajectory=args.trajectory, **belt)
         row = {"theta_i": float(theta), "status": str(ds.status.item()),
                "theta_f": float(ds.theta_f), "dy": float(ds.dy),
                "contact_travel": float(ds.contact_travel),
@@ -110,8 +128,9 @@ def cmd_rollout(args):
     if args.json:
         _print_json(rows)
         return
+    speed = f"  belt {args.belt_speed:g} mm/s  mu_s = {args.mu_s:g}" if belt else ""
     print(f"part {part.id}  a = {part.a:.3f} mm  model {args.model}  mu_c = {args.mu_c:g}  "
-          f"pin radius {args.pin_radius:g} mm  d = {args.d:+g}")
+          f"pin radius {args.pin_radius:g} mm  d = {args.d:+g}{speed}")
     print(f"{'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9} {'travel':>8} "
           f"{'changes':>7} {'peak F':>7}")
     for r in rows:
@@ -639,7 +658,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("rollout", help="roll a part past one pin for some initial orientations")
-    _add_physics(p)
+    _add_physics(p, belt=True)
     p.add_argument("--theta-i", required=True, help="initial orientations, degrees: 'a,b,c' or 'start:stop:step'")
     p.add_argument("--d", type=float, required=True, help="contact parameter (y_pin - y_com)/a")
     p.add_argument("--trajectory", action="store_true", help="also show the trajectory: a short table, or every sample and the "
