@@ -44,7 +44,9 @@ JAM_NOTCH = 2  # two simultaneous contacts
 JAM_TRAVEL = 3  # pin travel in contact past 50 a
 JAM_NO_PUSH = 4  # the pin moves into the part and no pushing solution exists
 JAM_CHATTER = 5  # contact feature changes without progress
-JAM_REASONS = ("", "no rotation", "notch", "travel limit", "no pushing solution", "chatter")
+TRUNC_STEP_BUDGET = 6  # status truncated: the integrator's step budget ran out
+JAM_REASONS = ("", "no rotation", "notch", "travel limit", "no pushing solution", "chatter",
+               "step budget")
 
 _EVENT_TOL = 1e-10  # event functions may dip this far below zero (units of a)
 _SAME_FEATURE = 1e-3  # contact points closer than this (units of a) are one feature
@@ -58,6 +60,27 @@ DEFAULT_DS_MAX = 0.1  # units of a
 DEFAULT_TOL = 1e-7  # local error per step, units of a and radians
 _DTHETA_CAP = 0.2  # radians of contact-normal turn per step
 _GROW_MAX = 2.0  # largest step growth between accepted steps
+
+# Step budget (issue 12): a rollout ends with status ``truncated`` and reason
+# "step budget" after this many integration steps (accepted, rejected and
+# event-locating steps, plus re-contacts after a separation), so no input can
+# make it run without end. A normal rollout takes 20 to 200 steps; the budget
+# shrinks with the polygon size because a step's cost grows with it.
+# The largest budget seen used on the test grids is about 500 steps; a step
+# of a degenerate contact (a pin 1e5 times the part) costs up to ~80 us for a
+# triangle, so 5,000 steps stay near a second on a slow core. A 500-vertex
+# outline gets 1,000 steps (~1.3 ms each).
+MAX_STEPS = 5000  # for parts of up to MAX_STEPS_WORK / MAX_STEPS vertices
+MAX_STEPS_WORK = 150000  # steps x vertices
+MIN_STEPS = 1000
+
+# Rows of the scratch array ``work`` (``_W_ROWS`` x 6 float64) that
+# ``_rollout_core`` uses instead of allocating, so the same code runs in a
+# CUDA thread with a fixed-size local array.
+_W_Y, _W_YNEW, _W_K1, _W_KEND, _W_YLOC, _W_TMP, _W_YI, _W_YTRY = 0, 1, 2, 3, 4, 5, 6, 7
+_W_KS = 8  # six rows: the Runge-Kutta stages
+_W_GEND, _W_GWORK, _W_MASK, _W_WARM = 14, 15, 16, 17
+_W_ROWS = 18
 
 
 @jit
@@ -225,7 +248,7 @@ def _first_event(g, tol):
 def _min_over(g, mask):
     m = np.inf
     for j in range(4):
-        if mask[j] and g[j] < m:
+        if mask[j] != 0.0 and g[j] < m:
             m = g[j]
     return m
 
@@ -245,22 +268,22 @@ def _hermite(y0, k0, y1, k1, h, alpha, out):
 
 @jit
 def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vpwy, y0, k1, h,
-            y1, k_end, g1, y_out, ks, tmp, warm, g, mask):
+            y1, k_end, g1, y_out, ks, tmp, warm, g, mask, yi, y_try):
     """Shrink the step from ``y0`` to end on the first event crossed by the
     full step of size ``h`` to ``y1`` (slope ``k_end``, event values ``g1``).
 
     The crossing is first found on the step's Hermite interpolant (no contact
     solves), then refined with real steps by safeguarded secant iterations.
-    The state just before the crossing goes to ``y_out``.
-    Returns ``(fraction, event)``.
+    The state just before the crossing goes to ``y_out``; ``yi`` and
+    ``y_try`` are scratch. Returns ``(fraction, event, steps)`` with the
+    number of real steps taken.
     """
     for j in range(4):
-        mask[j] = g1[j] < -_EVENT_TOL
+        mask[j] = 1.0 if g1[j] < -_EVENT_TOL else 0.0
     _events(verts, convex, kind, idx, rp, vpwx, vpwy, y0, g)
     f0 = _min_over(g, mask)
     f1 = _min_over(g1, mask)
     # 1. Root of the event function along the interpolant (Illinois).
-    yi = np.empty(5)
     for i in range(5):
         yi[i] = y0[i]
     lo, hi, f_lo, f_hi, side = 0.0, 1.0, f0, f1, 0
@@ -288,19 +311,20 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
     #    inside the bracket of real evaluations.
     for i in range(5):
         y_out[i] = y0[i]
-    y_try = np.empty(5)
     lo, hi, f_lo = 0.0, 1.0, f0
     frac = 0.0
     prev_alpha, prev_f = -1.0, 0.0
+    n_steps = 0
     for it in range(60):
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
+        n_steps += 1
         _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1,
               alpha * h, y_try, ks, tmp, warm)
         _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_try, g)
         for j in range(4):
-            if not mask[j] and g[j] < -_EVENT_TOL:
-                mask[j] = True  # an earlier event than the ones seen so far
+            if mask[j] == 0.0 and g[j] < -_EVENT_TOL:
+                mask[j] = 1.0  # an earlier event than the ones seen so far
         f = _min_over(g, mask)
         # Close enough when within the integrator's own event tolerance; a
         # state a hair past the crossing (f >= -_EVENT_TOL / 10) is kept too.
@@ -330,18 +354,15 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
     ev = 0
     best = np.inf
     for j in range(4):
-        if mask[j] and g[j] < best:
+        if mask[j] != 0.0 and g[j] < best:
             best, ev = g[j], j
-    return frac, ev
+    return frac, ev, n_steps
 
 
 @jit
-def _grow(buf, m):
-    if m < buf.shape[0]:
-        return buf
-    out = np.empty((2 * buf.shape[0], buf.shape[1]))
-    out[: buf.shape[0]] = buf
-    return out
+def max_steps_for(n_vertices):
+    """Default step budget of a rollout for a polygon of ``n_vertices``."""
+    return max(MIN_STEPS, min(MAX_STEPS, MAX_STEPS_WORK // max(n_vertices, 1)))
 
 
 @jit
@@ -371,12 +392,53 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         ``theta_f`` in radians in [0, 2 pi); lengths in the part's unit;
         ``trajectory`` rows ``(s, x, y, theta)`` (theta unwrapped, radians) and
         ``force`` rows ``(s, f_x, f_y)`` (force on the pin, units of mu_s m g);
-        both empty unless ``record``.
+        both empty unless ``record``. A rollout that uses up the step budget
+        ``max_steps_for(len(verts))`` ends ``TRUNCATED`` with reason
+        ``TRUNC_STEP_BUDGET``.
+    """
+    res = _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d,
+                          v_pin, max_travel, ds_max, tol, record,
+                          max_steps_for(verts.shape[0]))
+    return res[0], res[1], res[2], res[3], res[4], res[5], res[6], res[7], res[8]
+
+
+@jit
+def _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
+                    max_travel, ds_max, tol, record, max_steps):
+    """``_rollout`` with an explicit step budget ``max_steps``; returns its
+    nine results plus the number of steps used (at most ``max_steps`` plus
+    one event location, 61 steps)."""
+    work = np.empty((_W_ROWS, 6))
+    cap = max_steps + 4 if record else 1
+    traj = np.empty((cap, 4))
+    force = np.empty((cap, 3))
+    res = _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d,
+                        v_pin, max_travel, ds_max, tol, record, max_steps, work, traj, force)
+    n_traj, n_force = res[7], res[8]
+    return (res[0], res[1], res[2], res[3], res[4], res[5], res[6], traj[:n_traj].copy(),
+            force[:n_force].copy(), res[9])
+
+
+@jit
+def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
+                  max_travel, ds_max, tol, record, max_steps, work, traj, force):
+    """The rollout itself, without allocating: the scalar code path shared by
+    the CPU kernels and the CUDA kernel (``kernels.cuda``).
+
+    ``work`` is a ``(_W_ROWS, 6)`` float64 scratch array; ``traj`` and
+    ``force`` take the records when ``record`` (at least ``max_steps + 4``
+    rows; unused otherwise). Returns ``(status, jam_reason, theta_f, dy,
+    contact_travel, feature_changes, peak_force, n_traj, n_force, steps)``.
+
+    Notes
+    -----
+    Every integration attempt counts against ``max_steps``: accepted and
+    rejected steps, the real steps of an event location and each re-contact
+    after a separation. The budget is checked before each step, so at most
+    one event location (61 steps) runs past it.
     """
     rp = r_pin / a
     s_cap = max_travel / a
-    traj = np.empty((64 if record else 0, 4))
-    force = np.empty((64 if record else 0, 3))
     n_traj = 0
     n_force = 0
     two_pi = 2.0 * math.pi
@@ -391,31 +453,41 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
     sigma, kind, idx = _ray_first_contact(verts, qx, qy, wx, wy, rp, 0.0)
     theta_wrapped = theta_i % two_pi
     if not math.isfinite(sigma):
-        return MISS, JAM_NONE, theta_wrapped, 0.0, 0.0, 0, 0.0, traj[:0], force[:0]
-    y = np.array([theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d])
-    y_new = np.empty(5)
-    k1 = np.empty(5)
-    k_end = np.empty(5)
-    y_located = np.empty(5)
-    ks = np.empty((6, 5))
-    tmp = np.empty(5)
-    g_end = np.empty(4)
-    g_work = np.empty(4)
-    mask = np.zeros(4, dtype=np.bool_)
-    warm = np.array([wx, wy, 0.0, 0.0])  # previous twist and contact mode
+        return MISS, JAM_NONE, theta_wrapped, 0.0, 0.0, 0, 0.0, 0, 0, 0
+    y = work[_W_Y]
+    y_new = work[_W_YNEW]
+    k1 = work[_W_K1]
+    k_end = work[_W_KEND]
+    y_located = work[_W_YLOC]
+    tmp = work[_W_TMP]
+    ks = work[_W_KS:_W_KS + 6]
+    g_end = work[_W_GEND]
+    g_work = work[_W_GWORK]
+    mask = work[_W_MASK]
+    warm = work[_W_WARM]
+    y[0], y[1], y[2], y[3], y[4] = theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d
+    # previous twist and contact mode
+    warm[0], warm[1], warm[2], warm[3] = wx, wy, 0.0, 0.0
+    for j in range(4):
+        mask[j] = 0.0
     s = 0.0
     h_next = ds_max
     travel = 0.0
     changes = 0
+    steps = 0
     peak = 0.0
     theta_ref, travel_ref = theta_i, 0.0
     status, reason = OK, JAM_NONE
     if record:
-        traj[0] = (0.0, 0.0, 0.0, theta_i)
+        traj[0, 0], traj[0, 1], traj[0, 2], traj[0, 3] = 0.0, 0.0, 0.0, theta_i
         n_traj = 1
     separated = False
     have_k1 = False
+    st, mode, fx, fy = TWIST_OK, SEPARATE, 0.0, 0.0
     while True:
+        if steps >= max_steps:
+            status, reason = TRUNCATED, TRUNC_STEP_BUDGET
+            break
         if not have_k1:
             st, mode, fx, fy = _derivative(model, verts, quad, area, m_max, mu_c, kind, idx,
                                            vpwx, vpwy, y, warm, k1)
@@ -432,12 +504,12 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
             fwx, fwy = 0.0, 0.0
         peak = max(peak, math.hypot(fwx, fwy))
         if record:
-            force = _grow(force, n_force)
-            force[n_force] = (s * a, -fwx, -fwy)
+            force[n_force, 0], force[n_force, 1], force[n_force, 2] = s * a, -fwx, -fwy
             n_force += 1
         if mode == SEPARATE:
             # The pin moves away: the part rests while the pin travels on; a
             # non-convex part may be caught again further along the path.
+            steps += 1
             wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
             sigma, kind, idx = _ray_first_contact(verts, y[1], y[2], wx, wy, rp, 1e-9)
             if not math.isfinite(sigma):
@@ -465,6 +537,7 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
                 h = _DTHETA_CAP / turn
         rejected = False
         while True:
+            steps += 1
             ok, err = _step(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy,
                             y, k1, h, y_new, ks, tmp, warm)
             if h < 1e-12:
@@ -493,9 +566,10 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         ev = _first_event(g_end, _EVENT_TOL)
         frac = 1.0
         if ev >= 0:
-            frac, ev = _locate(model, verts, quad, area, m_max, mu_c, convex, kind, idx, rp,
-                               vpwx, vpwy, y, k1, h, y_new, k_end, g_end, y_located, ks, tmp,
-                               warm, g_work, mask)
+            frac, ev, n_loc = _locate(model, verts, quad, area, m_max, mu_c, convex, kind, idx,
+                                      rp, vpwx, vpwy, y, k1, h, y_new, k_end, g_end, y_located,
+                                      ks, tmp, warm, g_work, mask, work[_W_YI], work[_W_YTRY])
+            steps += n_loc
             for i in range(5):
                 y_new[i] = y_located[i]
         else:
@@ -508,8 +582,8 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         s += frac * h
         travel += frac * h
         if record:
-            traj = _grow(traj, n_traj)
-            traj[n_traj] = (s * a, (y[3]) * a, (y[4] + d) * a, y[0])
+            traj[n_traj, 0], traj[n_traj, 1] = s * a, y[3] * a
+            traj[n_traj, 2], traj[n_traj, 3] = (y[4] + d) * a, y[0]
             n_traj += 1
         if abs(y[0] - theta_ref) >= _JAM_ANGLE:
             theta_ref, travel_ref = y[0], travel
@@ -535,10 +609,9 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
             _project(verts, kind, idx, rp, y)
         separated = ev == 2
     if record:
-        force = _grow(force, n_force)
-        force[n_force] = (s * a, 0.0, 0.0)
+        force[n_force, 0], force[n_force, 1], force[n_force, 2] = s * a, 0.0, 0.0
         n_force += 1
     if status == OK and travel == 0.0:
         status = MISS
     return (status, reason, y[0] % two_pi, (y[4] + d) * a, travel * a, changes, peak,
-            traj[:n_traj].copy(), force[:n_force].copy())
+            n_traj, n_force, steps)

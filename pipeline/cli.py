@@ -83,7 +83,7 @@ def cmd_rollout(args):
     print(f"{'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9} {'travel':>8} "
           f"{'changes':>7} {'peak F':>7}")
     for r in rows:
-        note = f"  ({r['jam_reason']})" if r["status"] == "jammed" else ""
+        note = f"  ({r['jam_reason']})" if r["jam_reason"] != "none" else ""
         print(f"{r['theta_i']:8.2f} {r['status']:>9} {r['theta_f']:9.3f} {r['dy']:9.3f} "
               f"{r['contact_travel']:8.2f} {r['feature_changes']:7d} {r['peak_force']:7.3f}{note}")
 

@@ -16,7 +16,7 @@ import numba
 import numpy as np
 import xarray as xr
 
-from kernels.batch import _rollout_grid
+from kernels.batch import _rollout_grid, blocks_for
 from kernels.models import MODEL_NAMES
 from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
                              _rollout)
@@ -34,7 +34,8 @@ STATUS_ATTRS = {
     "flag_meanings": " ".join(STATUS_NAMES),
 }
 JAM_ATTRS = {
-    "long_name": "why a jammed rollout was declared jammed",
+    "long_name": "why a rollout was declared jammed, or 'step budget' for a truncated "
+                 "rollout that ran out of integration steps",
     "flag_values": np.arange(len(JAM_REASONS), dtype=np.int8),
     "flag_meanings": " ".join(["none"] + [r.replace(" ", "_") for r in JAM_REASONS[1:]]),
 }
@@ -130,7 +131,8 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
     ds = xr.Dataset(
         {
             "status": ((), STATUS_NAMES[status], {"long_name": "rollout status"}),
-            "jam_reason": ((), JAM_REASONS[reason] or "none", {"long_name": "why jammed"}),
+            "jam_reason": ((), JAM_REASONS[reason] or "none",
+                           {"long_name": "why jammed (or truncated by the step budget)"}),
             "theta_f": ((), _wrap_deg(math.degrees(theta_f)),
                         {"units": "degree", "long_name": "final orientation"}),
             "dy": ((), dy, {"units": unit, "long_name": "centroid displacement across the belt"}),
@@ -177,7 +179,8 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
     with _threads(threads) as n:
         status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
             *part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
-            np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol), n)
+            np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol),
+            blocks_for(n, th.size * dd.size))
     unit = length_unit
     return xr.Dataset(
         {
