@@ -17,7 +17,7 @@ import numpy as np
 from numba import prange
 
 from ._numba import jit_parallel
-from .rollout import _W_ROWS, _rollout_core, max_steps_for
+from .rollout import _W_COLS, _W_ROWS, _rollout_core, max_steps_for
 
 _CHUNK = 8  # rollouts per chunk: 64 bytes of each float64 output
 BLOCKS_PER_THREAD = 8
@@ -51,7 +51,7 @@ def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     n_blocks = max(1, min(n_blocks, n_chunks))
     max_steps = max_steps_for(verts.shape[0])
     for b in prange(n_blocks):
-        work = np.empty((_W_ROWS, 6))
+        work = np.empty((_W_ROWS, _W_COLS))
         traj = np.empty((1, 4))
         force = np.empty((1, 3))
         for c in range(b, n_chunks, n_blocks):

@@ -74,13 +74,14 @@ MAX_STEPS = 5000  # for parts of up to MAX_STEPS_WORK / MAX_STEPS vertices
 MAX_STEPS_WORK = 150000  # steps x vertices
 MIN_STEPS = 1000
 
-# Rows of the scratch array ``work`` (``_W_ROWS`` x 6 float64) that
+# Rows of the scratch array ``work`` (``_W_ROWS`` x ``_W_COLS`` float64) that
 # ``_rollout_core`` uses instead of allocating, so the same code runs in a
 # CUDA thread with a fixed-size local array.
 _W_Y, _W_YNEW, _W_K1, _W_KEND, _W_YLOC, _W_TMP, _W_YI, _W_YTRY = 0, 1, 2, 3, 4, 5, 6, 7
 _W_KS = 8  # six rows: the Runge-Kutta stages
 _W_GEND, _W_GWORK, _W_MASK, _W_WARM = 14, 15, 16, 17
 _W_ROWS = 18
+_W_COLS = 10
 
 
 @jit
@@ -128,21 +129,42 @@ def _contact_geometry(verts, kind, idx, qx, qy):
 
 
 @jit
-def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, warm, out):
-    """Right-hand side at state ``y`` into ``out``; updates the warm-start twist.
+def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, sp, warm, out):
+    """Right-hand side at state ``y`` (belt travel ``sp``) into ``out``;
+    updates the warm-start history ``warm``.
 
     Returns ``(status, mode, fx, fy)`` with the pin force on the part in the
     body frame.
+
+    Notes
+    -----
+    ``warm`` holds the last two solved twists and the travel at which they
+    were solved: ``(vx, vy, om, mode, s, vx', vy', om', s', count)``. The
+    minpower solve starts from their linear extrapolation to ``sp``: the
+    twist is smooth in the travel within a contact feature, so the start is
+    off by O(ds^2) rather than O(ds), which saves Newton iterations. The
+    answer does not depend on the start (the solve converges from anywhere).
     """
     cx, cy, nx, ny, _, _ = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     vpx = cs * vpwx + sn * vpwy
     vpy = -sn * vpwx + cs * vpwy
+    wvx, wvy, wom = warm[0], warm[1], warm[2]
+    if warm[9] >= 2.0:
+        span = warm[4] - warm[8]
+        r = (sp - warm[4]) / span if span != 0.0 else 0.0
+        if -1.5 <= r <= 1.5:
+            wvx += r * (warm[0] - warm[5])
+            wvy += r * (warm[1] - warm[6])
+            wom += r * (warm[2] - warm[7])
     st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
-                                                  nx, ny, vpx, vpy, mu, warm[0], warm[1],
-                                                  warm[2], int(warm[3]))
+                                                  nx, ny, vpx, vpy, mu, wvx, wvy, wom,
+                                                  int(warm[3]))
     if st == TWIST_OK and mode != SEPARATE:
-        warm[0], warm[1], warm[2], warm[3] = vx, vy, om, mode
+        if sp != warm[4] or warm[9] < 1.0:
+            warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
+            warm[9] = min(warm[9] + 1.0, 2.0)
+        warm[0], warm[1], warm[2], warm[3], warm[4] = vx, vy, om, mode, sp
     out[0] = om
     out[1] = vpx - (vx - om * y[2])
     out[2] = vpy - (vy + om * y[1])
@@ -186,10 +208,11 @@ _CK_B4 = np.array([2825.0 / 27648.0, 0.0, 18575.0 / 48384.0, 13525.0 / 55296.0,
 
 
 @jit
-def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1, h, y1,
+def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, s0, k1, h, y1,
           ks, tmp, warm):
-    """One Cash-Karp step of size ``h`` from ``y0`` (slope ``k1`` given) into
-    ``y1`` (5th-order solution, projected back onto the contact).
+    """One Cash-Karp step of size ``h`` from ``y0`` at travel ``s0`` (slope
+    ``k1`` given) into ``y1`` (5th-order solution, projected back onto the
+    contact).
 
     Returns ``(ok, err)``: ``ok`` is False if a stage found no pushing
     solution; ``err`` is the max-norm of the embedded error estimate.
@@ -204,7 +227,7 @@ def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1
                 acc += _CK_A[st, j] * ks[j, i]
             tmp[i] = y0[i] + h * acc
         res = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp,
-                          warm, ks[st])
+                          s0 + _CK_C[st] * h, warm, ks[st])
         ok = ok and res[0] == TWIST_OK
     err = 0.0
     for i in range(5):
@@ -267,8 +290,8 @@ def _hermite(y0, k0, y1, k1, h, alpha, out):
 
 
 @jit
-def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vpwy, y0, k1, h,
-            y1, k_end, g1, y_out, ks, tmp, warm, g, mask, yi, y_try):
+def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vpwy, y0, s0, k1,
+            h, y1, k_end, g1, y_out, ks, tmp, warm, g, mask, yi, y_try):
     """Shrink the step from ``y0`` to end on the first event crossed by the
     full step of size ``h`` to ``y1`` (slope ``k_end``, event values ``g1``).
 
@@ -319,7 +342,7 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
         n_steps += 1
-        _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1,
+        _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, s0, k1,
               alpha * h, y_try, ks, tmp, warm)
         _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_try, g)
         for j in range(4):
@@ -408,7 +431,7 @@ def _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, the
     """``_rollout`` with an explicit step budget ``max_steps``; returns its
     nine results plus the number of steps used (at most ``max_steps`` plus
     one event location, 61 steps)."""
-    work = np.empty((_W_ROWS, 6))
+    work = np.empty((_W_ROWS, _W_COLS))
     cap = max_steps + 4 if record else 1
     traj = np.empty((cap, 4))
     force = np.empty((cap, 3))
@@ -425,7 +448,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     """The rollout itself, without allocating: the scalar code path shared by
     the CPU kernels and the CUDA kernel (``kernels.cuda``).
 
-    ``work`` is a ``(_W_ROWS, 6)`` float64 scratch array; ``traj`` and
+    ``work`` is a ``(_W_ROWS, _W_COLS)`` float64 scratch array; ``traj`` and
     ``force`` take the records when ``record`` (at least ``max_steps + 4``
     rows; unused otherwise). Returns ``(status, jam_reason, theta_f, dy,
     contact_travel, feature_changes, peak_force, n_traj, n_force, steps)``.
@@ -466,8 +489,9 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     mask = work[_W_MASK]
     warm = work[_W_WARM]
     y[0], y[1], y[2], y[3], y[4] = theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d
-    # previous twist and contact mode
-    warm[0], warm[1], warm[2], warm[3] = wx, wy, 0.0, 0.0
+    # Warm-start history (see _derivative): a translation along the pin's path.
+    warm[0], warm[1], warm[2], warm[3], warm[4] = wx, wy, 0.0, 0.0, 0.0
+    warm[9] = 0.0
     for j in range(4):
         mask[j] = 0.0
     s = 0.0
@@ -490,7 +514,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             break
         if not have_k1:
             st, mode, fx, fy = _derivative(model, verts, quad, area, m_max, mu_c, kind, idx,
-                                           vpwx, vpwy, y, warm, k1)
+                                           vpwx, vpwy, y, s, warm, k1)
         have_k1 = False
         if separated:
             # A located separation ends just before n . v_p crosses zero.
@@ -539,7 +563,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         while True:
             steps += 1
             ok, err = _step(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy,
-                            y, k1, h, y_new, ks, tmp, warm)
+                            y, s, k1, h, y_new, ks, tmp, warm)
             if h < 1e-12:
                 break
             if not ok:
@@ -561,13 +585,13 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         # Slope at the step's end: the next step's first stage when no event
         # intervenes, and the end slope of the dense output otherwise.
         st_e, mode_e, fx_e, fy_e = _derivative(model, verts, quad, area, m_max, mu_c, kind,
-                                               idx, vpwx, vpwy, y_new, warm, k_end)
+                                               idx, vpwx, vpwy, y_new, s + h, warm, k_end)
         _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_new, g_end)
         ev = _first_event(g_end, _EVENT_TOL)
         frac = 1.0
         if ev >= 0:
             frac, ev, n_loc = _locate(model, verts, quad, area, m_max, mu_c, convex, kind, idx,
-                                      rp, vpwx, vpwy, y, k1, h, y_new, k_end, g_end, y_located,
+                                      rp, vpwx, vpwy, y, s, k1, h, y_new, k_end, g_end, y_located,
                                       ks, tmp, warm, g_work, mask, work[_W_YI], work[_W_YTRY])
             steps += n_loc
             for i in range(5):
