@@ -19,7 +19,7 @@ import xarray as xr
 from kernels.batch import _rollout_grid, blocks_for
 from kernels.models import MODEL_NAMES
 from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
-                             _rollout)
+                             _rollout, max_steps_for)
 
 from . import __version__
 from .errors import PinfeedError
@@ -161,26 +161,61 @@ def _wrap_deg(x):
     return np.where(w >= 360.0, 0.0, w) if np.ndim(w) else (0.0 if w >= 360.0 else float(w))
 
 
+BACKENDS = ("cpu", "cuda")
+
+
+def cuda_grid():
+    """The GPU grid function, or a one-line :class:`PinfeedError` saying why
+    the ``cuda`` backend cannot run here."""
+    try:
+        from numba import cuda
+    except ImportError:  # pragma: no cover - numba ships numba.cuda or numba-cuda
+        cuda = None
+    if cuda is None or not _cuda_installed():
+        raise PinfeedError("backend 'cuda' needs numba-cuda: pip install '.[cuda]' "
+                           "(or use backend 'cpu')")
+    from kernels import cuda as kcuda
+    if not kcuda.available():
+        raise PinfeedError("backend 'cuda': no usable NVIDIA GPU or driver found here; "
+                           "use backend 'cpu'")
+    return kcuda.rollout_grid
+
+
+def _cuda_installed() -> bool:
+    import importlib.util
+    return importlib.util.find_spec("numba_cuda") is not None
+
+
 def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "minpower",
         v_pin: float = 0.0, max_travel: float | None = None, threads: int | None = None,
         ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
-        length_unit: str = "mm") -> xr.Dataset:
+        length_unit: str = "mm", backend: str = "cpu") -> xr.Dataset:
     """Configuration map set: rollouts over ``d x theta_i`` (paper eq. 2).
 
-    Runs in parallel on ``threads`` Numba threads (default: all Numba has).
+    Runs in parallel on ``threads`` Numba threads (default: all Numba has),
+    or with ``backend="cuda"`` one rollout per GPU thread (numba-cuda, same
+    kernel code; ``threads`` is then ignored).
     Returns a Dataset with dims ``(d, theta_i)`` and variables ``theta_f``,
     ``dy``, ``status`` (int8 flags, see its ``flag_meanings``), ``jam_reason``,
     ``contact_travel``, ``feature_changes`` and ``peak_force``.
     """
     check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
+    if backend not in BACKENDS:
+        raise PinfeedError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
     th = _angles(theta_i, "theta_i")
     dd = _angles(d, "d")
     cap = np.inf if max_travel is None else float(max_travel)
-    with _threads(threads) as n:
-        status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
-            *part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
-            np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol),
-            blocks_for(n, th.size * dd.size))
+    prep = part.prepared()
+    if backend == "cuda":
+        status, reason, theta_f, dy, travel, changes, peak = cuda_grid()(
+            *prep, MODELS.index(model), float(mu_c), float(pin_radius), np.radians(th), dd,
+            float(v_pin), cap, float(ds_max), float(tol), max_steps_for(prep[0].shape[0]))
+    else:
+        with _threads(threads) as n:
+            status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
+                *prep, MODELS.index(model), float(mu_c), float(pin_radius),
+                np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol),
+                blocks_for(n, th.size * dd.size))
     unit = length_unit
     return xr.Dataset(
         {
@@ -197,7 +232,8 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
             "d": ("d", dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"}),
             "theta_i": ("theta_i", th, {"units": "degree", "long_name": "initial orientation"}),
         },
-        attrs=_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit),
+        attrs=dict(_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit),
+                   kernel_backend=backend),
     )
 
 
