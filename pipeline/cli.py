@@ -134,7 +134,7 @@ def cmd_rollout(args):
     print(f"{'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9} {'travel':>8} "
           f"{'changes':>7} {'peak F':>7}")
     for r in rows:
-        note = f"  ({r['jam_reason']})" if r["status"] == "jammed" else ""
+        note = f"  ({r['jam_reason']})" if r["jam_reason"] != "none" else ""
         print(f"{r['theta_i']:8.2f} {r['status']:>9} {r['theta_f']:9.3f} {r['dy']:9.3f} "
               f"{r['contact_travel']:8.2f} {r['feature_changes']:7d} {r['peak_force']:7.3f}{note}")
     if args.trajectory:
@@ -171,7 +171,7 @@ def cmd_map(args):
     check_out_path(args.out, MAP_SUFFIXES)
     theta = np.arange(0.0, 360.0 - 1e-9, args.theta_step)
     ds = simulate.map(part, theta, d, args.mu_c, args.pin_radius, model=args.model,
-                      v_pin=args.v_pin, threads=args.threads)
+                      v_pin=args.v_pin, threads=args.threads, backend=args.backend)
     ds.attrs.update(provenance_attrs())
     write_atomic(ds, args.out)
     counts = {name: int((ds.status.values == k).sum()) for k, name in enumerate(simulate.STATUSES)}
@@ -320,7 +320,7 @@ def cmd_sweep(args):
     if args.catalog:
         config["catalog_dir"] = args.catalog
     written = run_sweep(config, scheduler=args.scheduler, threads=args.threads,
-                        progress=not args.quiet)
+                        progress=not args.quiet, backend=args.backend)
     print(f"computed {len(written)} shards; catalog index at {config['catalog_dir']}/index.json")
 
 
@@ -673,6 +673,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--d", required=True, help="contact parameters: 'a,b,c' or inclusive 'start:stop:step'")
     p.add_argument("--theta-step", type=float, default=1.0, help="theta_i step, degrees (default 1)")
     p.add_argument("--threads", type=int, default=None, help="Numba threads (default: all cores)")
+    p.add_argument("--backend", choices=("cpu", "cuda"), default="cpu",
+                   help="cpu (Numba threads, default) or cuda (an NVIDIA GPU; pip install '.[cuda]')")
     p.add_argument("--out", required=True, help="output file (.h5)")
     p.set_defaults(func=cmd_map)
 
@@ -688,6 +690,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--catalog", default=None, help="catalog folder (default: the config's catalog_dir)")
     p.add_argument("--scheduler", default=None, help="dask.distributed scheduler address, e.g. tcp://host:8786")
     p.add_argument("--threads", type=int, default=None, help="Numba threads per shard")
+    p.add_argument("--backend", choices=("cpu", "cuda"), default=None,
+                   help="cpu or cuda (an NVIDIA GPU per worker; default: the config's "
+                        "sweep.backend, else cpu)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_sweep)
 

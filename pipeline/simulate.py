@@ -16,11 +16,11 @@ import numba
 import numpy as np
 import xarray as xr
 
-from kernels.batch import _rollout_grid
+from kernels.batch import _rollout_grid, blocks_for
 from kernels.points import _rollout_points
 from kernels.models import MODEL_NAMES
 from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
-                             _rollout)
+                             _rollout, max_steps_for)
 
 from . import __version__
 from .checks import check_kernel_settings, check_pin_ratio
@@ -36,7 +36,8 @@ STATUS_ATTRS = {
     "flag_meanings": " ".join(STATUS_NAMES),
 }
 JAM_ATTRS = {
-    "long_name": "why a jammed rollout was declared jammed",
+    "long_name": "why a rollout was declared jammed, or 'step budget' for a truncated "
+                 "rollout that ran out of integration steps",
     "flag_values": np.arange(len(JAM_REASONS), dtype=np.int8),
     "flag_meanings": " ".join(["none"] + [r.replace(" ", "_") for r in JAM_REASONS[1:]]),
 }
@@ -142,7 +143,8 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
     ds = xr.Dataset(
         {
             "status": ((), STATUS_NAMES[status], {"long_name": "rollout status"}),
-            "jam_reason": ((), JAM_REASONS[reason] or "none", {"long_name": "why jammed"}),
+            "jam_reason": ((), JAM_REASONS[reason] or "none",
+                           {"long_name": "why jammed (or truncated by the step budget)"}),
             "theta_f": ((), _wrap_deg(math.degrees(theta_f)),
                         {"units": "degree", "long_name": "final orientation"}),
             "dy": ((), dy, {"units": unit, "long_name": "centroid displacement across the belt"}),
@@ -171,17 +173,44 @@ def _wrap_deg(x):
     return np.where(w >= 360.0, 0.0, w) if np.ndim(w) else (0.0 if w >= 360.0 else float(w))
 
 
+BACKENDS = ("cpu", "cuda")
+
+
+def cuda_grid():
+    """The GPU grid function, or a one-line :class:`PinfeedError` saying why
+    the ``cuda`` backend cannot run here."""
+    try:
+        from numba import cuda
+    except ImportError:  # pragma: no cover - numba ships numba.cuda or numba-cuda
+        cuda = None
+    if cuda is None or not _cuda_installed():
+        raise PinfeedError("backend 'cuda' needs numba-cuda: pip install '.[cuda]' "
+                           "(or use backend 'cpu')")
+    from kernels import cuda as kcuda
+    if not kcuda.available():
+        raise PinfeedError("backend 'cuda': no usable NVIDIA GPU or driver found here; "
+                           "use backend 'cpu'")
+    return kcuda.rollout_grid
+
+
+def _cuda_installed() -> bool:
+    import importlib.util
+    return importlib.util.find_spec("numba_cuda") is not None
+
+
 def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "minpower",
         v_pin: float = 0.0, max_travel: float | None = None, threads: int | None = None,
         ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
         length_unit: str = "mm", belt_speed: float | None = None,
-        mu_s: float = 0.5) -> xr.Dataset:
+        mu_s: float = 0.5, backend: str = "cpu") -> xr.Dataset:
     """Configuration map set: rollouts over ``d x theta_i`` (paper eq. 2).
 
     ``model="dynamic"`` needs ``belt_speed`` (mm/s; the part in mm) and takes
     ``mu_s``; its ``jam_reason`` flags add ``step_budget``.
 
-    Runs in parallel on ``threads`` Numba threads (default: all Numba has).
+    Runs in parallel on ``threads`` Numba threads (default: all Numba has),
+    or with ``backend="cuda"`` one rollout per GPU thread (numba-cuda, same
+    kernel code; ``threads`` is then ignored; quasi-static models only).
     Returns a Dataset with dims ``(d, theta_i)`` and variables ``theta_f``,
     ``dy``, ``status`` (int8 flags, see its ``flag_meanings``), ``jam_reason``,
     ``contact_travel``, ``feature_changes`` and ``peak_force``.
@@ -196,22 +225,33 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
     check_parameters(mu_c, pin_radius, "minpower" if dynamic else model, v_pin, max_travel)
     check_pin_ratio(part, pin_radius)
     check_kernel_settings(ds_max, tol)
+    if backend not in BACKENDS:
+        raise PinfeedError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
+    if backend == "cuda" and dynamic:
+        raise PinfeedError("the cuda backend runs the quasi-static models; use backend cpu for model dynamic")
     th = _angles(theta_i, "theta_i")
     dd = _angles(d, "d")
     cap = np.inf if max_travel is None else float(max_travel)
-    with _threads(threads) as n:
-        if dynamic:
-            from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
-                                         _dyn_rollout_grid)
-            verts, area, a, quad, _, convex = part.prepared()
-            status, reason, theta_f, dy, travel, changes, peak = _dyn_rollout_grid(
-                verts, area, a, quad, convex, float(mu_c), float(pin_radius), np.radians(th), dd,
-                float(v_pin), fr, 0.0, DEFAULT_V_REG / float(belt_speed), DEFAULT_H, cap,
-                DEFAULT_MAX_STEPS, n)
-        else:
-            status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
-                *part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
-                np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol), n)
+    prep = part.prepared()
+    if backend == "cuda":
+        status, reason, theta_f, dy, travel, changes, peak = cuda_grid()(
+            *prep, MODELS.index(model), float(mu_c), float(pin_radius), np.radians(th), dd,
+            float(v_pin), cap, float(ds_max), float(tol), max_steps_for(prep[0].shape[0]))
+    else:
+        with _threads(threads) as n:
+            if dynamic:
+                from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
+                                             _dyn_rollout_grid)
+                verts, area, a, quad, _, convex = prep
+                status, reason, theta_f, dy, travel, changes, peak = _dyn_rollout_grid(
+                    verts, area, a, quad, convex, float(mu_c), float(pin_radius), np.radians(th), dd,
+                    float(v_pin), fr, 0.0, DEFAULT_V_REG / float(belt_speed), DEFAULT_H, cap,
+                    DEFAULT_MAX_STEPS, n)
+            else:
+                status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
+                    *prep, MODELS.index(model), float(mu_c), float(pin_radius),
+                    np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol),
+                    blocks_for(n, th.size * dd.size))
     unit = length_unit
     jam_attrs = dict(JAM_ATTRS)
     attrs = _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit)
@@ -236,7 +276,7 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
             "d": ("d", dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"}),
             "theta_i": ("theta_i", th, {"units": "degree", "long_name": "initial orientation"}),
         },
-        attrs=attrs,
+        attrs=dict(attrs, kernel_backend=backend),
     )
 
 

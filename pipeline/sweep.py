@@ -93,14 +93,18 @@ def find_job(config, family, part_id, model, tag) -> ShardJob:
     raise PinfeedError(f"the config has no shard {family}/{part_id}/{model}/{tag}")
 
 
-def compute_shard(config, job: ShardJob, threads=None):
-    """The map set of one shard as a self-describing Dataset."""
+def compute_shard(config, job: ShardJob, threads=None, backend=None):
+    """The map set of one shard as a self-describing Dataset.
+
+    ``backend`` (``"cpu"`` or ``"cuda"``) overrides the config's
+    ``sweep.backend`` (default ``"cpu"``)."""
     sweep = config["sweep"]
     kernel = sweep.get("kernel", {})
     ds = simulate.map(job.part, theta_grid(config), np.asarray(sweep["d"], float), job.mu_c,
                       sweep["pin_radius"], model=job.model, v_pin=job.v_pin, threads=threads,
                       **({"belt_speed": job.belt_speed, "mu_s": job.mu_s} if job.belt_speed > 0 else {}),
-                      ds_max=kernel.get("ds_max", 0.1), tol=kernel.get("tol", 1e-7))
+                      ds_max=kernel.get("ds_max", 0.1), tol=kernel.get("tol", 1e-7),
+                      backend=backend or sweep.get("backend", "cpu"))
     ds.attrs.update(provenance_attrs())
     ds.attrs.update({
         "title": f"pinfeed configuration maps: {job.part.id}, {job.model}, mu_c={job.mu_c:g}, "
@@ -125,24 +129,25 @@ def _encoding(ds):
     return enc
 
 
-def write_shard(config, job: ShardJob, out=None, threads=None) -> Path:
+def write_shard(config, job: ShardJob, out=None, threads=None, backend=None) -> Path:
     """Compute one shard and write it atomically (to ``out`` or its catalog path)."""
     out = Path(out) if out else job.path(config["catalog_dir"])
-    ds = compute_shard(config, job, threads=threads)
+    ds = compute_shard(config, job, threads=threads, backend=backend)
     return write_atomic(ds, out, encoding=_encoding(ds))
 
 
-def _write_job(config, job, threads):
-    return str(write_shard(config, job, threads=threads))
+def _write_job(config, job, threads, backend=None):
+    return str(write_shard(config, job, threads=threads, backend=backend))
 
 
 def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
-              progress: bool = True) -> list[Path]:
+              progress: bool = True, backend: str | None = None) -> list[Path]:
     """Compute every missing shard, then rebuild the catalog index.
 
     With ``scheduler`` (a dask.distributed address such as ``tcp://host:8786``)
     the shards run as tasks on that cluster; otherwise here, one after
-    another, each on ``threads`` Numba threads.
+    another, each on ``threads`` Numba threads (or on this worker's GPU with
+    ``backend="cuda"``, overriding the config's ``sweep.backend``).
     """
     from .catalog import Catalog
     root = Path(config["catalog_dir"])
@@ -151,12 +156,13 @@ def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
     if scheduler:
         from distributed import as_completed
         with _client(scheduler) as client:
-            futures = [client.submit(_write_job, config, j, threads, pure=False) for j in todo]
+            futures = [client.submit(_write_job, config, j, threads, backend, pure=False)
+                       for j in todo]
             for fut in _progress(as_completed(futures), len(futures), progress):
                 written.append(Path(fut.result()))
     else:
         for job in _progress(todo, len(todo), progress):
-            written.append(write_shard(config, job, threads=threads))
+            written.append(write_shard(config, job, threads=threads, backend=backend))
     Catalog.rebuild(root)
     return written
 
