@@ -214,3 +214,17 @@ def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys):
     assert "0 new rollouts" in text and " deg" in text and "#1:" in text
     assert main(args[:-2] + ["--mu-c", "0.3:0.1"]) == 2
     assert main(args + ["--depth", "0"]) == 2
+    # The speed limit of the stored plan (dynamic model), issue 18's keys.
+    stored = tmp_path / "cat" / "plans" / "tri.json"
+    assert main(args + ["--out", str(stored)]) == 0
+    capsys.readouterr()
+    assert main(["speed", "--part", "tri", "--catalog", str(tmp_path / "cat"), "--trials", "3", "--json"]) == 0
+    sp = json.loads(capsys.readouterr().out)
+    assert set(sp) >= {"pin_labels", "pin_heights_mm", "final_set", "mu_c", "mu_s", "speed_limit_mm_s", "curve"}
+    assert sp["pin_labels"] == out["plans"][0]["pins"]
+    ok = [v for v, frac in sp["curve"] if frac >= 0.99]
+    assert sp["speed_limit_mm_s"] == max(ok)  # the highest speed that holds
+    assert all(frac < 0.99 for v, frac in sp["curve"] if v > sp["speed_limit_mm_s"]) or \
+        sp["speed_limit_mm_s"] == max(v for v, _ in sp["curve"])
+    assert main(["speed", "--part", "nope", "--catalog", str(tmp_path / "cat")]) == 2
+    assert main(["speed", "--part", "tri", "--catalog", str(tmp_path / "cat"), "--mu-c", "0.2"]) == 2
