@@ -337,7 +337,7 @@ def cmd_plan(args):
         pc["frictions"] = []
     parse_friction(pc["mu_c"])  # a clear error before any work
     if args.depth is not None and args.depth < 1:
-        raise PinfeedError(f"--depth must be 1 or more, got {args.depth}")
+        raise PinfeedError(f"--depth must be at least 1 (the largest number of pins), got {args.depth}")
     for key in ("model", "depth", "coverage"):
         if getattr(args, key) is not None:
             pc[key] = getattr(args, key)
@@ -639,7 +639,8 @@ def cmd_sense_classify(args):
         mu_c, model = float(stored["mu_c"]), stored["model"]
     else:
         sensor = Sensor.from_config(config["sensing"]["sensor"])
-        mu_c = float(plan["mu_c"]) if plan else float(config["planner"]["mu_c"])
+        from .planning import nominal_friction, parse_friction
+        mu_c = float(plan["mu_c"]) if plan else nominal_friction(parse_friction(config["planner"]["mu_c"]))
         model = plan["model"] if plan else config["planner"]["model"]
     pin_radius = float(entry["pin_radius"])
     raw = read_profile_csv(args.profile)

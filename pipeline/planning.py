@@ -41,7 +41,7 @@ def parse_friction(value):
     else:
         nums = [float(value)]
     if len(nums) not in (1, 2) or not all(math.isfinite(x) and x >= 0 for x in nums):
-        raise PinfeedError(f"friction {value!r} must be a number >= 0 or a range LO:HI of such numbers")
+        raise PinfeedError(f"friction (--mu-c, planner.mu_c) {value!r} must be a finite number >= 0 or a range LO:HI of such numbers")
     if len(nums) == 2:
         if nums[1] < nums[0]:
             raise PinfeedError(f"friction range {value!r} has LO > HI; write it as LO:HI")

@@ -181,7 +181,7 @@ def test_inputs_that_would_run_without_end_are_refused():
     with pytest.raises(PolygonError, match="smaller than the limit of 0.001 mm"):
         Part.from_vertices(np.array(TRI) * 1e-9)
     ang = 2 * np.pi * np.arange(MAX_VERTICES + 1) / (MAX_VERTICES + 1)
-    with pytest.raises(PolygonError, match=f"101 vertices, more than the limit of {MAX_VERTICES}"):
+    with pytest.raises(PolygonError, match=f"{MAX_VERTICES + 1} vertices, more than the limit of {MAX_VERTICES}"):
         Part.from_vertices(np.column_stack([30 * np.cos(ang), 30 * np.sin(ang)]))
     ang = ang[:MAX_VERTICES]  # at the limit: accepted
     Part.from_vertices(np.column_stack([30 * np.cos(ang), 30 * np.sin(ang)]))
@@ -327,7 +327,7 @@ def test_plan_depth_zero_is_refused(capsys):
     one_line_error(capsys, ["plan", "--vertices", "0,0 60,0 15,35", "--depth", "0"],
                    "--depth must be at least 1")
     one_line_error(capsys, ["plan", "--vertices", "0,0 60,0 15,35", "--mu-c", "nan"],
-                   "--mu-c must be a finite number")
+                   "must be a finite number >= 0")
 
 
 # --------------------------------------------------------------------------- workflow faults
