@@ -442,27 +442,42 @@ def _print_plan_result(result, part, config, mode):
               f"margin in d {plan['margin']:.3f}")
 
 
+def _results_arg(args, config) -> Path:
+    """The results folder of stored plans and sensing: --results, else the config's."""
+    from .config import results_folder
+    return Path(args.results) if args.results else results_folder(config)
+
+
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
     from .animate import animate_stored, plan_inputs
     from .config import load_config
     from .stages import read_json
     config = load_config(args.config)
-    root = Path(args.catalog or config["catalog_dir"])
-    path = root / "plans" / f"{args.part}.json"
+    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
-        raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
-                           f"{args.part} --out {path}' or the workflow ('make run') first")
+        raise PinfeedError(f"no stored plan for {args.part} at {path}; "
+                           f"{_plan_hint(config, args.part, path.parent.parent)} first")
     result = read_json(path)
     inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
     pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
                        for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
-    print(f"animating plan {args.plan} of {args.part}: {pins}; {len(inputs['states'])} initial states",
-          flush=True)
+    print(f"animating the {inputs['what']} of {args.part}: {pins}; {len(inputs['states'])} initial "
+          f"states", flush=True)
     done = animate_stored(result, config, args.out, args.plan, frames=args.frames, fps=args.fps)
     outcomes = ", ".join(f"{k}: {v}" for k, v in done["outcomes"].items())
     print(f"wrote {done['out']}: {done['frames']} frames over {done['belt_travel']:.0f} mm of belt "
           f"travel ({outcomes})")
+
+
+def _plan_choice(text: str):
+    """--plan: ``tight`` or a paper-mode plan number (1 = best)."""
+    if text == "tight":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected 'tight' or a plan number, got {text!r}") from None
 
 
 PROFILE_FORMAT = """\
@@ -483,8 +498,9 @@ def _best_fixed_plan(plan_result: dict):
 
 
 def _plan_hint(config: dict, name: str, root) -> str:
-    """How to make the stored plan of ``name``: the workflow plans the config's
-    parts; a part planned from --vertices or --outline needs 'pinfeed plan'."""
+    """How to make the stored plan of ``name`` under results folder ``root``: the
+    workflow plans the config's parts; a part planned from --vertices or
+    --outline needs 'pinfeed plan'."""
     if name in config["planner"]["parts"]:
         return "run the workflow ('make run')"
     return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
@@ -501,8 +517,8 @@ def cmd_sense_classify(args):
     from .sensor_plan import describe_sets, final_for_verdict, stored_sensor_plan
     from .stages import config_part_id, read_json
     config = load_config(args.config)
-    root = Path(args.catalog or config["catalog_dir"])
-    cat = Catalog.open(root)
+    cat = Catalog.open(args.catalog or config["catalog_dir"])
+    root = _results_arg(args, config)  # stored plans and sensor plans
     # The config's outline wins over older ones stored under the same name.
     wanted = config_part_id(config, args.part)
     if wanted != args.part and not any(e["part_id"] == wanted for e in cat.entries):
@@ -724,17 +740,22 @@ def build_parser() -> argparse.ArgumentParser:
                    "else the stored plan's)")
     q.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     q.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    q.add_argument("--results", default=None, help="results folder holding plans/ and sensing/ "
+                   "(default: the config's, RESULTS_DIR/NAME)")
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
 
     p = sub.add_parser("animate", help="animate a stored plan: every initial state past the pins")
-    p.add_argument("--part", required=True, help="part name (its plan is CATALOG/plans/NAME.json)")
-    p.add_argument("--plan", type=int, default=1, help="which plan, 1 = the recommended one (default 1)")
+    p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
+    p.add_argument("--plan", type=_plan_choice, default=None,
+                   help="which plan: 'tight' (the tight planner's recommended plan) or N (paper "
+                   "mode's Nth best; 1 = best); default: the tight one if any, else 1")
     p.add_argument("--out", required=True, help="animation file: .gif (Pillow) or .mp4 (needs ffmpeg)")
     p.add_argument("--frames", type=int, default=120, help="number of frames (default 120)")
     p.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
-    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    p.add_argument("--results", default=None, help="results folder holding plans/ "
+                   "(default: the config's, RESULTS_DIR/NAME)")
     p.set_defaults(func=cmd_animate)
 
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")

@@ -209,7 +209,7 @@ def sense_part(cat, name: str, config: dict, log=print) -> dict:
 
 
 def stored_sensor_plan(root, name: str):
-    """The stored sensing result of part ``name`` under catalog ``root``, or None."""
+    """The stored sensing result of part ``name`` under results folder ``root``, or None."""
     from .stages import read_json
     path = Path(root) / "sensing" / f"{name}.json"
     return read_json(path) if path.is_file() else None
