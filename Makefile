@@ -14,8 +14,11 @@ $(STAMP): pyproject.toml
 
 # The main job: the Snakemake workflow on the embedded default config
 # (config/config.yaml). Resumes an interrupted run; does nothing if up to date.
+# Ends by printing the path of the report (results/<config name>/report.html).
 run: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/snakemake --cores all --rerun-incomplete
+	@$(BIN)/python -c 'from pipeline.config import load_config, results_folder; \
+	print("report:", (results_folder(load_config()) / "report.html").resolve())'
 
 demo: $(STAMP)
 	$(BIN)/pinfeed demo --out results/demo
