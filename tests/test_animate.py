@@ -76,7 +76,7 @@ def test_plan_inputs_prefers_the_tight_recommended_plan():
     """The recommended plan is the tight planner's (first friction): its own
     heights, speeds and the friction range's middle."""
     from pipeline.animate import recommended_index
-    config = {"planner": {"pins": [0.0, 5.0]}, "sweep": {"pin_radius": 3.0}}
+    config = {"planner": {"pins": [0.0, 5.0, 10.0, 15.0, 20.0]}, "sweep": {"pin_radius": 3.0}}
     stored = _stored()
     stored["tight"] = [{"friction": "0.1:0.3", "mu_c": [0.1, 0.3],
                         "recommended": {"pins": ["P7", "P9"], "pin_heights_mm": [12.5, 30.0],
@@ -107,9 +107,9 @@ def test_cli_animate(tmp_path, capsys):
         assert im.n_frames == 3
     assert main(["animate", "--part", "nope", "--results", str(tmp_path), "--out", str(out)]) == 2
     assert "no stored plan for nope" in capsys.readouterr().err
-    assert main(["animate", "--part", "tri", "--results", str(tmp_path), "--plan", "best",
-                 "--out", str(out)]) == 2
-    assert "expected 'tight' or a plan number" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:  # argparse: one line, status 2
+        main(["animate", "--part", "tri", "--results", str(tmp_path), "--plan", "best", "--out", str(out)])
+    assert exc.value.code == 2 and "expected 'tight' or a plan number" in capsys.readouterr().err
 
 
 def test_moving_pin_touches_at_its_height_on_the_clock():
