@@ -553,7 +553,8 @@ def cmd_sense_classify(args):
         mu_c, model = float(stored["mu_c"]), stored["model"]
     else:
         sensor = Sensor.from_config(config["sensing"]["sensor"])
-        mu_c = float(plan["mu_c"]) if plan else float(config["planner"]["mu_c"])
+        from .planning import nominal_friction, parse_friction  # a range: its middle
+        mu_c = float(plan["mu_c"]) if plan else nominal_friction(parse_friction(config["planner"]["mu_c"]))
         model = plan["model"] if plan else config["planner"]["model"]
     pin_radius = float(entry["pin_radius"])
     raw = read_profile_csv(args.profile)

@@ -4,6 +4,7 @@ import json
 import numpy as np
 import pytest
 
+from pipeline.config import results_folder
 from pipeline.errors import PinfeedError
 from pipeline.sensing import (Profile, Sensor, classify, measure, profile_from_rollout, read_profile_csv,
                               score, sensor_groups, sign_matrix)
@@ -245,7 +246,7 @@ def sym_catalog(tmp_path_factory):
     """The default config's symmetric triangle, swept at the planner's model and
     friction only, planned and sensed as the workflow does, in a temporary catalog."""
     from pipeline.catalog import Catalog
-    from pipeline.config import load_config, results_folder, validate_config
+    from pipeline.config import load_config, validate_config
     from pipeline.io import write_json
     from pipeline.sensor_plan import sense_part
     from pipeline.stages import plan_part
@@ -390,7 +391,6 @@ def test_cli_classify_bad_input(sym_catalog, tmp_path, capsys):
     root = cfg["catalog_dir"]
     good = _write_csv(tmp_path / "ok.csv", _timed(np.linspace(1, 0.2, 400), 0.3 * np.ones(400)),
                       header=False, extra=False)
-    from pipeline.config import results_folder
     base = ["sense", "classify", "--catalog", root, "--results", str(results_folder(cfg))]
     _one_line_error(*_run(base + ["--part", "sym_triangle", "--profile", str(tmp_path / "none.csv")],
                           capsys)[::2], "no profile file")
