@@ -199,7 +199,7 @@ def _side_by_side(res: dict, ver: dict | None) -> list[str]:
     """The paper-mode plan beside the tight planner's, with verification counts."""
     from .arcs import format_arcs
     checks = {c["kind"]: c for c in (ver or {}).get("checks", [])}
-    p = ["<h4>Paper mode beside the tight planner</h4><table><tr><th>planner</th>"
+    p = ['<h4>Paper mode beside the tight planner</h4><table class="side-by-side"><tr><th>planner</th>'
          "<th>friction mu_c</th><th>pins (height, mm)</th><th>final sets</th>"
          "<th>orientation sets</th><th>verified (successes/trials)</th></tr>"]
     static = res.get("best_static")

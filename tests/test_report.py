@@ -110,6 +110,17 @@ def test_report_numbers_match_the_verify_json(workflow):
             want += [[" ".join(check["plan"]), check["kind"], r["state"], str(r["trials"]),
                       str(r["successes"]), str(r["failures"])] for r in check["rows"]]
     assert [r[:6] for r in table] == want and want
+    side = [r for r in page.rows["side-by-side"] if r[0] != "planner" and len(r) == 6]  # tri's rows, then rect's
+    want = []
+    for name in ("tri", "rect"):
+        plan = json.loads((results / "plans" / f"{name}.json").read_text())
+        checks = {c["kind"]: c for c in json.loads((results / "verify" / f"{name}.json").read_text())["checks"]}
+        rows = [("paper mode, fixed pins", plan["best_static"])]
+        rows += [(f"tight, mu_c {t['friction']}", t["recommended"]) for t in plan["tight"] if t["recommended"]]
+        for kind, best in rows:
+            ok = sum(r["successes"] for r in checks[kind]["rows"])
+            want.append([str(best["n_final_sets"]), f"{ok}/{sum(r['trials'] for r in checks[kind]['rows'])}"])
+    assert [[r[3], r[5]] for r in side] == want
     assert all(int(r[3]) == 3 + 2 ** (3 + len(r[0].split())) for r in table)  # verify.trials 3 + corners
 
 
