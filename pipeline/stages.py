@@ -3,8 +3,10 @@
 bands  -> one JSON per shard: B_j, K_j, COM_j and adjusted bands for every d
 plan   -> one JSON per planned part: the ranked fixed-pins plans
 verify -> one JSON per planned part: perturbed full rollouts of the best plan
-figures, report -> PNGs and one HTML page linking everything
-All JSON is written atomically.
+figures, outline, animate, report -> PNGs, one GIF per part, one HTML page
+All of it lives in the config's results folder (``results_dir/NAME``,
+:func:`pipeline.config.results_folder`; file names in :func:`part_files`);
+the catalog is shared. All JSON is written atomically.
 """
 from __future__ import annotations
 
