@@ -4,10 +4,12 @@
 #   snakemake --cores all                       # default config (the paper's set-up)
 #   snakemake --cores 16 --configfile config/workstation.yaml
 import os
+import sys
 
 from snakemake.utils import min_version
 
 from pipeline.config import config_name, validate_config
+from pipeline.workflow import reconcile_catalog
 
 min_version("8.0")
 
@@ -31,6 +33,14 @@ config.update(validate_config(
 
 
 report: "rules/report/workflow.rst"
+
+
+# The catalog against disk, before Snakemake plans its jobs: a deleted or
+# damaged shard removes the stale index, so this run recomputes it
+# (pipeline/workflow.py says why Snakemake would not).
+if workflow.is_main_process:
+    for note in reconcile_catalog(config):
+        print(f"pinfeed: {note}", file=sys.stderr)
 
 
 include: "rules/common.smk"

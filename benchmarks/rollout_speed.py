@@ -1,11 +1,14 @@
 """Rollouts per second per model for a scalene triangle (issue: kernels).
 
 Grid: theta_i every 1 degree x the paper's 18 d values, mu_c = 0.2 and 0.0,
-pin radius 3 mm, on 1 and 2 Numba threads. Compile time is excluded (one
-warm-up call). Prints a Markdown table for the README, including the cost
-ratio minpower / ellipsoid measured in this same run.
+pin radius 3 mm, on 1 thread and on all cores (``--threads``). Compile time
+is excluded (one warm-up call). Prints a Markdown table for the README,
+including the cost ratio minpower / ellipsoid and the parallel efficiency
+measured in this same run. ``--backend cuda`` adds the GPU rate (needs
+``pip install '.[cuda]'`` and an NVIDIA GPU; a larger grid, ``--gpu-scale``
+times more theta_i, keeps the device busy).
 
-    .venv/bin/python benchmarks/rollout_speed.py [--repeat 3]
+    .venv/bin/python benchmarks/rollout_speed.py [--repeat 3] [--threads N] [--backend cuda]
 """
 import argparse
 import datetime
@@ -23,13 +26,15 @@ from pipeline.parts import Part
 TRIANGLE = [(0, 0), (60, 0), (15, 35)]
 
 
-def rate(part, model, mu_c, threads, repeat):
-    theta = np.arange(0.0, 360.0, 1.0)
-    simulate.map(part, theta[:4], PAPER_D[:2], mu_c, 3.0, model=model, threads=threads)
+def rate(part, model, mu_c, threads, repeat, backend="cpu", scale=1):
+    theta = np.arange(0.0, 360.0, 1.0 / scale)
+    simulate.map(part, theta[:4], PAPER_D[:2], mu_c, 3.0, model=model, threads=threads,
+                 backend=backend)
     best = np.inf
     for _ in range(repeat):
         t0 = time.perf_counter()
-        simulate.map(part, theta, PAPER_D, mu_c, 3.0, model=model, threads=threads)
+        simulate.map(part, theta, PAPER_D, mu_c, 3.0, model=model, threads=threads,
+                     backend=backend)
         best = min(best, time.perf_counter() - t0)
     return theta.size * len(PAPER_D) / best
 
@@ -37,18 +42,31 @@ def rate(part, model, mu_c, threads, repeat):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3, help="best of N timings")
+    ap.add_argument("--threads", type=int, default=numba.config.NUMBA_NUM_THREADS,
+                    help="the 'all cores' column (default: every Numba thread)")
+    ap.add_argument("--backend", choices=("cpu", "cuda"), default="cpu",
+                    help="cuda: also time the GPU backend")
+    ap.add_argument("--gpu-scale", type=int, default=100,
+                    help="GPU grid: this many times more theta_i (default 100)")
     args = ap.parse_args()
+    nt = args.threads
     part = Part.from_vertices(TRIANGLE, name="scalene")
     cpu = platform.processor() or platform.machine()
     print(f"{datetime.date.today()} | {platform.node()} | {cpu} | {os.cpu_count()} cores | "
           f"numba {numba.__version__} | numba threads available {numba.config.NUMBA_NUM_THREADS}\n")
-    print("| mu_c | model | 1 thread (rollouts/s) | 2 threads (rollouts/s) | cost vs ellipsoid (1 thread) |")
-    print("|---|---|---|---|---|")
+    gpu = args.backend == "cuda"
+    print(f"| mu_c | model | 1 thread (rollouts/s) | {nt} threads (rollouts/s) | "
+          f"parallel efficiency | cost vs ellipsoid (1 thread) |" + (" GPU (rollouts/s) |" if gpu else ""))
+    print("|---|---|---|---|---|---|" + ("---|" if gpu else ""))
     for mu_c in (0.2, 0.0):
-        rates = {m: [rate(part, m, mu_c, t, args.repeat) for t in (1, 2)]
+        rates = {m: [rate(part, m, mu_c, t, args.repeat) for t in (1, nt)]
                  for m in ("ellipsoid", "tip", "minpower")}
-        for m, (r1, r2) in rates.items():
-            print(f"| {mu_c:g} | {m} | {r1:,.0f} | {r2:,.0f} | {rates['ellipsoid'][0] / r1:.1f} |")
+        for m, (r1, rn) in rates.items():
+            row = (f"| {mu_c:g} | {m} | {r1:,.0f} | {rn:,.0f} | {rn / (nt * r1):.0%} | "
+                   f"{rates['ellipsoid'][0] / r1:.2f} |")
+            if gpu:
+                row += f" {rate(part, m, mu_c, None, args.repeat, 'cuda', args.gpu_scale):,.0f} |"
+            print(row)
 
 
 if __name__ == "__main__":

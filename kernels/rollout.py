@@ -44,7 +44,9 @@ JAM_NOTCH = 2  # two simultaneous contacts
 JAM_TRAVEL = 3  # pin travel in contact past 50 a
 JAM_NO_PUSH = 4  # the pin moves into the part and no pushing solution exists
 JAM_CHATTER = 5  # contact feature changes without progress
-JAM_REASONS = ("", "no rotation", "notch", "travel limit", "no pushing solution", "chatter")
+TRUNC_STEP_BUDGET = 6  # status truncated: the integrator's step budget ran out
+JAM_REASONS = ("", "no rotation", "notch", "travel limit", "no pushing solution", "chatter",
+               "step budget")
 
 _EVENT_TOL = 1e-10  # event functions may dip this far below zero (units of a)
 _SAME_FEATURE = 1e-3  # contact points closer than this (units of a) are one feature
@@ -58,6 +60,28 @@ DEFAULT_DS_MAX = 0.1  # units of a
 DEFAULT_TOL = 1e-7  # local error per step, units of a and radians
 _DTHETA_CAP = 0.2  # radians of contact-normal turn per step
 _GROW_MAX = 2.0  # largest step growth between accepted steps
+
+# Step budget (issue 12): a rollout ends with status ``truncated`` and reason
+# "step budget" after this many integration steps (accepted, rejected and
+# event-locating steps, plus re-contacts after a separation), so no input can
+# make it run without end. A normal rollout takes 20 to 200 steps; the budget
+# shrinks with the polygon size because a step's cost grows with it.
+# The largest budget seen used on the test grids is about 500 steps; a step
+# of a degenerate contact (a pin 1e5 times the part) costs up to ~80 us for a
+# triangle, so 5,000 steps stay near a second on a slow core. A 500-vertex
+# outline gets 1,000 steps (~1.3 ms each).
+MAX_STEPS = 5000  # for parts of up to MAX_STEPS_WORK / MAX_STEPS vertices
+MAX_STEPS_WORK = 150000  # steps x vertices
+MIN_STEPS = 1000
+
+# Rows of the scratch array ``work`` (``_W_ROWS`` x ``_W_COLS`` float64) that
+# ``_rollout_core`` uses instead of allocating, so the same code runs in a
+# CUDA thread with a fixed-size local array.
+_W_Y, _W_YNEW, _W_K1, _W_KEND, _W_YLOC, _W_TMP, _W_YI, _W_YTRY = 0, 1, 2, 3, 4, 5, 6, 7
+_W_KS = 8  # six rows: the Runge-Kutta stages
+_W_GEND, _W_GWORK, _W_MASK, _W_WARM = 14, 15, 16, 17
+_W_ROWS = 18
+_W_COLS = 10
 
 
 @jit
@@ -105,21 +129,42 @@ def _contact_geometry(verts, kind, idx, qx, qy):
 
 
 @jit
-def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, warm, out):
-    """Right-hand side at state ``y`` into ``out``; updates the warm-start twist.
+def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, sp, warm, out):
+    """Right-hand side at state ``y`` (belt travel ``sp``) into ``out``;
+    updates the warm-start history ``warm``.
 
     Returns ``(status, mode, fx, fy)`` with the pin force on the part in the
     body frame.
+
+    Notes
+    -----
+    ``warm`` holds the last two solved twists and the travel at which they
+    were solved: ``(vx, vy, om, mode, s, vx', vy', om', s', count)``. The
+    minpower solve starts from their linear extrapolation to ``sp``: the
+    twist is smooth in the travel within a contact feature, so the start is
+    off by O(ds^2) rather than O(ds), which saves Newton iterations. The
+    answer does not depend on the start (the solve converges from anywhere).
     """
     cx, cy, nx, ny, _, _ = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     vpx = cs * vpwx + sn * vpwy
     vpy = -sn * vpwx + cs * vpwy
+    wvx, wvy, wom = warm[0], warm[1], warm[2]
+    if warm[9] >= 2.0:
+        span = warm[4] - warm[8]
+        r = (sp - warm[4]) / span if span != 0.0 else 0.0
+        if -1.5 <= r <= 1.5:
+            wvx += r * (warm[0] - warm[5])
+            wvy += r * (warm[1] - warm[6])
+            wom += r * (warm[2] - warm[7])
     st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
-                                                  nx, ny, vpx, vpy, mu, warm[0], warm[1],
-                                                  warm[2], int(warm[3]))
+                                                  nx, ny, vpx, vpy, mu, wvx, wvy, wom,
+                                                  int(warm[3]))
     if st == TWIST_OK and mode != SEPARATE:
-        warm[0], warm[1], warm[2], warm[3] = vx, vy, om, mode
+        if sp != warm[4] or warm[9] < 1.0:
+            warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
+            warm[9] = min(warm[9] + 1.0, 2.0)
+        warm[0], warm[1], warm[2], warm[3], warm[4] = vx, vy, om, mode, sp
     out[0] = om
     out[1] = vpx - (vx - om * y[2])
     out[2] = vpy - (vy + om * y[1])
@@ -163,10 +208,11 @@ _CK_B4 = np.array([2825.0 / 27648.0, 0.0, 18575.0 / 48384.0, 13525.0 / 55296.0,
 
 
 @jit
-def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1, h, y1,
+def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, s0, k1, h, y1,
           ks, tmp, warm):
-    """One Cash-Karp step of size ``h`` from ``y0`` (slope ``k1`` given) into
-    ``y1`` (5th-order solution, projected back onto the contact).
+    """One Cash-Karp step of size ``h`` from ``y0`` at travel ``s0`` (slope
+    ``k1`` given) into ``y1`` (5th-order solution, projected back onto the
+    contact).
 
     Returns ``(ok, err)``: ``ok`` is False if a stage found no pushing
     solution; ``err`` is the max-norm of the embedded error estimate.
@@ -181,7 +227,7 @@ def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1
                 acc += _CK_A[st, j] * ks[j, i]
             tmp[i] = y0[i] + h * acc
         res = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp,
-                          warm, ks[st])
+                          s0 + _CK_C[st] * h, warm, ks[st])
         ok = ok and res[0] == TWIST_OK
     err = 0.0
     for i in range(5):
@@ -225,7 +271,7 @@ def _first_event(g, tol):
 def _min_over(g, mask):
     m = np.inf
     for j in range(4):
-        if mask[j] and g[j] < m:
+        if mask[j] != 0.0 and g[j] < m:
             m = g[j]
     return m
 
@@ -244,23 +290,23 @@ def _hermite(y0, k0, y1, k1, h, alpha, out):
 
 
 @jit
-def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vpwy, y0, k1, h,
-            y1, k_end, g1, y_out, ks, tmp, warm, g, mask):
+def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vpwy, y0, s0, k1,
+            h, y1, k_end, g1, y_out, ks, tmp, warm, g, mask, yi, y_try):
     """Shrink the step from ``y0`` to end on the first event crossed by the
     full step of size ``h`` to ``y1`` (slope ``k_end``, event values ``g1``).
 
     The crossing is first found on the step's Hermite interpolant (no contact
     solves), then refined with real steps by safeguarded secant iterations.
-    The state just before the crossing goes to ``y_out``.
-    Returns ``(fraction, event)``.
+    The state just before the crossing goes to ``y_out``; ``yi`` and
+    ``y_try`` are scratch. Returns ``(fraction, event, steps)`` with the
+    number of real steps taken.
     """
     for j in range(4):
-        mask[j] = g1[j] < -_EVENT_TOL
+        mask[j] = 1.0 if g1[j] < -_EVENT_TOL else 0.0
     _events(verts, convex, kind, idx, rp, vpwx, vpwy, y0, g)
     f0 = _min_over(g, mask)
     f1 = _min_over(g1, mask)
     # 1. Root of the event function along the interpolant (Illinois).
-    yi = np.empty(5)
     for i in range(5):
         yi[i] = y0[i]
     lo, hi, f_lo, f_hi, side = 0.0, 1.0, f0, f1, 0
@@ -288,19 +334,20 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
     #    inside the bracket of real evaluations.
     for i in range(5):
         y_out[i] = y0[i]
-    y_try = np.empty(5)
     lo, hi, f_lo = 0.0, 1.0, f0
     frac = 0.0
     prev_alpha, prev_f = -1.0, 0.0
+    n_steps = 0
     for it in range(60):
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
-        _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, k1,
+        n_steps += 1
+        _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, s0, k1,
               alpha * h, y_try, ks, tmp, warm)
         _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_try, g)
         for j in range(4):
-            if not mask[j] and g[j] < -_EVENT_TOL:
-                mask[j] = True  # an earlier event than the ones seen so far
+            if mask[j] == 0.0 and g[j] < -_EVENT_TOL:
+                mask[j] = 1.0  # an earlier event than the ones seen so far
         f = _min_over(g, mask)
         # Close enough when within the integrator's own event tolerance; a
         # state a hair past the crossing (f >= -_EVENT_TOL / 10) is kept too.
@@ -330,18 +377,15 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
     ev = 0
     best = np.inf
     for j in range(4):
-        if mask[j] and g[j] < best:
+        if mask[j] != 0.0 and g[j] < best:
             best, ev = g[j], j
-    return frac, ev
+    return frac, ev, n_steps
 
 
 @jit
-def _grow(buf, m):
-    if m < buf.shape[0]:
-        return buf
-    out = np.empty((2 * buf.shape[0], buf.shape[1]))
-    out[: buf.shape[0]] = buf
-    return out
+def max_steps_for(n_vertices):
+    """Default step budget of a rollout for a polygon of ``n_vertices``."""
+    return max(MIN_STEPS, min(MAX_STEPS, MAX_STEPS_WORK // max(n_vertices, 1)))
 
 
 @jit
@@ -371,12 +415,53 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         ``theta_f`` in radians in [0, 2 pi); lengths in the part's unit;
         ``trajectory`` rows ``(s, x, y, theta)`` (theta unwrapped, radians) and
         ``force`` rows ``(s, f_x, f_y)`` (force on the pin, units of mu_s m g);
-        both empty unless ``record``.
+        both empty unless ``record``. A rollout that uses up the step budget
+        ``max_steps_for(len(verts))`` ends ``TRUNCATED`` with reason
+        ``TRUNC_STEP_BUDGET``.
+    """
+    res = _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d,
+                          v_pin, max_travel, ds_max, tol, record,
+                          max_steps_for(verts.shape[0]))
+    return res[0], res[1], res[2], res[3], res[4], res[5], res[6], res[7], res[8]
+
+
+@jit
+def _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
+                    max_travel, ds_max, tol, record, max_steps):
+    """``_rollout`` with an explicit step budget ``max_steps``; returns its
+    nine results plus the number of steps used (at most ``max_steps`` plus
+    one event location, 61 steps)."""
+    work = np.empty((_W_ROWS, _W_COLS))
+    cap = max_steps + 4 if record else 1
+    traj = np.empty((cap, 4))
+    force = np.empty((cap, 3))
+    res = _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d,
+                        v_pin, max_travel, ds_max, tol, record, max_steps, work, traj, force)
+    n_traj, n_force = res[7], res[8]
+    return (res[0], res[1], res[2], res[3], res[4], res[5], res[6], traj[:n_traj].copy(),
+            force[:n_force].copy(), res[9])
+
+
+@jit
+def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
+                  max_travel, ds_max, tol, record, max_steps, work, traj, force):
+    """The rollout itself, without allocating: the scalar code path shared by
+    the CPU kernels and the CUDA kernel (``kernels.cuda``).
+
+    ``work`` is a ``(_W_ROWS, _W_COLS)`` float64 scratch array; ``traj`` and
+    ``force`` take the records when ``record`` (at least ``max_steps + 4``
+    rows; unused otherwise). Returns ``(status, jam_reason, theta_f, dy,
+    contact_travel, feature_changes, peak_force, n_traj, n_force, steps)``.
+
+    Notes
+    -----
+    Every integration attempt counts against ``max_steps``: accepted and
+    rejected steps, the real steps of an event location and each re-contact
+    after a separation. The budget is checked before each step, so at most
+    one event location (61 steps) runs past it.
     """
     rp = r_pin / a
     s_cap = max_travel / a
-    traj = np.empty((64 if record else 0, 4))
-    force = np.empty((64 if record else 0, 3))
     n_traj = 0
     n_force = 0
     two_pi = 2.0 * math.pi
@@ -391,34 +476,45 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
     sigma, kind, idx = _ray_first_contact(verts, qx, qy, wx, wy, rp, 0.0)
     theta_wrapped = theta_i % two_pi
     if not math.isfinite(sigma):
-        return MISS, JAM_NONE, theta_wrapped, 0.0, 0.0, 0, 0.0, traj[:0], force[:0]
-    y = np.array([theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d])
-    y_new = np.empty(5)
-    k1 = np.empty(5)
-    k_end = np.empty(5)
-    y_located = np.empty(5)
-    ks = np.empty((6, 5))
-    tmp = np.empty(5)
-    g_end = np.empty(4)
-    g_work = np.empty(4)
-    mask = np.zeros(4, dtype=np.bool_)
-    warm = np.array([wx, wy, 0.0, 0.0])  # previous twist and contact mode
+        return MISS, JAM_NONE, theta_wrapped, 0.0, 0.0, 0, 0.0, 0, 0, 0
+    y = work[_W_Y]
+    y_new = work[_W_YNEW]
+    k1 = work[_W_K1]
+    k_end = work[_W_KEND]
+    y_located = work[_W_YLOC]
+    tmp = work[_W_TMP]
+    ks = work[_W_KS:_W_KS + 6]
+    g_end = work[_W_GEND]
+    g_work = work[_W_GWORK]
+    mask = work[_W_MASK]
+    warm = work[_W_WARM]
+    y[0], y[1], y[2], y[3], y[4] = theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d
+    # Warm-start history (see _derivative): a translation along the pin's path.
+    warm[0], warm[1], warm[2], warm[3], warm[4] = wx, wy, 0.0, 0.0, 0.0
+    warm[9] = 0.0
+    for j in range(4):
+        mask[j] = 0.0
     s = 0.0
     h_next = ds_max
     travel = 0.0
     changes = 0
+    steps = 0
     peak = 0.0
     theta_ref, travel_ref = theta_i, 0.0
     status, reason = OK, JAM_NONE
     if record:
-        traj[0] = (0.0, 0.0, 0.0, theta_i)
+        traj[0, 0], traj[0, 1], traj[0, 2], traj[0, 3] = 0.0, 0.0, 0.0, theta_i
         n_traj = 1
     separated = False
     have_k1 = False
+    st, mode, fx, fy = TWIST_OK, SEPARATE, 0.0, 0.0
     while True:
+        if steps >= max_steps:
+            status, reason = TRUNCATED, TRUNC_STEP_BUDGET
+            break
         if not have_k1:
             st, mode, fx, fy = _derivative(model, verts, quad, area, m_max, mu_c, kind, idx,
-                                           vpwx, vpwy, y, warm, k1)
+                                           vpwx, vpwy, y, s, warm, k1)
         have_k1 = False
         if separated:
             # A located separation ends just before n . v_p crosses zero.
@@ -432,12 +528,12 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
             fwx, fwy = 0.0, 0.0
         peak = max(peak, math.hypot(fwx, fwy))
         if record:
-            force = _grow(force, n_force)
-            force[n_force] = (s * a, -fwx, -fwy)
+            force[n_force, 0], force[n_force, 1], force[n_force, 2] = s * a, -fwx, -fwy
             n_force += 1
         if mode == SEPARATE:
             # The pin moves away: the part rests while the pin travels on; a
             # non-convex part may be caught again further along the path.
+            steps += 1
             wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
             sigma, kind, idx = _ray_first_contact(verts, y[1], y[2], wx, wy, rp, 1e-9)
             if not math.isfinite(sigma):
@@ -465,8 +561,9 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
                 h = _DTHETA_CAP / turn
         rejected = False
         while True:
+            steps += 1
             ok, err = _step(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy,
-                            y, k1, h, y_new, ks, tmp, warm)
+                            y, s, k1, h, y_new, ks, tmp, warm)
             if h < 1e-12:
                 break
             if not ok:
@@ -488,14 +585,15 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         # Slope at the step's end: the next step's first stage when no event
         # intervenes, and the end slope of the dense output otherwise.
         st_e, mode_e, fx_e, fy_e = _derivative(model, verts, quad, area, m_max, mu_c, kind,
-                                               idx, vpwx, vpwy, y_new, warm, k_end)
+                                               idx, vpwx, vpwy, y_new, s + h, warm, k_end)
         _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_new, g_end)
         ev = _first_event(g_end, _EVENT_TOL)
         frac = 1.0
         if ev >= 0:
-            frac, ev = _locate(model, verts, quad, area, m_max, mu_c, convex, kind, idx, rp,
-                               vpwx, vpwy, y, k1, h, y_new, k_end, g_end, y_located, ks, tmp,
-                               warm, g_work, mask)
+            frac, ev, n_loc = _locate(model, verts, quad, area, m_max, mu_c, convex, kind, idx,
+                                      rp, vpwx, vpwy, y, s, k1, h, y_new, k_end, g_end, y_located,
+                                      ks, tmp, warm, g_work, mask, work[_W_YI], work[_W_YTRY])
+            steps += n_loc
             for i in range(5):
                 y_new[i] = y_located[i]
         else:
@@ -508,8 +606,8 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         s += frac * h
         travel += frac * h
         if record:
-            traj = _grow(traj, n_traj)
-            traj[n_traj] = (s * a, (y[3]) * a, (y[4] + d) * a, y[0])
+            traj[n_traj, 0], traj[n_traj, 1] = s * a, y[3] * a
+            traj[n_traj, 2], traj[n_traj, 3] = (y[4] + d) * a, y[0]
             n_traj += 1
         if abs(y[0] - theta_ref) >= _JAM_ANGLE:
             theta_ref, travel_ref = y[0], travel
@@ -535,10 +633,9 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
             _project(verts, kind, idx, rp, y)
         separated = ev == 2
     if record:
-        force = _grow(force, n_force)
-        force[n_force] = (s * a, 0.0, 0.0)
+        force[n_force, 0], force[n_force, 1], force[n_force, 2] = s * a, 0.0, 0.0
         n_force += 1
     if status == OK and travel == 0.0:
         status = MISS
     return (status, reason, y[0] % two_pi, (y[4] + d) * a, travel * a, changes, peak,
-            traj[:n_traj].copy(), force[:n_force].copy())
+            n_traj, n_force, steps)

@@ -54,9 +54,9 @@ def _edge_support(px, py, r1, qx, qy, r2):
     Returns ``(E, Gx, Gy, Nxx, Nxy, Nyy)``.
     """
     ex, ey = qx - px, qy - py
-    length = math.hypot(ex, ey)
-    ex /= length
-    ey /= length
+    inv = 1.0 / math.sqrt(ex * ex + ey * ey)
+    ex *= inv
+    ey *= inv
     mx, my = ey, -ex
     h = px * ey - py * ex
     if abs(h) <= 1e-15 * (r1 + r2):
@@ -94,12 +94,12 @@ def _support(verts, rx, ry):
     n = verts.shape[0]
     e_val = gx = gy = nxx = nxy = nyy = 0.0
     px, py = verts[0, 0] - rx, verts[0, 1] - ry
-    r_first = math.hypot(px, py)
+    r_first = math.sqrt(px * px + py * py)
     r1 = r_first
     for j in range(n):
         if j + 1 < n:
             qx, qy = verts[j + 1, 0] - rx, verts[j + 1, 1] - ry
-            r2 = math.hypot(qx, qy)
+            r2 = math.sqrt(qx * qx + qy * qy)
         else:
             qx, qy = verts[0, 0] - rx, verts[0, 1] - ry
             r2 = r_first
@@ -173,7 +173,7 @@ def _power(verts, quad, area, vx, vy, om):
         wx, wy, wt = quad[i, 0], quad[i, 1], quad[i, 2]
         ux = vx - om * wy
         uy = vy + om * wx
-        nu = math.hypot(ux, uy)
+        nu = math.sqrt(ux * ux + uy * uy)
         p_val += wt * nu
         hx, hy = ux / nu, uy / nu
         g0 += wt * hx

@@ -16,6 +16,14 @@ Queries return lazy (dask-backed) xarray objects::
 
 Shards written before dynamic pins existed have no ``v_pin`` attribute and
 count as static pins (v_pin = 0).
+
+Integrity: each entry records the shard's SHA-256, size and modification
+time. Opening a catalog (``catalog list/show``, every query) compares size and
+time with the disk and re-hashes only the shards whose time changed, so a
+shard overwritten with same-size garbage is flagged without hashing the whole
+catalog; serving a shard always checks its hash (once per opened catalog).
+The index itself is checked against :data:`INDEX_SCHEMA`; a malformed one is
+refused with the command that rebuilds it.
 """
 from __future__ import annotations
 
@@ -23,6 +31,7 @@ import hashlib
 import json
 from pathlib import Path
 
+import jsonschema
 import numpy as np
 import xarray as xr
 
@@ -31,6 +40,35 @@ from .io import write_json
 
 INDEX_NAME = "index.json"
 INDEX_VERSION = 1
+
+_NUM = {"type": "number"}
+_STR = {"type": "string"}
+INDEX_SCHEMA = {
+    "type": "object",
+    "required": ["index_version", "entries"],
+    "properties": {
+        "index_version": {"const": INDEX_VERSION},
+        "problems": {"type": "array", "items": _STR},
+        "entries": {"type": "array", "items": {
+            "type": "object",
+            "required": ["file", "sha256", "size", "family", "part_id", "part_name", "part_vertices",
+                         "model", "mu_c", "pin_radius", "d", "theta_step", "n_theta"],
+            "properties": {
+                # Relative, inside the catalog, an .h5 file.
+                "file": {"type": "string", "pattern": r"^(?!/)(?!.*(^|/)\.\.(/|$)).+\.h5$"},
+                "sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+                "size": {"type": "integer", "minimum": 0},
+                "mtime_ns": {"type": "integer"},
+                "family": _STR, "part_id": _STR, "part_name": _STR, "model": _STR,
+                "part_vertices": {"type": "array", "minItems": 3,
+                                  "items": {"type": "array", "minItems": 2, "maxItems": 2, "items": _NUM}},
+                "mu_c": _NUM, "pin_radius": _NUM, "v_pin": _NUM, "theta_step": _NUM,
+                "d": {"type": "array", "items": _NUM},
+                "n_theta": {"type": "integer", "minimum": 1},
+            },
+        }},
+    },
+}
 
 
 def _sha256(path: Path) -> str:
@@ -60,6 +98,7 @@ def _entry_from_file(root: Path, path: Path) -> dict:
         "file": path.relative_to(root).as_posix(),
         "sha256": _sha256(path),
         "size": path.stat().st_size,
+        "mtime_ns": path.stat().st_mtime_ns,
         "family": str(attrs["family"]),
         "part_id": str(attrs["part_id"]),
         "part_name": str(attrs["part_name"]),
@@ -68,6 +107,8 @@ def _entry_from_file(root: Path, path: Path) -> dict:
         "mu_c": float(attrs["mu_c"]),
         "pin_radius": float(attrs["pin_radius"]),
         "v_pin": float(attrs.get("v_pin", 0.0)),
+        "belt_speed": float(attrs.get("belt_speed", 0.0)),
+        "mu_s": float(attrs.get("mu_s", 0.5)),
         "d": d,
         "theta_step": float(attrs["theta_step"]),
         "n_theta": n_theta,
@@ -79,6 +120,37 @@ def _entry_from_file(root: Path, path: Path) -> dict:
     }
 
 
+def _read_index(index: Path, root: Path) -> dict:
+    """The index as a dict, checked against :data:`INDEX_SCHEMA`."""
+    hint = f"rebuild it with 'pinfeed catalog index --catalog {root}'"
+    try:
+        with open(index) as fh:
+            data = json.load(fh)
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise PinfeedError(f"{index} is corrupt; {hint}") from None
+    except OSError as exc:
+        raise PinfeedError(f"cannot read {index}: {exc.strerror}; check its permissions") from None
+    err = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(INDEX_SCHEMA).iter_errors(data))
+    if err is not None:
+        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
+        raise PinfeedError(f"{index} is not a pinfeed catalog index (at {where}: "
+                           f"{err.message[:120]}); {hint}")
+    return data
+
+
+def _disk_problem(path: Path, e: dict) -> str | None:
+    """Why an index entry no longer matches its file, or None. Cheap: the file is
+    hashed only when its modification time differs from the indexed one."""
+    if not path.is_file():
+        return f"{path}: listed in the index but gone from disk"
+    st = path.stat()
+    if st.st_size != e["size"]:
+        return f"{path}: changed since it was indexed (size)"
+    if st.st_mtime_ns != e.get("mtime_ns") and _sha256(path) != e["sha256"]:
+        return f"{path}: changed since it was indexed (checksum)"
+    return None
+
+
 class Catalog:
     """An opened catalog: verified entries plus the problems found on disk."""
 
@@ -86,6 +158,7 @@ class Catalog:
         self.root = Path(root)
         self.entries = entries
         self.problems = problems
+        self._verified = set()  # files whose checksum was checked when served
 
     # ------------------------------------------------------------------ building
 
@@ -121,20 +194,12 @@ class Catalog:
         if not index.is_file():
             raise PinfeedError(f"no catalog index at {index}; run the workflow ('make run') "
                                f"or 'pinfeed catalog index --catalog {root}'")
-        try:
-            with open(index) as fh:
-                data = json.load(fh)
-            raw = data["entries"]
-        except (json.JSONDecodeError, KeyError, TypeError):
-            raise PinfeedError(f"{index} is corrupt; rebuild it with 'pinfeed catalog index "
-                               f"--catalog {root}'") from None
+        data = _read_index(index, root)
         entries, problems = [], list(data.get("problems", []))
-        for e in raw:
-            path = root / e["file"]
-            if not path.is_file():
-                problems.append(f"{path}: listed in the index but gone from disk")
-            elif path.stat().st_size != e["size"]:
-                problems.append(f"{path}: changed since it was indexed")
+        for e in data["entries"]:
+            problem = _disk_problem(root / e["file"], e)
+            if problem:
+                problems.append(problem)
             else:
                 entries.append(e)
         return cls(root, entries, problems)
@@ -162,6 +227,10 @@ class Catalog:
             raise PinfeedError(f"unknown part {part!r}; known parts: {', '.join(known) or 'none'} "
                                f"('pinfeed catalog list' shows them)")
         ids = sorted({e["part_id"] for e in found})
+        families = sorted({e["family"] for e in found})
+        if len(families) > 1:
+            raise PinfeedError(f"part {part!r} is stored in several families ({', '.join(families)}); "
+                               f"rename it in one of them and re-run the workflow")
         if len(ids) > 1:
             raise PinfeedError(f"part name {part!r} matches several parts ({', '.join(ids)}); give the id")
         return found
@@ -170,13 +239,16 @@ class Catalog:
         path = self.root / e["file"]
         if not path.is_file():
             raise PinfeedError(f"{path} is gone from disk; re-run the workflow to recompute it")
-        if _sha256(path) != e["sha256"]:
-            raise PinfeedError(f"{path} changed since it was indexed; re-run the workflow or "
-                               f"'pinfeed catalog index'")
+        if path not in self._verified:
+            if _sha256(path) != e["sha256"]:
+                raise PinfeedError(f"{path} changed since it was indexed (checksum); re-run the "
+                                   f"workflow ('make run') to recompute it")
+            self._verified.add(path)
         return xr.open_dataset(path, engine="h5netcdf", chunks={})
 
     def query(self, part: str, model: str = "minpower", mu_c=None, d=None,
-              method: str = "nearest", v_pin: float = 0.0) -> xr.Dataset:
+              method: str = "nearest", v_pin: float = 0.0,
+              belt_speed: float = 0.0) -> xr.Dataset:
         """Maps of one part, model and pin speed, lazily.
 
         ``mu_c`` and ``d`` select stored values: ``method="nearest"`` takes the
@@ -184,14 +256,25 @@ class Catalog:
         the exact one). ``None`` keeps all. ``v_pin`` (speed ratio v_pin / v_b,
         default 0: static pins) must be stored exactly, since maps of different
         speeds are not interpolated. ``attrs["selection"]`` says what was
-        chosen. Returns dims ``(mu_c, d, theta_i)``.
+        chosen. ``belt_speed`` (mm/s, default 0: quasi-static) selects the
+        dynamic model's maps at that speed, stored exactly (``model`` is then
+        ``"dynamic"``). Returns dims ``(mu_c, d, theta_i)``.
         """
+        if float(belt_speed) > 0.0:
+            model = "dynamic"
         if method not in ("nearest", "bracket"):
             raise PinfeedError(f"unknown selection method {method!r}; use nearest or bracket")
+        _check_finite(mu_c=mu_c, d=d, v_pin=v_pin)
         found = [e for e in self._entries_for(part) if e["model"] == model]
         if not found:
             models = sorted({e["model"] for e in self._entries_for(part)})
             raise PinfeedError(f"part {part!r} has no {model} maps; stored models: {', '.join(models)}")
+        belts = sorted({e.get("belt_speed", 0.0) for e in found})
+        found = [e for e in found if e.get("belt_speed", 0.0) == float(belt_speed)]
+        if not found:
+            raise PinfeedError(f"part {part!r} has no {model} maps at belt speed {float(belt_speed):g} mm/s; "
+                               f"stored belt speeds: {', '.join(f'{v:g}' for v in belts)} "
+                               f"(add it to sweep.belt_speed)")
         speeds = sorted({e.get("v_pin", 0.0) for e in found})
         found = [e for e in found if e.get("v_pin", 0.0) == float(v_pin)]
         if not found:
@@ -220,7 +303,9 @@ class Catalog:
 
     def cube(self, family: str) -> xr.Dataset:
         """All maps of a family as one lazy cube (part, model, mu_c, v_pin, d, theta_i)."""
-        found = [e for e in self.entries if e["family"] == family]
+        # Quasi-static maps only: dynamic maps at belt speed > 0 are queried
+        # one speed at a time (``query(..., belt_speed=...)``).
+        found = [e for e in self.entries if e["family"] == family and not e.get("belt_speed", 0.0)]
         if not found:
             fams = sorted({e["family"] for e in self.entries})
             raise PinfeedError(f"unknown family {family!r}; known families: {', '.join(fams) or 'none'}")
@@ -234,6 +319,20 @@ class Catalog:
         cube.attrs.update(family=family, title=f"pinfeed map cube of family {family}")
         cube["v_pin"].attrs.update(units="1", long_name="pin speed across the belt over belt speed")
         return cube
+
+
+def _check_finite(**values) -> None:
+    """Refuse NaN and infinity: every comparison with NaN is false, so 'nearest'
+    would silently serve the first stored value."""
+    for name, value in values.items():
+        if value is None:
+            continue
+        try:
+            arr = np.atleast_1d(np.asarray(value, dtype=float))
+        except (TypeError, ValueError):
+            raise PinfeedError(f"{name} must be a number, got {value!r}") from None
+        if not np.all(np.isfinite(arr)):
+            raise PinfeedError(f"{name} must be a finite number, got {value!r}")
 
 
 def _select(stored: list[float], want: float, method: str) -> list[float]:

@@ -28,18 +28,26 @@ def _print_json(obj, **kw):
 
 
 def parse_values(text: str, what: str) -> np.ndarray:
-    """``"a,b,c"`` or an inclusive range ``"start:stop:step"``."""
+    """``"a,b,c"`` or an inclusive range ``"start:stop:step"``: finite, distinct,
+    at most ``checks.MAX_VALUES`` values (refused before anything is allocated)."""
+    from .checks import check_grid_size, check_values, range_size
+    bad = PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
+                       f"of finite numbers with step > 0")
     try:
         if ":" in text:
             start, stop, step = (float(x) for x in text.split(":"))
-            if step <= 0 or stop < start:
-                raise ValueError
-            n = int(math.floor((stop - start) / step + 1e-9)) + 1
-            return np.round(start + step * np.arange(n), 10) + 0.0
-        return np.array([float(x) for x in text.split(",") if x.strip()])
+        else:
+            values = [float(x) for x in text.split(",") if x.strip()]
     except ValueError:
-        raise PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
-                           f"with step > 0") from None
+        raise bad from None
+    if ":" in text:
+        if not all(map(math.isfinite, (start, stop, step))) or step <= 0 or stop < start:
+            raise bad
+        n = range_size(start, stop, step)
+        check_grid_size(n, f"{what} {text}")
+        return np.round(start + step * np.arange(n), 10) + 0.0
+    check_grid_size(len(values), what)
+    return check_values(values, f"{what} {text!r}")
 
 
 def _part_from_args(args):
@@ -71,12 +79,21 @@ def _add_outline_args(p, required=True):
                    "outline file's name)")
 
 
-def _add_physics(p, d_required=True):
+def _add_physics(p, d_required=True, belt=False):
     _add_outline_args(p)
     p.add_argument("--mu-c", type=float, required=True, help="pin-part friction coefficient (>= 0)")
     p.add_argument("--pin-radius", type=float, required=True, help="pin radius (mm, > 0)")
-    p.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"],
-                   help="contact model (default minpower)")
+    if belt:
+        p.add_argument("--model", default="minpower",
+                       choices=["minpower", "tip", "ellipsoid", "dynamic", "mujoco"],
+                       help="contact model (default minpower); dynamic and mujoco need --belt-speed")
+        p.add_argument("--belt-speed", dest="belt_speed", type=float, default=None,
+                       help="belt speed, mm/s (models dynamic and mujoco)")
+        p.add_argument("--mu-s", dest="mu_s", type=float, default=0.5,
+                       help="belt-part friction coefficient (models dynamic and mujoco; default 0.5)")
+    else:
+        p.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"],
+                       help="contact model (default minpower)")
     p.add_argument("--v-pin", type=float, default=0.0,
                    help="pin speed across the belt / belt speed (default 0: static pin)")
 
@@ -84,11 +101,20 @@ def _add_physics(p, d_required=True):
 def cmd_rollout(args):
     from . import simulate
     part = _part_from_args(args)
+    belt = {}
+    if args.model in simulate.BELT_MODELS:
+        if args.belt_speed is None:
+            raise PinfeedError(f"--model {args.model} needs --belt-speed MM_S")
+        simulate.check_belt(part, args.belt_speed, args.mu_s)
+        belt = dict(belt_speed=args.belt_speed, mu_s=args.mu_s)
+    elif args.belt_speed is not None:
+        raise PinfeedError(f"--belt-speed is for --model dynamic or mujoco, not {args.model} "
+                           f"(quasi-static: no belt speed)")
     rows = []
     for theta in parse_values(args.theta_i, "--theta-i"):
         ds = simulate.rollout(part, theta, args.d, args.mu_c, args.pin_radius, model=args.model,
                               v_pin=args.v_pin, max_travel=args.max_travel,
-                              trajectory=args.trajectory)
+                              trajectory=args.trajectory, **belt)
         row = {"theta_i": float(theta), "status": str(ds.status.item()),
                "theta_f": float(ds.theta_f), "dy": float(ds.dy),
                "contact_travel": float(ds.contact_travel),
@@ -102,12 +128,13 @@ def cmd_rollout(args):
     if args.json:
         _print_json(rows)
         return
+    speed = f"  belt {args.belt_speed:g} mm/s  mu_s = {args.mu_s:g}" if belt else ""
     print(f"part {part.id}  a = {part.a:.3f} mm  model {args.model}  mu_c = {args.mu_c:g}  "
-          f"pin radius {args.pin_radius:g} mm  d = {args.d:+g}")
+          f"pin radius {args.pin_radius:g} mm  d = {args.d:+g}{speed}")
     print(f"{'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9} {'travel':>8} "
           f"{'changes':>7} {'peak F':>7}")
     for r in rows:
-        note = f"  ({r['jam_reason']})" if r["status"] == "jammed" else ""
+        note = f"  ({r['jam_reason']})" if r["jam_reason"] != "none" else ""
         print(f"{r['theta_i']:8.2f} {r['status']:>9} {r['theta_f']:9.3f} {r['dy']:9.3f} "
               f"{r['contact_travel']:8.2f} {r['feature_changes']:7d} {r['peak_force']:7.3f}{note}")
     if args.trajectory:
@@ -132,15 +159,19 @@ def _print_trajectory(row, n_rows: int = 11):
 
 def cmd_map(args):
     from . import simulate
+    from .checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
     from .io import write_atomic
     from .provenance import provenance_attrs
     part = _part_from_args(args)
     d = parse_values(args.d, "--d")
     if not args.theta_step > 0 or args.theta_step > 360:
         raise PinfeedError(f"--theta-step must be in (0, 360] degrees, got {args.theta_step}")
+    check_grid_size(math.ceil(360.0 / args.theta_step), f"--theta-step {args.theta_step:g} (theta_i grid)")
+    check_grid_size(d.size * math.ceil(360.0 / args.theta_step), "the map (d x theta_i)", MAX_MAP)
+    check_out_path(args.out, MAP_SUFFIXES)
     theta = np.arange(0.0, 360.0 - 1e-9, args.theta_step)
     ds = simulate.map(part, theta, d, args.mu_c, args.pin_radius, model=args.model,
-                      v_pin=args.v_pin, threads=args.threads)
+                      v_pin=args.v_pin, threads=args.threads, backend=args.backend)
     ds.attrs.update(provenance_attrs())
     write_atomic(ds, args.out)
     counts = {name: int((ds.status.values == k).sum()) for k, name in enumerate(simulate.STATUSES)}
@@ -160,8 +191,10 @@ def _bands_option(text):
 
 
 def cmd_plot_map(args):
+    from .checks import IMAGE_SUFFIXES, check_out_path
     from .figures.maps import plot_map
     from .io import read_map
+    check_out_path(args.out, IMAGE_SUFFIXES)
     out = plot_map(read_map(args.map), args.out, bands=_bands_option(args.bands))
     print(f"wrote {out}")
 
@@ -268,7 +301,9 @@ def cmd_catalog_query(args):
 
 
 def cmd_catalog_plot(args):
+    from .checks import IMAGE_SUFFIXES, check_out_path
     from .figures.maps import plot_map
+    check_out_path(args.out, IMAGE_SUFFIXES)
     ds = _query(args)
     if ds.sizes["mu_c"] != 1:
         raise PinfeedError("plot one friction at a time: give --mu-c")
@@ -285,7 +320,7 @@ def cmd_sweep(args):
     if args.catalog:
         config["catalog_dir"] = args.catalog
     written = run_sweep(config, scheduler=args.scheduler, threads=args.threads,
-                        progress=not args.quiet)
+                        progress=not args.quiet, backend=args.backend)
     print(f"computed {len(written)} shards; catalog index at {config['catalog_dir']}/index.json")
 
 
@@ -448,6 +483,71 @@ def _results_arg(args, config) -> Path:
     return Path(args.results) if args.results else results_folder(config)
 
 
+def cmd_speed(args):
+    """A plan's success rate against belt speed and its speed limit (dynamic model)."""
+    from .config import load_config
+    from .planning import friction_label
+    from .speed_limit import speed_curve
+    from .stages import read_json
+    config = load_config(args.config)
+    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
+    if not path.is_file():
+        raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
+                           f"{args.part} --mode both --out {path}' or the workflow ('make run') first")
+    result = read_json(path)
+    plan, mu_c = _pick_tight_plan(result, args.plan, args.mu_c)
+    if not (args.mu_s > 0):
+        raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
+    from .parts import Part
+    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    v = dict(config.get("verify", {}))
+    perturb = {"theta_deg": 2.0 * v.get("theta_sigma", 1.0), "y_mm": v.get("y_halfwidth", 0.5),
+               "pin_mm": v.get("pin_halfwidth", 0.3)}
+    states = [(s["theta"], s["y_c"]) for s in result["initial_states"].values()]
+    arcs = [(s["start"], s["width"]) for s in plan["final_sets"]]
+    res = speed_curve(part, plan["pin_heights_mm"], plan["pin_speeds"], states, arcs, mu_c,
+                      mu_s=args.mu_s, perturb=perturb, trials=args.trials,
+                      r_pin=config["sweep"]["pin_radius"])
+    out = {"part": part.name, "pin_labels": list(plan["pins"]),
+           "pin_heights_mm": list(plan["pin_heights_mm"]),
+           "final_set": [{"start": s, "width": w} for s, w in arcs],
+           "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c, "mu_s": args.mu_s,
+           "speed_limit_mm_s": res["speed_limit_mm_s"], "curve": res["curve"],
+           "method": f"dynamic model, {args.trials} perturbed trials per initial state plus corners "
+                     f"at each speed; limit = highest speed with >= 99 % in the final set, 5 mm/s "
+                     f"bisection"}
+    if args.json:
+        _print_json(out, default=float)
+        return
+    print(f"{part.name}, plan {' '.join(plan['pins'])} (mu_c {friction_label(mu_c)}, mu_s {args.mu_s:g}): "
+          f"speed limit {res['speed_limit_mm_s']:g} mm/s")
+    for speed, frac in res["curve"]:
+        print(f"  {speed:7.1f} mm/s: {100 * frac:5.1f} % of trials in the final set")
+
+
+def _pick_tight_plan(result: dict, n: int, mu_text):
+    """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
+    (default: the first planned friction), and that friction."""
+    from .planning import friction_label, parse_friction
+    tight = result.get("tight") or []
+    if not tight:
+        raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan'")
+    entry = tight[0]
+    if mu_text is not None:
+        want = friction_label(parse_friction(mu_text))
+        found = [t for t in tight if t["friction"] == want]
+        if not found:
+            raise PinfeedError(f"no stored plan at mu_c {want}; stored: "
+                               f"{', '.join(t['friction'] for t in tight)}")
+        entry = found[0]
+    if not entry["plans"]:
+        raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
+    if not 1 <= n <= len(entry["plans"]):
+        raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
+    mu = entry["mu_c"]
+    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu)
+
+
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
     from .animate import animate_stored, plan_inputs
@@ -514,8 +614,9 @@ def cmd_sense_classify(args):
     from .parts import Part
     from .sensing import (Sensor, classify, read_profile_csv, reference_profiles, resample,
                           sign_matrix)
-    from .sensor_plan import describe_sets, final_for_verdict, stored_sensor_plan
-    from .stages import config_part_id, read_json
+    from .sensor_plan import (PLAN_SCHEMA, describe_sets, final_for_verdict, read_checked_json,
+                              stored_sensor_plan)
+    from .stages import config_part_id
     config = load_config(args.config)
     cat = Catalog.open(args.catalog or config["catalog_dir"])
     root = _results_arg(args, config)  # stored plans and sensor plans
@@ -530,7 +631,7 @@ def cmd_sense_classify(args):
     if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
         stored = None  # no sensor plan, or one for another outline of that name
     plan_path = root / "plans" / f"{name}.json"
-    plan = read_json(plan_path) if plan_path.is_file() else None
+    plan = read_checked_json(plan_path, PLAN_SCHEMA, "pinfeed plan result") if plan_path.is_file() else None
     if plan is not None and plan["part"].get("id", part.id) != part.id:
         plan = None
     first_pin = None
@@ -586,7 +687,9 @@ def cmd_sense_classify(args):
           f"mu_c {mu_c:g}, pin radius {pin_radius:g} mm")
     print(f"profile {args.profile}: {measured.t.size} samples over {measured.t[-1]:.3f} s at "
           f"{sensor.rate_hz:g} Hz")
-    if verdict["decided"]:
+    if verdict.get("note"):
+        print(f"verdict: undecided ({verdict['note']})")
+    elif verdict["decided"]:
         print(f"verdict: {verdict['best']} (decided: every other state scores at least "
               f"{sensor.margin} elements lower)")
     else:
@@ -637,7 +740,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("rollout", help="roll a part past one pin for some initial orientations")
-    _add_physics(p)
+    _add_physics(p, belt=True)
     p.add_argument("--theta-i", required=True, help="initial orientations, degrees: 'a,b,c' or 'start:stop:step'")
     p.add_argument("--d", type=float, required=True, help="contact parameter (y_pin - y_com)/a")
     p.add_argument("--trajectory", action="store_true", help="also show the trajectory: a short table, or every sample and the "
@@ -652,6 +755,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--d", required=True, help="contact parameters: 'a,b,c' or inclusive 'start:stop:step'")
     p.add_argument("--theta-step", type=float, default=1.0, help="theta_i step, degrees (default 1)")
     p.add_argument("--threads", type=int, default=None, help="Numba threads (default: all cores)")
+    p.add_argument("--backend", choices=("cpu", "cuda"), default="cpu",
+                   help="cpu (Numba threads, default) or cuda (an NVIDIA GPU; pip install '.[cuda]')")
     p.add_argument("--out", required=True, help="output file (.h5)")
     p.set_defaults(func=cmd_map)
 
@@ -667,6 +772,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--catalog", default=None, help="catalog folder (default: the config's catalog_dir)")
     p.add_argument("--scheduler", default=None, help="dask.distributed scheduler address, e.g. tcp://host:8786")
     p.add_argument("--threads", type=int, default=None, help="Numba threads per shard")
+    p.add_argument("--backend", choices=("cpu", "cuda"), default=None,
+                   help="cpu or cuda (an NVIDIA GPU per worker; default: the config's "
+                        "sweep.backend, else cpu)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_sweep)
 
@@ -759,6 +867,18 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: the config's, RESULTS_DIR/NAME)")
     p.set_defaults(func=cmd_animate)
 
+    p = sub.add_parser("speed", help="a stored plan's success against belt speed and its speed limit")
+    p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
+    p.add_argument("--plan", type=int, default=1, help="which tight plan, 1 = the recommended one")
+    p.add_argument("--mu-c", dest="mu_c", default=None, help="which planned friction: X or LO:HI")
+    p.add_argument("--mu-s", dest="mu_s", type=float, default=0.5, help="belt friction (default 0.5)")
+    p.add_argument("--trials", type=int, default=300, help="random trials per initial state (default 300)")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--results", default=None, help="results folder holding plans/ "
+                   "(default: the config's, RESULTS_DIR/NAME)")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_speed)
+
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")
     p.set_defaults(func=cmd_demo)
@@ -769,6 +889,8 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(_join_signed_values(sys.argv[1:] if argv is None else list(argv)))
     try:
+        from .provenance import source_date_epoch
+        source_date_epoch()  # before numpy's f2py reads it (and crashes on a bad value)
         args.func(args)
     except PinfeedError as exc:
         print(f"pinfeed: error: {exc}", file=sys.stderr)

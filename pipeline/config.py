@@ -19,8 +19,10 @@ from pathlib import Path
 import jsonschema
 import yaml
 
+from .checks import MAX_MAP, check_finite_tree, check_grid_size, check_pin_ratio
 from .errors import PinfeedError
 from .families import family_parts
+from .provenance import source_date_epoch
 
 SCHEMA_PATH = Path(__file__).resolve().parent.parent / "config" / "schema.yaml"
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config" / "config.yaml"
@@ -86,8 +88,14 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
     """Return a validated copy of ``config`` with defaults filled in. Relative
     outline paths are taken relative to ``base_dir`` (default: the working
     directory). ``name`` (the config file's stem) is the default of ``name``."""
+    source_date_epoch()  # before any kernel import trips over a bad value
     cfg = copy.deepcopy(config)
     cfg.setdefault("name", name or "default")
+    for key in ("catalog_dir", "results_dir"):
+        if isinstance(cfg.get(key), str) and not cfg[key].strip():
+            raise PinfeedError(f"config error at {key}: it is empty, which would write into the "
+                               f"current folder; name a folder (default {key.split('_')[0]})")
+    check_finite_tree(cfg)
     resolve_outlines(cfg, base_dir or Path.cwd())
     schema = _schema()
     validator = _fill_defaults(jsonschema.Draft202012Validator)(schema)
@@ -101,9 +109,11 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
     if abs(steps - round(steps)) > 1e-9:
         raise PinfeedError(f"config error at sweep/theta_step: 360 is not a multiple of "
                            f"{cfg['sweep']['theta_step']}")
-    names = set()
-    for name, spec in cfg["families"].items():
-        names.update(p.name for p in family_parts(name, spec))  # raises on a bad outline
+    try:
+        check_grid_size(len(cfg["sweep"]["d"]) * round(steps), "one shard (d x theta_i)", MAX_MAP)
+    except PinfeedError as exc:
+        raise PinfeedError(f"config error at sweep/d: {exc}") from None
+    names = _part_names(cfg)
     unknown = [p for p in cfg["planner"]["parts"] if p not in names]
     if unknown:
         raise PinfeedError(f"config error at planner/parts: {', '.join(unknown)} not in any family; "
@@ -125,6 +135,24 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
                            f"(the sensor plans on the planner's maps); planned parts: "
                            f"{', '.join(cfg['planner']['parts']) or 'none'}")
     return cfg
+
+
+def _part_names(cfg: dict) -> set:
+    """Names of every part; raises on a bad outline, a name in two families, or a
+    pin too large for a part."""
+    home = {}
+    for family, spec in cfg["families"].items():
+        for part in family_parts(family, spec):  # raises on a bad outline
+            if part.name in home:
+                raise PinfeedError(f"config error at families/{family}: part {part.name} is also in "
+                                   f"family {home[part.name]}; part names must be unique across "
+                                   f"families (rename one)")
+            home[part.name] = family
+            try:
+                check_pin_ratio(part, cfg["sweep"]["pin_radius"])
+            except PinfeedError as exc:
+                raise PinfeedError(f"config error at sweep/pin_radius: {exc}") from None
+    return set(home)
 
 
 def load_config(path=None) -> dict:

@@ -2,7 +2,10 @@
 
 Writes are atomic: the file is written under a temporary name in the same
 folder and renamed into place, so an interrupted run never leaves a
-half-written file under the real name.
+half-written file under the real name. A ``kill -9`` can leave the
+temporary file behind: its name starts with a dot and ends in ``.tmp``, so
+the catalog never reads it, and the workflow's start removes it
+(:func:`remove_stale_temps`).
 """
 from __future__ import annotations
 
@@ -17,6 +20,7 @@ import xarray as xr
 from .errors import PinfeedError
 
 MAP_VARIABLES = ("theta_f", "dy", "status")
+TMP_SUFFIX = ".tmp"  # atomic writes: '.NAME.XXXX.tmp' beside NAME; never a '*.h5' the catalog scans
 
 
 def _umask_mode() -> int:
@@ -30,8 +34,12 @@ def atomic_target(path):
     """Yield a temporary path beside ``path``; on success it is renamed onto
     ``path`` (with the umask's permissions), on any error it is removed."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=TMP_SUFFIX, dir=path.parent)
+    except OSError as exc:  # read-only folder, a file in the way, disk full...
+        raise PinfeedError(f"cannot write {path}: {exc.strerror or exc} in {path.parent}; make the "
+                           f"folder writable or choose another") from None
     os.close(fd)
     try:
         yield tmp
@@ -40,6 +48,17 @@ def atomic_target(path):
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def remove_stale_temps(folder) -> list[Path]:
+    """Delete the temporary files of atomic writes that a killed run left under
+    ``folder`` (only call it when no other run can be writing there)."""
+    gone = []
+    for tmp in Path(folder).rglob(f".*{TMP_SUFFIX}"):
+        if tmp.is_file():
+            tmp.unlink(missing_ok=True)
+            gone.append(tmp)
+    return gone
 
 
 def write_atomic(ds: xr.Dataset, path, encoding=None) -> Path:

@@ -8,6 +8,7 @@ import subprocess
 from pathlib import Path
 
 from . import __version__
+from .errors import PinfeedError
 
 
 @functools.lru_cache(maxsize=1)
@@ -24,10 +25,26 @@ def git_commit() -> str:
         return "unknown"
 
 
+def source_date_epoch() -> int | None:
+    """``SOURCE_DATE_EPOCH`` as seconds, None if unset, or a clear error. Checked
+    at start-up too (the CLI and config loading): numpy's f2py, which the kernels
+    import, crashes on a non-numeric value before pinfeed would see it."""
+    epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    if not epoch:
+        return None
+    try:
+        value = int(epoch)
+        _dt.datetime.fromtimestamp(value, _dt.timezone.utc)
+    except (ValueError, OverflowError, OSError):
+        raise PinfeedError(f"SOURCE_DATE_EPOCH must be a whole number of seconds since 1970 "
+                           f"(e.g. 1700000000), got {epoch!r}; fix or unset it") from None
+    return value
+
+
 def creation_time() -> str:
     """UTC time stamp; ``SOURCE_DATE_EPOCH`` pins it for bit-identical rebuilds."""
-    epoch = os.environ.get("SOURCE_DATE_EPOCH")
-    when = (_dt.datetime.fromtimestamp(int(epoch), _dt.timezone.utc) if epoch
+    epoch = source_date_epoch()
+    when = (_dt.datetime.fromtimestamp(epoch, _dt.timezone.utc) if epoch is not None
             else _dt.datetime.now(_dt.timezone.utc))
     return when.strftime("%Y-%m-%dT%H:%M:%SZ")
 

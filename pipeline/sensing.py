@@ -133,11 +133,21 @@ def processed(profile: Profile, sensor: Sensor) -> dict:
     return {"t": t, "fx": fx, "fy": fy, "dfx": gx, "dfy": gy}
 
 
+MAX_SAMPLES = 1_000_000  # a resampled profile (83 minutes at 200 Hz; a contact lasts seconds)
+MAX_PROFILE_BYTES = 100 * 2**20  # a measured CSV file
+
+
 def resample(profile: Profile, rate_hz: float) -> Profile:
     """The profile on a uniform grid at ``rate_hz`` from its first sample (linear
-    interpolation), so a measurement at any rate is smoothed over the same time."""
+    interpolation), so a measurement at any rate is smoothed over the same time.
+    Refuses more than ``MAX_SAMPLES`` samples before allocating them."""
     t = np.asarray(profile.t, float) - float(profile.t[0])
-    n = max(2, int(math.floor(t[-1] * rate_hz + 1e-9)) + 1)
+    span = float(t[-1]) * rate_hz
+    if not span < MAX_SAMPLES:
+        raise PinfeedError(f"the profile spans {t[-1]:.4g} s, {span:.3g} samples at {rate_hz:g} Hz, "
+                           f"more than the limit of {MAX_SAMPLES:,}; check the time column is in "
+                           f"seconds and give only the contact")
+    n = max(2, int(math.floor(span + 1e-9)) + 1)
     grid = np.arange(n) / rate_hz
     return Profile(grid, np.interp(grid, t, profile.fx), np.interp(grid, t, profile.fy))
 
@@ -183,6 +193,13 @@ def classify(measured: np.ndarray, references: dict, margin: int) -> dict:
     best = max(scores.values())
     tied = sorted(k for k, v in scores.items() if best - v < margin)
     ranked = sorted(scores, key=lambda k: (-scores[k], k))
+    if not np.any(measured):
+        # No force above the dead zone: no contact, or a dead sensor. The zeros
+        # would match whichever state's matrix has most zeros; decide nothing.
+        # It may still be one of the states that miss the pin, if any do.
+        missing = sorted(k for k, s in references.items() if not np.any(s))
+        return {"scores": scores, "best": ranked[0], "candidates": missing or sorted(scores),
+                "decided": False, "note": "no force above the dead zone: undecided"}
     return {"scores": scores, "best": ranked[0], "candidates": tied, "decided": len(tied) == 1}
 
 
@@ -295,8 +312,25 @@ def read_profile_csv(path) -> Profile:
     path = Path(path)
     if not path.is_file():
         raise PinfeedError(f"no profile file at {path}; give a CSV with columns time, F_x, F_y")
+    if path.stat().st_size > MAX_PROFILE_BYTES:
+        raise PinfeedError(f"{path} is {path.stat().st_size / 2**20:.0f} MiB, more than the limit of "
+                           f"{MAX_PROFILE_BYTES // 2**20} MiB for a profile; give only the contact")
+    try:
+        rows = _profile_rows(path)
+    except (UnicodeDecodeError, csv.Error):
+        raise PinfeedError(f"{path} is not a text CSV file (binary data?); give a CSV with columns "
+                           f"time, F_x, F_y") from None
+    if len(rows) < 2:
+        raise PinfeedError(f"{path}: needs at least two samples of time, F_x, F_y")
+    arr = np.asarray(rows)
+    if np.any(np.diff(arr[:, 0]) <= 0):
+        raise PinfeedError(f"{path}: time must increase from row to row")
+    return Profile(arr[:, 0] - arr[0, 0], arr[:, 1], arr[:, 2])
+
+
+def _profile_rows(path: Path) -> list:
     rows = []
-    with open(path, newline="") as fh:
+    with open(path, newline="", encoding="utf-8") as fh:
         for k, rec in enumerate(csv.reader(fh), start=1):
             if not rec or all(not c.strip() for c in rec):
                 continue
@@ -311,9 +345,4 @@ def read_profile_csv(path) -> Profile:
             if not all(math.isfinite(v) for v in vals):
                 raise PinfeedError(f"{path}, line {k}: values must be finite")
             rows.append(vals)
-    if len(rows) < 2:
-        raise PinfeedError(f"{path}: needs at least two samples of time, F_x, F_y")
-    arr = np.asarray(rows)
-    if np.any(np.diff(arr[:, 0]) <= 0):
-        raise PinfeedError(f"{path}: time must increase from row to row")
-    return Profile(arr[:, 0] - arr[0, 0], arr[:, 1], arr[:, 2])
+    return rows

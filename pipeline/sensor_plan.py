@@ -189,11 +189,11 @@ def sense_part(cat, name: str, config: dict, log=print) -> dict:
     """The sensing stage for one planned part: score table at the chosen first
     pin, the sensor plan and its per-verdict final sets, with provenance."""
     from .provenance import provenance_attrs
-    from .stages import build_planner
+    from .stages import build_planner, paper_depth
     sc = config["sensing"]
     part, planner, mu_used, selection = build_planner(cat, name, config, dynamic=False)
     sensor = Sensor.from_config(sc["sensor"])
-    res = plan_with_sensor(planner, config["planner"]["depth"], mu_used, config["sweep"]["pin_radius"],
+    res = plan_with_sensor(planner, paper_depth(config), mu_used, config["sweep"]["pin_radius"],
                            config["planner"]["model"], sensor, trials=sc["trials"],
                            perturb=dict(PERTURB_DEFAULTS, **sc["perturb"]), seed=sc["seed"],
                            apart_fraction=sc["apart_fraction"], max_first_pins=sc["max_first_pins"],
@@ -204,15 +204,52 @@ def sense_part(cat, name: str, config: dict, log=print) -> dict:
     if res["found"]:
         out["verification"] = verify_sensor_plan(part, out, mu_used, config["sweep"]["pin_radius"],
                                                  config["planner"]["model"], sensor,
-                                                 config.get("verify", {}))
+                                                 dict(config.get("verify", {}), trials=sc["trials"]))
     return dict(out, **provenance_attrs())
+
+
+_OBJ = {"type": "object"}
+_NUM = {"type": "number"}
+# What ``pinfeed sense classify`` reads of a stored sensing result: checked
+# first, so a file of another shape is an error naming it, not a traceback.
+SENSING_SCHEMA = {
+    "type": "object", "required": ["found", "part"],
+    "properties": {"found": {"type": "boolean"}, "part": _OBJ},
+    "if": {"properties": {"found": {"const": True}}},
+    "then": {"required": ["first_pin", "y_pin", "sensor", "mu_c", "model", "plan", "states"],
+             "properties": {"first_pin": {"type": "string"}, "y_pin": _NUM, "sensor": _OBJ,
+                            "mu_c": _NUM, "model": {"type": "string"},
+                            "plan": {"type": "object", "required": ["pins"],
+                                     "properties": {"pins": {"type": "array"}}},
+                            "states": {"type": "object", "additionalProperties": {
+                                "type": "object", "required": ["final_sets"]}}}},
+}
+PLAN_SCHEMA = {
+    "type": "object", "required": ["part", "pins", "plans"],
+    "properties": {"part": _OBJ, "pins": _OBJ, "plans": {"type": "array", "items": _OBJ}},
+}
+
+
+def read_checked_json(path, schema: dict, what: str) -> dict:
+    """A stored result file, checked against ``schema``; a file of the wrong shape
+    is a :class:`PinfeedError` that says to delete it and re-run the workflow."""
+    import jsonschema
+
+    from .errors import PinfeedError
+    from .stages import read_json
+    data = read_json(path)
+    err = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(schema).iter_errors(data))
+    if err is not None:
+        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
+        raise PinfeedError(f"{path} is not a {what} (at {where}: {err.message[:100]}); delete it and "
+                           f"re-run the workflow ('make run')")
+    return data
 
 
 def stored_sensor_plan(root, name: str):
     """The stored sensing result of part ``name`` under results folder ``root``, or None."""
-    from .stages import read_json
     path = Path(root) / "sensing" / f"{name}.json"
-    return read_json(path) if path.is_file() else None
+    return read_checked_json(path, SENSING_SCHEMA, "pinfeed sensing result") if path.is_file() else None
 
 
 def final_for_verdict(sensing: dict, candidates) -> list[dict]:

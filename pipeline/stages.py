@@ -108,17 +108,17 @@ def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=Non
     pc = config["planner"]
     part, planner, mu_used, selection = build_planner(cat, name, config)
     dyn = pc.get("dynamic", {})
-    plans = planner.search(pc["depth"], keep=keep, dynamic_depth=dyn.get("depth", 0),
+    plans = planner.search(paper_depth(config), keep=keep, dynamic_depth=dyn.get("depth", 0),
                            dynamic_beam=dyn.get("beam", 50))
     states = planner.initial_states()
     static_only = [p for p in plans if p.n_dynamic == 0]
     if planner.dynamic_labels and not static_only:
-        static_only = [p for p in planner.search(pc["depth"], keep=1) if p.n_dynamic == 0]
+        static_only = [p for p in planner.search(paper_depth(config), keep=1) if p.n_dynamic == 0]
     return {
         "part": part.to_dict(), "model": pc["model"], "mu_c": mu_used, "selection": selection,
         "pins": planner.pins,
         "pin_speeds": {k: v for k, v in planner.speeds.items() if v != 0.0},
-        "depth": pc["depth"], "dynamic_depth": dyn.get("depth", 0) if planner.dynamic_labels else 0,
+        "depth": paper_depth(config), "dynamic_depth": dyn.get("depth", 0) if planner.dynamic_labels else 0,
         "d_min": pc["d_min"], "d_max": pc["d_max"],
         "coverage": planner.coverage,
         "best_static": static_only[0].to_dict() if static_only else None,
@@ -128,6 +128,13 @@ def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=Non
         "tight": plan_tight_all(part, config, cat.root, keep=keep, progress=progress) if tight else [],
         **provenance_attrs(),
     }
+
+
+def paper_depth(config: dict) -> int:
+    """Depth of the paper-mode planner (and the sensor planner built on it):
+    ``planner.paper_depth``, at most ``planner.depth``."""
+    pc = config["planner"]
+    return int(min(pc["depth"], pc.get("paper_depth", 3)))
 
 
 def plan_frictions(config: dict) -> list:

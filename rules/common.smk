@@ -8,8 +8,8 @@ JOBS = {str(job.path(CATALOG)): job for job in shard_jobs(config)}
 wildcard_constraints:
     family="[A-Za-z0-9_]+",
     part="[A-Za-z0-9_]+-[0-9a-f]{10}",
-    model="minpower|tip|ellipsoid",
-    tag="mu_c=[0-9.eE+-]+(_v_pin=[0-9.eE+-]+)?",
+    model="minpower|tip|ellipsoid|dynamic",
+    tag="mu_c=[0-9.eE+-]+(_v_pin=[0-9.eE+-]+)?(_belt=[0-9.eE+-]+_mu_s=[0-9.eE+-]+)?",
 
 
 def shard_params(wildcards):

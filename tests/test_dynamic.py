@@ -178,9 +178,10 @@ def test_cli_plan_with_a_moving_pin_stores_its_maps(tmp_path, capsys):
     from pipeline.cli import main
     cat = tmp_path / "cat"
     base = ["plan", "--vertices", "0,0 40,0 40,20 0,20", "--name", "rect", "--catalog", str(cat),
-            "--depth", "1", "--pins=-5,5,15,25,35"]
-    assert main(base + ["--speeds", "-1.5", "--dynamic-depth", "1", "--json"]) == 0
-    res = json.loads(capsys.readouterr().out)
+            "--depth", "1", "--pins=-5,5,15,25,35", "--mode", "paper"]
+    assert main(base + ["--speeds", "-1.5", "--dynamic-depth", "1", "--out", str(tmp_path / "p.json")]) == 0
+    capsys.readouterr()
+    res = json.loads((tmp_path / "p.json").read_text())
     assert res["pin_speeds"] and set(res["pin_speeds"].values()) == {-1.5}
     assert all(label.endswith("v-1.5") for label in res["pin_speeds"])
     speeds = {e["v_pin"] for e in Catalog.open(cat).entries}

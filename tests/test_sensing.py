@@ -294,7 +294,7 @@ def test_sym_triangle_sensor_plan_reports_a_final_set_per_verdict(sym_catalog):
     # The sensor can only help: never more sets per verdict than fixed pins alone.
     assert res["worst_sets"] <= res["static_best"]["n_final_sets"]
     rows = res["verification"]["rows"]
-    assert all(r["trials"] == cfg["verify"]["trials"] and
+    assert all(r["trials"] == cfg["sensing"]["trials"] and
                r["right"] + r["wrong"] + r["ambiguous"] + r["jammed"] == r["trials"] for r in rows.values())
     assert all(r["wrong"] == 0 for r in rows.values())
 

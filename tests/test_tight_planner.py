@@ -214,3 +214,15 @@ def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys):
     assert "0 new rollouts" in text and " deg" in text and "#1:" in text
     assert main(args[:-2] + ["--mu-c", "0.3:0.1"]) == 2
     assert main(args + ["--depth", "0"]) == 2
+    # The speed limit of the stored plan (dynamic model), issue 18's keys.
+    stored = tmp_path / "res" / "plans" / "tri.json"  # a results folder (--results)
+    assert main(args + ["--out", str(stored)]) == 0
+    capsys.readouterr()
+    assert main(["speed", "--part", "tri", "--results", str(tmp_path / "res"), "--trials", "3", "--json"]) == 0
+    sp = json.loads(capsys.readouterr().out)
+    assert set(sp) >= {"pin_labels", "pin_heights_mm", "final_set", "mu_c", "mu_s", "speed_limit_mm_s", "curve"}
+    assert sp["pin_labels"] == out["plans"][0]["pins"]
+    ok = [v for v, frac in sp["curve"] if frac >= 0.99]
+    assert sp["speed_limit_mm_s"] in ok  # the replay holds at the stated limit
+    assert main(["speed", "--part", "nope", "--results", str(tmp_path / "res")]) == 2
+    assert main(["speed", "--part", "tri", "--results", str(tmp_path / "res"), "--mu-c", "0.2"]) == 2
