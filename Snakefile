@@ -8,7 +8,7 @@ import sys
 
 from snakemake.utils import min_version
 
-from pipeline.config import validate_config
+from pipeline.config import config_name, validate_config
 from pipeline.workflow import reconcile_catalog
 
 min_version("8.0")
@@ -24,10 +24,15 @@ if not {"families", "sweep"} & set(config):
 
 # Schema validation (descriptions in config/schema.yaml), defaults filled in,
 # part outlines checked: a bad config stops here, before any job runs.
-# Relative outline paths are relative to the last --configfile's folder.
+# Relative outline paths are relative to the last --configfile's folder; its
+# stem names the config (results go to results_dir/NAME/) unless it says name:.
 _CONFIG_FILES = list(getattr(workflow, "configfiles", None) or [])
 config.update(validate_config(
-    config, base_dir=os.path.dirname(os.path.abspath(_CONFIG_FILES[-1])) if _CONFIG_FILES else None))
+    config, base_dir=os.path.dirname(os.path.abspath(_CONFIG_FILES[-1])) if _CONFIG_FILES else None,
+    name=config_name(_CONFIG_FILES[-1]) if _CONFIG_FILES else None))
+
+
+report: "rules/report/workflow.rst"
 
 
 # The catalog against disk, before Snakemake plans its jobs: a deleted or

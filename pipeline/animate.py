@@ -292,17 +292,47 @@ def _moving_figure(part, still, panes, stations, heights, speeds, pin_radius):
 _LABEL = re.compile(r"^P(\d+)(?:v([+-]?[\d.]+))?$")
 
 
-def plan_inputs(result: dict, plan_index: int, config: dict) -> dict:
-    """Plain inputs of plan ``plan_index`` (1-based) of a stored plan result
-    (``catalog/plans/NAME.json``): pin labels, heights, speeds, states, physics.
-    Heights: the plan's ``pin_heights_mm`` if present, else the result's
-    label -> height table, else the config's ``planner.pins`` by label P1..."""
+def recommended_index(result: dict):
+    """Which plan of a stored result is the recommended one: ``"tight"`` (the
+    tight planner's recommended plan at the first friction), else ``1`` (paper
+    mode's best), else None (no plan)."""
+    tight = (result.get("tight") or [None])[0]
+    if tight and tight.get("recommended"):
+        return "tight"
+    return 1 if result.get("plans") else None
+
+
+def _chosen_plan(result: dict, plan_index):
+    """(plan dict, friction, description) of ``plan_index``: None (the recommended
+    plan), ``"tight"``, or a 1-based paper-mode index."""
+    from .planning import nominal_friction, parse_friction
+    name = result["part"]["name"]
+    if plan_index is None:
+        plan_index = recommended_index(result)
+        if plan_index is None:
+            raise PinfeedError(f"{name}: the stored result has no plan to animate")
+    if plan_index == "tight":
+        tight = (result.get("tight") or [None])[0]
+        if not tight or not tight.get("recommended"):
+            raise PinfeedError(f"{name}: the stored result has no recommended tight plan")
+        mu = nominal_friction(parse_friction(tight["mu_c"]))
+        return tight["recommended"], mu, f"tight plan at mu_c {tight['friction']}"
     plans = result.get("plans") or []
     if not plans:
-        raise PinfeedError(f"{result['part']['name']}: the stored result has no plan to animate")
+        raise PinfeedError(f"{name}: the stored result has no paper-mode plan to animate")
     if not 1 <= plan_index <= len(plans):
-        raise PinfeedError(f"--plan {plan_index}: {result['part']['name']} has plans 1 to {len(plans)}")
-    plan = plans[plan_index - 1]
+        raise PinfeedError(f"--plan {plan_index}: {name} has plans 1 to {len(plans)}")
+    return plans[plan_index - 1], float(result["mu_c"]), f"plan {plan_index}"
+
+
+def plan_inputs(result: dict, plan_index, config: dict) -> dict:
+    """Plain inputs of a plan of a stored plan result (``RESULTS/plans/NAME.json``):
+    pin labels, heights, speeds, states, physics, and ``what`` (which plan).
+    ``plan_index``: None for the recommended plan (the tight planner's, else
+    paper mode's best), ``"tight"``, or a 1-based paper-mode plan. Heights: the
+    plan's ``pin_heights_mm`` if present, else the result's label -> height
+    table, else the config's ``planner.pins`` by label P1..."""
+    plan, mu_c, what = _chosen_plan(result, plan_index)
     labels = list(plan["pins"])
     table = result.get("pins") if isinstance(result.get("pins"), dict) else {}
     speeds_table = result.get("pin_speeds") or {}
@@ -316,27 +346,30 @@ def plan_inputs(result: dict, plan_index: int, config: dict) -> dict:
         elif m and int(m.group(1)) <= len(config["planner"]["pins"]):
             h = float(config["planner"]["pins"][int(m.group(1)) - 1])
         else:
-            raise PinfeedError(f"pin {label!r} of plan {plan_index} has no height in the plan or the config")
+            raise PinfeedError(f"pin {label!r} of the {what} has no height in the plan or the config")
         heights.append(h)
         if plan.get("pin_speeds") is not None:
             speeds.append(float(plan["pin_speeds"][k]))
         else:
             speeds.append(float(speeds_table.get(label, float(m.group(2)) if m and m.group(2) else 0.0)))
-    states = {k: (float(s["theta"]), float(s["y_c"])) for k, s in result["initial_states"].items()}
+    # 'pinfeed plan --mode tight' files keep the resting states per friction entry.
+    stored = result.get("initial_states") or ((result.get("tight") or [{}])[0].get("initial_states") or {})
+    states = {k: (float(s["theta"]), float(s["y_c"])) for k, s in stored.items()}
     return {"labels": labels, "heights": heights, "speeds": speeds, "states": states,
-            "mu_c": float(result["mu_c"]), "model": result["model"],
+            "mu_c": mu_c, "model": result["model"], "what": what,
             "pin_radius": float(result.get("pin_radius", config["sweep"]["pin_radius"]))}
 
 
-def animate_stored(result: dict, config: dict, out, plan_index: int = 1, frames: int = 120,
+def animate_stored(result: dict, config: dict, out, plan_index=None, frames: int = 120,
                    fps: int = 20) -> dict:
-    """Animate plan ``plan_index`` of a stored plan result (what ``pinfeed animate``
-    and a workflow rule call). Returns :func:`animate_plan`'s summary plus the inputs."""
+    """Animate a plan of a stored plan result (``plan_index`` as in :func:`plan_inputs`;
+    what ``pinfeed animate`` and the workflow's animate rule call). Returns
+    :func:`animate_plan`'s summary plus the inputs."""
     from .parts import Part
     inputs = plan_inputs(result, plan_index, config)
     part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
     done = animate_plan(part, inputs["heights"], inputs["speeds"], inputs["states"], inputs["mu_c"],
                         inputs["model"], inputs["pin_radius"], out, labels=inputs["labels"],
                         frames=frames, fps=fps,
-                        title=f"{part.name}: plan {plan_index}, pins {' → '.join(inputs['labels'])}")
+                        title=f"{part.name}: {inputs['what']}, pins {' → '.join(inputs['labels'])}")
     return {**done, **inputs}

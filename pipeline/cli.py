@@ -477,6 +477,12 @@ def _print_plan_result(result, part, config, mode):
               f"margin in d {plan['margin']:.3f}")
 
 
+def _results_arg(args, config) -> Path:
+    """The results folder of stored plans and sensing: --results, else the config's."""
+    from .config import results_folder
+    return Path(args.results) if args.results else results_folder(config)
+
+
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from .config import load_config
@@ -484,13 +490,12 @@ def cmd_speed(args):
     from .speed_limit import speed_curve
     from .stages import read_json
     config = load_config(args.config)
-    root = Path(args.catalog or config["catalog_dir"])
-    path = root / "plans" / f"{args.part}.json"
+    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
                            f"{args.part} --mode both --out {path}' or the workflow ('make run') first")
     result = read_json(path)
-    plan, mu_c = _pick_tight_plan(result, args.plan, args.mu_c)
+    plan, mu_c, entry = _pick_tight_plan(result, args.plan, args.mu_c)
     if not (args.mu_s > 0):
         raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
     from .parts import Part
@@ -498,7 +503,9 @@ def cmd_speed(args):
     v = dict(config.get("verify", {}))
     perturb = {"theta_deg": 2.0 * v.get("theta_sigma", 1.0), "y_mm": v.get("y_halfwidth", 0.5),
                "pin_mm": v.get("pin_halfwidth", 0.3)}
-    states = [(s["theta"], s["y_c"]) for s in result["initial_states"].values()]
+    # A tight-only plan file keeps the resting states per friction entry.
+    stored_states = entry.get("initial_states") or result.get("initial_states") or {}
+    states = [(s["theta"], s["y_c"]) for s in stored_states.values()]
     arcs = [(s["start"], s["width"]) for s in plan["final_sets"]]
     res = speed_curve(part, plan["pin_heights_mm"], plan["pin_speeds"], states, arcs, mu_c,
                       mu_s=args.mu_s, perturb=perturb, trials=args.trials,
@@ -522,7 +529,7 @@ def cmd_speed(args):
 
 def _pick_tight_plan(result: dict, n: int, mu_text):
     """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
-    (default: the first planned friction), and that friction."""
+    (default: the first planned friction), that friction and its stored entry."""
     from .planning import friction_label, parse_friction
     tight = result.get("tight") or []
     if not tight:
@@ -540,7 +547,7 @@ def _pick_tight_plan(result: dict, n: int, mu_text):
     if not 1 <= n <= len(entry["plans"]):
         raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
     mu = entry["mu_c"]
-    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu)
+    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
 
 
 def cmd_animate(args):
@@ -549,21 +556,30 @@ def cmd_animate(args):
     from .config import load_config
     from .stages import read_json
     config = load_config(args.config)
-    root = Path(args.catalog or config["catalog_dir"])
-    path = root / "plans" / f"{args.part}.json"
+    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
-        raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
-                           f"{args.part} --out {path}' or the workflow ('make run') first")
+        raise PinfeedError(f"no stored plan for {args.part} at {path}; "
+                           f"{_plan_hint(config, args.part, path.parent.parent)} first")
     result = read_json(path)
     inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
     pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
                        for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
-    print(f"animating plan {args.plan} of {args.part}: {pins}; {len(inputs['states'])} initial states",
-          flush=True)
+    print(f"animating the {inputs['what']} of {args.part}: {pins}; {len(inputs['states'])} initial "
+          f"states", flush=True)
     done = animate_stored(result, config, args.out, args.plan, frames=args.frames, fps=args.fps)
     outcomes = ", ".join(f"{k}: {v}" for k, v in done["outcomes"].items())
     print(f"wrote {done['out']}: {done['frames']} frames over {done['belt_travel']:.0f} mm of belt "
           f"travel ({outcomes})")
+
+
+def _plan_choice(text: str):
+    """--plan: ``tight`` or a paper-mode plan number (1 = best)."""
+    if text == "tight":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected 'tight' or a plan number, got {text!r}") from None
 
 
 PROFILE_FORMAT = """\
@@ -584,8 +600,9 @@ def _best_fixed_plan(plan_result: dict):
 
 
 def _plan_hint(config: dict, name: str, root) -> str:
-    """How to make the stored plan of ``name``: the workflow plans the config's
-    parts; a part planned from --vertices or --outline needs 'pinfeed plan'."""
+    """How to make the stored plan of ``name`` under results folder ``root``: the
+    workflow plans the config's parts; a part planned from --vertices or
+    --outline needs 'pinfeed plan'."""
     if name in config["planner"]["parts"]:
         return "run the workflow ('make run')"
     return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
@@ -603,8 +620,8 @@ def cmd_sense_classify(args):
                               stored_sensor_plan)
     from .stages import config_part_id
     config = load_config(args.config)
-    root = Path(args.catalog or config["catalog_dir"])
-    cat = Catalog.open(root)
+    cat = Catalog.open(args.catalog or config["catalog_dir"])
+    root = _results_arg(args, config)  # stored plans and sensor plans
     # The config's outline wins over older ones stored under the same name.
     wanted = config_part_id(config, args.part)
     if wanted != args.part and not any(e["part_id"] == wanted for e in cat.entries):
@@ -639,7 +656,7 @@ def cmd_sense_classify(args):
         mu_c, model = float(stored["mu_c"]), stored["model"]
     else:
         sensor = Sensor.from_config(config["sensing"]["sensor"])
-        from .planning import nominal_friction, parse_friction
+        from .planning import nominal_friction, parse_friction  # a range: its middle
         mu_c = float(plan["mu_c"]) if plan else nominal_friction(parse_friction(config["planner"]["mu_c"]))
         model = plan["model"] if plan else config["planner"]["model"]
     pin_radius = float(entry["pin_radius"])
@@ -834,27 +851,33 @@ def build_parser() -> argparse.ArgumentParser:
                    "else the stored plan's)")
     q.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     q.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    q.add_argument("--results", default=None, help="results folder holding plans/ and sensing/ "
+                   "(default: the config's, RESULTS_DIR/NAME)")
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
 
     p = sub.add_parser("animate", help="animate a stored plan: every initial state past the pins")
-    p.add_argument("--part", required=True, help="part name (its plan is CATALOG/plans/NAME.json)")
-    p.add_argument("--plan", type=int, default=1, help="which plan, 1 = the recommended one (default 1)")
+    p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
+    p.add_argument("--plan", type=_plan_choice, default=None,
+                   help="which plan: 'tight' (the tight planner's recommended plan) or N (paper "
+                   "mode's Nth best; 1 = best); default: the tight one if any, else 1")
     p.add_argument("--out", required=True, help="animation file: .gif (Pillow) or .mp4 (needs ffmpeg)")
     p.add_argument("--frames", type=int, default=120, help="number of frames (default 120)")
     p.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
-    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    p.add_argument("--results", default=None, help="results folder holding plans/ "
+                   "(default: the config's, RESULTS_DIR/NAME)")
     p.set_defaults(func=cmd_animate)
 
     p = sub.add_parser("speed", help="a stored plan's success against belt speed and its speed limit")
-    p.add_argument("--part", required=True, help="part name (its plan is CATALOG/plans/NAME.json)")
+    p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
     p.add_argument("--plan", type=int, default=1, help="which tight plan, 1 = the recommended one")
     p.add_argument("--mu-c", dest="mu_c", default=None, help="which planned friction: X or LO:HI")
     p.add_argument("--mu-s", dest="mu_s", type=float, default=0.5, help="belt friction (default 0.5)")
     p.add_argument("--trials", type=int, default=300, help="random trials per initial state (default 300)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
-    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    p.add_argument("--results", default=None, help="results folder holding plans/ "
+                   "(default: the config's, RESULTS_DIR/NAME)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_speed)
 

@@ -13,6 +13,7 @@ import copy
 import hashlib
 import json
 import math
+import re
 from pathlib import Path
 
 import jsonschema
@@ -71,12 +72,25 @@ def resolve_outlines(cfg: dict, base_dir) -> None:
                 p["outline"] = str((Path(base_dir) / p["outline"]).resolve())
 
 
-def validate_config(config: dict, base_dir=None) -> dict:
+def config_name(path) -> str:
+    """The default config name of a config file: its stem, in file-name-safe characters."""
+    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem).lstrip(".-")
+    return stem or "default"
+
+
+def results_folder(config: dict) -> Path:
+    """This config's results folder: ``results_dir/name`` (plans, verification,
+    sensing, figures, animations, report)."""
+    return Path(config["results_dir"]) / config.get("name", "default")
+
+
+def validate_config(config: dict, base_dir=None, name: str | None = None) -> dict:
     """Return a validated copy of ``config`` with defaults filled in. Relative
     outline paths are taken relative to ``base_dir`` (default: the working
-    directory)."""
+    directory). ``name`` (the config file's stem) is the default of ``name``."""
     source_date_epoch()  # before any kernel import trips over a bad value
     cfg = copy.deepcopy(config)
+    cfg.setdefault("name", name or "default")
     for key in ("catalog_dir", "results_dir"):
         if isinstance(cfg.get(key), str) and not cfg[key].strip():
             raise PinfeedError(f"config error at {key}: it is empty, which would write into the "
@@ -153,7 +167,7 @@ def load_config(path=None) -> dict:
         raise PinfeedError(f"{path} is not valid YAML: {exc}".splitlines()[0]) from None
     if not isinstance(config, dict):
         raise PinfeedError(f"{path} must hold a YAML mapping of settings")
-    return validate_config(config, base_dir=path.resolve().parent)
+    return validate_config(config, base_dir=path.resolve().parent, name=config_name(path))
 
 
 def config_hash(config: dict) -> str:

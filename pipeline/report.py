@@ -1,4 +1,10 @@
-"""One HTML page that links every result: maps, plans, sequence diagrams, verification."""
+"""One HTML page per config that links every result: a table of contents, then
+a section per part (outline, maps, plans, verification, animation, sensing).
+
+Every figure, JSON file and catalog shard is linked relatively from the page
+(``RESULTS_DIR/NAME/report.html``); warnings and failing verification rows
+come first, in red. Each table is shown once, its numbers read from the JSON
+it links."""
 from __future__ import annotations
 
 import html
@@ -11,74 +17,154 @@ from .figures.tables import HEADER, verification_rows
 from .io import write_text_atomic
 from .provenance import creation_time, git_commit
 
+SECTIONS = (("outline", "Outline"), ("maps", "Configuration maps"), ("plans", "Plans"),
+            ("verification", "Verification"), ("animation", "Animation"), ("sensing", "Sensing"))
+STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto}img{max-width:100%}"
+         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;font-size:90%}"
+         "tr.fail td{background:#f8d0d0}.files{font-size:90%}")
+
 
 def _rel(path, base):
     return html.escape(os.path.relpath(path, base))
 
 
-def write_report(config, plans: dict, verifications: dict, figures: dict, out,
-                 sensing: dict | None = None) -> Path:
-    """``plans``/``verifications``/``sensing``: part -> result dict; ``figures``: part ->
-    {kind: path} plus key ``"verification"``. Writes ``out`` (HTML)."""
-    sensing = sensing or {}
+def _anchor(name: str, section: str = "") -> str:
+    return html.escape(f"part-{name}" + (f"-{section}" if section else ""))
+
+
+def _link(path, base, text) -> str:
+    return f'<a href="{_rel(path, base)}">{html.escape(text)}</a>'
+
+
+def _figure(files: dict, kind: str, base, title: str) -> list[str]:
+    """A figure under a heading, the image linking to its file; nothing if absent."""
+    if kind not in files:
+        return []
+    src = _rel(files[kind], base)
+    return [f"<h4>{html.escape(title)}</h4>",
+            f'<a href="{src}"><img src="{src}" alt="{html.escape(title)}"></a>']
+
+
+def write_report(config, parts: dict, out, overview: dict | None = None, catalog=None) -> Path:
+    """``parts``: name -> {"plan", "verify", optional "sensing" (results), "files"
+    (kind -> path), "shards" (catalog entries)}; ``overview``: text -> path of the
+    all-parts files; ``catalog``: the catalog folder (shard links). Writes ``out``."""
     out = Path(out)
     base = out.parent
-    p = ['<!doctype html><html><head><meta charset="utf-8"><title>pinfeed results</title>',
-         "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto}"
-         "img{max-width:100%}table{border-collapse:collapse}td,th{border:1px solid #ccc;"
-         "padding:3px 8px;font-size:90%}</style></head><body>",
-         "<h1>pinfeed results</h1>",
+    pc, bc = config["planner"], config["bands"]
+    p = ['<!doctype html><html><head><meta charset="utf-8">'
+         f"<title>pinfeed results: {html.escape(config.get('name', ''))}</title>"
+         f"<style>{STYLE}</style></head><body>",
+         f"<h1>pinfeed results: config {html.escape(config.get('name', ''))}</h1>",
          f"<p>pinfeed {html.escape(__version__)} ({html.escape(git_commit())}), config "
          f"{config_hash(config)}, made {creation_time()}. Planner: model "
-         f"{html.escape(config['planner']['model'])}, mu_c {html.escape(str(config['planner']['mu_c']))}, depth "
-         f"{config['planner']['depth']}, d in [{config['planner']['d_min']:g}, "
-         f"{config['planner']['d_max']:g}], T = {config['bands']['threshold_T']:g} deg, "
-         f"c = {config['bands']['factor_c']:g}.</p>"]
-    p += _warnings(plans, verifications)
-    if "verification" in figures:
-        p.append("<h2>Verification (full rollouts, perturbed)</h2>")
-        p.append(f'<img src="{_rel(figures["verification"], base)}" alt="verification table">')
-    for name, res in plans.items():
-        p.append(f"<h2>{html.escape(name)}</h2>")
-        p.append(f"<p>maps: {html.escape(res['selection'])}; initial states: " + ", ".join(
-            f"{html.escape(k)}: θ = {v['theta']:.1f}°, y_c = {v['y_c']:.2f} mm"
-            for k, v in res["initial_states"].items()) + "</p>")
-        figs = figures.get(name, {})
-        if "maps" in figs:
-            p.append(f'<h3>Configuration maps with bands</h3><img src="{_rel(figs["maps"], base)}">')
-        if "speeds" in figs:
-            p.append(f'<h3>Maps by pin speed (dynamic pins)</h3><img src="{_rel(figs["speeds"], base)}">')
-        p += _side_by_side(res, verifications.get(name))
-        if "carried" in figs:
-            p.append(f'<h3>Carried sets against replayed rollouts (recommended plan)</h3>'
-                     f'<img src="{_rel(figs["carried"], base)}">')
-        p.append("<h3>Paper-mode plans (adjusted bands), best first</h3><table><tr><th>rank</th><th>pins</th>"
-                 "<th>heights (mm) @ speed (v_pin/v_b)</th><th>sets after each pin</th>"
-                 "<th>final sets</th><th>orientation sets (deg)</th><th>margin in d</th></tr>")
-        speeds = res.get("pin_speeds", {})
-        for k, plan in enumerate(res["plans"], start=1):
-            sets = ", ".join(f"[{s['start']:.0f}, {s['start'] + s['width']:.0f}]" for s in plan["final_sets"])
-            heights = ", ".join(f"{res['pins'][q]:g}" + (f" @ {speeds[q]:+g}" if q in speeds else "")
-                                for q in plan["pins"])
-            after = " → ".join(str(n) for n in plan.get("sets_after_each_pin", []))
-            p.append(f"<tr><td>{k}</td><td>{' → '.join(plan['pins'])}</td><td>{heights}</td>"
-                     f"<td>{after}</td><td>{plan['n_final_sets']}</td><td>{sets}</td>"
-                     f"<td>{plan['margin']:.3f}</td></tr>")
-        p.append("</table>")
-        if "sequence" in figs:
-            p.append(f'<h3>Pin sequence: fixed pins</h3><img src="{_rel(figs["sequence"], base)}">')
-        if "sequence_dynamic" in figs:
-            p.append(f'<h3>Pin sequence: with dynamic pins</h3>'
-                     f'<img src="{_rel(figs["sequence_dynamic"], base)}">')
-        if name in verifications:
-            rows = verification_rows({name: verifications[name]})
-            p.append("<table><tr>" + "".join(f"<th>{h}</th>" for h in HEADER) + "</tr>")
-            p += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows]
-            p.append("</table>")
-        if name in sensing:
-            p += _sensing_section(sensing[name], figs, base)
+         f"{html.escape(pc['model'])}, mu_c {html.escape(str(pc['mu_c']))}, depth "
+         f"{pc['depth']}, d in [{pc['d_min']:g}, {pc['d_max']:g}], T = {bc['threshold_T']:g} deg, "
+         f"c = {bc['factor_c']:g}.</p>"]
+    p += _warnings({n: v["plan"] for n, v in parts.items()}, {n: v["verify"] for n, v in parts.items()})
+    p += _toc(parts)
+    if overview:
+        p.append('<p class="files">All parts: ' + ", ".join(
+            _link(path, base, text) for text, path in overview.items()) + "</p>")
+    for name, part in parts.items():
+        p += _part_section(name, part, base, catalog)
     p.append("</body></html>")
     return write_text_atomic("\n".join(p), out)
+
+
+def _toc(parts: dict) -> list[str]:
+    """The table of contents: one entry per part, its sections beneath."""
+    p = ['<nav id="toc"><h2>Contents</h2><ul>']
+    for name in parts:
+        subs = "".join(f'<li><a href="#{_anchor(name, key)}">{title}</a></li>' for key, title in SECTIONS
+                       if key != "sensing" or "sensing" in parts[name])
+        p.append(f'<li class="toc-part"><a href="#{_anchor(name)}">{html.escape(name)}</a><ul>{subs}</ul></li>')
+    return p + ["</ul></nav>"]
+
+
+def _part_section(name: str, part: dict, base, catalog) -> list[str]:
+    """One part: its files, then outline, maps, plans, verification, animation, sensing."""
+    res, ver, files = part["plan"], part["verify"], part["files"]
+    p = [f'<h2 id="{_anchor(name)}">{html.escape(name)}</h2>',
+         '<p class="files">Files: ' + ", ".join(
+             _link(files[k], base, f"{k} JSON") for k in ("plan", "verify", "sensing") if k in files) + "</p>"]
+    if part.get("shards") and catalog is not None:
+        p.append('<details class="files"><summary>Catalog shards of this part '
+                 f'({len(part["shards"])})</summary><ul>' + "".join(
+                     f"<li>{_link(Path(catalog) / e['file'], base, e['file'])}: {html.escape(e['model'])}, "
+                     f"mu_c {e['mu_c']:g}, v_pin/v_b {e.get('v_pin', 0.0):+g}</li>" for e in part["shards"])
+                 + "</ul></details>")
+    p.append(f'<h3 id="{_anchor(name, "outline")}">Outline</h3>')
+    p.append(f"<p>Part id {html.escape(res['part']['id'])}; initial states: " + ", ".join(
+        f"{html.escape(k)}: θ = {v['theta']:.1f}°, y_c = {v['y_c']:.2f} mm"
+        for k, v in res["initial_states"].items()) + "</p>")
+    p += _figure(files, "outline", base, "Outline, centroid and resting states")
+    p.append(f'<h3 id="{_anchor(name, "maps")}">Configuration maps</h3>')
+    p.append(f"<p>Maps: {html.escape(res['selection'])}.</p>")
+    p += _figure(files, "maps", base, "Configuration maps with bands (rows: models)")
+    p += _figure(files, "speeds", base, "Maps by pin speed (dynamic pins)")
+    p.append(f'<h3 id="{_anchor(name, "plans")}">Plans</h3>')
+    p += _side_by_side(res, ver)
+    p += _paper_plans(res)
+    p += _figure(files, "sequence", base, "Pin sequence: best plan of fixed pins")
+    p += _figure(files, "sequence_dynamic", base, "Pin sequence: best plan with dynamic pins")
+    p += _figure(files, "carried", base, "Carried sets against replayed rollouts (recommended tight plan)")
+    p.append(f'<h3 id="{_anchor(name, "verification")}">Verification</h3>')
+    p += _verification_table(name, ver)
+    p += _figure(files, "verification", base, "Verification by plan (failing states in red)")
+    p.append(f'<h3 id="{_anchor(name, "animation")}">Animation</h3>')
+    p += _animation(res, files, base)
+    if "sensing" in part:
+        p.append(f'<h3 id="{_anchor(name, "sensing")}">Sensing</h3>')
+        p += _sensing_section(part["sensing"], files, base)
+    return p
+
+
+def _paper_plans(res: dict) -> list[str]:
+    """Paper mode's ranked plans (adjusted bands), best first."""
+    from .arcs import format_arcs
+    if not res["plans"]:
+        return ["<p>Paper mode: no allowed plan within the depth.</p>"]
+    p = ["<h4>Paper-mode plans (adjusted bands), best first</h4><table><tr><th>rank</th><th>pins</th>"
+         "<th>heights (mm) @ speed (v_pin/v_b)</th><th>sets after each pin</th>"
+         "<th>final sets</th><th>orientation sets</th><th>margin in d</th></tr>"]
+    speeds = res.get("pin_speeds", {})
+    for k, plan in enumerate(res["plans"], start=1):
+        sets = format_arcs([(s["start"], s["width"]) for s in plan["final_sets"]])
+        heights = ", ".join(f"{res['pins'][q]:g}" + (f" @ {speeds[q]:+g}" if q in speeds else "")
+                            for q in plan["pins"])
+        after = " → ".join(str(n) for n in plan.get("sets_after_each_pin", []))
+        p.append(f"<tr><td>{k}</td><td>{' → '.join(plan['pins'])}</td><td>{heights}</td>"
+                 f"<td>{after}</td><td>{plan['n_final_sets']}</td><td>{html.escape(sets)}</td>"
+                 f"<td>{plan['margin']:.3f}</td></tr>")
+    return p + ["</table>"]
+
+
+def _verification_table(name: str, ver: dict) -> list[str]:
+    """Every verified plan's rows (trials, successes, failures by reason); failing rows red."""
+    rows = verification_rows({name: ver})
+    if not rows:
+        return [f"<p>Nothing verified: {html.escape(ver.get('note', 'no plan'))}.</p>"]
+    fail = HEADER.index("failures")
+    p = ['<table class="verification"><tr>' + "".join(f"<th>{h}</th>" for h in HEADER[1:]) + "</tr>"]
+    for r in rows:
+        cls = ' class="fail"' if r[fail] != "0" else ""
+        p.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(c)}</td>" for c in r[1:]) + "</tr>")
+    return p + ["</table>"]
+
+
+def _animation(res: dict, files: dict, base) -> list[str]:
+    """The recommended plan's animation (the tight planner's, else paper mode's best)."""
+    from .animate import recommended_index
+    which = recommended_index(res)
+    if "animation" not in files:
+        return ["<p>No animation.</p>"]
+    what = {"tight": f"the tight planner's recommended plan (mu_c {(res.get('tight') or [{}])[0].get('friction')})",
+            1: "paper mode's best plan", None: "no plan"}[which]
+    src = _rel(files["animation"], base)
+    return [f"<p>Every initial state past the pins of {html.escape(what)}; "
+            f"'pinfeed animate --part {html.escape(res['part']['name'])}' makes a smoother one.</p>",
+            f'<a href="{src}"><img src="{src}" alt="animation"></a>']
 
 
 def _warnings(plans: dict, verifications: dict) -> list[str]:
@@ -113,7 +199,7 @@ def _side_by_side(res: dict, ver: dict | None) -> list[str]:
     """The paper-mode plan beside the tight planner's, with verification counts."""
     from .arcs import format_arcs
     checks = {c["kind"]: c for c in (ver or {}).get("checks", [])}
-    p = ["<h3>Plans: paper mode beside the tight planner</h3><table><tr><th>planner</th>"
+    p = ['<h4>Paper mode beside the tight planner</h4><table class="side-by-side"><tr><th>planner</th>'
          "<th>friction mu_c</th><th>pins (height, mm)</th><th>final sets</th>"
          "<th>orientation sets</th><th>verified (successes/trials)</th></tr>"]
     static = res.get("best_static")
@@ -144,7 +230,7 @@ def _sets(sets) -> str:
 
 def _sensing_section(res: dict, figs: dict, base) -> list[str]:
     """Force/torque sensor on the first pin: the verdict table and the two figures."""
-    p = ["<h3>Force/torque sensor on the first pin</h3>"]
+    p = []
     if not res.get("found"):
         return p + ["<p>No allowed plan within the depth: no sensor plan.</p>"]
     t = res["score_table"]
@@ -170,7 +256,6 @@ def _sensing_section(res: dict, figs: dict, base) -> list[str]:
             p.append(f"<tr><td>{html.escape(lab)}</td><td>{r['trials']}</td><td>{r['right']}</td>"
                      f"<td>{r['wrong']}</td><td>{r['ambiguous']}</td><td>{r['jammed']}</td></tr>")
         p.append("</table>")
-    for kind, alt in (("profiles", "force/torque profiles"), ("scores", "score table")):
-        if kind in figs:
-            p.append(f'<img src="{_rel(figs[kind], base)}" alt="{alt}">')
+    p += _figure(figs, "profiles", base, "Force/torque profiles on the first pin")
+    p += _figure(figs, "scores", base, "Score matrix")
     return p

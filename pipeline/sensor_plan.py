@@ -247,7 +247,7 @@ def read_checked_json(path, schema: dict, what: str) -> dict:
 
 
 def stored_sensor_plan(root, name: str):
-    """The stored sensing result of part ``name`` under catalog ``root``, or None."""
+    """The stored sensing result of part ``name`` under results folder ``root``, or None."""
     path = Path(root) / "sensing" / f"{name}.json"
     return read_checked_json(path, SENSING_SCHEMA, "pinfeed sensing result") if path.is_file() else None
 

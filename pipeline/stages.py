@@ -3,8 +3,10 @@
 bands  -> one JSON per shard: B_j, K_j, COM_j and adjusted bands for every d
 plan   -> one JSON per planned part: the ranked fixed-pins plans
 verify -> one JSON per planned part: perturbed full rollouts of the best plan
-figures, report -> PNGs and one HTML page linking everything
-All JSON is written atomically.
+figures, outline, animate, report -> PNGs, one GIF per part, one HTML page
+All of it lives in the config's results folder (``results_dir/NAME``,
+:func:`pipeline.config.results_folder`; file names in :func:`part_files`);
+the catalog is shared. All JSON is written atomically.
 """
 from __future__ import annotations
 
@@ -325,6 +327,45 @@ def _carried_figure(config, res, path):
                  f"rollouts per state", path)
 
 
+def config_part_source(config: dict, name: str) -> str | None:
+    """The CAD outline file a config part was read from (None for vertices)."""
+    for spec in config.get("families", {}).values():
+        for p in spec.get("parts", []) if isinstance(spec, dict) else []:
+            if isinstance(p, dict) and p.get("name") == name:
+                return p.get("outline")
+    return None
+
+
+def outline_figure(plan_result: dict, config: dict, out) -> Path:
+    """The outline figure of a planned part (from its plan JSON)."""
+    from .figures.outline import plot_outline
+    part = Part.from_vertices(plan_result["part"]["vertices"], name=plan_result["part"]["name"])
+    return plot_outline(part, out, source=config_part_source(config, part.name))
+
+
+def animate_part(plan_result: dict, config: dict, out, frames: int, fps: int) -> dict:
+    """The part's recommended plan as an animation: the tight planner's
+    recommended plan (first friction) if there is one, else paper mode's best;
+    with no plan at all, a one-frame note. Returns the summary (``plan``:
+    which one)."""
+    from .animate import animate_stored, recommended_index
+    which = recommended_index(plan_result)
+    if which is None:
+        _placeholder_gif(out, f"{plan_result['part']['name']}: no plan to animate")
+        return {"out": str(out), "frames": 1, "plan": None, "outcomes": {}}
+    return animate_stored(plan_result, config, out, which, frames=frames, fps=fps)
+
+
+def _placeholder_gif(path, text):
+    """A one-frame GIF saying ``text`` (a part with no plan)."""
+    from PIL import Image
+    png = Path(path).with_name(Path(path).stem + ".note.png")
+    _placeholder(png, text)
+    with Image.open(png) as im:
+        im.convert("RGB").save(path, format="GIF")
+    png.unlink()
+
+
 def _placeholder(path, text):
     import matplotlib.pyplot as plt
 
@@ -335,25 +376,45 @@ def _placeholder(path, text):
     save_figure(fig, path, dpi=100)
 
 
+PART_FIGURES = ("outline", "maps", "speeds", "sequence", "sequence_dynamic", "carried", "verification",
+                "profiles", "scores")
+
+
+def part_files(results, name: str) -> dict:
+    """Where the workflow writes a part's files under ``results`` (RESULTS_DIR/NAME):
+    JSON (``plan``, ``verify``, ``sensing``), figures (:data:`PART_FIGURES`) and
+    the ``animation``; the rules in rules/*.smk use the same names."""
+    results = Path(results)
+    out = {kind: results / kind.replace("plan", "plans") / f"{name}.json"
+           for kind in ("plan", "verify", "sensing")}
+    out.update({kind: results / "figures" / f"{kind}_{name}.png" for kind in PART_FIGURES})
+    out["animation"] = results / "animations" / f"{name}.gif"
+    return out
+
+
 def make_report(config, plan_paths, verify_paths, out, sensing_paths=()):
+    """The HTML page (``out``, in the results folder) of the planned parts: their
+    results, every figure found beside them, and the catalog shards they use."""
     from .report import write_report
-    results = Path(config["results_dir"]) / "figures"
-    plans, verifications, figures = {}, {}, {"verification": results / "verification.png"}
+    results = Path(out).parent
+    cat = Catalog.open(config["catalog_dir"])
+    parts = {}
     for plan_path, verify_path in zip(plan_paths, verify_paths):
-        res = read_json(plan_path)
-        name = res["part"]["name"]
-        plans[name] = res
-        verifications[name] = read_json(verify_path)
-        figures[name] = {kind: results / f"{kind}_{name}.png"
-                         for kind in ("maps", "speeds", "sequence", "sequence_dynamic", "carried")}
-    sensing = {}  # force/torque sensor on the first pin (rules/sense.smk)
-    for path in sensing_paths:
+        plan = read_json(plan_path)
+        name = plan["part"]["name"]
+        files = {k: p for k, p in part_files(results, name).items() if Path(p).is_file()}
+        files.update(plan=Path(plan_path), verify=Path(verify_path))
+        parts[name] = {"plan": plan, "verify": read_json(verify_path), "files": files,
+                       "shards": sorted((e for e in cat.entries if e["part_id"] == plan["part"]["id"]),
+                                        key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0)))}
+    for path in sensing_paths:  # force/torque sensor on the first pin (rules/sense.smk)
         res = read_json(path)
-        name = res["part"]["name"]
-        sensing[name] = res
-        figures.setdefault(name, {}).update(profiles=results / f"profiles_{name}.png",
-                                            scores=results / f"scores_{name}.png")
-    return write_report(config, plans, verifications, figures, out, sensing=sensing)
+        parts[res["part"]["name"]]["sensing"] = res
+        parts[res["part"]["name"]]["files"]["sensing"] = Path(path)
+    overview = {k: results / f for k, f in (("verification figure", "figures/verification.png"),
+                                            ("verification table", "verification.md"))
+                if (results / f).is_file()}
+    return write_report(config, parts, out, overview=overview, catalog=cat.root)
 
 
 def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:

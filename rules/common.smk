@@ -26,8 +26,11 @@ def shard_params(wildcards):
     }
 
 
-RESULTS = config["results_dir"]
+# This config's results (plans, verification, sensing, bands, figures, report):
+# results_dir/NAME, so two configs never overwrite each other's. The catalog is shared.
+RESULTS = f"{config['results_dir']}/{config['name']}"
+LOGS = f"logs/{config['name']}"
 PLANNED = config["planner"]["parts"]
 BAND_FILES = [
-    p.replace(f"{CATALOG}/", f"{CATALOG}/bands/", 1).replace(".h5", ".json") for p in JOBS
+    p.replace(f"{CATALOG}/", f"{RESULTS}/bands/", 1).replace(".h5", ".json") for p in JOBS
 ]

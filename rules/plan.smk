@@ -5,11 +5,11 @@ rule bands:
     input:
         shard=f"{CATALOG}/{{family}}/{{part}}/{{model}}/{{tag}}.h5",
     output:
-        bands=f"{CATALOG}/bands/{{family}}/{{part}}/{{model}}/{{tag}}.json",
+        bands=f"{RESULTS}/bands/{{family}}/{{part}}/{{model}}/{{tag}}.json",
     params:
         bands=config["bands"],
     log:
-        "logs/bands/{family}/{part}/{model}/{tag}.log",
+        f"{LOGS}/bands/{{family}}/{{part}}/{{model}}/{{tag}}.log",
     conda:
         "envs/pinfeed.yaml"
     script:
@@ -20,12 +20,12 @@ rule plan:
     input:
         index=rules.catalog_index.output.index,
     output:
-        plan=f"{CATALOG}/plans/{{name}}.json",
+        plan=f"{RESULTS}/plans/{{name}}.json",
     params:
         settings={k: config[k] for k in ("planner", "bands", "verify")},
         sweep={k: config["sweep"][k] for k in ("pin_radius", "kernel")},
     log:
-        "logs/plan/{name}.log",
+        f"{LOGS}/plan/{{name}}.log",
     conda:
         "envs/pinfeed.yaml"
     script:
@@ -36,11 +36,11 @@ rule verify:
     input:
         plan=rules.plan.output.plan,
     output:
-        verify=f"{CATALOG}/verify/{{name}}.json",
+        verify=f"{RESULTS}/verify/{{name}}.json",
     params:
         settings=config["verify"],
     log:
-        "logs/verify/{name}.log",
+        f"{LOGS}/verify/{{name}}.log",
     conda:
         "envs/pinfeed.yaml"
     script:

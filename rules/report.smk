@@ -1,27 +1,67 @@
-# Stage 6: figures and the page that links every result.
+# Stage 6: figures, outlines, animations and the page that links every result.
+# Figures are marked with report() (captions in rules/report/) for 'snakemake --report'.
 
 
 rule figures:
     input:
         index=rules.catalog_index.output.index,
-        plans=expand(f"{CATALOG}/plans/{{name}}.json", name=PLANNED),
-        verify=expand(f"{CATALOG}/verify/{{name}}.json", name=PLANNED),
+        plans=expand(f"{RESULTS}/plans/{{name}}.json", name=PLANNED),
+        verify=expand(f"{RESULTS}/verify/{{name}}.json", name=PLANNED),
     output:
-        maps=expand(f"{RESULTS}/figures/maps_{{name}}.png", name=PLANNED),
-        speeds=expand(f"{RESULTS}/figures/speeds_{{name}}.png", name=PLANNED),
-        sequence=expand(f"{RESULTS}/figures/sequence_{{name}}.png", name=PLANNED),
-        sequence_dynamic=expand(f"{RESULTS}/figures/sequence_dynamic_{{name}}.png", name=PLANNED),
-        carried=expand(f"{RESULTS}/figures/carried_{{name}}.png", name=PLANNED),
-        verification=f"{RESULTS}/figures/verification.png",
+        maps=report(expand(f"{RESULTS}/figures/maps_{{name}}.png", name=PLANNED),
+                    caption="report/maps.rst", category="Configuration maps"),
+        speeds=report(expand(f"{RESULTS}/figures/speeds_{{name}}.png", name=PLANNED),
+                      caption="report/speeds.rst", category="Configuration maps"),
+        sequence=report(expand(f"{RESULTS}/figures/sequence_{{name}}.png", name=PLANNED),
+                        caption="report/sequence.rst", category="Plans"),
+        sequence_dynamic=report(expand(f"{RESULTS}/figures/sequence_dynamic_{{name}}.png", name=PLANNED),
+                                caption="report/sequence_dynamic.rst", category="Plans"),
+        carried=report(expand(f"{RESULTS}/figures/carried_{{name}}.png", name=PLANNED),
+                       caption="report/carried.rst", category="Plans"),
+        verification_plans=report(expand(f"{RESULTS}/figures/verification_{{name}}.png", name=PLANNED),
+                                  caption="report/verification_plans.rst", category="Verification"),
+        verification=report(f"{RESULTS}/figures/verification.png",
+                            caption="report/verification.rst", category="Verification"),
         table=f"{RESULTS}/verification.md",
     params:
         settings=config["figures"],
     log:
-        "logs/figures.log",
+        f"{LOGS}/figures.log",
     conda:
         "envs/pinfeed.yaml"
     script:
         "scripts/figures.py"
+
+
+rule outline:
+    input:
+        plan=rules.plan.output.plan,
+    output:
+        outline=report(f"{RESULTS}/figures/outline_{{name}}.png", caption="report/outline.rst",
+                       category="Parts"),
+    log:
+        f"{LOGS}/outline/{{name}}.log",
+    conda:
+        "envs/pinfeed.yaml"
+    script:
+        "scripts/outline.py"
+
+
+rule animate:
+    input:
+        plan=rules.plan.output.plan,
+    output:
+        animation=report(f"{RESULTS}/animations/{{name}}.gif", caption="report/animation.rst",
+                         category="Animations"),
+    params:
+        frames=config["figures"]["animation_frames"],
+        fps=config["figures"]["animation_fps"],
+    log:
+        f"{LOGS}/animate/{{name}}.log",
+    conda:
+        "envs/pinfeed.yaml"
+    script:
+        "scripts/animate.py"
 
 
 rule report:
@@ -29,14 +69,16 @@ rule report:
         rules.figures.output,
         plans=rules.figures.input.plans,
         verify=rules.figures.input.verify,
+        outlines=expand(rules.outline.output.outline, name=PLANNED),
+        animations=expand(rules.animate.output.animation, name=PLANNED),
         # sensing (rules/sense.smk): results and figures of the sensed parts
-        sensing=expand(f"{CATALOG}/sensing/{{name}}.json", name=SENSED),
+        sensing=expand(rules.sense.output.sensing, name=SENSED),
         sensing_figures=expand(f"{RESULTS}/figures/{{kind}}_{{name}}.png",
                                kind=("profiles", "scores"), name=SENSED),
     output:
         report=f"{RESULTS}/report.html",
     log:
-        "logs/report.log",
+        f"{LOGS}/report.log",
     conda:
         "envs/pinfeed.yaml"
     script:

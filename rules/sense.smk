@@ -6,13 +6,13 @@ SENSED = config["sensing"]["parts"]
 rule sense:
     input:
         index=rules.catalog_index.output.index,
-        plan=f"{CATALOG}/plans/{{name}}.json",
+        plan=rules.plan.output.plan,
     output:
-        sensing=f"{CATALOG}/sensing/{{name}}.json",
+        sensing=f"{RESULTS}/sensing/{{name}}.json",
     params:
         settings={k: config[k] for k in ("sensing", "planner", "bands", "verify")},
     log:
-        "logs/sense/{name}.log",
+        f"{LOGS}/sense/{{name}}.log",
     conda:
         "envs/pinfeed.yaml"
     script:
@@ -23,10 +23,12 @@ rule sensing_figures:
     input:
         sensing=rules.sense.output.sensing,
     output:
-        profiles=f"{RESULTS}/figures/profiles_{{name}}.png",
-        scores=f"{RESULTS}/figures/scores_{{name}}.png",
+        profiles=report(f"{RESULTS}/figures/profiles_{{name}}.png", caption="report/profiles.rst",
+                        category="Sensing"),
+        scores=report(f"{RESULTS}/figures/scores_{{name}}.png", caption="report/scores.rst",
+                      category="Sensing"),
     log:
-        "logs/sense/figures_{name}.log",
+        f"{LOGS}/sense/figures_{{name}}.log",
     conda:
         "envs/pinfeed.yaml"
     script:

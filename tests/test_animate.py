@@ -67,6 +67,27 @@ def test_plan_inputs_heights_from_plan_or_config():
     assert plan_inputs(_stored(True), 1, config)["heights"] == [7.0, 11.0]
     with pytest.raises(PinfeedError, match="--plan 2: tri has plans 1 to 1"):
         plan_inputs(_stored(), 2, config)
+    assert plan_inputs(_stored(), None, config)["what"] == "plan 1"  # no tight plan: paper mode's best
+    with pytest.raises(PinfeedError, match="tri: the stored result has no recommended tight plan"):
+        plan_inputs(_stored(), "tight", config)
+
+
+def test_plan_inputs_prefers_the_tight_recommended_plan():
+    """The recommended plan is the tight planner's (first friction): its own
+    heights, speeds and the friction range's middle."""
+    from pipeline.animate import recommended_index
+    config = {"planner": {"pins": [0.0, 5.0, 10.0, 15.0, 20.0]}, "sweep": {"pin_radius": 3.0}}
+    stored = _stored()
+    stored["tight"] = [{"friction": "0.1:0.3", "mu_c": [0.1, 0.3],
+                        "recommended": {"pins": ["P7", "P9"], "pin_heights_mm": [12.5, 30.0],
+                                        "pin_speeds": [0.0, -1.0]}}]
+    assert recommended_index(stored) == "tight"
+    got = plan_inputs(stored, None, config)
+    assert got["labels"] == ["P7", "P9"] and got["heights"] == [12.5, 30.0] and got["speeds"] == [0.0, -1.0]
+    assert got["mu_c"] == pytest.approx(0.2) and got["what"] == "tight plan at mu_c 0.1:0.3"
+    assert plan_inputs(stored, 1, config)["labels"] == ["P2", "P5v+2"]  # paper mode on request
+    stored["tight"][0]["recommended"] = None
+    assert recommended_index(stored) == 1 and recommended_index({"plans": []}) is None
 
 
 def test_cli_animate(tmp_path, capsys):
@@ -79,13 +100,16 @@ def test_cli_animate(tmp_path, capsys):
     stored["plans"][0]["pin_heights_mm"] = [10.0]
     (tmp_path / "plans" / "tri.json").write_text(json.dumps(stored))
     out = tmp_path / "tri.gif"
-    assert main(["animate", "--part", "tri", "--catalog", str(tmp_path), "--out", str(out),
+    assert main(["animate", "--part", "tri", "--results", str(tmp_path), "--out", str(out),
                  "--frames", "3"]) == 0
     assert "wrote" in capsys.readouterr().out
     with Image.open(out) as im:
         assert im.n_frames == 3
-    assert main(["animate", "--part", "nope", "--catalog", str(tmp_path), "--out", str(out)]) == 2
+    assert main(["animate", "--part", "nope", "--results", str(tmp_path), "--out", str(out)]) == 2
     assert "no stored plan for nope" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:  # argparse: one line, status 2
+        main(["animate", "--part", "tri", "--results", str(tmp_path), "--plan", "best", "--out", str(out)])
+    assert exc.value.code == 2 and "expected 'tight' or a plan number" in capsys.readouterr().err
 
 
 def test_moving_pin_touches_at_its_height_on_the_clock():

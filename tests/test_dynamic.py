@@ -227,25 +227,26 @@ def test_workflow_plans_verifies_and_draws_moving_pins(tmp_path):
         "planner": {"parts": ["tri"], "model": "ellipsoid", "mu_c": 0.2, "depth": 1,
                     "pins": [-10, -5, 0, 5, 10, 15, 20, 25, 30, 35, 40],
                     "dynamic": {"speeds": [-1.5], "depth": 1}},
-        "verify": {"trials": 3}, "sensing": {"trials": 3}, "figures": {"d": [0.4]},
+        "verify": {"trials": 3}, "sensing": {"trials": 3}, "figures": {"d": [0.4], "animation_frames": 3},
     }
     (tmp_path / "cfg.yaml").write_text(yaml.safe_dump(cfg))
     run = _snakemake(tmp_path, "--configfile", str(tmp_path / "cfg.yaml"))
     assert run.returncode == 0, run.stderr[-3000:]
-    plan = json.loads((tmp_path / "cat" / "plans" / "tri.json").read_text())
+    plan = json.loads((tmp_path / "res" / "cfg" / "plans" / "tri.json").read_text())
     assert plan["pin_speeds"] == {f"P{k}v-1.5": -1.5 for k in range(1, 12)}
     assert plan["best_static"]["n_dynamic_pins"] == 0
     for p in plan["plans"]:  # what each pin adds, and moving pins only at the end
         assert len(p["sets_after_each_pin"]) == len(p["pins"]) and p["sets_after_each_pin"][-1] == p["n_final_sets"]
         kinds = [q in plan["pin_speeds"] for q in p["pins"]]
         assert kinds == sorted(kinds) and sum(kinds) == p["n_dynamic_pins"]
-    checks = json.loads((tmp_path / "cat" / "verify" / "tri.json").read_text())["checks"]
+    checks = json.loads((tmp_path / "res" / "cfg" / "verify" / "tri.json").read_text())["checks"]
     want = ["paper mode, fixed pins"] + (["paper mode, with dynamic pins"] if plan["plans"][0]["n_dynamic_pins"] else [])
     want += ["tight, mu_c 0.2"] if plan["tight"][0]["recommended"] else []
     assert [c["kind"] for c in checks] == want
     assert all(r["trials"] == 3 + 2 ** (3 + len(c["plan"])) for c in checks for r in c["rows"])
-    figures = tmp_path / "res" / "figures"
+    figures = tmp_path / "res" / "cfg" / "figures"  # results_dir/<config file's stem>
     for kind in ("maps", "speeds", "sequence", "sequence_dynamic", "profiles", "scores"):
         assert (figures / f"{kind}_tri.png").stat().st_size > 1000, kind
-    page = (tmp_path / "res" / "report.html").read_text()
+    assert (tmp_path / "res" / "cfg" / "animations" / "tri.gif").stat().st_size > 1000
+    page = (tmp_path / "res" / "cfg" / "report.html").read_text()
     assert "speeds_tri.png" in page and "sequence_dynamic_tri.png" in page and "sets after each pin" in page

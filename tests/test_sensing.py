@@ -4,6 +4,7 @@ import json
 import numpy as np
 import pytest
 
+from pipeline.config import results_folder
 from pipeline.errors import PinfeedError
 from pipeline.sensing import (Profile, Sensor, classify, measure, profile_from_rollout, read_profile_csv,
                               score, sensor_groups, sign_matrix)
@@ -263,12 +264,13 @@ def sym_catalog(tmp_path_factory):
     cfg["planner"]["parts"] = ["sym_triangle"]
     cfg["sensing"].pop("parts")
     root = tmp_path_factory.mktemp("sym") / "catalog"
-    cfg = validate_config(dict(cfg, catalog_dir=str(root)))
+    cfg = validate_config(dict(cfg, catalog_dir=str(root), results_dir=str(root.parent / "results")))
+    results = results_folder(cfg)  # plans and sensing results: results_dir/NAME
     run_sweep(cfg, progress=False)
     cat = Catalog.open(root)
-    write_json(plan_part(cat, "sym_triangle", cfg, tight=False), root / "plans" / "sym_triangle.json")
+    write_json(plan_part(cat, "sym_triangle", cfg, tight=False), results / "plans" / "sym_triangle.json")
     result = sense_part(cat, "sym_triangle", cfg, log=lambda *a: None)
-    write_json(result, root / "sensing" / "sym_triangle.json")
+    write_json(result, results / "sensing" / "sym_triangle.json")
     return cfg, cat, result
 
 
@@ -353,9 +355,9 @@ def test_cli_classify_reads_a_profile_and_names_the_final_orientation(sym_catalo
     prof = reference_profiles(part, res["initial_states"], res["y_pin"], res["mu_c"], res["pin_radius"],
                               res["model"], sensor)["state 2"]
     csv_path = _write_csv(tmp_path / "state2.csv", prof, scale=9.81, t0=12.5)
-    root = cfg["catalog_dir"]
+    root, results = cfg["catalog_dir"], str(results_folder(cfg))
     code, out, err = _run(["sense", "classify", "--part", "sym_triangle", "--profile", str(csv_path),
-                           "--catalog", root, "--json"], capsys)
+                           "--catalog", root, "--results", results, "--json"], capsys)
     assert code == 0, err
     got = json.loads(out)
     assert {"part", "y_pin", "y_pin_source", "scores", "best", "candidates", "decided", "margin",
@@ -365,12 +367,12 @@ def test_cli_classify_reads_a_profile_and_names_the_final_orientation(sym_catalo
     assert got["final_sets"] == final_for_verdict(res, got["candidates"])
     assert got["final_known"] == (len(got["final_sets"]) == 1)
     code, out, err = _run(["sense", "classify", "--part", "sym_triangle", "--profile", str(csv_path),
-                           "--catalog", root], capsys)
+                           "--catalog", root, "--results", results], capsys)
     assert code == 0, err
     assert "verdict:" in out and "state 2: 40" in out and "final orientation" in out
     # Another pin: no final orientation from the stored sensor plan.
     code, out, err = _run(["sense", "classify", "--part", "sym_triangle", "--profile", str(csv_path),
-                           "--catalog", root, "--y-pin", "-2.5", "--json"], capsys)
+                           "--catalog", root, "--results", results, "--y-pin", "-2.5", "--json"], capsys)
     assert code == 0, err
     got = json.loads(out)
     assert got["y_pin"] == -2.5 and got["final_sets"] is None and got["final_known"] is None
@@ -389,7 +391,7 @@ def test_cli_classify_bad_input(sym_catalog, tmp_path, capsys):
     root = cfg["catalog_dir"]
     good = _write_csv(tmp_path / "ok.csv", _timed(np.linspace(1, 0.2, 400), 0.3 * np.ones(400)),
                       header=False, extra=False)
-    base = ["sense", "classify", "--catalog", root]
+    base = ["sense", "classify", "--catalog", root, "--results", str(results_folder(cfg))]
     _one_line_error(*_run(base + ["--part", "sym_triangle", "--profile", str(tmp_path / "none.csv")],
                           capsys)[::2], "no profile file")
     bad = tmp_path / "bad.csv"
@@ -405,9 +407,10 @@ def test_cli_classify_without_a_plan_needs_y_pin(sym_catalog, tmp_path, capsys):
     import shutil
     cfg, _, _ = sym_catalog
     root = tmp_path / "catalog"
-    shutil.copytree(cfg["catalog_dir"], root, ignore=shutil.ignore_patterns("plans", "sensing"))
+    shutil.copytree(cfg["catalog_dir"], root)
     good = _write_csv(tmp_path / "ok.csv", _timed(np.linspace(1, 0.2, 400), 0.3 * np.ones(400)))
-    argv = ["sense", "classify", "--part", "sym_triangle", "--profile", str(good), "--catalog", str(root)]
+    argv = ["sense", "classify", "--part", "sym_triangle", "--profile", str(good), "--catalog", str(root),
+            "--results", str(tmp_path / "results")]  # an empty results folder: no plans stored
     _one_line_error(*_run(argv, capsys)[::2], "--y-pin", "run the workflow")
     code, out, err = _run(argv + ["--y-pin", "27.5", "--json"], capsys)
     assert code == 0, err

@@ -215,14 +215,19 @@ def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys):
     assert main(args[:-2] + ["--mu-c", "0.3:0.1"]) == 2
     assert main(args + ["--depth", "0"]) == 2
     # The speed limit of the stored plan (dynamic model), issue 18's keys.
-    stored = tmp_path / "cat" / "plans" / "tri.json"
+    stored = tmp_path / "res" / "plans" / "tri.json"  # a results folder (--results)
     assert main(args + ["--out", str(stored)]) == 0
     capsys.readouterr()
-    assert main(["speed", "--part", "tri", "--catalog", str(tmp_path / "cat"), "--trials", "3", "--json"]) == 0
+    assert main(["speed", "--part", "tri", "--results", str(tmp_path / "res"), "--trials", "3", "--json"]) == 0
     sp = json.loads(capsys.readouterr().out)
     assert set(sp) >= {"pin_labels", "pin_heights_mm", "final_set", "mu_c", "mu_s", "speed_limit_mm_s", "curve"}
     assert sp["pin_labels"] == out["plans"][0]["pins"]
     ok = [v for v, frac in sp["curve"] if frac >= 0.99]
     assert sp["speed_limit_mm_s"] in ok  # the replay holds at the stated limit
-    assert main(["speed", "--part", "nope", "--catalog", str(tmp_path / "cat")]) == 2
-    assert main(["speed", "--part", "tri", "--catalog", str(tmp_path / "cat"), "--mu-c", "0.2"]) == 2
+    assert main(["speed", "--part", "nope", "--results", str(tmp_path / "res")]) == 2
+    assert main(["speed", "--part", "tri", "--results", str(tmp_path / "res"), "--mu-c", "0.2"]) == 2
+    # A tight-only plan file animates too (its resting states live in the friction entry).
+    from pipeline.animate import plan_inputs
+    from pipeline.config import load_config
+    inputs = plan_inputs(json.loads(stored.read_text()), None, load_config(None))
+    assert inputs["labels"] == out["plans"][0]["pins"] and len(inputs["states"]) == 3

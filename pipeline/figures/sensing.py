@@ -89,7 +89,7 @@ def plot_scores(table: dict, title, out) -> Path:
 
 
 def sensing_figures(result: dict, out_profiles, out_scores) -> tuple[Path, Path]:
-    """Both figures for a stored sensing result (``catalog/sensing/NAME.json``)."""
+    """Both figures for a stored sensing result (``RESULTS/sensing/NAME.json``)."""
     from ..parts import Part
     from ..sensing import PERTURB_DEFAULTS, reference_profiles, synthetic_measurement
     part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
