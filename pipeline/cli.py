@@ -530,18 +530,8 @@ def cmd_speed(args):
 def _pick_tight_plan(result: dict, n: int, mu_text):
     """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
     (default: the first planned friction), that friction and its stored entry."""
-    from .planning import friction_label, parse_friction
-    tight = result.get("tight") or []
-    if not tight:
-        raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan'")
-    entry = tight[0]
-    if mu_text is not None:
-        want = friction_label(parse_friction(mu_text))
-        found = [t for t in tight if t["friction"] == want]
-        if not found:
-            raise PinfeedError(f"no stored plan at mu_c {want}; stored: "
-                               f"{', '.join(t['friction'] for t in tight)}")
-        entry = found[0]
+    from .sensor_plan import tight_entry
+    entry = tight_entry(result, mu_text)
     if not entry["plans"]:
         raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
     if not 1 <= n <= len(entry["plans"]):
@@ -608,26 +598,65 @@ def _plan_hint(config: dict, name: str, root) -> str:
     return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
 
 
-def cmd_sense_classify(args):
-    from pathlib import Path
-
+def _classify_part(args, config, root):
+    """The part to classify for: ``(part, pin_radius or None)`` from the catalog
+    (the config's outline wins over older ones stored under the same name),
+    else from a stored sensing or plan result of that name under ``root`` (a
+    part planned with --vertices has refinement shards only)."""
     from .catalog import Catalog
-    from .config import load_config
     from .parts import Part
+    from .stages import config_part_id, read_json
+    try:
+        cat = Catalog.open(args.catalog or config["catalog_dir"])
+        wanted = config_part_id(config, args.part)
+        if wanted != args.part and not any(e["part_id"] == wanted for e in cat.entries):
+            wanted = args.part  # the config's outline is not stored: use what the catalog has
+        entry = cat._entries_for(wanted)[0]  # unknown part: says how to list them
+        return Part.from_vertices(entry["part_vertices"], name=entry["part_name"]), float(entry["pin_radius"])
+    except PinfeedError:
+        for kind in ("sensing", "plans"):
+            path = root / kind / f"{args.part}.json"
+            if path.is_file():
+                stored = read_json(path)["part"]
+                return Part.from_vertices(stored["vertices"], name=stored["name"]), None
+        raise
+
+
+def _classify_pin(args, stored, plan, root, name):
+    """``(y_pin, first_pin, source, plan_entry)``: where the sensor sits. The
+    stored sensor plan's first pin, else the first pin of the stored recommended
+    tight plan (first planned friction), else that of paper mode's best
+    fixed-pin plan, else --y-pin (which always wins)."""
+    from .sensor_plan import tight_entry
+    entry = tight_entry(plan) if plan is not None and plan.get("tight") else None
+    plan_path = root / "plans" / f"{name}.json"
+    if args.y_pin is not None:
+        if not math.isfinite(args.y_pin):
+            raise PinfeedError(f"--y-pin must be a finite height in mm, got {args.y_pin}")
+        return float(args.y_pin), None, "--y-pin", entry
+    if stored is not None:
+        return float(stored["y_pin"]), stored["first_pin"], f"sensor plan {root / 'sensing' / (name + '.json')}", entry
+    if entry is not None and entry.get("recommended"):
+        rec = entry["recommended"]
+        return (float(rec["pin_heights_mm"][0]), rec["pins"][0],
+                f"first pin of the recommended tight plan at mu_c {entry['friction']} {plan_path}", entry)
+    if plan is not None and plan.get("pins") and _best_fixed_plan(plan):
+        first_pin = _best_fixed_plan(plan)["pins"][0]  # the sensor sits on a fixed pin
+        return (float(plan["pins"][first_pin]), first_pin,
+                f"first pin of the best fixed-pin plan {plan_path}", entry)
+    return None, None, None, entry
+
+
+def cmd_sense_classify(args):
+    from .config import load_config
+    from .planning import parse_friction
     from .sensing import (Sensor, classify, read_profile_csv, reference_profiles, resample,
                           sign_matrix)
-    from .sensor_plan import (PLAN_SCHEMA, describe_sets, final_for_verdict, read_checked_json,
-                              stored_sensor_plan)
-    from .stages import config_part_id
+    from .sensor_plan import (PLAN_SCHEMA, count_sets, describe_sets, final_for_verdict,
+                              read_checked_json, sensing_frictions, stored_sensor_plan)
     config = load_config(args.config)
-    cat = Catalog.open(args.catalog or config["catalog_dir"])
     root = _results_arg(args, config)  # stored plans and sensor plans
-    # The config's outline wins over older ones stored under the same name.
-    wanted = config_part_id(config, args.part)
-    if wanted != args.part and not any(e["part_id"] == wanted for e in cat.entries):
-        wanted = args.part  # the config's outline is not stored: use what the catalog has
-    entry = cat._entries_for(wanted)[0]  # unknown part: says how to list them
-    part = Part.from_vertices(entry["part_vertices"], name=entry["part_name"])
+    part, catalog_radius = _classify_part(args, config, root)
     name = part.name
     stored = stored_sensor_plan(root, name)
     if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
@@ -636,30 +665,31 @@ def cmd_sense_classify(args):
     plan = read_checked_json(plan_path, PLAN_SCHEMA, "pinfeed plan result") if plan_path.is_file() else None
     if plan is not None and plan["part"].get("id", part.id) != part.id:
         plan = None
-    first_pin = None
-    if args.y_pin is not None:
-        if not math.isfinite(args.y_pin):
-            raise PinfeedError(f"--y-pin must be a finite height in mm, got {args.y_pin}")
-        y_pin, source = float(args.y_pin), "--y-pin"
-    elif stored is not None:
-        first_pin, y_pin = stored["first_pin"], float(stored["y_pin"])
-        source = f"sensor plan {root / 'sensing' / (name + '.json')}"
-    elif plan is not None and _best_fixed_plan(plan):
-        # The sensor sits on a fixed pin: the first pin of the best fixed-pin plan.
-        first_pin = _best_fixed_plan(plan)["pins"][0]
-        y_pin, source = float(plan["pins"][first_pin]), f"first pin of the best fixed-pin plan {plan_path}"
-    else:
+    y_pin, first_pin, source, entry = _classify_pin(args, stored, plan, root, name)
+    if y_pin is None:
         raise PinfeedError(f"no stored sensor plan or plan for {name} under {root}; "
                            f"{_plan_hint(config, name, root)} or give the sensor pin's height with --y-pin MM")
+    # The friction, resolved once (sensor_plan.sensing_frictions): as planned, and
+    # the one value of the simulated profiles (a range's middle).
     if stored is not None:
         sensor = Sensor.from_config(stored["sensor"])
-        mu_c, model = float(stored["mu_c"]), stored["model"]
+        mu_planned, model = stored["mu_c"], stored["model"]
+        mu_profiles = float(stored["mu_c_profiles"])
     else:
         sensor = Sensor.from_config(config["sensing"]["sensor"])
-        from .planning import nominal_friction, parse_friction  # a range: its middle
-        mu_c = float(plan["mu_c"]) if plan else nominal_friction(parse_friction(config["planner"]["mu_c"]))
-        model = plan["model"] if plan else config["planner"]["model"]
-    pin_radius = float(entry["pin_radius"])
+        if entry is not None:
+            friction = entry
+        elif plan is not None and "mu_c" in plan:
+            friction = {"mu_c": plan["mu_c"]}
+        else:
+            friction = {"mu_c": parse_friction(config["planner"]["mu_c"])}
+        mu_planned, mu_profiles = sensing_frictions(friction)
+        mu_planned = list(mu_planned) if isinstance(mu_planned, tuple) else mu_planned
+        model = plan.get("model", config["planner"]["model"]) if plan else config["planner"]["model"]
+    if stored is not None:
+        pin_radius = float(stored["pin_radius"])
+    else:
+        pin_radius = catalog_radius if catalog_radius is not None else float(config["sweep"]["pin_radius"])
     raw = read_profile_csv(args.profile)
     measured = resample(raw, sensor.rate_hz)
     if measured.t.size < sensor.regions:
@@ -668,25 +698,29 @@ def cmd_sense_classify(args):
     states = {f"state {k}": {"theta": float(th), "y_c": float(y)}
               for k, (th, y) in enumerate(part.stable_states(), start=1)}
     refs = {k: sign_matrix(p, sensor) for k, p in
-            reference_profiles(part, states, y_pin, mu_c, pin_radius, model, sensor).items()}
+            reference_profiles(part, states, y_pin, mu_profiles, pin_radius, model, sensor).items()}
     signs = sign_matrix(measured, sensor)
     verdict = classify(signs, refs, sensor.margin)
     on_plan = stored is not None and abs(y_pin - float(stored["y_pin"])) < 1e-9
     final = final_for_verdict(stored, verdict["candidates"]) if on_plan else None
+    known = None
+    if final is not None:  # one physical orientation (modulo the part's symmetry)
+        known = count_sets([(f["start"], f["width"]) for f in final], stored["symmetry_order"]) == 1
     result = {"part": name, "part_id": part.id, "profile": str(args.profile), "y_pin": y_pin,
               "y_pin_source": source, "first_pin": first_pin if args.y_pin is None else None,
-              "model": model, "mu_c": mu_c, "pin_radius": pin_radius, "sensor": sensor.to_dict(),
-              "samples": int(measured.t.size), "duration": float(measured.t[-1]),
+              "model": model, "mu_c": mu_planned, "mu_c_profiles": mu_profiles, "pin_radius": pin_radius,
+              "sensor": sensor.to_dict(), "samples": int(measured.t.size), "duration": float(measured.t[-1]),
               "elements": int(signs.size), "margin": sensor.margin, "scores": verdict["scores"],
               "best": verdict["best"], "candidates": verdict["candidates"],
               "decided": verdict["decided"], "measured_signs": signs.tolist(),
               "sensor_plan": stored["plan"]["pins"] if on_plan else None,
-              "final_sets": final, "final_known": (len(final) == 1) if final is not None else None}
+              "final_sets": final, "final_known": known}
     if args.json:
         _print_json(result)
         return
-    print(f"part {part.id}: sensor pin at y = {y_pin:g} mm ({source}); model {model}, "
-          f"mu_c {mu_c:g}, pin radius {pin_radius:g} mm")
+    planned = f"{mu_planned[0]:g}:{mu_planned[1]:g}" if isinstance(mu_planned, list) else f"{mu_planned:g}"
+    print(f"part {part.id}: sensor pin at y = {y_pin:g} mm ({source}); model {model}, mu_c {planned} "
+          f"(profiles simulated at {mu_profiles:g}), pin radius {pin_radius:g} mm")
     print(f"profile {args.profile}: {measured.t.size} samples over {measured.t[-1]:.3f} s at "
           f"{sensor.rate_hz:g} Hz")
     if verdict.get("note"):
@@ -705,7 +739,7 @@ def cmd_sense_classify(args):
     elif final is None:
         print(f"final orientation: unknown (the stored sensor plan reads pin {stored['first_pin']} "
               f"at y = {stored['y_pin']:g} mm, not this one)")
-    elif len(final) == 1:
+    elif known:
         print(f"final orientation: {describe_sets(final)} (sensor plan {' -> '.join(stored['plan']['pins'])})")
     else:
         print(f"final orientation: one of {describe_sets(final)} (the verdict does not decide it)")
@@ -844,11 +878,13 @@ def build_parser() -> argparse.ArgumentParser:
                         "matrix) and print the verdict, the scores and, if a sensor plan is\n"
                         "stored, the final orientation that results.", epilog=PROFILE_FORMAT,
                         formatter_class=argparse.RawDescriptionHelpFormatter)
-    q.add_argument("--part", required=True, help="part name or id in the catalog")
+    q.add_argument("--part", required=True, help="part name or id in the catalog, or of a stored plan "
+                   "under --results")
     q.add_argument("--profile", required=True, help="measured profile: CSV time (s), F_x, F_y (see below)")
     q.add_argument("--y-pin", dest="y_pin", type=float, default=None,
                    help="height of the sensor pin, mm (default: the stored sensor plan's first pin, "
-                   "else the stored plan's)")
+                   "else the first pin of the stored recommended tight plan, else of paper mode's "
+                   "best fixed-pin plan)")
     q.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     q.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
     q.add_argument("--results", default=None, help="results folder holding plans/ and sensing/ "

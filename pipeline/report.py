@@ -232,15 +232,19 @@ def _sensing_section(res: dict, figs: dict, base) -> list[str]:
     """Force/torque sensor on the first pin: the verdict table and the two figures."""
     p = []
     if not res.get("found"):
-        return p + ["<p>No allowed plan within the depth: no sensor plan.</p>"]
+        return p + [f"<p>No sensor plan: {html.escape(res.get('note', 'no stored verified plan'))}.</p>"]
     t = res["score_table"]
     known = ("a known final orientation for every initial state" if res["known_for_every_state"]
              else f"up to {res['worst_sets']} final orientation sets for one verdict")
-    p.append(f"<p>Sensor on {html.escape(res['first_pin'])} (y = {res['y_pin']:g} mm), plan "
-             f"{html.escape(' → '.join(res['plan']['pins']))}: {known}. Classification accuracy "
-             f"{100 * t['accuracy']:.0f} % (wrong {100 * t['wrong']:.0f} %) over {t['trials']} synthetic "
-             f"measurements per state; fixed pins alone: {res['static_best']['n_final_sets']} sets "
-             f"({html.escape(' → '.join(res['static_best']['pins']))}).</p>")
+    alone = res["without_sensor"]
+    p.append(f"<p>Sensor on {html.escape(res['first_pin'])} (y = {res['y_pin']:g} mm), stored tight "
+             f"plan #{res['plan_rank']} {html.escape(' → '.join(res['plan']['pins']))} at mu_c "
+             f"{html.escape(res['friction'])} (simulated profiles at mu_c {res['mu_c_profiles']:g}): "
+             f"{known}. Without the sensor the recommended plan "
+             f"{html.escape(' → '.join(alone['pins']))} ends in {alone['n_final_sets']} set(s)"
+             f"{'' if res['sensor_needed'] else ': the sensor is not needed for the orientation, its verdict tells which resting state arrived'}. "
+             f"Classification accuracy {100 * t['accuracy']:.0f} % (wrong {100 * t['wrong']:.0f} %) over "
+             f"{t['trials']} synthetic measurements per state.</p>")
     p.append("<table><tr><th>sensor verdict (states it cannot tell apart)</th>"
              "<th>final orientation set(s) (deg)</th><th>known</th></tr>")
     for g in res["groups"]:

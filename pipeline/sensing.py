@@ -221,34 +221,41 @@ def reference_profiles(part, states: dict, y_pin, mu_c, pin_radius, model, senso
     return out
 
 
-
-
 def synthetic_measurement(part, state: dict, y_pin, mu_c, pin_radius, model, sensor: Sensor,
                           perturb: dict, rng) -> Profile:
     """One synthetic reading of ``state`` at the pin: perturbed inputs (theta_i
-    normal, y_c and pin position uniform, mu_c normal clipped at 0) rolled out
-    again, sampled at the sensor rate, then sensor bias and noise."""
-    r = first_pin_rollout(part, state["theta"] + rng.normal(0, perturb["theta_sigma"]),
-                          state["y_c"] + rng.uniform(-perturb["y_halfwidth"], perturb["y_halfwidth"]),
-                          y_pin + rng.uniform(-perturb["pin_halfwidth"], perturb["pin_halfwidth"]),
-                          max(0.0, mu_c + rng.normal(0, perturb["mu_sigma"])), pin_radius, model)
+    normal, y_c and pin position uniform; ``mu_c`` a value: normal around it,
+    clipped at 0; a range ``(lo, hi)``: uniform over it, as the verify stage
+    draws it) rolled out again, sampled at the sensor rate, then sensor bias
+    and noise."""
+    theta = state["theta"] + rng.normal(0, perturb["theta_sigma"])
+    y_c = state["y_c"] + rng.uniform(-perturb["y_halfwidth"], perturb["y_halfwidth"])
+    y_at = y_pin + rng.uniform(-perturb["pin_halfwidth"], perturb["pin_halfwidth"])
+    if isinstance(mu_c, (tuple, list)):
+        mu = rng.uniform(float(mu_c[0]), float(mu_c[1]))
+    else:
+        mu = max(0.0, mu_c + rng.normal(0, perturb["mu_sigma"]))
+    r = first_pin_rollout(part, theta, y_c, y_at, mu, pin_radius, model)
     prof = profile_from_rollout(r.force_s.values, r.force_x.values, r.force_y.values, sensor)
     return measure(prof, sensor, rng)
 
 
 def score_table(part, states: dict, y_pin, mu_c, pin_radius, model, sensor: Sensor,
                 trials: int = 20, perturb: dict | None = None, seed: int = 1,
-                apart_fraction: float = 0.9) -> dict:
+                apart_fraction: float = 0.9, measured_mu=None) -> dict:
     """The paper's Table 4: mean score of simulated rows against measured columns.
 
-    Measured profiles are synthetic (:func:`synthetic_measurement`), ``trials``
-    per initial state. Returns the mean scores, the classification accuracy
+    Simulated (reference) profiles are rolled out at the one friction ``mu_c``;
+    measured profiles are synthetic (:func:`synthetic_measurement`), ``trials``
+    per initial state, at friction ``measured_mu`` (a value or a range ``(lo,
+    hi)``; default ``mu_c``). Returns the mean scores, the classification accuracy
     (decided and right), the rate of wrong decisions, and which pairs of
     states the sensor tells apart: in at least ``apart_fraction`` of the
     trials from either state the verdict excludes the other. ``groups`` are
     the states it cannot tell apart (connected through 'not apart').
     """
     perturb = dict(PERTURB_DEFAULTS, **(perturb or {}))
+    measured = mu_c if measured_mu is None else measured_mu
     rng = np.random.default_rng(seed)
     refs = reference_profiles(part, states, y_pin, mu_c, pin_radius, model, sensor)
     ref_s = {k: sign_matrix(p, sensor) for k, p in refs.items()}
@@ -259,7 +266,7 @@ def score_table(part, states: dict, y_pin, mu_c, pin_radius, model, sensor: Sens
     verdicts = []
     for truth in labels:
         for _ in range(trials):
-            meas = sign_matrix(synthetic_measurement(part, states[truth], y_pin, mu_c, pin_radius,
+            meas = sign_matrix(synthetic_measurement(part, states[truth], y_pin, measured, pin_radius,
                                                      model, sensor, perturb, rng), sensor)
             v = classify(meas, ref_s, sensor.margin)
             for sim in labels:

@@ -1,16 +1,17 @@
 # Stage 5b: a force/torque sensor on the first pin (spec section 7): score
-# table, sensor plan with the final set per verdict, and its two figures.
+# table, sensor plan with the final set per verdict, and its two figures. The
+# sensor plan is chosen among the stored tight plans (no search of its own).
 SENSED = config["sensing"]["parts"]
 
 
 rule sense:
     input:
-        index=rules.catalog_index.output.index,
         plan=rules.plan.output.plan,
     output:
         sensing=f"{RESULTS}/sensing/{{name}}.json",
     params:
-        settings={k: config[k] for k in ("sensing", "planner", "bands", "verify")},
+        settings={k: config[k] for k in ("sensing", "verify")},
+        sweep={k: config["sweep"][k] for k in ("pin_radius", "kernel")},
     log:
         f"{LOGS}/sense/{{name}}.log",
     conda:

@@ -102,15 +102,18 @@ def sensing_figures(result: dict, out_profiles, out_scores) -> tuple[Path, Path]
     sensor = Sensor.from_config(result["sensor"])
     table = result["score_table"]
     states = result["initial_states"]
-    args = (result["y_pin"], result["mu_c"], result["pin_radius"], result["model"], sensor)
-    sim = reference_profiles(part, states, *args)
+    common = (result["pin_radius"], result["model"], sensor)
+    # References at the one friction of the profiles; measurements over the planned friction.
+    sim = reference_profiles(part, states, result["y_pin"], result["mu_c_profiles"], *common)
     rng = np.random.default_rng(table["seed"])
     perturb = dict(PERTURB_DEFAULTS, **table["perturb"])
-    meas = {k: synthetic_measurement(part, s, *args, perturb, rng) for k, s in states.items()}
+    meas = {k: synthetic_measurement(part, s, result["y_pin"], result["mu_c"], *common, perturb, rng)
+            for k, s in states.items()}
     where = f"sensor on {result['first_pin']} at y = {result['y_pin']:g} mm"
+    friction = f"mu_c {result['friction']} (simulated profiles at {result['mu_c_profiles']:g})"
     plot_profiles(sim, meas, sensor, f"{name}: force on the pin, {where}; belt "
                   f"{sensor.belt_speed:g} mm/s, {sensor.rate_hz:g} Hz, moving average of "
                   f"{sensor.window} samples", out_profiles)
-    plot_scores(table, f"{name}: sign-matrix scores, {where}", out_scores)
+    plot_scores(table, f"{name}: sign-matrix scores, {where}\n{friction}", out_scores)
     return Path(out_profiles), Path(out_scores)
 

@@ -1,20 +1,22 @@
-"""Snakemake script: the force/torque sensor on the first pin for one planned part."""
+"""Snakemake script: the force/torque sensor on the first pin for one planned part
+(reads the part's stored plan result; no search of its own)."""
 import sys
 from pathlib import Path
 
 # The repository is the workflow: make its pipeline importable under --use-conda too.
 sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
 
-from pipeline.catalog import Catalog
 from pipeline.logs import log_to
 from pipeline.sensor_plan import sense_part
 from pipeline.stages import write_json
 
 with log_to(snakemake.log[0]):  # noqa: F821
-    cat = Catalog.open(snakemake.config["catalog_dir"])  # noqa: F821
-    result = sense_part(cat, snakemake.wildcards.name, snakemake.config)  # noqa: F821
+    result = sense_part(snakemake.input.plan, snakemake.config)  # noqa: F821
     write_json(result, snakemake.output.sensing)  # noqa: F821
     if result["found"]:
-        print(f"sensor on {result['first_pin']} ({result['y_pin']:g} mm), plan {result['plan']['pins']}: "
-              f"worst {result['worst_sets']} final set(s) per verdict; groups "
-              f"{[g['states'] for g in result['groups']]}")
+        print(f"mu_c {result['friction']} (profiles at {result['mu_c_profiles']:g}): sensor on "
+              f"{result['first_pin']} ({result['y_pin']:g} mm), stored plan #{result['plan_rank']} "
+              f"{result['plan']['pins']}: worst {result['worst_sets']} final set(s) per verdict; groups "
+              f"{[g['states'] for g in result['groups']]}; {result['note']}")
+    else:
+        print(result["note"])
