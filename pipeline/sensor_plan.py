@@ -233,7 +233,8 @@ def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor
     from .sensing import classify, measure, profile_from_rollout, sign_matrix
     from .simulate import rollout
     from .verify import DEFAULTS, perturbed_inputs
-    cfg = dict(DEFAULTS, **(settings or {}), corners=False)
+    cfg = dict(DEFAULTS, **(settings or {}))
+    cfg["corners"] = False
     kernel = {k: v for k, v in (kernel or {}).items() if k in ("ds_max", "tol")}
     rng = np.random.default_rng(cfg["seed"])
     refs = {k: np.asarray(v) for k, v in result["score_table"]["reference_signs"].items()}
