@@ -667,8 +667,9 @@ def cmd_sense_classify(args):
         plan = None
     y_pin, first_pin, source, entry = _classify_pin(args, stored, plan, root, name)
     if y_pin is None:
-        raise PinfeedError(f"no stored sensor plan or plan for {name} under {root}; "
-                           f"{_plan_hint(config, name, root)} or give the sensor pin's height with --y-pin MM")
+        raise PinfeedError(f"no sensor pin for {name}: no stored sensor plan and no recommended plan under "
+                           f"{root}; {_plan_hint(config, name, root)} or give the sensor pin's height with "
+                           f"--y-pin MM")
     # The friction, resolved once (sensor_plan.sensing_frictions): as planned, and
     # the one value of the simulated profiles (a range's middle).
     if stored is not None:

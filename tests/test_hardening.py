@@ -233,8 +233,11 @@ def test_sensing_inputs_are_bounded(tmp_path):
 @pytest.mark.parametrize("content, where", [
     ([1, 2, 3], "(top level)"),
     ({"found": True, "part": {}}, "(top level)"),
-    ({"found": True, "part": {}, "first_pin": "P1", "y_pin": "high", "sensor": {}, "mu_c": 0.1,
-      "model": "minpower", "plan": {"pins": []}, "states": {}}, "y_pin"),
+    ({"found": True, "part": {}, "first_pin": "P1", "y_pin": "high", "sensor": {}, "mu_c": [0.1, 0.3],
+      "mu_c_profiles": 0.2, "symmetry_order": 1, "model": "minpower",
+      "plan": {"pins": [], "pin_heights_mm": []}, "states": {}}, "y_pin"),
+    ({"found": True, "part": {}, "first_pin": "P1", "y_pin": 5.0, "sensor": {}, "mu_c": 0.1,
+      "model": "minpower", "plan": {"pins": []}, "states": {}}, "(top level)"),  # before issue 11
 ])
 def test_sensing_json_of_the_wrong_shape_is_refused(tmp_path, content, where):
     from pipeline.sensor_plan import stored_sensor_plan

@@ -4,7 +4,6 @@ import json
 import numpy as np
 import pytest
 
-from pipeline.config import results_folder
 from pipeline.errors import PinfeedError
 from pipeline.sensing import (Profile, Sensor, classify, measure, profile_from_rollout, read_profile_csv,
                               score, sensor_groups, sign_matrix)
@@ -215,109 +214,188 @@ def test_score_table_accuracy_on_the_asymmetric_triangle():
 # ---------------------------------------------------------------- planning with the sensor
 
 
-def _plan(finals: dict, margin: float, pins=("P1",)):
-    from pipeline.planner import Plan, Step, merge_arcs
-    branches = {lab: [[Step(pins[0], 10.0, 0.3, 0.3, (start, 5.0), 1.0, 1.0)] for start in starts]
+def _stored_plan(finals: dict, pins=("P1",), heights=(10.0,), n_sets=None):
+    """A plan shaped like a stored tight plan: per state, one branch per final arc."""
+    from pipeline.arcs import merge_arcs
+    step = {"pin": pins[-1], "y_pin": heights[-1], "v_pin": 0.0, "d_range": [0.2, 0.3]}
+    branches = {lab: [[dict(step, band={"start": s, "width": 5.0})] for s in starts]
                 for lab, starts in finals.items()}
     sets = merge_arcs([(s, 5.0) for starts in finals.values() for s in starts])
-    return Plan(tuple(pins), len(sets), sets, margin, branches)
+    return {"pins": list(pins), "pin_heights_mm": list(heights), "pin_speeds": [0.0] * len(pins),
+            "n_final_sets": len(sets) if n_sets is None else n_sets,
+            "final_sets": [{"start": a, "width": w} for a, w in sets], "initial_states": branches}
 
 
 def test_sensor_ranking_counts_final_sets_per_verdict():
-    from pipeline.sensor_plan import final_arcs, sensor_rank_key, verdict_outcome
+    from pipeline.sensor_plan import group_arcs, sensor_rank_key, verdict_outcome, worst_sets
     groups = [["s1"], ["s2", "s3"]]
-    a = _plan({"s1": [10.0], "s2": [100.0], "s3": [100.0]}, margin=0.3)  # 2 sets, 1 per verdict
-    b = _plan({"s1": [10.0], "s2": [10.0], "s3": [200.0]}, margin=0.4)  # 2 sets, 2 for s2/s3
-    c = _plan({"s1": [10.0], "s2": [10.0], "s3": [10.0]}, margin=0.2)  # 1 set, narrower margin
-    d = _plan({"s1": [10.0, 250.0], "s2": [100.0], "s3": [100.0]}, margin=0.5)  # s1 branches
-    assert a.n_sets == b.n_sets == 2
-    assert [sensor_rank_key(p, groups)[0] for p in (a, b, c, d)] == [1, 2, 1, 2]
-    # worst sets per verdict first (a, c: 1), then the wider margin (a 0.3 > c 0.2; d 0.5 > b 0.4)
-    assert sorted((a, b, c, d), key=lambda p: sensor_rank_key(p, groups)) == [a, c, d, b]
-    assert final_arcs(b, ["s2", "s3"]) == [(10.0, 5.0), (200.0, 5.0)]
-    finals = {lab: final_arcs(a, [lab]) for lab in ("s1", "s2", "s3")}
+    a = _stored_plan({"s1": [10.0], "s2": [100.0], "s3": [100.0]})  # 2 sets, 1 per verdict
+    b = _stored_plan({"s1": [10.0], "s2": [10.0], "s3": [200.0]})  # 2 sets, 2 for s2/s3
+    c = _stored_plan({"s1": [10.0], "s2": [10.0], "s3": [10.0]})  # 1 set
+    d = _stored_plan({"s1": [10.0, 250.0], "s2": [100.0], "s3": [100.0]})  # s1 branches
+    assert [worst_sets(p, groups) for p in (a, b, c, d)] == [1, 2, 1, 2]
+    # Worst sets per verdict first, then the stored rank (the list's order).
+    stored = [b, d, a, c]
+    ranked = sorted(range(4), key=lambda k: sensor_rank_key(stored[k], k, groups))
+    assert [stored[k] is p for k, p in zip(ranked, (a, c, b, d))] == [True] * 4
+    assert group_arcs(b, ["s2", "s3"]) == [(10.0, 5.0), (200.0, 5.0)]
+    finals = {lab: group_arcs(a, [lab]) for lab in ("s1", "s2", "s3")}
     assert verdict_outcome(["s2", "s3"], "s3", finals) == "known"
     assert verdict_outcome(["s2"], "s1", finals) == "wrong"
     assert verdict_outcome(["s1", "s2"], "s1", finals) == "ambiguous"
+    # A part with 2-fold symmetry: sets 180 degrees apart are one orientation.
+    e = _stored_plan({"s1": [10.0], "s2": [190.0], "s3": [190.0]})
+    assert worst_sets(e, [["s1", "s2", "s3"]], order=1) == 2
+    assert worst_sets(e, [["s1", "s2", "s3"]], order=2) == 1
+
+
+def test_friction_is_resolved_once_for_the_profiles():
+    from pipeline.sensor_plan import sensing_frictions
+    assert sensing_frictions({"mu_c": [0.1, 0.3]}) == ((0.1, 0.3), pytest.approx(0.2))
+    assert sensing_frictions({"mu_c": 0.15}) == (0.15, 0.15)
+
+
+def test_synthetic_measurement_draws_a_friction_range_uniformly(monkeypatch):
+    # Over a planned range the measurements' friction spreads over the whole range
+    # (as verification draws it), not around one value.
+    from pipeline import sensing
+
+    class Drawn(Exception):
+        pass
+
+    seen = []
+
+    def record(part, theta, y_c, y_pin, mu_c, pin_radius, model):
+        seen.append(mu_c)
+        raise Drawn
+
+    monkeypatch.setattr(sensing, "first_pin_rollout", record)
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        with pytest.raises(Drawn):
+            sensing.synthetic_measurement(None, {"theta": 0.0, "y_c": 10.0}, 20.0, (0.1, 0.3), 3.0,
+                                          "minpower", Sensor(), sensing.PERTURB_DEFAULTS, rng)
+    assert 0.1 <= min(seen) < 0.12 and 0.28 < max(seen) <= 0.3
+
+
+TRI = "0,0 60,0 15,35"  # the asymmetric triangle
+TRI_PLAN = ["--depth", "2", "--pins=7.5,27.5", "--mu-c", "0", "--dynamic-depth", "0"]
 
 
 @pytest.fixture(scope="module")
-def sym_catalog(tmp_path_factory):
-    """The default config's symmetric triangle, swept at the planner's model and
-    friction only, planned and sensed as the workflow does, in a temporary catalog."""
-    from pipeline.catalog import Catalog
-    from pipeline.config import load_config, validate_config
+def stored_tri(tmp_path_factory):
+    """Tight plans of the asymmetric triangle on a two-pin grid, stored by
+    ``pinfeed plan --out`` (as a user or the plan stage stores them), and a copy
+    of that file without the plans that end in one set (a feeder whose fixed
+    pins cannot orient the part)."""
+    from pipeline.cli import main
+    tmp = tmp_path_factory.mktemp("sense")
+    cat, full, partial = tmp / "cat", tmp / "full", tmp / "partial"
+    path = full / "plans" / "tri.json"
+    assert main(["plan", "--vertices", TRI, "--name", "tri", "--catalog", str(cat), *TRI_PLAN,
+                 "--out", str(path), "--json"]) == 0
+    assert main(["catalog", "index", "--catalog", str(cat)]) == 0  # refinement shards only
+    stored = json.loads(path.read_text())
+    entry = stored["tight"][0]
+    assert entry["plans"][0]["n_final_sets"] == 1 and any(p["n_final_sets"] > 1 for p in entry["plans"])
+    entry["plans"] = [p for p in entry["plans"] if p["n_final_sets"] > 1]
+    entry["recommended"] = entry["plans"][0]
+    (partial / "plans").mkdir(parents=True)
+    (partial / "plans" / "tri.json").write_text(json.dumps(stored))
+    return {"catalog": cat, "full": full, "partial": partial}
+
+
+def _sense_config(**sensing):
+    from pipeline.config import load_config
+    cfg = load_config()
+    cfg["sensing"].update(trials=20, **sensing)
+    return cfg
+
+
+@pytest.fixture(scope="module")
+def sensed(stored_tri):
+    """The sensing stage on both stored files, written where classify finds them."""
     from pipeline.io import write_json
     from pipeline.sensor_plan import sense_part
-    from pipeline.stages import plan_part
-    from pipeline.sweep import run_sweep
-    cfg = load_config()
-    sym = next(p for fam in cfg["families"].values() for p in fam.get("parts", [])
-               if p["name"] == "sym_triangle")
-    cfg["families"] = {"paper_triangles": {"parts": [sym]}}
-    cfg["sweep"]["models"] = [cfg["planner"]["model"]]
-    cfg["planner"].update(mu_c=0.15, frictions=[], depth=3)  # the paper-mode planner's friction
-    cfg["verify"]["trials"] = 30
-    cfg["sweep"]["mu_c"] = [cfg["planner"]["mu_c"]]
-    cfg["sweep"]["v_pin"] = [0.0]  # the sensor plans fixed pins only
-    cfg["planner"]["dynamic"]["speeds"] = []
-    cfg["planner"]["parts"] = ["sym_triangle"]
-    cfg["sensing"].pop("parts")
-    root = tmp_path_factory.mktemp("sym") / "catalog"
-    cfg = validate_config(dict(cfg, catalog_dir=str(root), results_dir=str(root.parent / "results")))
-    results = results_folder(cfg)  # plans and sensing results: results_dir/NAME
-    run_sweep(cfg, progress=False)
-    cat = Catalog.open(root)
-    write_json(plan_part(cat, "sym_triangle", cfg, tight=False), results / "plans" / "sym_triangle.json")
-    result = sense_part(cat, "sym_triangle", cfg, log=lambda *a: None)
-    write_json(result, results / "sensing" / "sym_triangle.json")
-    return cfg, cat, result
+    out = {}
+    for kind in ("full", "partial"):
+        res = sense_part(stored_tri[kind] / "plans" / "tri.json", _sense_config(), log=lambda *a: None)
+        write_json(res, stored_tri[kind] / "sensing" / "tri.json")
+        out[kind] = res
+    return out
 
 
-def test_sym_triangle_sensor_plan_reports_a_final_set_per_verdict(sym_catalog):
-    from pipeline.planner import merge_arcs
-    cfg, _, res = sym_catalog
-    assert res["found"] and res["plan"]["pins"][0] == res["first_pin"]
-    labels = list(res["initial_states"])
-    assert sorted(s for g in res["groups"] for s in g["states"]) == sorted(labels)
-    per_state = {}
-    for lab in labels:  # the plan's own branches give each state's final sets
-        arcs = [(b[-1]["band"]["start"], b[-1]["band"]["width"]) for b in res["plan"]["initial_states"][lab]]
-        per_state[lab] = merge_arcs(arcs)
-        assert [(s["start"], s["width"]) for s in res["states"][lab]["final_sets"]] == per_state[lab]
-    for g in res["groups"]:
-        want = merge_arcs([a for lab in g["states"] for a in per_state[lab]])
-        assert [(s["start"], s["width"]) for s in g["final_sets"]] == want
-        assert g["known"] == (len(want) == 1)
-    assert res["worst_sets"] == max(len(g["final_sets"]) for g in res["groups"])
-    assert res["known_for_every_state"] == all(g["known"] for g in res["groups"])
-    # The sensor can only help: never more sets per verdict than fixed pins alone.
-    assert res["worst_sets"] <= res["static_best"]["n_final_sets"]
-    rows = res["verification"]["rows"]
-    assert all(r["trials"] == cfg["sensing"]["trials"] and
-               r["right"] + r["wrong"] + r["ambiguous"] + r["jammed"] == r["trials"] for r in rows.values())
-    assert all(r["wrong"] == 0 for r in rows.values())
+def test_one_set_plan_needs_no_sensor_and_the_table_is_still_reported(stored_tri, sensed):
+    stored = json.loads((stored_tri["full"] / "plans" / "tri.json").read_text())["tight"][0]
+    res = sensed["full"]
+    assert res["plan"] == stored["recommended"] and res["plan_rank"] == 1
+    assert not res["sensor_needed"] and "not needed" in res["note"]
+    assert res["known_for_every_state"] and res["worst_sets"] == 1
+    assert res["mu_c"] == stored["mu_c"] and res["mu_c_profiles"] == stored["mu_c"]
+    assert res["first_pin"] == stored["recommended"]["pins"][0]
+    assert res["y_pin"] == stored["recommended"]["pin_heights_mm"][0]
+    table = res["score_table"]
+    assert sorted(s for g in table["groups"] for s in g) == sorted(stored["initial_states"])
+    assert set(table["reference_signs"]) == set(stored["initial_states"])
 
 
-def test_sym_triangle_final_orientation_known_with_an_ideal_sensor(sym_catalog):
-    # Exact inputs and a noise-free sensor: some first pin tells the three resting
-    # states apart, and with it every state ends in a final set its verdict names.
-    from pipeline.sensor_plan import plan_with_sensor
-    from pipeline.stages import build_planner
-    cfg, cat, _ = sym_catalog
-    _, planner, mu, _ = build_planner(cat, "sym_triangle", cfg)
-    still = {"theta_sigma": 0.0, "y_halfwidth": 0.0, "mu_sigma": 0.0, "pin_halfwidth": 0.0}
-    ideal = Sensor.from_config(dict(cfg["sensing"]["sensor"], noise_sigma=0.0, bias_x=0.0, bias_y=0.0))
-    res = plan_with_sensor(planner, cfg["planner"]["depth"], mu, cfg["sweep"]["pin_radius"],
-                           cfg["planner"]["model"], ideal, trials=2, perturb=still, log=lambda *a: None)
-    assert res["known_for_every_state"], (res["first_pin"], [g["states"] for g in res["groups"]])
-    assert len(res["groups"]) == len(res["initial_states"])
-    assert all(o["known"] == 1.0 for o in res["final_outcomes"].values())
+def test_sensor_plan_is_a_stored_candidate_not_a_new_search(stored_tri, sensed):
+    # The stored file lacks the one-set plan that a search on this grid finds
+    # first (the full file's recommendation): a planner that searched again, or
+    # ignored the stored file, would return it.
+    full = json.loads((stored_tri["full"] / "plans" / "tri.json").read_text())["tight"][0]
+    stored = json.loads((stored_tri["partial"] / "plans" / "tri.json").read_text())["tight"][0]
+    res = sensed["partial"]
+    assert res["plan"] == stored["plans"][res["plan_rank"] - 1]
+    assert res["plan"]["pins"] != full["recommended"]["pins"]
+    assert res["sensor_needed"] and res["without_sensor"]["pins"] == stored["plans"][0]["pins"]
+    # The sensor tells the states apart at the chosen first pin: fewer sets per verdict.
+    assert res["worst_sets"] < res["without_sensor"]["n_final_sets"]
+    assert {f["pin"] for f in res["first_pins"]} == {p["pins"][0] for p in stored["plans"]}
 
 
-def test_sym_triangle_final_orientation_known_with_the_default_sensor(sym_catalog):
-    _, _, res = sym_catalog
-    assert res["known_for_every_state"]
+def test_final_sets_per_verdict_hold_in_full_rollout_replay(sensed):
+    # Every state of a verdict's group, replayed past the sensor plan's pins by
+    # perturbed full rollouts (the verify stage's sizes, random trials and every
+    # corner of the box), ends in that verdict's final sets.
+    from pipeline.arcs import in_arc
+    from pipeline.parts import Part
+    from pipeline.verify import DEFAULTS, corner_inputs, perturbed_batch, replay
+    res = sensed["partial"]
+    kernel = _sense_config()["sweep"]["kernel"]  # the verify stage's rollout settings
+    part = Part.from_vertices(res["part"]["vertices"])
+    heights, speeds = res["plan"]["pin_heights_mm"], res["plan"]["pin_speeds"]
+    rng = np.random.default_rng(7)
+    for group in res["groups"]:
+        for label in group["states"]:
+            st = res["initial_states"][label]
+            draws = [perturbed_batch(st["theta"], st["y_c"], res["mu_c"], len(heights), DEFAULTS, rng, 100),
+                     corner_inputs(st["theta"], st["y_c"], res["mu_c"], len(heights), DEFAULTS)]
+            th, yc, mu, offs = (np.concatenate(x) for x in zip(*draws))
+            theta, _, jam, _ = replay(part, heights, speeds, th, yc, mu, offs, res["pin_radius"],
+                                      res["model"], kernel["ds_max"], kernel["tol"])
+            assert not any(jam), label
+            inside = np.zeros(theta.size, bool)
+            for s in group["final_sets"]:
+                inside |= in_arc(theta, s["start"], s["width"], 1e-6)
+            assert inside.all(), (label, theta[~inside])
+    rows = res["verification"]["rows"]  # the stage's own end-to-end check with the sensor
+    assert all(r["trials"] == 20 and r["right"] + r["wrong"] + r["ambiguous"] + r["jammed"] == 20
+               for r in rows.values())
+    assert all(r["wrong"] == 0 and r["jammed"] == 0 for r in rows.values())
+
+
+def test_sensor_stage_without_a_verified_plan(stored_tri, tmp_path):
+    from pipeline.sensor_plan import sense_part
+    stored = json.loads((stored_tri["partial"] / "plans" / "tri.json").read_text())
+    stored["tight"][0].update(plans=[], recommended=None, warning="no plan passed verification: test")
+    path = tmp_path / "plans" / "tri.json"
+    path.parent.mkdir()
+    path.write_text(json.dumps(stored))
+    res = sense_part(path, _sense_config(), log=lambda *a: None)
+    assert not res["found"] and "no plan passed verification: test" in res["note"]
+    with pytest.raises(PinfeedError, match="no stored plan at mu_c 0.2; stored: 0"):
+        sense_part(path, _sense_config(), friction="0.2")
 
 
 # ---------------------------------------------------------------- pinfeed sense classify
@@ -343,36 +421,42 @@ def _write_csv(path, profile, scale=1.0, t0=0.0, header=True, extra=True):
     return path
 
 
-def test_cli_classify_reads_a_profile_and_names_the_final_orientation(sym_catalog, tmp_path, capsys):
+def _classify_args(stored_tri, kind, *extra):
+    return ["sense", "classify", "--catalog", str(stored_tri["catalog"]), "--results",
+            str(stored_tri[kind]), *extra]
+
+
+def test_cli_classify_reads_a_profile_and_names_the_final_orientation(stored_tri, sensed, tmp_path, capsys):
     # The noise-free simulated profile of one state, written in other units, with a
-    # time offset and an extra column, must score 40/40 against that state.
+    # time offset and an extra column, must score 40/40 against that state. The
+    # part is known from the stored results (the catalog holds refinements only).
     from pipeline.parts import Part
     from pipeline.sensing import reference_profiles
     from pipeline.sensor_plan import final_for_verdict
-    cfg, _, res = sym_catalog
+    res = sensed["partial"]
     part = Part.from_vertices(res["part"]["vertices"])
     sensor = Sensor.from_config(res["sensor"])
-    prof = reference_profiles(part, res["initial_states"], res["y_pin"], res["mu_c"], res["pin_radius"],
-                              res["model"], sensor)["state 2"]
+    prof = reference_profiles(part, res["initial_states"], res["y_pin"], res["mu_c_profiles"],
+                              res["pin_radius"], res["model"], sensor)["state 2"]
     csv_path = _write_csv(tmp_path / "state2.csv", prof, scale=9.81, t0=12.5)
-    root, results = cfg["catalog_dir"], str(results_folder(cfg))
-    code, out, err = _run(["sense", "classify", "--part", "sym_triangle", "--profile", str(csv_path),
-                           "--catalog", root, "--results", results, "--json"], capsys)
+    argv = _classify_args(stored_tri, "partial", "--part", "tri", "--profile", str(csv_path))
+    code, out, err = _run(argv + ["--json"], capsys)
     assert code == 0, err
     got = json.loads(out)
     assert {"part", "y_pin", "y_pin_source", "scores", "best", "candidates", "decided", "margin",
-            "elements", "measured_signs", "final_sets", "final_known", "sensor_plan"} <= set(got)
-    assert got["y_pin"] == res["y_pin"] and got["elements"] == 40
+            "elements", "measured_signs", "final_sets", "final_known", "sensor_plan", "mu_c",
+            "mu_c_profiles"} <= set(got)
+    assert got["y_pin"] == res["y_pin"] and got["elements"] == 40 and got["sensor_plan"] == res["plan"]["pins"]
+    assert got["mu_c"] == res["mu_c"] and got["mu_c_profiles"] == res["mu_c_profiles"]
     assert got["scores"]["state 2"] == 40 and "state 2" in got["candidates"]
     assert got["final_sets"] == final_for_verdict(res, got["candidates"])
     assert got["final_known"] == (len(got["final_sets"]) == 1)
-    code, out, err = _run(["sense", "classify", "--part", "sym_triangle", "--profile", str(csv_path),
-                           "--catalog", root, "--results", results], capsys)
+    code, out, err = _run(argv, capsys)
     assert code == 0, err
     assert "verdict:" in out and "state 2: 40" in out and "final orientation" in out
+    assert "profiles simulated at 0" in out
     # Another pin: no final orientation from the stored sensor plan.
-    code, out, err = _run(["sense", "classify", "--part", "sym_triangle", "--profile", str(csv_path),
-                           "--catalog", root, "--results", results, "--y-pin", "-2.5", "--json"], capsys)
+    code, out, err = _run(argv + ["--y-pin", "-2.5", "--json"], capsys)
     assert code == 0, err
     got = json.loads(out)
     assert got["y_pin"] == -2.5 and got["final_sets"] is None and got["final_known"] is None
@@ -386,32 +470,47 @@ def _one_line_error(code, err, *words):
         assert w in lines[0], (w, err)
 
 
-def test_cli_classify_bad_input(sym_catalog, tmp_path, capsys):
-    cfg, _, _ = sym_catalog
-    root = cfg["catalog_dir"]
+def test_cli_classify_bad_input(stored_tri, sensed, tmp_path, capsys):
     good = _write_csv(tmp_path / "ok.csv", _timed(np.linspace(1, 0.2, 400), 0.3 * np.ones(400)),
                       header=False, extra=False)
-    base = ["sense", "classify", "--catalog", root, "--results", str(results_folder(cfg))]
-    _one_line_error(*_run(base + ["--part", "sym_triangle", "--profile", str(tmp_path / "none.csv")],
+    base = _classify_args(stored_tri, "partial")
+    _one_line_error(*_run(base + ["--part", "tri", "--profile", str(tmp_path / "none.csv")],
                           capsys)[::2], "no profile file")
     bad = tmp_path / "bad.csv"
     bad.write_text("t,fx,fy\n0,1,2\n0.01,abc,2\n")
-    _one_line_error(*_run(base + ["--part", "sym_triangle", "--profile", str(bad)], capsys)[::2],
+    _one_line_error(*_run(base + ["--part", "tri", "--profile", str(bad)], capsys)[::2],
                     "line 3", "not three numbers")
     _one_line_error(*_run(base + ["--part", "nope", "--profile", str(good)], capsys)[::2],
                     "unknown part 'nope'", "pinfeed catalog list")
-    _one_line_error(*_run(["sense", "classify", "--part", "sym_triangle"], capsys)[::2], "--profile")
+    _one_line_error(*_run(["sense", "classify", "--part", "tri"], capsys)[::2], "--profile")
+    old = stored_tri["partial"] / "old"  # a sensing result of the format before issue 11
+    (old / "sensing").mkdir(parents=True, exist_ok=True)
+    before = {k: v for k, v in sensed["partial"].items() if k not in ("mu_c_profiles", "symmetry_order")}
+    (old / "sensing" / "tri.json").write_text(json.dumps(before))
+    argv = ["sense", "classify", "--catalog", str(stored_tri["catalog"]), "--results", str(old),
+            "--part", "tri", "--profile", str(good)]
+    _one_line_error(*_run(argv, capsys)[::2], "not a pinfeed sensing result", "re-run the workflow")
 
 
-def test_cli_classify_without_a_plan_needs_y_pin(sym_catalog, tmp_path, capsys):
+def test_cli_classify_pin_from_the_stored_plan_or_y_pin(stored_tri, sensed, tmp_path, capsys):
+    # No sensor plan stored: the sensor pin is the recommended tight plan's first
+    # pin; with no verified plan either, --y-pin is required.
     import shutil
-    cfg, _, _ = sym_catalog
-    root = tmp_path / "catalog"
-    shutil.copytree(cfg["catalog_dir"], root)
     good = _write_csv(tmp_path / "ok.csv", _timed(np.linspace(1, 0.2, 400), 0.3 * np.ones(400)))
-    argv = ["sense", "classify", "--part", "sym_triangle", "--profile", str(good), "--catalog", str(root),
-            "--results", str(tmp_path / "results")]  # an empty results folder: no plans stored
-    _one_line_error(*_run(argv, capsys)[::2], "--y-pin", "run the workflow")
+    results = tmp_path / "results"
+    shutil.copytree(stored_tri["full"] / "plans", results / "plans")
+    argv = ["sense", "classify", "--part", "tri", "--profile", str(good), "--catalog",
+            str(stored_tri["catalog"]), "--results", str(results)]
+    code, out, err = _run(argv + ["--json"], capsys)
+    assert code == 0, err
+    got = json.loads(out)
+    rec = json.loads((results / "plans" / "tri.json").read_text())["tight"][0]["recommended"]
+    assert got["y_pin"] == rec["pin_heights_mm"][0] and got["first_pin"] == rec["pins"][0]
+    assert "recommended tight plan" in got["y_pin_source"] and got["final_sets"] is None
+    stored = json.loads((results / "plans" / "tri.json").read_text())
+    stored["tight"][0].update(plans=[], recommended=None)
+    (results / "plans" / "tri.json").write_text(json.dumps(stored))
+    _one_line_error(*_run(argv, capsys)[::2], "--y-pin", "pinfeed plan --part tri")
     code, out, err = _run(argv + ["--y-pin", "27.5", "--json"], capsys)
     assert code == 0, err
     assert json.loads(out)["final_sets"] is None
@@ -427,9 +526,8 @@ def test_cli_module_entry_point():
     assert run.returncode == 0 and "time (s), F_x, F_y" in run.stdout
 
 
-def test_sensing_figures_are_written(sym_catalog, tmp_path):
+def test_sensing_figures_are_written(sensed, tmp_path):
     from pipeline.figures.sensing import sensing_figures
-    _, _, res = sym_catalog
-    prof, scores = sensing_figures(res, tmp_path / "profiles.png", tmp_path / "scores.png")
+    prof, scores = sensing_figures(sensed["partial"], tmp_path / "profiles.png", tmp_path / "scores.png")
     for path in (prof, scores):
         assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
