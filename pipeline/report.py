@@ -240,11 +240,10 @@ def _sensing_section(res: dict, figs: dict, base) -> list[str]:
     p.append(f"<p>Sensor on {html.escape(res['first_pin'])} (y = {res['y_pin']:g} mm), stored tight "
              f"plan #{res['plan_rank']} {html.escape(' → '.join(res['plan']['pins']))} at mu_c "
              f"{html.escape(res['friction'])} (simulated profiles at mu_c {res['mu_c_profiles']:g}): "
-             f"{known}. Without the sensor the recommended plan "
-             f"{html.escape(' → '.join(alone['pins']))} ends in {alone['n_final_sets']} set(s)"
-             f"{'' if res['sensor_needed'] else ': the sensor is not needed for the orientation, its verdict tells which resting state arrived'}. "
-             f"Classification accuracy {100 * t['accuracy']:.0f} % (wrong {100 * t['wrong']:.0f} %) over "
-             f"{t['trials']} synthetic measurements per state.</p>")
+             f"{known}; {html.escape(res['note'])}. Without the sensor the recommended plan "
+             f"{html.escape(' → '.join(alone['pins']))} ({alone['moving_pins']} moving pin(s)) ends in "
+             f"{alone['n_final_sets']} set(s). Classification accuracy {100 * t['accuracy']:.0f} % "
+             f"(wrong {100 * t['wrong']:.0f} %) over {t['trials']} synthetic measurements per state.</p>")
     p.append("<table><tr><th>sensor verdict (states it cannot tell apart)</th>"
              "<th>final orientation set(s) (deg)</th><th>known</th></tr>")
     for g in res["groups"]:

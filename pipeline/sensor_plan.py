@@ -23,21 +23,25 @@ ranked below its stored ``keep`` best (for instance one pin that leaves each
 state in its own set while a two-set plan exists) is not seen; a wider search
 would need its own verification and is not done.
 
-Ranking. For every candidate first pin (a fixed pin; the sensor is on the
-first pin) the sensor's groups (initial states it cannot tell apart, from the
-synthetic score table of :func:`pipeline.sensing.score_table`) are computed
-once. A plan is ranked by the worst number of final sets over the groups
-(each group's states, all their branches, must end in one set for the
-reading to say the final orientation; sets are counted modulo the part's
-rotational symmetry, as the planner counts them), then by its stored rank
-(the plan stage's order: fewest sets, verified success, fewest pins, jump
-steps, margin in d, set width). The sensor's accuracy at the first pin is
-reported, not ranked.
+Ranking. Candidates are the stored plans whose first pin is fixed (the
+sensor sits on it). For every candidate first pin the sensor's groups
+(initial states it cannot tell apart, from the synthetic score table of
+:func:`pipeline.sensing.score_table`) are computed once. A plan is ranked by
+the worst number of final sets over the groups (each group's states, all
+their branches, must end in one set for the reading to say the final
+orientation; sets are counted modulo the part's rotational symmetry, as the
+planner counts them), then by its number of moving pins (the sensor is the
+paper's alternative to moving pins: fixed pins and a sensor beat moving pins
+that reach no fewer sets), then by its stored rank (the plan stage's order:
+fewest sets, verified success, fewest pins, jump steps, margin in d, set
+width). The sensor's accuracy at the first pin is reported, not ranked.
 
-Where the recommended plan already ends in one set, the sensor is not needed
-for the orientation (``sensor_needed`` false): that plan is the sensor plan,
-and the score table at its first pin is still computed and reported, since
-users read the sensor to tell which resting state arrived.
+Where a stored plan of fixed pins already ends in one set, the sensor is not
+needed for the orientation (``sensor_needed`` false): the first such plan is
+the sensor plan (nothing can rank above it), and the score table at its
+first pin is still computed and reported, since users read the sensor to
+tell which resting state arrived. ``sensor_needed`` is true where the chosen
+plan alone leaves several sets and only the verdict says which results.
 
 Friction, resolved once by :func:`sensing_frictions`: ``mu_c`` is the stored
 entry's friction as planned (a value or a range ``[lo, hi]``); the simulated
@@ -116,9 +120,15 @@ def worst_sets(plan: dict, groups, order: int = 1) -> int:
     return max(count_sets(group_arcs(plan, g), order) for g in groups)
 
 
+def moving_pins(plan: dict) -> int:
+    """Number of moving pins in a stored plan."""
+    return sum(1 for v in plan["pin_speeds"] if v)
+
+
 def sensor_rank_key(plan: dict, stored_rank: int, groups, order: int = 1):
-    """Rank of a stored plan with the sensor: worst sets per verdict, then its stored rank."""
-    return (worst_sets(plan, groups, order), stored_rank)
+    """Rank of a stored plan with the sensor: worst sets per verdict, then fewest
+    moving pins, then its stored rank."""
+    return (worst_sets(plan, groups, order), moving_pins(plan), stored_rank)
 
 
 def verdict_outcome(candidates, truth, finals: dict, order: int = 1) -> str:
@@ -151,9 +161,10 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
         why = entry.get("warning") or "no verified plan starts with a fixed pin"
         return dict(out, note=f"no stored verified plan to put the sensor on: {why}")
     recommended = stored[0]
-    sensor_needed = recommended["n_final_sets"] > 1
-    if candidates[0][1]["n_final_sets"] == 1:
-        candidates = candidates[:1]  # one set already: nothing ranks above it
+    fixed = [(rank, p) for rank, p in candidates if not moving_pins(p)]
+    one_set = [(rank, p) for rank, p in fixed if p["n_final_sets"] == 1]
+    if one_set:
+        candidates = one_set[:1]  # fixed pins end in one set: nothing ranks above it
     order_of_pins = []  # first pins by the stored rank of their best plan
     for _, p in candidates:
         if (p["pins"][0], p["pin_heights_mm"][0]) not in order_of_pins:
@@ -169,6 +180,7 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
     ranked = sorted((sensor_rank_key(p, rank, tables[p["pins"][0]]["groups"], order), rank, p)
                     for rank, p in candidates if p["pins"][0] in tables)
     best_key, best_rank, best = ranked[0]
+    sensor_needed = best["n_final_sets"] > 1
     pin = best["pins"][0]
     table = tables[pin]
     finals = {lab: predicted_sets(best, lab) for lab in labels}
@@ -186,9 +198,12 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
     per_pin = {}
     for key, _, p in ranked:
         per_pin.setdefault(p["pins"][0], key)
-    note = ("the recommended plan ends in one set: the sensor is not needed for the final orientation "
-            "(its verdict still tells which resting state arrived)" if not sensor_needed else
-            f"without the sensor the recommended plan ends in {recommended['n_final_sets']} sets")
+    if sensor_needed:
+        note = (f"the plan alone ends in {best['n_final_sets']} sets; the sensor's verdict says which "
+                f"results (worst {best_key[0]} per verdict)")
+    else:
+        note = ("the plan ends in one set: the sensor is not needed for the final orientation "
+                "(its verdict still tells which resting state arrived)")
     return dict(
         out,
         sensor_needed=sensor_needed, note=note,
@@ -204,13 +219,17 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
         first_pins=[{"pin": q, "y_pin": y, "groups": tables[q]["groups"],
                      "accuracy": tables[q]["accuracy"], "wrong": tables[q]["wrong"],
                      "worst_sets": per_pin[q][0] if q in per_pin else None,
-                     "best_stored_rank": per_pin[q][1] + 1 if q in per_pin else None}
+                     "best_stored_rank": per_pin[q][2] + 1 if q in per_pin else None}
                     for q, y in evaluated],
-        without_sensor={"pins": list(recommended["pins"]),
-                        "pin_heights_mm": list(recommended["pin_heights_mm"]),
-                        "n_final_sets": recommended["n_final_sets"],
-                        "final_sets": recommended["final_sets"]},
+        without_sensor=_summary(recommended),
+        best_fixed_pins=_summary(fixed[0][1]) if fixed else None,
     )
+
+
+def _summary(plan: dict) -> dict:
+    return {"pins": list(plan["pins"]), "pin_heights_mm": list(plan["pin_heights_mm"]),
+            "moving_pins": moving_pins(plan), "n_final_sets": plan["n_final_sets"],
+            "final_sets": plan["final_sets"]}
 
 
 def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor: Sensor,

@@ -243,6 +243,11 @@ def test_sensor_ranking_counts_final_sets_per_verdict():
     assert verdict_outcome(["s2", "s3"], "s3", finals) == "known"
     assert verdict_outcome(["s2"], "s1", finals) == "wrong"
     assert verdict_outcome(["s1", "s2"], "s1", finals) == "ambiguous"
+    # Fixed pins and a sensor rank above moving pins that reach no fewer sets per verdict.
+    m = _stored_plan({"s1": [10.0], "s2": [10.0], "s3": [10.0]}, pins=("P1", "P2v+2"), heights=(10.0, 5.0))
+    m["pin_speeds"] = [0.0, 2.0]
+    assert sensor_rank_key(a, 5, groups) < sensor_rank_key(m, 0, groups)
+    assert sensor_rank_key(m, 0, groups) < sensor_rank_key(b, 1, groups)
     # A part with 2-fold symmetry: sets 180 degrees apart are one orientation.
     e = _stored_plan({"s1": [10.0], "s2": [190.0], "s3": [190.0]})
     assert worst_sets(e, [["s1", "s2", "s3"]], order=1) == 2
