@@ -131,8 +131,8 @@ def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=Non
 
 
 def paper_depth(config: dict) -> int:
-    """Depth of the paper-mode planner (and the sensor planner built on it):
-    ``planner.paper_depth``, at most ``planner.depth``."""
+    """Depth of the paper-mode planner: ``planner.paper_depth``, at most
+    ``planner.depth`` (the sensor planner reads the stored tight plans instead)."""
     pc = config["planner"]
     return int(min(pc["depth"], pc.get("paper_depth", 3)))
 
