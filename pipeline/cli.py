@@ -487,7 +487,7 @@ def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from .config import load_config
     from .planning import friction_label
-    from .speed_limit import speed_curve
+    from .speed_limit import perturbation_from_verify, speed_curve
     from .stages import read_json
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
@@ -500,9 +500,7 @@ def cmd_speed(args):
         raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
     from .parts import Part
     part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
-    v = dict(config.get("verify", {}))
-    perturb = {"theta_deg": 2.0 * v.get("theta_sigma", 1.0), "y_mm": v.get("y_halfwidth", 0.5),
-               "pin_mm": v.get("pin_halfwidth", 0.3)}
+    perturb = perturbation_from_verify(config.get("verify", {}))
     # A tight-only plan file keeps the resting states per friction entry.
     stored_states = entry.get("initial_states") or result.get("initial_states") or {}
     states = [(s["theta"], s["y_c"]) for s in stored_states.values()]
@@ -528,26 +526,9 @@ def cmd_speed(args):
 
 
 def _pick_tight_plan(result: dict, n: int, mu_text):
-    """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
-    (default: the first planned friction), that friction and its stored entry."""
-    from .planning import friction_label, parse_friction
-    tight = result.get("tight") or []
-    if not tight:
-        raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan'")
-    entry = tight[0]
-    if mu_text is not None:
-        want = friction_label(parse_friction(mu_text))
-        found = [t for t in tight if t["friction"] == want]
-        if not found:
-            raise PinfeedError(f"no stored plan at mu_c {want}; stored: "
-                               f"{', '.join(t['friction'] for t in tight)}")
-        entry = found[0]
-    if not entry["plans"]:
-        raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
-    if not 1 <= n <= len(entry["plans"]):
-        raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
-    mu = entry["mu_c"]
-    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
+    """See :func:`pipeline.planning.pick_tight_plan` (shared with ``pinfeed layout``)."""
+    from .planning import pick_tight_plan
+    return pick_tight_plan(result, n, mu_text)
 
 
 def cmd_animate(args):

@@ -142,3 +142,25 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
 
 def planner_pin_heights(planner: TightPlanner) -> dict:
     return {label: pin.y for label, pin in planner.pins.items()}
+
+
+def pick_tight_plan(result: dict, n: int, mu_text):
+    """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
+    (default: the first planned friction), that friction and its stored entry."""
+    tight = result.get("tight") or []
+    if not tight:
+        raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan'")
+    entry = tight[0]
+    if mu_text is not None:
+        want = friction_label(parse_friction(mu_text))
+        found = [t for t in tight if t["friction"] == want]
+        if not found:
+            raise PinfeedError(f"no stored plan at mu_c {want}; stored: "
+                               f"{', '.join(t['friction'] for t in tight)}")
+        entry = found[0]
+    if not entry["plans"]:
+        raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
+    if not 1 <= n <= len(entry["plans"]):
+        raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
+    mu = entry["mu_c"]
+    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
