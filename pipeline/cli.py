@@ -531,6 +531,53 @@ def _pick_tight_plan(result: dict, n: int, mu_text):
     return pick_tight_plan(result, n, mu_text)
 
 
+def cmd_layout(args):
+    """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
+    from .config import load_config
+    from .layout import check_drawing_path, layout_stored, write_drawing
+    from .stages import read_json
+    config = load_config(args.config)
+    if args.out:
+        check_drawing_path(args.out)  # before minutes of trials
+    settings = {}
+    if args.margin is not None:
+        if not (math.isfinite(args.margin) and args.margin >= 0):
+            raise PinfeedError(f"--margin must be a length >= 0 mm, got {args.margin:g}")
+        settings["station_margin_mm"] = args.margin
+    if args.trials is not None:
+        settings["trials"] = args.trials
+    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
+    if not path.is_file():
+        raise PinfeedError(f"no stored plan for {args.part} at {path}; "
+                           f"{_plan_hint(config, args.part, path.parent.parent)} first")
+    out = layout_stored(read_json(path), config, args.plan, args.mu_c, belt_speed=args.belt_speed,
+                        mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
+    for warning in out["warnings"]:
+        print(f"pinfeed: warning: {warning}", file=sys.stderr)
+    if args.out:
+        write_drawing(out, args.out)
+    if args.json:
+        _print_json(out, default=float)
+        return
+    m = out["method"]
+    print(f"{out['part']}, plan {out['plan']['number']}: {' '.join(out['plan']['pins'])} "
+          f"(mu_c {out['plan']['friction']}); model {m['model']}, {m['trials']['replayed']} trials "
+          f"({m['trials']['jammed_left_out']} jammed, left out)")
+    for s in out["stations"]:
+        print(f"  pin {s['label']:<6} x = {s['x_mm']:8.1f} mm   y = {s['y_mm']:6.1f} mm   "
+              f"radius {s['radius_mm']:g} mm")
+    speed = out["belt_speed_mm_s"]
+    print(f"belt speed {'n/a' if speed is None else f'{speed:.1f} mm/s'} ({m['belt_speed']}); "
+          f"speed limit {out['speed_limit_mm_s']:g} mm/s")
+    print(f"pitch {out['pitch_mm']:.1f} mm; belt width {out['belt_width_mm']:.1f} mm "
+          f"(y {out['belt_y_mm'][0]:.1f} to {out['belt_y_mm'][1]:.1f}); fence at y = 0 up to "
+          f"x = {out['fence_end_x_mm']:.1f} mm")
+    tp = out["throughput_per_min"]
+    print(f"throughput {'n/a' if tp is None else f'{tp:.1f} parts/min'}")
+    if args.out:
+        print(f"wrote {args.out}")
+
+
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
     from .animate import animate_stored, plan_inputs
@@ -861,6 +908,29 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: the config's, RESULTS_DIR/NAME)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_speed)
+
+    p = sub.add_parser("layout", help="a feeder to build: pin stations, part pitch, belt width, "
+                       "throughput and a drawing (DXF, SVG, PNG)")
+    p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
+    p.add_argument("--plan", type=int, default=1, help="which tight plan, 1 = the recommended one")
+    p.add_argument("--mu-c", dest="mu_c", default=None, help="which planned friction: X or LO:HI")
+    p.add_argument("--belt-speed", dest="belt_speed", type=float, default=None,
+                   help="belt speed, mm/s (default: 80%% of the plan's speed limit)")
+    p.add_argument("--mu-s", dest="mu_s", type=float, default=None,
+                   help="belt friction (default: the config's layout.mu_s, 0.5)")
+    p.add_argument("--quasi-static", dest="quasi_static", action="store_true",
+                   help="replay the trials with the plan's quasi-static model (no inertia) "
+                        "instead of the dynamic model at the belt speed")
+    p.add_argument("--margin", type=float, default=None,
+                   help="station margin, mm (default: the config's layout.station_margin_mm, 5)")
+    p.add_argument("--trials", type=int, default=None,
+                   help="random trials per initial state (default: the config's layout.trials)")
+    p.add_argument("--out", default=None, help="also draw the feeder: .dxf, .svg or .png")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--results", default=None, help="results folder holding plans/ "
+                   "(default: the config's, RESULTS_DIR/NAME)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(func=cmd_layout)
 
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")

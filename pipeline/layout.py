@@ -422,3 +422,108 @@ def _drawing(part, states, nominal_lanes, stations, pitch, entry, pin_radius, ma
                            "outcome": lane.outcome,
                            "outline": outlines(part.vertices, [x_exit], [y_end], [th_end])[0].tolist()})
     return {"entry_parts": entry_parts, "exit_parts": exit_parts}
+
+
+# ------------------------------------------------------------- stored plans
+
+
+def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None,
+                  belt_speed: float | None = None, mu_s: float | None = None,
+                  quasi_static: bool = False, settings: dict | None = None) -> dict:
+    """The layout of tight plan ``plan_number`` of a stored plan result
+    (``RESULTS/plans/NAME.json``), as ``pinfeed layout`` and the workflow make it.
+
+    The plan's speed limit is computed (``speed_limit.speed_curve`` with
+    ``speed_trials`` trials per state); without ``belt_speed`` the belt runs at
+    ``speed_fraction`` (80 %) of it. A belt speed above the limit is kept and
+    named in ``warnings``. Trials use the dynamic model at that speed, or the
+    plan's quasi-static model with ``quasi_static`` (or when no belt speed
+    passes the speed grid at all: then there is no belt speed and no
+    throughput, and ``warnings`` says so).
+    """
+    from . import simulate
+    from .planning import friction_label, pick_tight_plan
+    from .provenance import provenance_attrs
+    from .speed_limit import DEFAULT_SPEEDS, perturbation_from_verify, speed_curve
+    cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})
+    plan, mu_c, entry = pick_tight_plan(result, int(plan_number), mu_text)
+    speeds = [float(v) for v in plan.get("pin_speeds") or []]
+    if any(speeds):
+        raise PinfeedError(f"plan {plan_number} ({' '.join(plan['pins'])}) has moving pins; a layout "
+                           f"places fixed pins only: choose a plan of fixed pins with --plan N")
+    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    stored_states = entry.get("initial_states") or result.get("initial_states") or {}
+    states = {k: (float(s["theta"]), float(s["y_c"])) for k, s in stored_states.items()}
+    pin_radius = float(result.get("pin_radius", config["sweep"]["pin_radius"]))
+    mu_s = float(cfg["mu_s"] if mu_s is None else mu_s)
+    heights = [float(h) for h in plan["pin_heights_mm"]]
+    arcs = [(s["start"], s["width"]) for s in plan["final_sets"]]
+    if belt_speed is not None:
+        simulate.check_belt(part, belt_speed, mu_s)
+    else:
+        simulate.check_belt(part, min(DEFAULT_SPEEDS), mu_s)  # a bad mu_s before any work
+    curve = speed_curve(part, heights, [0.0] * len(heights), list(states.values()), arcs, mu_c,
+                        mu_s=mu_s, perturb=perturbation_from_verify(config.get("verify", {})),
+                        trials=cfg["speed_trials"], r_pin=pin_radius, seed=cfg["seed"])
+    limit = curve["speed_limit_mm_s"]
+    warnings = []
+    if belt_speed is None and limit > 0:
+        belt_speed = cfg["speed_fraction"] * limit
+        source = f"{100 * cfg['speed_fraction']:g} % of the plan's speed limit {limit:g} mm/s"
+    elif belt_speed is None:
+        source = "none"
+        quasi_static = True
+        warnings.append(f"no belt speed of the grid ({', '.join(f'{v:g}' for v in DEFAULT_SPEEDS)} "
+                        f"mm/s) passes the plan's trials: laid out with the quasi-static model, no "
+                        f"throughput; give --belt-speed MM_S")
+    else:
+        source = "given"
+        if belt_speed > limit:
+            warnings.append(f"belt speed {belt_speed:g} mm/s is above the plan's speed limit "
+                            f"{limit:g} mm/s (fewer than 99 % of its trials end in the final set)")
+    out = layout_plan(part, plan["pins"], heights, states, mu_c, pin_radius, model=result["model"],
+                      belt_speed=None if quasi_static else belt_speed, mu_s=mu_s, settings=cfg,
+                      perturb=config.get("verify"))
+    out["belt_speed_mm_s"] = None if belt_speed is None else float(belt_speed)
+    out["mu_s"] = mu_s
+    out["throughput_per_min"] = None if belt_speed is None else 60.0 * belt_speed / out["pitch_mm"]
+    out["speed_limit_mm_s"] = float(limit)
+    out["mu_c"] = list(mu_c) if isinstance(mu_c, tuple) else mu_c
+    out["plan"] = {"number": int(plan_number), "friction": friction_label(mu_c),
+                   "pins": list(plan["pins"]), "pin_heights_mm": heights,
+                   "final_sets": plan["final_sets"]}
+    out["warnings"] = warnings
+    out["method"]["belt_speed"] = source
+    out["method"]["throughput"] = "60 x belt speed / pitch" if belt_speed else "none: no belt speed"
+    out["method"]["speed_limit"] = {
+        "model": "dynamic", "trials_per_state": cfg["speed_trials"], "corners_per_state": 4,
+        "required_fraction": 0.99, "speeds_mm_s": list(DEFAULT_SPEEDS), "bisection_mm_s": 5.0,
+        "curve": curve["curve"]}
+    out.update(provenance_attrs())
+    return out
+
+
+DRAWING_SUFFIXES = (".dxf", ".svg", ".png")
+
+
+def check_drawing_path(path):
+    """A drawing path: a known suffix and a folder that exists (or can be made)
+    and is writable; a one-line :class:`PinfeedError` otherwise."""
+    import os
+    from pathlib import Path
+
+    from .checks import check_out_path
+    path = check_out_path(path, DRAWING_SUFFIXES)
+    parent = next((p for p in Path(path).absolute().parents if p.exists()), Path("."))
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise PinfeedError(f"--out {path}: cannot write in {parent} (not writable); choose another path")
+    return Path(path)
+
+
+def write_drawing(layout: dict, path):
+    """Write the feeder drawing of ``layout`` to ``path`` (.dxf, .svg or .png), atomically."""
+    from .figures.feeder import draw_feeder, write_dxf
+    path = check_drawing_path(path)
+    if path.suffix.lower() == ".dxf":
+        return write_dxf(layout, path)
+    return draw_feeder(layout, path)
