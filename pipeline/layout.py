@@ -527,3 +527,48 @@ def write_drawing(layout: dict, path):
     if path.suffix.lower() == ".dxf":
         return write_dxf(layout, path)
     return draw_feeder(layout, path)
+
+
+def layout_part(plan_result: dict, config: dict, outputs: dict) -> str:
+    """The workflow's layout stage: the first tight plan of fixed pins at the
+    first planned friction, laid out and drawn; ``outputs`` maps ``json``,
+    ``dxf``, ``svg`` and ``png`` to paths. A part with no such plan gets a JSON
+    saying why and drawings of that note. Returns a one-line summary."""
+    import time
+
+    from .io import write_json
+    start = time.perf_counter()
+    tight = (plan_result.get("tight") or [{}])[0]
+    number = next((k for k, p in enumerate(tight.get("plans") or [], start=1)
+                   if not any(p.get("pin_speeds") or [])), None)
+    name = plan_result["part"]["name"]
+    if number is None:
+        note = f"{name}: no tight plan of fixed pins to lay out"
+        write_json({"part": name, "plan": None, "note": note}, outputs["json"])
+        _note_drawings(note, outputs)
+        return note
+    out = layout_stored(plan_result, config, number)
+    out["method"]["seconds"] = round(time.perf_counter() - start, 1)
+    for key in ("dxf", "svg", "png"):
+        write_drawing(out, outputs[key])
+    write_json(out, outputs["json"])
+    return (f"{name}: plan {number} ({' '.join(out['plan']['pins'])}), pitch {out['pitch_mm']:.1f} mm, "
+            f"belt {out['belt_speed_mm_s']} mm/s (limit {out['speed_limit_mm_s']:g}), throughput "
+            f"{out['throughput_per_min']} parts/min, {out['method']['seconds']} s; warnings {out['warnings']}")
+
+
+def _note_drawings(note: str, outputs: dict) -> None:
+    import ezdxf
+
+    from .io import atomic_target
+    from .stages import _placeholder
+    for key in ("svg", "png"):
+        with atomic_target(outputs[key]) as tmp:
+            _placeholder(tmp + "." + key, note)
+            import os
+            os.replace(tmp + "." + key, tmp)
+    doc = ezdxf.new("R2010")
+    doc.layers.add("TITLE")
+    doc.modelspace().add_text(note, height=3.5, dxfattribs={"layer": "TITLE"})
+    with atomic_target(outputs["dxf"]) as tmp:
+        doc.saveas(tmp)
