@@ -77,8 +77,9 @@ def drawing_items(layout: dict) -> dict:
     return {
         "belt": [((x_lo, y_lo), (x_hi, y_lo)), ((x_lo, y_hi), (x_hi, y_hi))],
         "fence": [((x_lo, layout["fence_y_mm"]), (layout["fence_end_x_mm"], layout["fence_y_mm"]))],
-        "pins": [((s["x_mm"], s["y_mm"]), s["radius_mm"], f"{s['label']} y={s['y_mm']:g}")
-                 for s in stations],
+        # Labels alternate above and below their pins, so close pins stay readable.
+        "pins": [((s["x_mm"], s["y_mm"]), s["radius_mm"], f"{s['label']} y={s['y_mm']:g}",
+                  1.0 if k % 2 == 0 else -1.0) for k, s in enumerate(stations)],
         "dims": dims,
         "parts": parts,
         "arrow": ((x_lo + 5.0, arrow_y), (x_lo + 35.0, arrow_y)),
@@ -106,9 +107,10 @@ def draw_feeder(layout: dict, out) -> Path:
         ax.text(a[0] + 2, a[1] - 1.0, "fence", fontsize=7, va="top")
     for k, poly in enumerate(items["parts"]):
         ax.add_patch(Polygon(poly, closed=True, fc="tab:blue", ec="k", alpha=0.35, lw=0.8))
-    for centre, r, label in items["pins"]:
+    for centre, r, label, side in items["pins"]:
         ax.add_patch(Circle(centre, r, color="tab:red", zorder=3))
-        ax.text(centre[0] + r + 1.0, centre[1] + r + 0.5, label, fontsize=7, color="tab:red")
+        ax.text(centre[0] + r + 1.0, centre[1] + side * (r + 0.5), label, fontsize=7, color="tab:red",
+                va="bottom" if side > 0 else "top")
     for p1, p2, at, text, angle in items["dims"]:
         if angle == 0.0:
             a, b = (p1[0], at[1]), (p2[0], at[1])
@@ -154,10 +156,10 @@ def write_dxf(layout: dict, out) -> Path:
         msp.add_line(a, b, dxfattribs={"layer": "BELT"})
     for a, b in items["fence"]:
         msp.add_line(a, b, dxfattribs={"layer": "FENCE"})
-    for centre, r, label in items["pins"]:
+    for centre, r, label, side in items["pins"]:
         msp.add_circle(centre, r, dxfattribs={"layer": "PINS"})
         msp.add_text(label, height=TEXT_MM * 0.7, dxfattribs={"layer": "PINS"}).set_placement(
-            (centre[0] + r + 1.0, centre[1] + r + 0.5))
+            (centre[0] + r + 1.0, centre[1] + side * (r + 0.5) - (TEXT_MM if side < 0 else 0.0)))
     for p1, p2, at, text, angle in items["dims"]:
         base = (p1[0], at[1]) if angle == 0.0 else (at[0], p1[1])
         dim = msp.add_linear_dim(base=base, p1=p1, p2=p2, angle=angle, text=text,
