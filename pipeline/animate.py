@@ -35,6 +35,18 @@ class Lane:
     contacts: list = field(default_factory=list)  # (pin index, B at first contact)
     lead: list = field(default_factory=list)  # per pin: x_world - B before that pin's contact
 
+    def poses(self, b):
+        """Centroid x, y and theta (deg) at the belt travels ``b`` (an array):
+        before the first sample and after the last the part rides the belt
+        (a jammed part stays at its pin)."""
+        b = np.asarray(b, float)
+        x = np.interp(b, self.B, self.x)
+        before, after = b < self.B[0], b > self.B[-1]
+        x = np.where(before, self.x[0] + (b - self.B[0]), x)
+        if self.outcome == "ok":
+            x = np.where(after, self.x[-1] + (b - self.B[-1]), x)
+        return x, np.interp(b, self.B, self.y), np.interp(b, self.B, self.theta)
+
     def pose(self, b: float):
         """Centroid (x, y) and theta (deg) at belt travel ``b``."""
         if b >= self.B[-1] and self.outcome != "ok":
@@ -62,11 +74,52 @@ def _gap(point, poly) -> float:
     return 0.0 if np.count_nonzero(cross) % 2 else float(d)
 
 
+def pin_reach(polygons, height, r_pin) -> np.ndarray:
+    """How far downstream a pin of radius ``r_pin`` on the line ``y = height`` can
+    stand and still touch each polygon: the largest pin-centre x with the disc
+    meeting the polygon (exact: the rightmost point of the polygon grown by the
+    disc on that line), ``-inf`` where the line passes by.
+
+    Parameters
+    ----------
+    polygons : array ``(..., n, 2)`` of outlines (world frame, mm).
+    height : the pin's y, mm.
+    r_pin : the pin radius, mm.
+
+    Returns
+    -------
+    array of shape ``polygons.shape[:-2]``.
+    """
+    a = np.asarray(polygons, float)
+    b = np.roll(a, -1, axis=-2)
+    # The polygon grown by the disc is the union of the polygon and a capsule
+    # per edge; on a horizontal line its rightmost point lies on an end circle
+    # or on a side of a capsule.
+    dy = height - a[..., 1]
+    best = np.where(np.abs(dy) <= r_pin, a[..., 0] + np.sqrt(np.clip(r_pin ** 2 - dy ** 2, 0.0, None)),
+                    -np.inf).max(axis=-1)
+    edge = b - a
+    length = np.hypot(edge[..., 0], edge[..., 1])
+    normal = np.stack([-edge[..., 1], edge[..., 0]], axis=-1) / np.where(length > 0, length, 1.0)[..., None]
+    for side in (1.0, -1.0):
+        p, q = a + side * r_pin * normal, b + side * r_pin * normal
+        flat = p[..., 1] == q[..., 1]
+        t = (height - p[..., 1]) / np.where(flat, 1.0, q[..., 1] - p[..., 1])
+        x = p[..., 0] + t * (q[..., 0] - p[..., 0])
+        crossing = ~flat & (t >= 0.0) & (t <= 1.0)
+        best = np.maximum(best, np.where(crossing, x, -np.inf).max(axis=-1))
+    return best
+
+
 def contact_offset(vertices, theta_deg, dh, v_pin, r_pin, a) -> float:
     """The centroid's station relative to the pin, u = x_free - X_k, at first touch:
     the pin sits at (-u, dh + v_pin u) from the centroid (``dh`` = pin height at the
-    station minus y_c). Scanned upstream to downstream, then bisected."""
+    station minus y_c). A fixed pin: exact (:func:`pin_reach`); a moving one:
+    scanned upstream to downstream, then bisected."""
     poly = _rotated(vertices, theta_deg)
+    if v_pin == 0.0:
+        reach = float(pin_reach(poly, dh, r_pin))
+        return -reach if math.isfinite(reach) else math.nan
     reach = (2.0 * a + r_pin + abs(dh)) * (1.0 + abs(v_pin))
     us = np.linspace(-reach, reach, 4001)
     touching = [_gap(np.array([-u, dh + v_pin * u]), poly) <= r_pin for u in us]
@@ -128,7 +181,8 @@ def _lane(part, label, steps, stations, heights, speeds, pin_radius) -> Lane:
             continue
         b0 = stations[k] + u - shift  # belt travel when x_free reaches X_k + u
         s = np.asarray(r.traj_s, float)
-        t_unwrapped = T[-1] + (np.asarray(r.traj_theta, float) - float(r.traj_theta[0]))
+        # The kernel records the absolute orientation, starting from theta.
+        t_unwrapped = T[-1] + (np.asarray(r.traj_theta, float) - theta)
         B += list(b0 + s)
         X += list(stations[k] + u + s + np.asarray(r.traj_x, float))
         Y += list(y_c + np.asarray(r.traj_y, float))

@@ -487,7 +487,7 @@ def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from .config import load_config
     from .planning import friction_label
-    from .speed_limit import speed_curve
+    from .speed_limit import perturbation_from_verify, speed_curve
     from .stages import read_json
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
@@ -500,9 +500,7 @@ def cmd_speed(args):
         raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
     from .parts import Part
     part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
-    v = dict(config.get("verify", {}))
-    perturb = {"theta_deg": 2.0 * v.get("theta_sigma", 1.0), "y_mm": v.get("y_halfwidth", 0.5),
-               "pin_mm": v.get("pin_halfwidth", 0.3)}
+    perturb = perturbation_from_verify(config.get("verify", {}))
     # A tight-only plan file keeps the resting states per friction entry.
     stored_states = entry.get("initial_states") or result.get("initial_states") or {}
     states = [(s["theta"], s["y_c"]) for s in stored_states.values()]
@@ -528,16 +526,56 @@ def cmd_speed(args):
 
 
 def _pick_tight_plan(result: dict, n: int, mu_text):
-    """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
-    (default: the first planned friction), that friction and its stored entry."""
-    from .sensor_plan import tight_entry
-    entry = tight_entry(result, mu_text)
-    if not entry["plans"]:
-        raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
-    if not 1 <= n <= len(entry["plans"]):
-        raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
-    mu = entry["mu_c"]
-    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
+    """See :func:`pipeline.planning.pick_tight_plan` (shared with ``pinfeed layout``)."""
+    from .planning import pick_tight_plan
+    return pick_tight_plan(result, n, mu_text)
+
+
+def cmd_layout(args):
+    """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
+    from .config import load_config
+    from .layout import check_drawing_path, layout_stored, write_drawing
+    from .stages import read_json
+    config = load_config(args.config)
+    if args.out:
+        check_drawing_path(args.out)  # before minutes of trials
+    settings = {}
+    if args.margin is not None:
+        if not (math.isfinite(args.margin) and args.margin >= 0):
+            raise PinfeedError(f"--margin must be a length >= 0 mm, got {args.margin:g}")
+        settings["station_margin_mm"] = args.margin
+    if args.trials is not None:
+        settings["trials"] = args.trials
+    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
+    if not path.is_file():
+        raise PinfeedError(f"no stored plan for {args.part} at {path}; "
+                           f"{_plan_hint(config, args.part, path.parent.parent)} first")
+    out = layout_stored(read_json(path), config, args.plan, args.mu_c, belt_speed=args.belt_speed,
+                        mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
+    for warning in out["warnings"]:
+        print(f"pinfeed: warning: {warning}", file=sys.stderr)
+    if args.out:
+        write_drawing(out, args.out)
+    if args.json:
+        _print_json(out, default=float)
+        return
+    m = out["method"]
+    print(f"{out['part']}, plan {out['plan']['number']}: {' '.join(out['plan']['pins'])} "
+          f"(mu_c {out['plan']['friction']}); model {m['model']}, {m['trials']['replayed']} trials "
+          f"({m['trials']['jammed_left_out']} jammed, left out)")
+    for s in out["stations"]:
+        print(f"  pin {s['label']:<6} x = {s['x_mm']:8.1f} mm   y = {s['y_mm']:6.1f} mm   "
+              f"radius {s['radius_mm']:g} mm")
+    speed = out["belt_speed_mm_s"]
+    print(f"belt speed {'n/a' if speed is None else f'{speed:.1f} mm/s'} ({m['belt_speed']}); "
+          f"speed limit {out['speed_limit_mm_s']:g} mm/s")
+    print(f"pitch {out['pitch_mm']:.1f} mm; belt width {out['belt_width_mm']:.1f} mm "
+          f"(y {out['belt_y_mm'][0]:.1f} to {out['belt_y_mm'][1]:.1f}); fence at y = 0 up to "
+          f"x = {out['fence_end_x_mm']:.1f} mm")
+    tp = out["throughput_per_min"]
+    print(f"throughput {'n/a' if tp is None else f'{tp:.1f} parts/min'}")
+    if args.out:
+        print(f"wrote {args.out}")
 
 
 def cmd_animate(args):
@@ -627,7 +665,7 @@ def _classify_pin(args, stored, plan, root, name):
     stored sensor plan's first pin, else the first pin of the stored recommended
     tight plan (first planned friction), else that of paper mode's best
     fixed-pin plan, else --y-pin (which always wins)."""
-    from .sensor_plan import tight_entry
+    from .planning import tight_entry
     entry = tight_entry(plan) if plan is not None and plan.get("tight") else None
     plan_path = root / "plans" / f"{name}.json"
     if args.y_pin is not None:
@@ -917,6 +955,29 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: the config's, RESULTS_DIR/NAME)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_speed)
+
+    p = sub.add_parser("layout", help="a feeder to build: pin stations, part pitch, belt width, "
+                       "throughput and a drawing (DXF, SVG, PNG)")
+    p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
+    p.add_argument("--plan", type=int, default=1, help="which tight plan, 1 = the recommended one")
+    p.add_argument("--mu-c", dest="mu_c", default=None, help="which planned friction: X or LO:HI")
+    p.add_argument("--belt-speed", dest="belt_speed", type=float, default=None,
+                   help="belt speed, mm/s (default: 80%% of the plan's speed limit)")
+    p.add_argument("--mu-s", dest="mu_s", type=float, default=None,
+                   help="belt friction (default: the config's layout.mu_s, 0.5)")
+    p.add_argument("--quasi-static", dest="quasi_static", action="store_true",
+                   help="replay the trials with the plan's quasi-static model (no inertia) "
+                        "instead of the dynamic model at the belt speed")
+    p.add_argument("--margin", type=float, default=None,
+                   help="station margin, mm (default: the config's layout.station_margin_mm, 5)")
+    p.add_argument("--trials", type=int, default=None,
+                   help="random trials per initial state (default: the config's layout.trials)")
+    p.add_argument("--out", default=None, help="also draw the feeder: .dxf, .svg or .png")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--results", default=None, help="results folder holding plans/ "
+                   "(default: the config's, RESULTS_DIR/NAME)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(func=cmd_layout)
 
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")

@@ -142,3 +142,31 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
 
 def planner_pin_heights(planner: TightPlanner) -> dict:
     return {label: pin.y for label, pin in planner.pins.items()}
+
+
+def tight_entry(plan_result: dict, friction=None) -> dict:
+    """The stored tight-planner entry at ``friction`` (a value, a range or its
+    text ``LO:HI``; default the first planned friction, ``planner.mu_c``)."""
+    tight = plan_result.get("tight") or []
+    if not tight:
+        raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan' "
+                           "(--mode tight or both) or re-run the workflow")
+    if friction is None:
+        return tight[0]
+    want = friction_label(parse_friction(friction))
+    found = [t for t in tight if t["friction"] == want]
+    if not found:
+        raise PinfeedError(f"no stored plan at mu_c {want}; stored: {', '.join(t['friction'] for t in tight)}")
+    return found[0]
+
+
+def pick_tight_plan(result: dict, n: int, mu_text):
+    """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
+    (default: the first planned friction), that friction and its stored entry."""
+    entry = tight_entry(result, mu_text)
+    if not entry["plans"]:
+        raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
+    if not 1 <= n <= len(entry["plans"]):
+        raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
+    mu = entry["mu_c"]
+    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry

@@ -18,7 +18,8 @@ from .io import write_text_atomic
 from .provenance import creation_time, git_commit
 
 SECTIONS = (("outline", "Outline"), ("maps", "Configuration maps"), ("plans", "Plans"),
-            ("verification", "Verification"), ("animation", "Animation"), ("sensing", "Sensing"))
+            ("verification", "Verification"), ("animation", "Animation"), ("layout", "Feeder layout"),
+            ("sensing", "Sensing"))
 STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto}img{max-width:100%}"
          "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;font-size:90%}"
          "tr.fail td{background:#f8d0d0}.files{font-size:90%}")
@@ -77,7 +78,7 @@ def _toc(parts: dict) -> list[str]:
     p = ['<nav id="toc"><h2>Contents</h2><ul>']
     for name in parts:
         subs = "".join(f'<li><a href="#{_anchor(name, key)}">{title}</a></li>' for key, title in SECTIONS
-                       if key != "sensing" or "sensing" in parts[name])
+                       if key not in ("sensing", "layout") or parts[name].get(key))
         p.append(f'<li class="toc-part"><a href="#{_anchor(name)}">{html.escape(name)}</a><ul>{subs}</ul></li>')
     return p + ["</ul></nav>"]
 
@@ -114,10 +115,33 @@ def _part_section(name: str, part: dict, base, catalog) -> list[str]:
     p += _figure(files, "verification", base, "Verification by plan (failing states in red)")
     p.append(f'<h3 id="{_anchor(name, "animation")}">Animation</h3>')
     p += _animation(res, files, base)
+    if part.get("layout"):
+        p.append(f'<h3 id="{_anchor(name, "layout")}">Feeder layout</h3>')
+        p += _layout_section(part["layout"], files, base)
     if "sensing" in part:
         p.append(f'<h3 id="{_anchor(name, "sensing")}">Sensing</h3>')
         p += _sensing_section(part["sensing"], files, base)
     return p
+
+
+def _layout_section(lay: dict, files: dict, base) -> list[str]:
+    """The feeder to build: throughput, speed limit, pitch, stations, the drawing."""
+    if not lay.get("plan"):
+        return [f"<p>{html.escape(lay.get('note', 'no layout'))}</p>"]
+    tp, v = lay.get("throughput_per_min"), lay.get("belt_speed_mm_s")
+    p = [f"<p>Plan {lay['plan']['number']} ({html.escape(' '.join(lay['plan']['pins']))}): "
+         f"<b>throughput {'n/a' if tp is None else f'{tp:.1f}'} parts/min</b> at belt speed "
+         f"{'n/a' if v is None else f'{v:.1f}'} mm/s ({html.escape(lay['method']['belt_speed'])}); "
+         f"<b>speed limit {lay['speed_limit_mm_s']:g} mm/s</b>; pitch {lay['pitch_mm']:.1f} mm; belt "
+         f"width {lay['belt_width_mm']:.1f} mm; model {html.escape(lay['method']['model'])}, "
+         f"{lay['method']['trials']['replayed']} trials. Stations: " + ", ".join(
+             f"{html.escape(s['label'])} at x = {s['x_mm']:.1f} mm, y = {s['y_mm']:g} mm"
+             for s in lay["stations"]) + "</p>"]
+    p += [f'<p class="warn">{html.escape(w)}</p>' for w in lay.get("warnings", [])]
+    p.append('<p class="files">Drawing: ' + ", ".join(
+        _link(files[k], base, k.replace("layout_", "").upper()) for k in
+        ("layout_json", "layout_dxf", "layout_svg") if k in files) + "</p>")
+    return p + _figure(files, "layout_png", base, "Feeder drawing (top view)")
 
 
 def _paper_plans(res: dict) -> list[str]:

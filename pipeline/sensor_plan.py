@@ -66,23 +66,6 @@ from .sensing import PERTURB_DEFAULTS, Sensor, score_table
 from .verify import predicted_sets
 
 
-def tight_entry(plan_result: dict, friction=None) -> dict:
-    """The stored tight-planner entry at ``friction`` (a value, a range or its
-    text ``LO:HI``; default the first planned friction, ``planner.mu_c``)."""
-    from .planning import friction_label, parse_friction
-    tight = plan_result.get("tight") or []
-    if not tight:
-        raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan' "
-                           "(--mode tight or both) or re-run the workflow")
-    if friction is None:
-        return tight[0]
-    want = friction_label(parse_friction(friction))
-    found = [t for t in tight if t["friction"] == want]
-    if not found:
-        raise PinfeedError(f"no stored plan at mu_c {want}; stored: {', '.join(t['friction'] for t in tight)}")
-    return found[0]
-
-
 def sensing_frictions(entry: dict):
     """``(planned, profiles)``: the entry's friction as planned (a value or a
     tuple ``(lo, hi)``) and the one value the simulated profiles use."""
@@ -300,6 +283,7 @@ def sense_part(plan_path, config: dict, log=print, friction=None) -> dict:
     table at its first pin, the per-verdict final sets and their end-to-end
     check, with provenance."""
     from .parts import Part
+    from .planning import tight_entry
     from .provenance import provenance_attrs
     from .stages import read_json
     sc, sweep = config["sensing"], config["sweep"]

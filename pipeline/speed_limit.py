@@ -24,6 +24,15 @@ from .simulate import FROUDE_MAX, G_MM_S2, check_belt
 DEFAULT_SPEEDS = (10.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
 
 
+def perturbation_from_verify(verify: dict) -> dict:
+    """The uniform half-widths of :func:`speed_curve` from a config's ``verify``
+    section: orientation +-2 sigma (verification truncates its normal there),
+    centroid height and pin position as verified."""
+    v = dict(verify or {})
+    return {"theta_deg": 2.0 * v.get("theta_sigma", 1.0), "y_mm": v.get("y_halfwidth", 0.5),
+            "pin_mm": v.get("pin_halfwidth", 0.3)}
+
+
 def _in_arcs(theta_deg, arcs):
     for start, width in arcs:
         if (theta_deg - start) % 360.0 <= width:

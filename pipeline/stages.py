@@ -389,6 +389,7 @@ def part_files(results, name: str) -> dict:
            for kind in ("plan", "verify", "sensing")}
     out.update({kind: results / "figures" / f"{kind}_{name}.png" for kind in PART_FIGURES})
     out["animation"] = results / "animations" / f"{name}.gif"
+    out.update({f"layout_{ext}": results / f"layout_{name}.{ext}" for ext in ("json", "png", "dxf", "svg")})
     return out
 
 
@@ -404,7 +405,9 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=()):
         name = plan["part"]["name"]
         files = {k: p for k, p in part_files(results, name).items() if Path(p).is_file()}
         files.update(plan=Path(plan_path), verify=Path(verify_path))
-        parts[name] = {"plan": plan, "verify": read_json(verify_path), "files": files,
+        if "layout_json" in files:  # the feeder layout (rules/layout.smk)
+            parts.setdefault(name, {})["layout"] = read_json(files["layout_json"])
+        parts[name] = {**parts.get(name, {}), "plan": plan, "verify": read_json(verify_path), "files": files,
                        "shards": sorted((e for e in cat.entries if e["part_id"] == plan["part"]["id"]),
                                         key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0)))}
     for path in sensing_paths:  # force/torque sensor on the first pin (rules/sense.smk)

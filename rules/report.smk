@@ -71,6 +71,9 @@ rule report:
         verify=rules.figures.input.verify,
         outlines=expand(rules.outline.output.outline, name=PLANNED),
         animations=expand(rules.animate.output.animation, name=PLANNED),
+        # feeder layouts (rules/layout.smk): stations, pitch, throughput, drawings
+        layouts=expand(rules.layout.output.layout, name=PLANNED),
+        layout_drawings=expand(rules.layout.output.png, name=PLANNED),
         # sensing (rules/sense.smk): results and figures of the sensed parts
         sensing=expand(rules.sense.output.sensing, name=SENSED),
         sensing_figures=expand(f"{RESULTS}/figures/{{kind}}_{{name}}.png",
