@@ -219,6 +219,8 @@ def _centre(cell):
 
 # Pairs of corner indices (in ``_corners`` order) joined by a cell edge.
 _EDGES = [(i, j) for i in range(8) for j in range(i + 1, 8) if bin(i ^ j).count("1") == 1]
+_EDGE_I = np.array([i for i, _ in _EDGES])
+_EDGE_J = np.array([j for _, j in _EDGES])
 
 
 def _split(cell, lo, hi):
@@ -263,11 +265,13 @@ def propagate(state: StateSet, y_pin: float, part: Part, lattice: OutcomeLattice
         used += len(cells) * 9
         if used > MAX_POINTS:
             return UNRESOLVED
-        lattice.ensure([k for c in cells for k in _corners(c) + [_centre(c)]])
+        cell_keys = [_corners(c) + [_centre(c)] for c in cells]
+        lattice.ensure([k for keys in cell_keys for k in keys])
         refine = []
-        for cell in cells:
-            touched = touched or any(lattice.known[k][0] != MISS for k in _corners(cell) + [_centre(cell)])
-            outcome = _cell_outcome(cell, lattice, tol, a, lo, hi)
+        for cell, keys in zip(cells, cell_keys):
+            vals = np.array([lattice.known[k] for k in keys])  # (9, 3): status, theta_f, dy
+            touched = touched or bool((vals[:, 0] != MISS).any())
+            outcome = _cell_outcome(cell, keys, vals, tol, a, lo, hi)
             if outcome == "jam":
                 if _is_finest(cell):
                     return None
@@ -285,23 +289,24 @@ def propagate(state: StateSet, y_pin: float, part: Part, lattice: OutcomeLattice
     return Transition(children, d_lo, d_hi, jump or len(children) > 1, touched)
 
 
-def _cell_outcome(cell, lattice, tol, a, lo, hi):
+def _cell_outcome(cell, keys, vals, tol, a, lo, hi):
     """``"jam"``, ``"split"`` or the padded piece ``(start, width, dy_lo, dy_hi,
     g_lo, g_hi)`` with ``g = dy - d a`` (mm): the new centroid height is
-    ``y_pin + offset + g``, which varies far less over a cell than ``dy``."""
-    keys = _corners(cell) + [_centre(cell)]
-    vals = [lattice.known[k] for k in keys]
-    if any(v[0] == JAMMED or v[0] == TRUNCATED for v in vals):
+    ``y_pin + offset + g``, which varies far less over a cell than ``dy``.
+    ``keys``: the cell's 8 corners (``_corners`` order) and centre; ``vals``
+    their outcomes as rows ``(status, theta_f, dy)``."""
+    status = vals[:, 0]
+    if ((status == JAMMED) | (status == TRUNCATED)).any():
         return "jam"
-    ref = vals[0][1]
-    rel = [((v[1] - ref + 180.0) % 360.0) - 180.0 for v in vals]
-    if any(abs(rel[i] - rel[j]) > tol.jump_deg for i, j in _EDGES):
+    ref = vals[0, 1]
+    rel = ((vals[:, 1] - ref + 180.0) % 360.0) - 180.0
+    if np.abs(rel[_EDGE_I] - rel[_EDGE_J]).max() > tol.jump_deg:
         return "split"
-    dys = [v[2] for v in vals]
-    gs = [v[2] - k[1] * UNITS[1] * a for v, k in zip(vals, keys)]
-    dev = abs(rel[8] - sum(rel[:8]) / 8.0)
-    dev_y = abs(dys[8] - sum(dys[:8]) / 8.0)
-    dev_g = abs(gs[8] - sum(gs[:8]) / 8.0)
+    dys = vals[:, 2]
+    gs = dys - np.array([k[1] for k in keys]) * (UNITS[1] * a)
+    dev = abs(rel[8] - rel[:8].mean())
+    dev_y = abs(dys[8] - dys[:8].mean())
+    dev_g = abs(gs[8] - gs[:8].mean())
     if (dev > tol.linear_deg or dev_y > tol.linear_dy) and not _is_finest(cell):
         return "split"
     pad = 2.0 * dev + tol.pad_deg
@@ -309,22 +314,31 @@ def _cell_outcome(cell, lattice, tol, a, lo, hi):
     pad_g = 2.0 * dev_g + tol.pad_dy
     # Only the part of the cell inside the box counts: interpolate the corners
     # multilinearly to the box's clipped corners (the pad covers the curvature).
-    fr = [(min(1.0, max(0.0, (lo[k] - c0) / (c1 - c0))), min(1.0, max(0.0, (hi[k] - c0) / (c1 - c0))))
-          for k, (c0, c1) in enumerate(cell)]
-    clipped = [[_trilinear(v[:8], u, w, x) for u in fr[0] for w in fr[1] for x in fr[2]]
-               for v in (rel, dys, gs)]
-    rel, dys, gs = clipped
-    return ((ref + min(rel) - pad) % 360.0, max(rel) - min(rel) + 2 * pad,
-            min(dys) - pad_y, max(dys) + pad_y, min(gs) - pad_g, max(gs) + pad_g)
+    clipped = _clip_corners(np.stack([rel[:8], dys[:8], gs[:8]]), cell, lo, hi)
+    rel_lo, dy_lo, g_lo = clipped.min(axis=1)
+    rel_hi, dy_hi, g_hi = clipped.max(axis=1)
+    return (float((ref + rel_lo - pad) % 360.0), float(rel_hi - rel_lo + 2 * pad),
+            float(dy_lo - pad_y), float(dy_hi + pad_y), float(g_lo - pad_g), float(g_hi + pad_g))
 
 
-def _trilinear(v, u, w, x):
-    """Interpolate corner values ``v`` (``_corners`` order) at fractions ``(u, w, x)``."""
-    out = 0.0
-    for i in range(8):
-        bt, bd, bm = (i >> 2) & 1, (i >> 1) & 1, i & 1
-        out += v[i] * (u if bt else 1 - u) * (w if bd else 1 - w) * (x if bm else 1 - x)
-    return out
+def _clip_corners(values, cell, lo, hi):
+    """Multilinear interpolation of corner values to the corners of the cell
+    clipped to the box ``[lo, hi]``.
+
+    ``values`` is ``(n, 8)`` in ``_corners`` order (theta, d, mu bits, theta
+    the slowest); returns ``(n, 8)``. One linear interpolation per axis in
+    turn: the interpolant is separable, so this equals the trilinear formula.
+    An axis the box covers whole keeps its corners."""
+    v = values.reshape(-1, 2, 2, 2)
+    for axis, (c0, c1) in enumerate(cell):
+        u0 = min(1.0, max(0.0, (lo[axis] - c0) / (c1 - c0)))
+        u1 = min(1.0, max(0.0, (hi[axis] - c0) / (c1 - c0)))
+        if u0 == 0.0 and u1 == 1.0:
+            continue
+        a0 = np.take(v, 0, axis=axis + 1)
+        a1 = np.take(v, 1, axis=axis + 1)
+        v = np.stack([a0 + (a1 - a0) * u0, a0 + (a1 - a0) * u1], axis=axis + 1)
+    return v.reshape(values.shape[0], 8)
 
 
 def _corner_pieces(cell, lattice, tol, a):
