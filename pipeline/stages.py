@@ -152,12 +152,15 @@ def plan_frictions(config: dict) -> list:
 
 def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progress=None) -> list:
     """Tight plans at every friction of :func:`plan_frictions` (the first is the
-    recommended one); the planner's rollouts are stored in the catalog."""
+    recommended one), at ``planner.belt_speed`` when it is set; the planner's
+    rollouts are stored in the catalog (keyed by model, pin speed and belt)."""
     from .lattice_store import load_lattice, save_lattice
-    from .planning import plan_tight
+    from .planning import plan_tight, planner_belt
     sweep, model = config["sweep"], config["planner"]["model"]
+    belt_speed, mu_s = planner_belt(config, part)
     speeds = [0.0] + [float(v) for v in config["planner"].get("dynamic", {}).get("speeds", [])]
-    lattices = {v: load_lattice(catalog_root, part, model, v, sweep["pin_radius"], sweep.get("kernel"))
+    lattices = {v: load_lattice(catalog_root, part, model, v, sweep["pin_radius"], sweep.get("kernel"),
+                                belt_speed=belt_speed, mu_s=mu_s)
                 for v in speeds}
     out = []
     for mu_c in plan_frictions(config):
@@ -213,7 +216,8 @@ def verify_part(plan_result: dict, config: dict) -> dict:
         mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
         res = verify_plan(part, plan, dict(zip(plan["pins"], plan["pin_heights_mm"])), states, mu,
                           radius, plan_result["model"], config.get("verify", {}), kernel=kernel,
-                          speeds=dict(zip(plan["pins"], plan["pin_speeds"])))
+                          speeds=dict(zip(plan["pins"], plan["pin_speeds"])),
+                          belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
         res.pop("trials_detail")
         out["checks"].append({"kind": f"tight, mu_c {tight['friction']}", **res})
     if not out["checks"]:
@@ -321,7 +325,8 @@ def _carried_figure(config, res, path):
     mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
     starts = {k: (v["theta"], v["y_c"]) for k, v in res["initial_states"].items()}
     replays = replayed_paths(part, plan, starts, mu, config["sweep"]["pin_radius"], res["model"],
-                             config.get("verify", {}), kernel=config["sweep"].get("kernel"))
+                             config.get("verify", {}), kernel=config["sweep"].get("kernel"),
+                             belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
     plot_carried(plan, replays, f"{name}: carried sets of plan {' '.join(plan['pins'])} (mu_c "
                  f"{tight['friction']}) against {len(next(iter(replays.values()))[0])} replayed "
                  f"rollouts per state", path)
