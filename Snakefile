@@ -48,6 +48,7 @@ include: "rules/sweep.smk"
 include: "rules/catalog.smk"
 include: "rules/plan.smk"
 include: "rules/sense.smk"
+include: "rules/speed.smk"
 include: "rules/report.smk"
 
 

@@ -502,68 +502,27 @@ def _results_arg(args, config) -> Path:
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from .config import load_config
-    from .planning import friction_label
-    from .speed_limit import speed_curve
+    from .speed_limit import stored_plan_speed
     from .stages import read_json
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
                            f"{args.part} --mode both --out {path}' or the workflow ('make run') first")
-    result = read_json(path)
-    plan, mu_c, entry = _pick_tight_plan(result, args.plan, args.mu_c)
     if not (args.mu_s > 0):
         raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
-    from .parts import Part
-    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
-    v = dict(config.get("verify", {}))
-    perturb = {"theta_deg": 2.0 * v.get("theta_sigma", 1.0), "y_mm": v.get("y_halfwidth", 0.5),
-               "pin_mm": v.get("pin_halfwidth", 0.3)}
-    # A tight-only plan file keeps the resting states per friction entry.
-    stored_states = entry.get("initial_states") or result.get("initial_states") or {}
-    states = [(s["theta"], s["y_c"]) for s in stored_states.values()]
-    arcs = [(s["start"], s["width"]) for s in plan["final_sets"]]
-    res = speed_curve(part, plan["pin_heights_mm"], plan["pin_speeds"], states, arcs, mu_c,
-                      mu_s=args.mu_s, perturb=perturb, trials=args.trials,
-                      r_pin=config["sweep"]["pin_radius"])
-    out = {"part": part.name, "pin_labels": list(plan["pins"]),
-           "pin_heights_mm": list(plan["pin_heights_mm"]),
-           "final_set": [{"start": s, "width": w} for s, w in arcs],
-           "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c, "mu_s": args.mu_s,
-           "speed_limit_mm_s": res["speed_limit_mm_s"], "curve": res["curve"],
-           "method": f"dynamic model, {args.trials} perturbed trials per initial state plus corners "
-                     f"at each speed; limit = highest speed with >= 99 % in the final set, 5 mm/s "
-                     f"bisection"}
+    if args.trials < 1:
+        raise PinfeedError(f"--trials must be at least 1, got {args.trials}")
+    out = stored_plan_speed(read_json(path), config, plan=args.plan, mu_text=args.mu_c,
+                            mu_s=args.mu_s, trials=args.trials)
     if args.json:
         _print_json(out, default=float)
         return
-    print(f"{part.name}, plan {' '.join(plan['pins'])} (mu_c {friction_label(mu_c)}, mu_s {args.mu_s:g}): "
-          f"speed limit {res['speed_limit_mm_s']:g} mm/s")
-    for speed, frac in res["curve"]:
+    print(f"{out['part']}, plan {' '.join(out['pin_labels'])} (mu_c {out['friction']}, mu_s "
+          f"{args.mu_s:g}): speed limit {out['speed_limit_mm_s']:g} mm/s "
+          f"({out['trials_per_speed']} trials per speed, {out['seconds']:.0f} s)")
+    for speed, frac in out["curve"]:
         print(f"  {speed:7.1f} mm/s: {100 * frac:5.1f} % of trials in the final set")
-
-
-def _pick_tight_plan(result: dict, n: int, mu_text):
-    """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
-    (default: the first planned friction), that friction and its stored entry."""
-    from .planning import friction_label, parse_friction
-    tight = result.get("tight") or []
-    if not tight:
-        raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan'")
-    entry = tight[0]
-    if mu_text is not None:
-        want = friction_label(parse_friction(mu_text))
-        found = [t for t in tight if t["friction"] == want]
-        if not found:
-            raise PinfeedError(f"no stored plan at mu_c {want}; stored: "
-                               f"{', '.join(t['friction'] for t in tight)}")
-        entry = found[0]
-    if not entry["plans"]:
-        raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
-    if not 1 <= n <= len(entry["plans"]):
-        raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
-    mu = entry["mu_c"]
-    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
 
 
 def cmd_animate(args):
