@@ -137,7 +137,9 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
                           kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
                           mu_s=planner.mu_s)
         plan.verification = {"trials": res["trials"], "successes": res["successes"],
-                             "failures": res["failures"], "rows": res["rows"]}
+                             "failures": res["failures"], "rows": res["rows"], "model": res["model"],
+                             **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}
+                                if "belt_speed" in res else {})}
         if progress:
             progress(f"verified {' '.join(plan.pins)}: {res['successes']}/{res['trials']} trials")
     candidates.sort(key=lambda p: p.rank_key())

@@ -11,7 +11,13 @@ LIMIT_COLOUR = "#b2182b"
 
 
 def plot_speed_curve(result: dict, out, title: str | None = None) -> Path:
-    """Draw a speed result (``speed_limit.stored_plan_speed``) to ``out``.
+    """Draw a speed result (``speed_limit.stored_plan_speed``) to ``out``
+    (see :func:`speed_curve_figure`)."""
+    return save_figure(speed_curve_figure(result, title), out)
+
+
+def speed_curve_figure(result: dict, title: str | None = None):
+    """The figure of a speed result (``speed_limit.stored_plan_speed``).
 
     x: belt speed in mm/s; y: fraction of the trials that end in the plan's
     final set. The required fraction is a dashed horizontal line, the speed
@@ -44,4 +50,4 @@ def plot_speed_curve(result: dict, out, title: str | None = None) -> Path:
     ax.set_title(title or f"{result.get('part', '')}: plan {pins}, mu_c {result.get('friction', '')}, "
                           f"mu_s {result.get('mu_s', 0.5):g}", fontsize=9)
     fig.tight_layout()
-    return save_figure(fig, out)
+    return fig
