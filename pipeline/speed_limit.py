@@ -1,11 +1,13 @@
 """How fast may a plan run? Success rate against belt speed, and the speed limit.
 
-Plain inputs only (the planner's plan format is being rewritten): a part, the
-pin heights of the sequence, their speed ratios, the initial states, the
-plan's predicted final arcs and the friction. Each trial perturbs the initial
-state, the pin heights and mu_c, and replays the sequence with the dynamic
-model (``kernels.dynamic``); a trial succeeds when every passage ends ok and
-the final orientation lies in one of the final arcs. The same random draws
+:func:`speed_curve` takes plain inputs: a part, the pin heights of the
+sequence, their speed ratios, the initial states, the plan's predicted final
+arcs and the friction; :func:`stored_plan_speed` reads them from a stored
+plan file (``pinfeed speed`` and the workflow's speed stage). Each trial
+perturbs the initial state, the pin heights and mu_c, and replays the
+sequence with the dynamic model (``kernels.dynamic``; every trial past one
+pin in one parallel batch); a trial succeeds when every passage ends ok or
+misses and the final orientation lies in one of the final arcs. The same random draws
 are used at every speed (common random numbers), so the curve is not noisy
 from speed to speed. The speed limit is the highest speed at which at least
 ``required`` of the trials succeed, found on the coarse grid and refined by
