@@ -102,6 +102,17 @@ def test_belt_speed_plan_is_verified_with_the_dynamic_model(planned):
     assert quasi["tight"][0]["plans"][0]["verification"]["model"] == "minpower"
 
 
+def _one_by_one(theta, y_c, mu, heights, belt_speed):
+    """Passages past each pin in turn with the scalar public API: ``(theta, y_c, ok)``,
+    ``ok`` False once a passage jams or is truncated."""
+    for h in heights:
+        one = simulate.dynamic_rollout(TRI, theta, (h - y_c) / TRI.a, mu, 3.0, belt_speed, 0.5)
+        if str(one.status.values) in ("jammed", "truncated"):
+            return theta, y_c, False
+        theta, y_c = float(one.theta_f), y_c + float(one.dy)
+    return theta, y_c, True
+
+
 def test_replay_at_belt_speed_equals_passages_one_by_one():
     rng = np.random.default_rng(3)
     theta, y_c = rng.uniform(0, 360, 4), rng.uniform(10, 14, 4)
@@ -109,13 +120,9 @@ def test_replay_at_belt_speed_equals_passages_one_by_one():
     tf, yf, jam, _ = replay(TRI, heights, [0.0, 0.0], theta, y_c, mu, offsets, 3.0, "minpower",
                             belt_speed=BELT, mu_s=0.5)
     for j in range(4):
-        th, y = theta[j], y_c[j]
-        for h in heights:
-            one = simulate.dynamic_rollout(TRI, th, (h - y) / TRI.a, mu[j], 3.0, BELT, 0.5)
-            if str(one.status.values) in ("jammed", "truncated"):
-                break
-            th, y = float(one.theta_f), y + float(one.dy)
-        if not jam[j]:
+        th, y, ok = _one_by_one(theta[j], y_c[j], mu[j], heights, BELT)
+        assert ok == (not jam[j])
+        if ok:
             assert tf[j] == pytest.approx(th % 360.0, abs=1e-6) and yf[j] == pytest.approx(y, abs=1e-6)
 
 
@@ -188,13 +195,7 @@ def test_batched_success_fraction_equals_passages_one_at_a_time():
     good = total = 0
     for th, yc, mu, pins in draws:
         for i in range(th.size):
-            theta, y, ok = th[i], yc[i], True
-            for k in range(len(heights)):
-                one = simulate.dynamic_rollout(TRI, theta, (pins[i, k] - y) / TRI.a, mu[i], 3.0, 200.0)
-                if str(one.status.values) in ("jammed", "truncated"):
-                    ok = False
-                    break
-                theta, y = float(one.theta_f), y + float(one.dy)
+            theta, _, ok = _one_by_one(th[i], yc[i], mu[i], pins[i], 200.0)
             good += ok and any((theta - s) % 360.0 <= w for s, w in arcs)
             total += 1
     assert 0 < good < total  # the arcs catch some trials and miss others: a real comparison
