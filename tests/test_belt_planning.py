@@ -66,8 +66,12 @@ def test_belt_speed_shards_are_apart_from_quasi_static_ones(planned):
     # The catalog index lists both refinement files.
     from pipeline.catalog import Catalog
     Catalog.rebuild(tmp / "cat")
-    listed = {r["file"] for r in json.loads((tmp / "cat" / "index.json").read_text())["refinements"]}
-    assert {quasi.relative_to(tmp / "cat").as_posix(), belt.relative_to(tmp / "cat").as_posix()} <= listed
+    listed = {r["file"]: r for r in json.loads((tmp / "cat" / "index.json").read_text())["refinements"]}
+    quasi_entry = listed[quasi.relative_to(tmp / "cat").as_posix()]
+    belt_entry = listed[belt.relative_to(tmp / "cat").as_posix()]
+    assert (quasi_entry["model"], quasi_entry["belt_speed"]) == ("minpower", None)
+    assert (belt_entry["model"], belt_entry["belt_speed"], belt_entry["mu_s"]) == ("dynamic", BELT, 0.5)
+    assert belt_entry["part_id"] == TRI.id and belt_entry["v_pin"] == 0.0
 
 
 def test_belt_speed_outcomes_are_dynamic_rollouts_at_that_speed(planned):
