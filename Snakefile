@@ -49,6 +49,7 @@ include: "rules/catalog.smk"
 include: "rules/plan.smk"
 include: "rules/sense.smk"
 include: "rules/layout.smk"
+include: "rules/speed.smk"
 include: "rules/report.smk"
 
 

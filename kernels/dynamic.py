@@ -424,3 +424,45 @@ def _dyn_rollout_grid(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_p
             changes[i, j] = res[5]
             peak[i, j] = res[6]
     return status, reason, theta_f, dy, travel, changes, peak
+
+
+@jit_parallel
+def _dyn_rollout_points(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, fr,
+                        restitution, eps, h, max_travel, max_steps, n_threads):
+    """Dynamic rollouts at scattered points ``(theta_i[k], d[k], mu_c[k])``.
+
+    The belt-speed twin of ``points._rollout_points``: the planner's
+    propagation and the verification replay at a belt speed need rollouts at
+    points that do not form a grid. Points go to threads in interleaved
+    chunks (``k, k + n_threads, ...``) so that long rollouts spread over
+    every thread; each point is independent, so the result does not depend
+    on the thread count.
+
+    Parameters
+    ----------
+    verts, area, a, quad, convex : from ``rollout._prepare``.
+    mu_c, theta_i, d : 1-D float64 arrays of equal length (theta_i in radians).
+    r_pin, v_pin, fr, restitution, eps, h, max_travel, max_steps : as for
+        :func:`_dyn_rollout`.
+    n_threads : number of interleaved chunks (use the thread count).
+
+    Returns
+    -------
+    (status, reason, theta_f, dy)
+        int8, int8 (``DYN_REASONS``), float64 (radians), float64 (part's unit).
+    """
+    n = theta_i.shape[0]
+    status = np.empty(n, dtype=np.int8)
+    reason = np.empty(n, dtype=np.int8)
+    theta_f = np.empty(n)
+    dy = np.empty(n)
+    n_threads = max(1, min(n_threads, n))
+    for t in prange(n_threads):
+        for k in range(t, n, n_threads):
+            res = _dyn_rollout(verts, area, a, quad, convex, mu_c[k], r_pin, theta_i[k], d[k],
+                               v_pin, fr, restitution, eps, h, max_travel, max_steps, False)
+            status[k] = res[0]
+            reason[k] = res[1]
+            theta_f[k] = res[2]
+            dy[k] = res[3]
+    return status, reason, theta_f, dy

@@ -175,7 +175,10 @@ class Catalog:
                 continue  # an unfinished atomic write
             if path.relative_to(root).parts[0] == "refine":
                 # the planner's on-demand rollouts (pipeline.lattice_store), not maps
-                refinements.append({"file": path.relative_to(root).as_posix(), "sha256": _sha256(path)})
+                from .lattice_store import refinement_fields
+                rel = path.relative_to(root)
+                refinements.append({"file": rel.as_posix(), **refinement_fields(rel),
+                                    "sha256": _sha256(path)})
                 continue
             try:
                 entries.append(_entry_from_file(root, path))

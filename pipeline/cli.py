@@ -344,7 +344,18 @@ def cmd_plan(args):
     _plan_dynamic_args(args, pc["dynamic"])
     if args.pins:
         pc["pins"] = [float(x) for x in parse_values(args.pins, "--pins")]
+    if args.belt_speed is not None:
+        pc["belt_speed"] = args.belt_speed
+    if args.mu_s is not None:
+        if pc.get("belt_speed") is None:
+            raise PinfeedError("--mu-s is the belt friction of the dynamic model: give --belt-speed too")
+        pc["mu_s"] = args.mu_s
     part = _plan_part_arg(args, config)
+    from .planning import planner_belt
+    belt_speed, _ = planner_belt(config, part)  # a bad belt: a one-line error before any work
+    if belt_speed is not None and args.mode != "tight":
+        raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
+                           "the paper-mode planner uses the quasi-static map shards: use --mode tight")
     if args.mode == "tight":
         result = _plan_tight_only(part, config, progress=None if args.json else _progress)
     else:
@@ -402,7 +413,10 @@ def _plan_part_arg(args, config):
 def _plan_tight_only(part, config, progress=None) -> dict:
     from .stages import plan_tight_all
     from .provenance import provenance_attrs
-    return {"part": part.to_dict(), "model": config["planner"]["model"],
+    from .planning import planner_belt
+    belt_speed, mu_s = planner_belt(config, part)
+    belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
+    return {"part": part.to_dict(), "model": config["planner"]["model"], **belt,
             "tight": plan_tight_all(part, config, config["catalog_dir"], progress=progress),
             **provenance_attrs()}
 
@@ -427,7 +441,8 @@ def _plan_summary(plan, pins=None) -> dict:
 
 
 def _plan_json(result, mode) -> dict:
-    out = {"part": result["part"]["name"], "part_id": result["part"]["id"], "mode": mode}
+    out = {"part": result["part"]["name"], "part_id": result["part"]["id"], "mode": mode,
+           "belt_speed": result.get("belt_speed"), "mu_s": result.get("mu_s")}
     tight = result.get("tight")
     if tight:
         first = tight[0]
@@ -447,8 +462,9 @@ def _plan_json(result, mode) -> dict:
 
 def _print_plan_result(result, part, config, mode):
     from .arcs import format_arcs
+    from .planning import mechanics_label, planner_belt
     pc = config["planner"]
-    print(f"part {part.id}: model {pc['model']}, depth {pc['depth']}")
+    print(f"part {part.id}: model {mechanics_label(pc['model'], *planner_belt(config))}, depth {pc['depth']}")
     for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
         print(f"  state {k}: resting on the fence at theta = {theta:.1f} deg, y_c = {y_c:.2f} mm")
     for t in result.get("tight", []):
@@ -486,42 +502,26 @@ def _results_arg(args, config) -> Path:
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from .config import load_config
-    from .planning import friction_label
-    from .speed_limit import perturbation_from_verify, speed_curve
+    from .speed_limit import stored_plan_speed
     from .stages import read_json
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
                            f"{args.part} --mode both --out {path}' or the workflow ('make run') first")
-    result = read_json(path)
-    plan, mu_c, entry = _pick_tight_plan(result, args.plan, args.mu_c)
     if not (args.mu_s > 0):
         raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
-    from .parts import Part
-    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
-    perturb = perturbation_from_verify(config.get("verify", {}))
-    # A tight-only plan file keeps the resting states per friction entry.
-    stored_states = entry.get("initial_states") or result.get("initial_states") or {}
-    states = [(s["theta"], s["y_c"]) for s in stored_states.values()]
-    arcs = [(s["start"], s["width"]) for s in plan["final_sets"]]
-    res = speed_curve(part, plan["pin_heights_mm"], plan["pin_speeds"], states, arcs, mu_c,
-                      mu_s=args.mu_s, perturb=perturb, trials=args.trials,
-                      r_pin=config["sweep"]["pin_radius"])
-    out = {"part": part.name, "pin_labels": list(plan["pins"]),
-           "pin_heights_mm": list(plan["pin_heights_mm"]),
-           "final_set": [{"start": s, "width": w} for s, w in arcs],
-           "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c, "mu_s": args.mu_s,
-           "speed_limit_mm_s": res["speed_limit_mm_s"], "curve": res["curve"],
-           "method": f"dynamic model, {args.trials} perturbed trials per initial state plus corners "
-                     f"at each speed; limit = highest speed with >= 99 % in the final set, 5 mm/s "
-                     f"bisection"}
+    if args.trials < 1:
+        raise PinfeedError(f"--trials must be at least 1, got {args.trials}")
+    out = stored_plan_speed(read_json(path), config, plan=args.plan, mu_text=args.mu_c,
+                            mu_s=args.mu_s, trials=args.trials)
     if args.json:
         _print_json(out, default=float)
         return
-    print(f"{part.name}, plan {' '.join(plan['pins'])} (mu_c {friction_label(mu_c)}, mu_s {args.mu_s:g}): "
-          f"speed limit {res['speed_limit_mm_s']:g} mm/s")
-    for speed, frac in res["curve"]:
+    print(f"{out['part']}, plan {' '.join(out['pin_labels'])} (mu_c {out['friction']}, mu_s "
+          f"{args.mu_s:g}): speed limit {out['speed_limit_mm_s']:g} mm/s "
+          f"({out['trials_per_speed']} trials per speed, {out['seconds']:.0f} s)")
+    for speed, frac in out["curve"]:
         print(f"  {speed:7.1f} mm/s: {100 * frac:5.1f} % of trials in the final set")
 
 
@@ -870,6 +870,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="dynamic pin speeds v_pin/v_b after the static pins: 'a,b' ('' for none)")
     p.add_argument("--dynamic-depth", dest="dynamic_depth", type=int, default=None,
                    help="largest number of dynamic pins (0: fixed pins only)")
+    p.add_argument("--belt-speed", dest="belt_speed", type=float, default=None, metavar="MM_S",
+                   help="plan and verify with the dynamic model at this belt speed, mm/s "
+                        "(default: the config's planner.belt_speed; none = quasi-static)")
+    p.add_argument("--mu-s", dest="mu_s", type=float, default=None,
+                   help="belt friction with --belt-speed (default: planner.mu_s, 0.5)")
     p.add_argument("--out", default=None, help="also write the result JSON here")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plan)

@@ -127,6 +127,7 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
         raise PinfeedError(f"config error at planner/dynamic/speeds: {', '.join(f'{v:g}' for v in bad)} "
                            f"must be non-zero and listed in sweep/v_pin "
                            f"({', '.join(f'{v:g}' for v in cfg['sweep']['v_pin'])})")
+    _check_planner_belt(cfg)
     sensing = cfg["sensing"]
     sensing.setdefault("parts", list(cfg["planner"]["parts"]))
     unplanned = [p for p in sensing["parts"] if p not in cfg["planner"]["parts"]]
@@ -135,6 +136,21 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
                            f"(the sensor plans on the planner's maps); planned parts: "
                            f"{', '.join(cfg['planner']['parts']) or 'none'}")
     return cfg
+
+
+def _check_planner_belt(cfg: dict) -> None:
+    """planner/belt_speed: every planned part must be pushed, not thrown, at it."""
+    speed = cfg["planner"].get("belt_speed")
+    if speed is None:
+        return
+    from .simulate import check_belt
+    for family, spec in cfg["families"].items():
+        for part in family_parts(family, spec):
+            if part.name in cfg["planner"]["parts"]:
+                try:
+                    check_belt(part, speed, cfg["planner"]["mu_s"])
+                except PinfeedError as exc:
+                    raise PinfeedError(f"config error at planner/belt_speed ({part.name}): {exc}") from None
 
 
 def _part_names(cfg: dict) -> set:

@@ -11,6 +11,12 @@ a warning with the reason is returned instead.
 Outcomes computed for the propagation are kept in the catalog under
 ``refine/PART_ID/MODEL/v_pin=V.h5`` (see :mod:`pipeline.lattice_store`) and
 reused by later runs.
+
+With ``planner.belt_speed`` (mm/s) set, the planner plans with the dynamic
+model (``kernels.dynamic``) at that belt speed and belt friction
+``planner.mu_s``, stores its outcomes apart
+(``refine/PART_ID/dynamic/v_pin=V_belt=S_mu_s=M.h5``) and verification
+replays with the dynamic model at the same speed.
 """
 from __future__ import annotations
 
@@ -61,12 +67,36 @@ def nominal_friction(mu_c) -> float:
     return 0.5 * (mu_c[0] + mu_c[1]) if isinstance(mu_c, tuple) else float(mu_c)
 
 
+def planner_belt(config: dict, part: Part | None = None):
+    """``(belt_speed, mu_s)`` the planner plans at: ``planner.belt_speed`` (mm/s;
+    ``None`` = quasi-static) and ``planner.mu_s`` (default 0.5). With ``part``,
+    a bad belt (speed <= 0, mu_s out of range, a part thrown rather than
+    pushed) raises a one-line :class:`PinfeedError`."""
+    pc = config["planner"]
+    speed = pc.get("belt_speed")
+    mu_s = pc.get("mu_s")
+    mu_s = 0.5 if mu_s is None else mu_s
+    if speed is None:
+        return None, float(mu_s)
+    if part is not None:
+        from .simulate import check_belt
+        check_belt(part, speed, mu_s)
+    return float(speed), float(mu_s)
+
+
+def mechanics_label(model: str, belt_speed: float | None, mu_s: float) -> str:
+    """What the plans were computed with: ``'minpower'`` or ``'dynamic at 150 mm/s, mu_s 0.5'``."""
+    return model if belt_speed is None else f"dynamic at {belt_speed:g} mm/s, mu_s {mu_s:g}"
+
+
 def planner_for(part: Part, config: dict, mu_c, lattices=None, moving: bool = False) -> TightPlanner:
     """A :class:`TightPlanner` with the config's pins, limits, model and sizes
     (and, with ``moving``, every candidate height at every ``planner.dynamic``
-    speed as a moving pin, labelled like ``P23v-2``)."""
+    speed as a moving pin, labelled like ``P23v-2``); at ``planner.belt_speed``
+    when it is set (:func:`planner_belt`)."""
     from .planner import pins_from_config
     pc, sweep = config["planner"], config["sweep"]
+    belt_speed, mu_s = planner_belt(config, part)
     static = pins_from_config(pc["pins"])
     speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if moving else []
     moving_pins = {f"{k}v{v:+g}": (y, v) for k, y in static.items() for v in speeds}
@@ -76,7 +106,7 @@ def planner_for(part: Part, config: dict, mu_c, lattices=None, moving: bool = Fa
                         sweep["pin_radius"], pc["model"], Uncertainty.from_verify(verify_cfg), tol,
                         moving=moving_pins, lattices=lattices, kernel=sweep.get("kernel"),
                         max_branches=pc.get("max_branches", 4),
-                        hard_limits=pc.get("hard_d_limits", False))
+                        hard_limits=pc.get("hard_d_limits", False), belt_speed=belt_speed, mu_s=mu_s)
 
 
 def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None = None,
@@ -104,9 +134,12 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     for plan in candidates:
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
                           config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
-                          kernel=config["sweep"].get("kernel"))
+                          kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
+                          mu_s=planner.mu_s)
         plan.verification = {"trials": res["trials"], "successes": res["successes"],
-                             "failures": res["failures"], "rows": res["rows"]}
+                             "failures": res["failures"], "rows": res["rows"], "model": res["model"],
+                             **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}
+                                if "belt_speed" in res else {})}
         if progress:
             progress(f"verified {' '.join(plan.pins)}: {res['successes']}/{res['trials']} trials")
     candidates.sort(key=lambda p: p.rank_key())
@@ -123,6 +156,8 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     return {
         "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c,
         "friction": friction_label(mu_c),
+        "belt_speed": planner.belt_speed, "mu_s": planner.mu_s if planner.belt_speed else None,
+        "mechanics": mechanics_label(pc["model"], planner.belt_speed, planner.mu_s),
         "symmetry_order": planner.order,
         "depth": depth, "complete_depth": int(pc.get("complete_depth", 2)),
         "beam": int(pc.get("beam", 30)),

@@ -146,14 +146,22 @@ def initial_state_sets(part: Part, mu_c, unc: Uncertainty) -> dict[str, StateSet
 
 class OutcomeLattice:
     """Rollout outcomes at dyadic lattice points ``(theta_i, d, mu_c)`` of one
-    part, model and pin speed, computed on demand in batches and kept.
+    part, model, pin speed and belt (speed and friction), computed on demand
+    in batches and kept.
 
-    ``known`` maps integer lattice keys to ``(status, theta_f_deg, dy)``.
+    ``belt_speed`` (mm/s) and ``mu_s`` select the dynamic model
+    (``kernels.dynamic``) at that belt speed; ``belt_speed=None`` is the
+    quasi-static ``model``. ``known`` maps integer lattice keys to
+    ``(status, theta_f_deg, dy)``.
     """
 
     def __init__(self, part: Part, model: str, pin_radius: float, v_pin: float = 0.0,
-                 ds_max: float | None = None, tol: float | None = None):
-        self.part, self.model, self.pin_radius, self.v_pin = part, model, pin_radius, float(v_pin)
+                 ds_max: float | None = None, tol: float | None = None,
+                 belt_speed: float | None = None, mu_s: float = 0.5):
+        self.part, self.pin_radius, self.v_pin = part, pin_radius, float(v_pin)
+        self.belt_speed = None if belt_speed is None else float(belt_speed)
+        self.mu_s = float(mu_s)
+        self.model = "dynamic" if self.belt_speed is not None else model
         self.ds_max, self.tol = ds_max, tol
         self.known: dict[tuple[int, int, int], tuple[int, float, float]] = {}
         self.n_computed = 0
@@ -167,6 +175,8 @@ class OutcomeLattice:
             return
         arr = np.asarray(todo, dtype=np.float64)
         kw = {}
+        if self.belt_speed is not None:
+            kw.update(belt_speed=self.belt_speed, mu_s=self.mu_s)
         if self.ds_max is not None:
             kw["ds_max"] = self.ds_max
         if self.tol is not None:

@@ -88,7 +88,7 @@ def _part_section(name: str, part: dict, base, catalog) -> list[str]:
     res, ver, files = part["plan"], part["verify"], part["files"]
     p = [f'<h2 id="{_anchor(name)}">{html.escape(name)}</h2>',
          '<p class="files">Files: ' + ", ".join(
-             _link(files[k], base, f"{k} JSON") for k in ("plan", "verify", "sensing") if k in files) + "</p>"]
+             _link(files[k], base, f"{k} JSON") for k in ("plan", "verify", "sensing", "speed") if k in files) + "</p>"]
     if part.get("shards") and catalog is not None:
         p.append('<details class="files"><summary>Catalog shards of this part '
                  f'({len(part["shards"])})</summary><ul>' + "".join(
@@ -105,11 +105,13 @@ def _part_section(name: str, part: dict, base, catalog) -> list[str]:
     p += _figure(files, "maps", base, "Configuration maps with bands (rows: models)")
     p += _figure(files, "speeds", base, "Maps by pin speed (dynamic pins)")
     p.append(f'<h3 id="{_anchor(name, "plans")}">Plans</h3>')
-    p += _side_by_side(res, ver)
+    p += _side_by_side(res, ver, part.get("speed"))
     p += _paper_plans(res)
     p += _figure(files, "sequence", base, "Pin sequence: best plan of fixed pins")
     p += _figure(files, "sequence_dynamic", base, "Pin sequence: best plan with dynamic pins")
     p += _figure(files, "carried", base, "Carried sets against replayed rollouts (recommended tight plan)")
+    p += _figure(files, "speed_limit", base, "Success against belt speed (recommended tight plan, "
+                 "dynamic model) and its speed limit")
     p.append(f'<h3 id="{_anchor(name, "verification")}">Verification</h3>')
     p += _verification_table(name, ver)
     p += _figure(files, "verification", base, "Verification by plan (failing states in red)")
@@ -219,31 +221,44 @@ def _counts(check) -> str:
     return f"{ok}/{t}"
 
 
-def _side_by_side(res: dict, ver: dict | None) -> list[str]:
-    """The paper-mode plan beside the tight planner's, with verification counts."""
+def _speed_cell(speed: dict | None, friction: str, pins) -> str:
+    """The speed limit of a tight plan, if the speed stage replayed this plan."""
+    if not speed or speed.get("speed_limit_mm_s") is None:
+        return "<td>n/a</td>"
+    if speed.get("friction") != friction or list(speed.get("pin_labels", [])) != list(pins):
+        return "<td>n/a</td>"
+    return f"<td>{speed['speed_limit_mm_s']:g}</td>"
+
+
+def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> list[str]:
+    """The paper-mode plan beside the tight planner's, with verification counts
+    and the speed limit (mm/s, dynamic model) of the plan the speed stage replayed."""
     from .arcs import format_arcs
     checks = {c["kind"]: c for c in (ver or {}).get("checks", [])}
     p = ['<h4>Paper mode beside the tight planner</h4><table class="side-by-side"><tr><th>planner</th>'
          "<th>friction mu_c</th><th>pins (height, mm)</th><th>final sets</th>"
-         "<th>orientation sets</th><th>verified (successes/trials)</th></tr>"]
+         "<th>orientation sets</th><th>verified (successes/trials)</th>"
+         "<th>speed limit (mm/s)</th></tr>"]
     static = res.get("best_static")
     if static:
         pins = ", ".join(f"{q} ({res['pins'][q]:g})" for q in static["pins"])
         sets = format_arcs([(s["start"], s["width"]) for s in static["final_sets"]])
         p.append(f"<tr><td>paper mode, fixed pins</td><td>{res['mu_c']:g} (stored maps)</td>"
                  f"<td>{html.escape(pins)}</td><td>{static['n_final_sets']}</td><td>{sets}</td>"
-                 f"<td>{_counts(checks.get('paper mode, fixed pins'))}</td></tr>")
+                 f"<td>{_counts(checks.get('paper mode, fixed pins'))}</td><td>n/a</td></tr>")
     for t in res.get("tight", []):
         plan = t["recommended"]
         if plan is None:
-            p.append(f"<tr><td>tight</td><td>{t['friction']}</td><td colspan=4 style='color:#b00'>"
+            p.append(f"<tr><td>tight</td><td>{t['friction']}</td><td colspan=5 style='color:#b00'>"
                      f"{html.escape(t['warning'] or 'no plan')}</td></tr>")
             continue
         pins = ", ".join(f"{q} ({y:g})" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
         sets = format_arcs([(s["start"], s["width"]) for s in plan["final_sets"]])
-        p.append(f"<tr><td>tight</td><td>{t['friction']}</td><td>{html.escape(pins)}</td>"
+        planner = "tight" + (f" at {t['belt_speed']:g} mm/s" if t.get("belt_speed") else "")
+        p.append(f"<tr><td>{planner}</td><td>{t['friction']}</td><td>{html.escape(pins)}</td>"
                  f"<td>{plan['n_final_sets']}</td><td>{sets}</td>"
-                 f"<td>{_counts(checks.get('tight, mu_c ' + t['friction']))}</td></tr>")
+                 f"<td>{_counts(checks.get('tight, mu_c ' + t['friction']))}</td>"
+                 f"{_speed_cell(speed, t['friction'], plan['pins'])}</tr>")
     p.append("</table>")
     return p
 

@@ -136,6 +136,11 @@ class TightPlanner:
     lattices : optional ``{v_pin: OutcomeLattice}`` holding stored outcomes.
     max_branches : a node whose state has more branches than this is dropped
         (reported in ``stats.pruned_branching``).
+    belt_speed : belt speed in mm/s (the part in mm): plan with the dynamic
+        model (``kernels.dynamic``) at that speed and belt friction ``mu_s``
+        instead of the quasi-static ``model``; ``None`` (default) is
+        quasi-static.
+    mu_s : belt friction for ``belt_speed``.
     hard_limits : forbid pins whose d range leaves ``d_min <= |d| <= d_max``
         (the paper's rule). By default these limits only set the margin
         (negative inside them): the propagation itself sees what makes small
@@ -147,9 +152,14 @@ class TightPlanner:
                  pin_radius: float, model: str = "minpower", uncertainty: Uncertainty = Uncertainty(),
                  tolerances: Tolerances = Tolerances(), moving: dict | None = None,
                  lattices: dict | None = None, kernel: dict | None = None, max_branches: int = 4,
-                 hard_limits: bool = False):
+                 hard_limits: bool = False, belt_speed: float | None = None, mu_s: float = 0.5):
         if not pins:
             raise PinfeedError("the planner needs at least one candidate pin")
+        if belt_speed is not None:
+            from .simulate import check_belt
+            check_belt(part, belt_speed, mu_s)
+        self.belt_speed = None if belt_speed is None else float(belt_speed)
+        self.mu_s = float(mu_s)
         self.part, self.model, self.pin_radius = part, model, float(pin_radius)
         self.d_min, self.d_max = float(d_min), float(d_max)
         self.mu_c, self.unc, self.tol = mu_c, uncertainty, tolerances
@@ -161,7 +171,14 @@ class TightPlanner:
         for v in {p.v_pin for p in self.pins.values()}:
             if v not in self.lattices:
                 self.lattices[v] = OutcomeLattice(part, model, pin_radius, v,
-                                                  kernel.get("ds_max"), kernel.get("tol"))
+                                                  kernel.get("ds_max"), kernel.get("tol"),
+                                                  belt_speed=self.belt_speed, mu_s=self.mu_s)
+        for v, lattice in self.lattices.items():
+            if lattice.belt_speed != self.belt_speed or (
+                    self.belt_speed is not None and lattice.mu_s != self.mu_s):
+                raise PinfeedError(f"the stored outcomes at v_pin {v:g} are for another belt "
+                                   f"(speed {lattice.belt_speed}, mu_s {lattice.mu_s:g}) than the "
+                                   f"planner's ({self.belt_speed}, {self.mu_s:g})")
         self.max_branches = int(max_branches)
         self.hard_limits = bool(hard_limits)
         self.order = part.symmetry_order()

@@ -282,16 +282,28 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
 
 def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str = "minpower",
                    v_pin: float = 0.0, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
-                   threads: int | None = None) -> dict:
+                   threads: int | None = None, belt_speed: float | None = None,
+                   mu_s: float = 0.5) -> dict:
     """Final states of independent rollouts at scattered points.
 
     ``theta_i`` (degrees), ``d`` and ``mu_c`` are equal-length 1-D arrays (or
     scalars, broadcast). Used by the planner's uncertainty propagation and by
-    verification, where the points are not a grid. Returns a dict of NumPy
-    arrays: ``status`` (int8 codes, see :data:`STATUSES`), ``jam_reason``
-    (int8), ``theta_f`` (degrees, [0, 360)) and ``dy`` (the part's unit).
+    verification, where the points are not a grid. ``model="dynamic"``
+    (``kernels.dynamic``) needs ``belt_speed`` (mm/s; the part in mm) and
+    takes the belt friction ``mu_s``; ``ds_max`` and ``tol`` are then unused.
+    Returns a dict of NumPy arrays: ``status`` (int8 codes, see
+    :data:`STATUSES`), ``jam_reason`` (int8, an index into
+    ``kernels.rollout.JAM_REASONS``, which the dynamic model shares),
+    ``theta_f`` (degrees, [0, 360)) and ``dy`` (the part's unit).
     """
-    check_parameters(0.0, pin_radius, model, v_pin)
+    dynamic = model == "dynamic"
+    if dynamic:
+        if belt_speed is None:
+            raise PinfeedError("model 'dynamic' needs a belt speed (mm/s)")
+        fr = check_belt(part, belt_speed, mu_s)
+    elif belt_speed is not None:
+        raise PinfeedError(f"a belt speed needs model 'dynamic' (the {model} model is quasi-static)")
+    check_parameters(0.0, pin_radius, "minpower" if dynamic else model, v_pin)
     th, dd, mu = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=np.float64))
                                        for x in (theta_i, d, mu_c)))
     for arr, what in ((th, "theta_i"), (dd, "d"), (mu, "mu_c")):
@@ -300,10 +312,19 @@ def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str =
     if np.any(mu < 0):
         raise PinfeedError("contact friction mu_c must be >= 0")
     with _threads(threads) as n:
-        status, reason, theta_f, dy = _rollout_points(
-            *part.prepared(), MODELS.index(model), np.ascontiguousarray(mu), float(pin_radius),
-            np.radians(th), np.ascontiguousarray(dd), float(v_pin), np.inf, float(ds_max),
-            float(tol), n)
+        if dynamic:
+            from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
+                                         _dyn_rollout_points)
+            verts, area, a, quad, _, convex = part.prepared()
+            status, reason, theta_f, dy = _dyn_rollout_points(
+                verts, area, a, quad, convex, np.ascontiguousarray(mu), float(pin_radius),
+                np.radians(th), np.ascontiguousarray(dd), float(v_pin), fr, 0.0,
+                DEFAULT_V_REG / float(belt_speed), DEFAULT_H, np.inf, DEFAULT_MAX_STEPS, n)
+        else:
+            status, reason, theta_f, dy = _rollout_points(
+                *part.prepared(), MODELS.index(model), np.ascontiguousarray(mu), float(pin_radius),
+                np.radians(th), np.ascontiguousarray(dd), float(v_pin), np.inf, float(ds_max),
+                float(tol), n)
     return {"status": status, "jam_reason": reason,
             "theta_f": _wrap_deg(np.degrees(theta_f)), "dy": dy}
 

@@ -1,11 +1,13 @@
 """How fast may a plan run? Success rate against belt speed, and the speed limit.
 
-Plain inputs only (the planner's plan format is being rewritten): a part, the
-pin heights of the sequence, their speed ratios, the initial states, the
-plan's predicted final arcs and the friction. Each trial perturbs the initial
-state, the pin heights and mu_c, and replays the sequence with the dynamic
-model (``kernels.dynamic``); a trial succeeds when every passage ends ok and
-the final orientation lies in one of the final arcs. The same random draws
+:func:`speed_curve` takes plain inputs: a part, the pin heights of the
+sequence, their speed ratios, the initial states, the plan's predicted final
+arcs and the friction; :func:`stored_plan_speed` reads them from a stored
+plan file (``pinfeed speed`` and the workflow's speed stage). Each trial
+perturbs the initial state, the pin heights and mu_c, and replays the
+sequence with the dynamic model (``kernels.dynamic``; every trial past one
+pin in one parallel batch); a trial succeeds when every passage ends ok or
+misses and the final orientation lies in one of the final arcs. The same random draws
 are used at every speed (common random numbers), so the curve is not noisy
 from speed to speed. The speed limit is the highest speed at which at least
 ``required`` of the trials succeed, found on the coarse grid and refined by
@@ -14,6 +16,7 @@ bisection to ``resolution`` mm/s.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
@@ -33,11 +36,13 @@ def perturbation_from_verify(verify: dict) -> dict:
             "pin_mm": v.get("pin_halfwidth", 0.3)}
 
 
-def _in_arcs(theta_deg, arcs):
+def _in_arcs(theta_deg, arcs) -> np.ndarray:
+    """Whether each orientation (degrees) lies in one of the arcs ``(start, width)``."""
+    theta_deg = np.asarray(theta_deg, float)
+    inside = np.zeros(theta_deg.shape, bool)
     for start, width in arcs:
-        if (theta_deg - start) % 360.0 <= width:
-            return True
-    return False
+        inside |= (theta_deg - start) % 360.0 <= width
+    return inside
 
 
 def _draws(part, pin_heights, states, mu_c, perturb, trials, seed):
@@ -63,28 +68,37 @@ def _draws(part, pin_heights, states, mu_c, perturb, trials, seed):
 
 
 def success_fraction(part: Part, pin_heights, pin_speed_ratios, draws, final_arcs, belt_speed,
-                     mu_s=0.5, r_pin=1.0):
-    """Fraction of the drawn trials that end in the final arcs at ``belt_speed``."""
-    from kernels.dynamic import DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG, OK, _dyn_rollout
-    fr = check_belt(part, belt_speed, mu_s)
-    verts, area, a, quad, _, convex = part.prepared()
-    good = total = 0
-    for th, yc, mu, pins in draws:
-        for i in range(th.size):
-            theta, y = math.radians(th[i]), yc[i]
-            ok = True
-            for k, v_pin in enumerate(pin_speed_ratios):
-                res = _dyn_rollout(verts, area, a, quad, convex, float(mu[i]), float(r_pin), theta,
-                                   (pins[i, k] - y) / a, float(v_pin), fr, 0.0,
-                                   DEFAULT_V_REG / belt_speed, DEFAULT_H, np.inf,
-                                   DEFAULT_MAX_STEPS, False)
-                if res[0] not in (OK, 1):  # a miss leaves the part as it was
-                    ok = False
-                    break
-                theta, y = res[2], y + res[3]
-            good += ok and _in_arcs(math.degrees(theta) % 360.0, final_arcs)
-            total += 1
-    return good / total
+                     mu_s=0.5, r_pin=1.0, threads=None):
+    """Fraction of the drawn trials that end in the final arcs at ``belt_speed``.
+
+    Every trial of every initial state is rolled past pin 1, then the
+    survivors past pin 2, and so on, one parallel batch per pin
+    (``kernels.dynamic._dyn_rollout_points`` through
+    :func:`pipeline.simulate.rollout_points`); a jammed or truncated passage
+    fails the trial, a miss leaves the part as it was.
+    """
+    from kernels.dynamic import JAMMED, TRUNCATED
+
+    from .simulate import rollout_points
+    check_belt(part, belt_speed, mu_s)
+    theta = np.concatenate([d[0] for d in draws])
+    y_c = np.concatenate([d[1] for d in draws])
+    mu = np.concatenate([d[2] for d in draws])
+    pins = np.vstack([d[3] for d in draws])
+    alive = np.ones(theta.size, bool)
+    for k, v_pin in enumerate(pin_speed_ratios):
+        idx = np.flatnonzero(alive)
+        if idx.size == 0:
+            break
+        res = rollout_points(part, theta[idx], (pins[idx, k] - y_c[idx]) / part.a, mu[idx], r_pin,
+                             "dynamic", v_pin=float(v_pin), threads=threads,
+                             belt_speed=float(belt_speed), mu_s=float(mu_s))
+        stuck = (res["status"] == JAMMED) | (res["status"] == TRUNCATED)
+        alive[idx[stuck]] = False
+        theta[idx] = res["theta_f"]
+        y_c[idx] = y_c[idx] + res["dy"]
+    good = alive & _in_arcs(theta % 360.0, final_arcs)
+    return float(good.sum()) / theta.size
 
 
 def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final_arcs, mu_c,
@@ -109,9 +123,10 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
 
     Returns
     -------
-    dict with ``curve`` (rows ``[speed_mm_s, success_fraction]``, sorted) and
+    dict with ``curve`` (rows ``[speed_mm_s, success_fraction]``, sorted),
     ``speed_limit_mm_s`` (``0.0`` if even the slowest speed fails; the
-    highest speed tried if none fails).
+    highest speed tried if none fails), ``trials_per_speed`` and
+    ``seconds`` (wall time).
     """
     if len(pin_heights) != len(pin_speed_ratios):
         raise PinfeedError("give one speed ratio per pin")
@@ -122,6 +137,7 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
     grid = sorted(v for v in speeds if 0 < v <= v_thrown)
     if not grid:
         raise PinfeedError("no belt speed in the grid below the speed at which the part is thrown")
+    start_time = time.perf_counter()
     draws = _draws(part, pin_heights, initial_states, mu_c, perturb, trials, seed)
     curve = {}
 
@@ -153,4 +169,49 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
             else:
                 hi = mid
         limit = lo
-    return {"curve": [[v, curve[v]] for v in sorted(curve)], "speed_limit_mm_s": float(limit)}
+    return {"curve": [[v, curve[v]] for v in sorted(curve)], "speed_limit_mm_s": float(limit),
+            "trials_per_speed": int(sum(d[0].size for d in draws)),
+            "seconds": round(time.perf_counter() - start_time, 2)}
+
+
+def stored_plan_speed(result: dict, config: dict, plan: int = 1, mu_text=None, mu_s: float = 0.5,
+                      trials: int = 300, speeds=DEFAULT_SPEEDS, resolution: float = 5.0,
+                      required: float = 0.99, seed: int = 0) -> dict:
+    """The speed curve and speed limit of a stored tight plan (a plan file's
+    ``tight`` entry, see :func:`pick_tight_plan`), with the verify stage's
+    perturbation sizes (``config["verify"]``) and the sweep's pin radius.
+
+    Returns the JSON of ``pinfeed speed`` and the workflow's speed stage:
+    ``part``, ``pin_labels``, ``pin_heights_mm``, ``pin_speeds``,
+    ``final_set`` (``start``, ``width`` in degrees), ``mu_c``, ``mu_s``,
+    ``required``, ``speed_limit_mm_s``, ``curve`` (rows of speed in mm/s and
+    success fraction), ``planned_belt_speed`` (``None``: planned
+    quasi-static), ``trials``, ``trials_per_speed``, ``seconds`` and ``method``.
+    """
+    from .parts import Part
+    from .planning import friction_label, pick_tight_plan
+    if not (isinstance(trials, int) and trials >= 1):
+        raise PinfeedError(f"trials must be a whole number >= 1, got {trials!r}")
+    chosen, mu_c, entry = pick_tight_plan(result, plan, mu_text)
+    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    perturb = perturbation_from_verify(config.get("verify", {}))
+    # A tight-only plan file keeps the resting states per friction entry.
+    stored_states = entry.get("initial_states") or result.get("initial_states") or {}
+    states = [(s["theta"], s["y_c"]) for s in stored_states.values()]
+    arcs = [(s["start"], s["width"]) for s in chosen["final_sets"]]
+    res = speed_curve(part, chosen["pin_heights_mm"], chosen["pin_speeds"], states, arcs, mu_c,
+                      mu_s=mu_s, perturb=perturb, trials=trials, speeds=speeds,
+                      resolution=resolution, required=required,
+                      r_pin=config["sweep"]["pin_radius"], seed=seed)
+    return {"part": part.name, "pin_labels": list(chosen["pins"]),
+            "pin_heights_mm": list(chosen["pin_heights_mm"]),
+            "pin_speeds": list(chosen["pin_speeds"]),
+            "final_set": [{"start": s, "width": w} for s, w in arcs],
+            "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c, "friction": friction_label(mu_c),
+            "mu_s": float(mu_s), "required": float(required),
+            "speed_limit_mm_s": res["speed_limit_mm_s"], "curve": res["curve"],
+            "planned_belt_speed": entry.get("belt_speed"), "trials": int(trials),
+            "trials_per_speed": res["trials_per_speed"], "seconds": res["seconds"],
+            "method": f"dynamic model, {trials} perturbed trials per initial state plus corners "
+                      f"at each speed; limit = highest speed with >= {100 * required:g} % in the "
+                      f"final set, {resolution:g} mm/s bisection"}

@@ -152,12 +152,15 @@ def plan_frictions(config: dict) -> list:
 
 def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progress=None) -> list:
     """Tight plans at every friction of :func:`plan_frictions` (the first is the
-    recommended one); the planner's rollouts are stored in the catalog."""
+    recommended one), at ``planner.belt_speed`` when it is set; the planner's
+    rollouts are stored in the catalog (keyed by model, pin speed and belt)."""
     from .lattice_store import load_lattice, save_lattice
-    from .planning import plan_tight
+    from .planning import plan_tight, planner_belt
     sweep, model = config["sweep"], config["planner"]["model"]
+    belt_speed, mu_s = planner_belt(config, part)
     speeds = [0.0] + [float(v) for v in config["planner"].get("dynamic", {}).get("speeds", [])]
-    lattices = {v: load_lattice(catalog_root, part, model, v, sweep["pin_radius"], sweep.get("kernel"))
+    lattices = {v: load_lattice(catalog_root, part, model, v, sweep["pin_radius"], sweep.get("kernel"),
+                                belt_speed=belt_speed, mu_s=mu_s)
                 for v in speeds}
     out = []
     for mu_c in plan_frictions(config):
@@ -213,12 +216,47 @@ def verify_part(plan_result: dict, config: dict) -> dict:
         mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
         res = verify_plan(part, plan, dict(zip(plan["pins"], plan["pin_heights_mm"])), states, mu,
                           radius, plan_result["model"], config.get("verify", {}), kernel=kernel,
-                          speeds=dict(zip(plan["pins"], plan["pin_speeds"])))
+                          speeds=dict(zip(plan["pins"], plan["pin_speeds"])),
+                          belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
         res.pop("trials_detail")
         out["checks"].append({"kind": f"tight, mu_c {tight['friction']}", **res})
     if not out["checks"]:
         out["note"] = "no allowed plan within the depth"
     return out
+
+
+# ---------------------------------------------------------------------- speed
+
+
+def speed_part(plan_result: dict, config: dict) -> dict:
+    """The speed curve and speed limit of a part's recommended tight plan (first
+    friction), with the settings of ``config["speed"]`` (trials per state,
+    ``mu_s``, speed grid, resolution, required fraction, seed): the JSON of
+    ``speed_limit.stored_plan_speed`` plus provenance. A part without a
+    recommended plan gets ``speed_limit_mm_s: None`` and a ``note``."""
+    from .speed_limit import stored_plan_speed
+    sc = config.get("speed", {})
+    name = plan_result["part"]["name"]
+    tight = (plan_result.get("tight") or [None])[0]
+    if not tight or not tight.get("plans"):
+        why = tight["warning"] if tight else "no tight plan"
+        return {"part": name, "speed_limit_mm_s": None, "curve": [], "note": why,
+                **provenance_attrs()}
+    res = stored_plan_speed(plan_result, config, plan=1, mu_s=float(sc.get("mu_s", 0.5)),
+                            trials=int(sc.get("trials", 30)),
+                            speeds=[float(v) for v in sc.get("speeds", (10, 50, 100, 150, 200, 300, 400, 500))],
+                            resolution=float(sc.get("resolution", 5.0)),
+                            required=float(sc.get("required", 0.99)), seed=int(sc.get("seed", 0)))
+    return {**res, **provenance_attrs()}
+
+
+def speed_figure(result: dict, out) -> Path:
+    """The speed curve figure of a :func:`speed_part` result (a note if no plan)."""
+    from .figures.speed import plot_speed_curve
+    if result.get("speed_limit_mm_s") is None:
+        _placeholder(out, f"{result['part']}: no speed limit ({result.get('note', 'no plan')})")
+        return Path(out)
+    return plot_speed_curve(result, out)
 
 
 def nominal_paths(plan_result: dict, config: dict, plan: dict | None = None) -> dict:
@@ -321,7 +359,8 @@ def _carried_figure(config, res, path):
     mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
     starts = {k: (v["theta"], v["y_c"]) for k, v in res["initial_states"].items()}
     replays = replayed_paths(part, plan, starts, mu, config["sweep"]["pin_radius"], res["model"],
-                             config.get("verify", {}), kernel=config["sweep"].get("kernel"))
+                             config.get("verify", {}), kernel=config["sweep"].get("kernel"),
+                             belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
     plot_carried(plan, replays, f"{name}: carried sets of plan {' '.join(plan['pins'])} (mu_c "
                  f"{tight['friction']}) against {len(next(iter(replays.values()))[0])} replayed "
                  f"rollouts per state", path)
@@ -377,23 +416,24 @@ def _placeholder(path, text):
 
 
 PART_FIGURES = ("outline", "maps", "speeds", "sequence", "sequence_dynamic", "carried", "verification",
-                "profiles", "scores")
+                "profiles", "scores", "speed_limit")
 
 
 def part_files(results, name: str) -> dict:
     """Where the workflow writes a part's files under ``results`` (RESULTS_DIR/NAME):
-    JSON (``plan``, ``verify``, ``sensing``), figures (:data:`PART_FIGURES`) and
-    the ``animation``; the rules in rules/*.smk use the same names."""
+    JSON (``plan``, ``verify``, ``sensing``, ``speed``), figures
+    (:data:`PART_FIGURES`) and the ``animation``; the rules in rules/*.smk use
+    the same names."""
     results = Path(results)
     out = {kind: results / kind.replace("plan", "plans") / f"{name}.json"
-           for kind in ("plan", "verify", "sensing")}
+           for kind in ("plan", "verify", "sensing", "speed")}
     out.update({kind: results / "figures" / f"{kind}_{name}.png" for kind in PART_FIGURES})
     out["animation"] = results / "animations" / f"{name}.gif"
     out.update({f"layout_{ext}": results / f"layout_{name}.{ext}" for ext in ("json", "png", "dxf", "svg")})
     return out
 
 
-def make_report(config, plan_paths, verify_paths, out, sensing_paths=()):
+def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_paths=()):
     """The HTML page (``out``, in the results folder) of the planned parts: their
     results, every figure found beside them, and the catalog shards they use."""
     from .report import write_report
@@ -414,6 +454,10 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=()):
         res = read_json(path)
         parts[res["part"]["name"]]["sensing"] = res
         parts[res["part"]["name"]]["files"]["sensing"] = Path(path)
+    for path in speed_paths:  # speed curve and limit of the recommended plan (rules/speed.smk)
+        res = read_json(path)
+        parts[res["part"]]["speed"] = res
+        parts[res["part"]]["files"]["speed"] = Path(path)
     overview = {k: results / f for k, f in (("verification figure", "figures/verification.png"),
                                             ("verification table", "verification.md"))
                 if (results / f).is_file()}

@@ -105,8 +105,12 @@ def _start(state):
 
 
 def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
-           ds_max=DEFAULT_DS_MAX, tol=DEFAULT_TOL, path=None):
+           ds_max=DEFAULT_DS_MAX, tol=DEFAULT_TOL, path=None, belt_speed=None, mu_s=0.5):
     """Roll every trial past every pin in turn (batched per pin).
+
+    ``belt_speed`` (mm/s) replays with the dynamic model at that speed and
+    belt friction ``mu_s`` (``model`` is then unused); ``None`` is
+    quasi-static ``model``.
 
     Returns ``(theta_f, y_c, jam_reason_or_empty, missed)``: arrays over trials,
     ``missed`` a boolean array ``(n_trials, n_pins)``. If ``path`` is a list,
@@ -121,8 +125,12 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
         if idx.size == 0:
             break
         d = (y_pin + offsets[idx, k] - y_c[idx]) / part.a
-        res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, model,
-                                      v_pin=float(v), ds_max=ds_max, tol=tol)
+        if belt_speed is None:
+            res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, model,
+                                          v_pin=float(v), ds_max=ds_max, tol=tol)
+        else:
+            res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, "dynamic",
+                                          v_pin=float(v), belt_speed=belt_speed, mu_s=mu_s)
         st = res["status"]
         stuck = (st == JAMMED) | (st == TRUNCATED)
         for j in np.flatnonzero(stuck):
@@ -138,8 +146,13 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
 
 def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, pin_radius: float,
                 model: str = "minpower", settings: dict | None = None,
-                speeds: dict | None = None, kernel: dict | None = None) -> dict:
+                speeds: dict | None = None, kernel: dict | None = None,
+                belt_speed: float | None = None, mu_s: float = 0.5) -> dict:
     """Run the trials for a stored plan (``to_dict()`` of a plan).
+
+    ``belt_speed`` (mm/s) replays every trial with the dynamic model at that
+    belt speed and belt friction ``mu_s``; ``None`` (default) with the
+    quasi-static ``model``.
 
     ``pins`` maps labels to heights (mm); ``speeds`` gives the speed ratio
     v_pin / v_b of each moving pin's label (absent: a static pin); a perturbed
@@ -163,7 +176,8 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
             th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), corners[:3]))
             offs = np.concatenate([offs, corners[3]])
         tf, yf, jam, missed = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
-                                     kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL))
+                                     kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL),
+                                     belt_speed=belt_speed, mu_s=mu_s)
         finals = predicted_sets(plan, label)
         first = plan.get("initial_sets", {}).get(label)
         start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)
@@ -184,5 +198,7 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
         rows.append(counts)
     total = {k: sum(r[k] for r in rows) for k in ("trials", "successes", "failures")}
     mu_out = list(mu_c) if isinstance(mu_c, (tuple, list)) else mu_c
-    return {"plan": labels, "settings": cfg, "mu_c": mu_out, "model": model, "rows": rows,
+    belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
+    return {"plan": labels, "settings": cfg, "mu_c": mu_out,
+            "model": model if belt_speed is None else "dynamic", **belt, "rows": rows,
             **total, "trials_detail": trials}

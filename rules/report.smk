@@ -78,6 +78,9 @@ rule report:
         sensing=expand(rules.sense.output.sensing, name=SENSED),
         sensing_figures=expand(f"{RESULTS}/figures/{{kind}}_{{name}}.png",
                                kind=("profiles", "scores"), name=SENSED),
+        # speed limit (rules/speed.smk): JSON and figure of every planned part
+        speed=expand(rules.speed.output.speed, name=PLANNED),
+        speed_figures=expand(rules.speed.output.figure, name=PLANNED),
     output:
         report=f"{RESULTS}/report.html",
     log:

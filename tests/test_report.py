@@ -19,6 +19,7 @@ TINY = {
     "planner": {"parts": ["tri", "rect"], "model": "ellipsoid", "mu_c": 0.2, "depth": 1,
                 "pins": [-10, -5, 0, 5, 10, 15, 20, 25, 30, 35, 40], "dynamic": {"speeds": []}},
     "verify": {"trials": 3}, "sensing": {"trials": 3, "parts": ["tri"]},
+    "speed": {"trials": 3, "speeds": [50, 200]},
     "figures": {"d": [0.4], "animation_frames": 3, "animation_fps": 2},
 }
 
@@ -88,9 +89,10 @@ def test_report_links_resolve_and_toc_has_one_entry_per_part(workflow):
     files = {str((results / h).resolve().relative_to(workflow.resolve())) for h in page.links + page.images}
     for name in ("tri", "rect"):  # every figure, JSON file and shard of each part is linked
         for want in (f"res/tiny/plans/{name}.json", f"res/tiny/verify/{name}.json",
-                     f"res/tiny/animations/{name}.gif",
+                     f"res/tiny/animations/{name}.gif", f"res/tiny/speed/{name}.json",
                      *(f"res/tiny/figures/{k}_{name}.png" for k in
-                       ("outline", "maps", "speeds", "sequence", "sequence_dynamic", "carried", "verification"))):
+                       ("outline", "maps", "speeds", "sequence", "sequence_dynamic", "carried", "verification",
+                        "speed_limit"))):
             assert want in files, want
         shards = {p.relative_to(workflow).as_posix() for p in (workflow / "cat" / "fam").rglob("*.h5")
                   if f"/{name}-" in p.as_posix()}
@@ -110,10 +112,16 @@ def test_report_numbers_match_the_verify_json(workflow):
             want += [[" ".join(check["plan"]), check["kind"], r["state"], str(r["trials"]),
                       str(r["successes"]), str(r["failures"])] for r in check["rows"]]
     assert [r[:6] for r in table] == want and want
-    side = [r for r in page.rows["side-by-side"] if r[0] != "planner" and len(r) == 6]  # tri's rows, then rect's
-    want = []
+    side = [r for r in page.rows["side-by-side"] if r[0] != "planner" and len(r) == 7]  # tri's rows, then rect's
+    want, limits = [], []
     for name in ("tri", "rect"):
         plan = json.loads((results / "plans" / f"{name}.json").read_text())
+        speed = json.loads((results / "speed" / f"{name}.json").read_text())
+        if plan["tight"][0]["recommended"]:  # the speed stage replays the first friction's plan
+            assert speed["pin_labels"] == plan["tight"][0]["recommended"]["pins"]
+            limits.append(f"{speed['speed_limit_mm_s']:g}")
+        else:
+            assert speed["speed_limit_mm_s"] is None
         checks = {c["kind"]: c for c in json.loads((results / "verify" / f"{name}.json").read_text())["checks"]}
         rows = [("paper mode, fixed pins", plan["best_static"])]
         rows += [(f"tight, mu_c {t['friction']}", t["recommended"]) for t in plan["tight"] if t["recommended"]]
@@ -121,6 +129,7 @@ def test_report_numbers_match_the_verify_json(workflow):
             ok = sum(r["successes"] for r in checks[kind]["rows"])
             want.append([str(best["n_final_sets"]), f"{ok}/{sum(r['trials'] for r in checks[kind]['rows'])}"])
     assert [[r[3], r[5]] for r in side] == want
+    assert [r[6] for r in side if r[0].startswith("tight") and r[6] != "n/a"] == limits
     assert all(int(r[3]) == 3 + 2 ** (3 + len(r[0].split())) for r in table)  # verify.trials 3 + corners
 
 
@@ -129,7 +138,7 @@ def test_standard_snakemake_report_has_the_figures(workflow):
     assert run.returncode == 0, run.stderr[-3000:]
     import zipfile
     names = zipfile.ZipFile(workflow / "std.zip").namelist()
-    for stem in ("outline_tri", "maps_rect", "verification_tri", "profiles_tri"):
+    for stem in ("outline_tri", "maps_rect", "verification_tri", "profiles_tri", "speed_limit_tri"):
         assert any(n.endswith(f"{stem}.png") for n in names), stem
     assert any(n.endswith("tri.gif") for n in names)
 

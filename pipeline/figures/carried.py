@@ -36,8 +36,9 @@ def carried_by_step(plan: dict, label: str) -> list[list[dict]]:
 
 
 def replayed_paths(part: Part, plan: dict, starts: dict, mu_c, pin_radius, model, cfg=None,
-                   trials=100, kernel=None):
-    """Per initial state: arrays of theta and y_c (trials x steps) of perturbed replays."""
+                   trials=100, kernel=None, belt_speed=None, mu_s=0.5):
+    """Per initial state: arrays of theta and y_c (trials x steps) of perturbed replays
+    (with the dynamic model at ``belt_speed`` mm/s and belt friction ``mu_s`` if given)."""
     cfg = dict(DEFAULTS, **(cfg or {}))
     kernel = kernel or {}
     rng = np.random.default_rng(cfg["seed"])
@@ -50,7 +51,8 @@ def replayed_paths(part: Part, plan: dict, starts: dict, mu_c, pin_radius, model
         offs = np.concatenate([offs, corners[3]])
         path = [(th % 360.0, yc.copy())]
         replay(part, plan["pin_heights_mm"], plan["pin_speeds"], th, yc, mu, offs, pin_radius, model,
-               path=path, **{k: v for k, v in kernel.items() if k in ("ds_max", "tol")})
+               path=path, belt_speed=belt_speed, mu_s=mu_s,
+               **{k: v for k, v in kernel.items() if k in ("ds_max", "tol")})
         out[label] = (np.stack([p[0] for p in path], axis=1), np.stack([p[1] for p in path], axis=1))
     return out
 
