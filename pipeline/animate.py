@@ -414,12 +414,47 @@ def plan_inputs(result: dict, plan_index, config: dict) -> dict:
             "pin_radius": float(result.get("pin_radius", config["sweep"]["pin_radius"]))}
 
 
+def layout_inputs(result: dict, layout: dict) -> dict:
+    """The plan a layout (``pinfeed layout``'s JSON) was made from, in a stored plan
+    result: ``{"labels", "heights", "states", "mu_c", "what"}``. A one-line
+    :class:`PinfeedError` when the layout is of another part, has no plan, or
+    its pins are not the stored plan's."""
+    from .planning import pick_tight_plan
+    name = result["part"]["name"]
+    if layout.get("part") != name:
+        raise PinfeedError(f"the layout is of {layout.get('part')!r}, not {name!r}")
+    if not layout.get("plan") or not layout.get("stations"):
+        raise PinfeedError(f"the layout of {name} has no plan to animate ({layout.get('note', 'no stations')})")
+    number, friction = int(layout["plan"]["number"]), layout["plan"].get("friction")
+    plan, mu_c, entry = pick_tight_plan(result, number, friction)
+    labels = [str(r["label"]) for r in layout["stations"]]
+    if list(plan["pins"]) != labels:
+        raise PinfeedError(f"the layout's pins {' '.join(labels)} are not tight plan {number}'s "
+                           f"({' '.join(plan['pins'])}) in the stored plan; re-run 'pinfeed layout'")
+    stored = entry.get("initial_states") or result.get("initial_states") or {}
+    return {"labels": labels, "heights": [float(r["y_mm"]) for r in layout["stations"]],
+            "states": {k: (float(s["theta"]), float(s["y_c"])) for k, s in stored.items()},
+            "mu_c": layout.get("mu_c", list(mu_c) if isinstance(mu_c, tuple) else mu_c),
+            "what": f"tight plan {number} at mu_c {entry['friction']}"}
+
+
 def animate_stored(result: dict, config: dict, out, plan_index=None, frames: int = 120,
-                   fps: int = 20) -> dict:
+                   fps: int = 20, layout: dict | None = None) -> dict:
     """Animate a plan of a stored plan result (``plan_index`` as in :func:`plan_inputs`;
     what ``pinfeed animate`` and the workflow's animate rule call). Returns
-    :func:`animate_plan`'s summary plus the inputs."""
+    :func:`animate_plan`'s summary plus the inputs.
+
+    With ``layout`` (``pinfeed layout``'s JSON for this part) the layout's own
+    plan is animated on one belt instead (:func:`animate_layout`): pins at the
+    stations, parts arriving at the layout's pitch; ``plan_index`` is then
+    not used."""
     from .parts import Part
+    if layout is not None:
+        inputs = layout_inputs(result, layout)
+        part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+        done = animate_layout(part, layout, inputs["states"], inputs["mu_c"], out, frames=frames, fps=fps,
+                              what=f"{inputs['what']}, pins {' → '.join(inputs['labels'])}")
+        return {**done, **inputs}
     inputs = plan_inputs(result, plan_index, config)
     part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
     done = animate_plan(part, inputs["heights"], inputs["speeds"], inputs["states"], inputs["mu_c"],
@@ -427,3 +462,183 @@ def animate_stored(result: dict, config: dict, out, plan_index=None, frames: int
                         frames=frames, fps=fps,
                         title=f"{part.name}: {inputs['what']}, pins {' → '.join(inputs['labels'])}")
     return {**done, **inputs}
+
+
+# ------------------------------------------------------- a layout's feeder (issue 19)
+
+
+@dataclass
+class StationScene:
+    """A laid-out feeder (``pinfeed layout``'s JSON) on one belt, world frame:
+    x downstream, the fence at y = ``fence_y``, pins at their stations. Parts
+    arrive ``pitch`` apart, cycling through the initial states: part k runs
+    ``lanes[k % len(lanes)]`` shifted ``k * pitch`` later on the belt clock B
+    (mm); at B = 0 part 0's centroid stands at x = -``entry``."""
+
+    part: object
+    lanes: list  # one Lane per initial state, world frame (first pin at its x_mm)
+    stations: list  # the layout's rows: label, x_mm, y_mm, radius_mm
+    pitch: float
+    entry: float
+    n_parts: int
+    fence_y: float
+    fence_end: float
+    belt_y: tuple
+    belt_speed: float | None
+    model: str  # what the passages were replayed with: "dynamic" or a quasi-static model
+    b_end: float = 0.0
+
+    def part_poses(self, b: float) -> list:
+        """``(k, state, x, y, theta_deg)`` of every part of the stream at belt travel ``b``."""
+        out = []
+        for k in range(self.n_parts):
+            lane = self.lanes[k % len(self.lanes)]
+            x, y, th = (float(v[0]) for v in lane.poses(np.array([b - k * self.pitch])))
+            out.append((k, lane.label, x, y, th))
+        return out
+
+
+def station_scene(part, layout: dict, states: dict, mu_c, n_parts: int | None = None) -> StationScene:
+    """Replay one nominal passage per initial state with the layout's model (the
+    dynamic model at its belt speed and ``mu_s`` when the layout used it, else
+    its quasi-static model: ``layout.run_trials(nominal=True)``, the kernels'
+    trajectories) past the layout's stations, and set up the stream of parts.
+
+    ``layout``: the JSON of ``pinfeed layout`` (``stations``, ``pitch_mm``,
+    ``fence_y_mm``, ``fence_end_x_mm``, ``belt_y_mm``, ``belt_speed_mm_s``,
+    ``mu_s``, ``method.model``, ``method.margins_mm``). ``states``: label ->
+    ``(theta_deg, y_c_mm)``. ``n_parts``: default one per state, at least 3."""
+    from .layout import run_trials, trial_lanes
+    from .planning import nominal_friction
+    rows = layout.get("stations") or []
+    if not rows:
+        raise PinfeedError(f"the layout of {layout.get('part', 'the part')} has no pin stations "
+                           f"({layout.get('note', 'no plan')})")
+    if not states:
+        raise PinfeedError("give at least one initial state")
+    pitch = float(layout["pitch_mm"])
+    if not pitch > 0:
+        raise PinfeedError(f"the layout's pitch must be > 0 mm, got {pitch!r}")
+    heights = [float(r["y_mm"]) for r in rows]
+    xs = [float(r["x_mm"]) for r in rows]
+    pin_radius = float(rows[0]["radius_mm"])
+    method = layout.get("method") or {}
+    model = method.get("model", "minpower")
+    speed = layout.get("belt_speed_mm_s")
+    if model == "dynamic" and speed is None:
+        raise PinfeedError("the layout used the dynamic model but gives no belt_speed_mm_s")
+    mu = nominal_friction(tuple(mu_c) if isinstance(mu_c, list) else mu_c)
+    trials = run_trials(part, heights, states, mu, pin_radius, model,
+                        belt_speed=float(speed) if model == "dynamic" else None,
+                        mu_s=float(layout.get("mu_s") or 0.5), nominal=True)
+    margin = float((method.get("margins_mm") or {}).get("station_margin_mm", 5.0))
+    # As the layout: every centroid starts far enough upstream of the first pin that nothing touches.
+    reach = [float(pin_reach(_rotated(part.vertices, t.theta), heights[0] - t.y_c, pin_radius))
+             for t in trials]
+    entry = max([r for r in reach if math.isfinite(r)] + [part.a + pin_radius]) + margin
+    lanes = trial_lanes(part, trials, [x - xs[0] for x in xs], pin_radius, entry)
+    for lane, t in zip(lanes, trials):
+        lane.x = lane.x + xs[0]
+        if t.jam:
+            lane.outcome = t.jam
+    n = int(n_parts or max(3, len(lanes)))
+    fence_y = float(layout.get("fence_y_mm", 0.0))
+    belt = layout.get("belt_y_mm") or [fence_y, max(float(ln.y.max()) for ln in lanes) + part.a]
+    scene = StationScene(part, lanes, rows, pitch, entry - xs[0], n, fence_y,
+                         float(layout.get("fence_end_x_mm", xs[0] - pin_radius)),
+                         (float(belt[0]), float(belt[1])), None if speed is None else float(speed), model)
+    # The clock runs until the last part has passed its last contact and ridden one size on.
+    scene.b_end = (n - 1) * pitch + max(float(ln.B[-1]) for ln in lanes) + 2.0 * part.a
+    return scene
+
+
+def station_figure(scene: StationScene, title: str) -> dict:
+    """The feeder's figure: belt, fence up to its end, pins (circles at the
+    stations), and one outline per part of the stream. Returns ``{"fig", "ax",
+    "pins", "parts", "draw"}``: ``pins`` the pin circles in station order,
+    ``parts`` the part polygons (part k first), ``draw(b)`` poses the parts at
+    belt travel ``b`` and returns the artists it changed."""
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Polygon, Rectangle
+
+    from .figures import save_figure  # noqa: F401 (selects the Agg backend)
+    part, a = scene.part, scene.part.a
+    x_lo = -scene.entry - 1.5 * a
+    x_hi = max([float(ln.x[-1]) for ln in scene.lanes]
+               + [float(r["x_mm"]) + float(r["radius_mm"]) for r in scene.stations]) + 2.0 * a
+    y_lo, y_hi = min(scene.belt_y[0], scene.fence_y) - 0.3 * a, scene.belt_y[1] + 0.6 * a
+    fig, ax = plt.subplots(figsize=(9.0, max(2.2, 9.0 * (y_hi - y_lo) / (x_hi - x_lo) + 1.2)), dpi=DPI)
+    ax.set_xlim(x_lo, x_hi)
+    ax.set_ylim(y_lo, y_hi)
+    ax.set_aspect("equal")
+    ax.add_patch(Rectangle((x_lo, scene.belt_y[0]), x_hi - x_lo, scene.belt_y[1] - scene.belt_y[0],
+                           fc="0.93", ec="0.5", lw=0.8, zorder=0))
+    ax.plot([x_lo, scene.fence_end], [scene.fence_y] * 2, color="k", lw=2.5, zorder=1)
+    ax.text(x_lo + 0.1 * a, scene.fence_y, "fence", fontsize=7, va="bottom")
+    pins = []
+    for row in scene.stations:
+        x, y, r = float(row["x_mm"]), float(row["y_mm"]), float(row["radius_mm"])
+        pins.append(ax.add_patch(Circle((x, y), r, color="tab:red", zorder=3, gid=f"pin {row['label']}")))
+        ax.axvline(x, color="tab:red", lw=0.4, ls=":", zorder=0)
+        ax.text(x, 1.02, f"{row['label']}: x {x:.0f}, y {y:g} mm", transform=ax.get_xaxis_transform(),
+                ha="center", va="bottom", fontsize=7, color="tab:red")
+    parts = [ax.add_patch(Polygon(np.zeros((3, 2)), closed=True, fc=f"C{k % len(scene.lanes)}", ec="k",
+                                  alpha=0.75, zorder=2)) for k in range(scene.n_parts)]
+    marks, = ax.plot([], [], "|", color="0.6", ms=5, zorder=1)
+    clock = ax.text(0.005, 0.98, "", transform=ax.transAxes, ha="left", va="top", fontsize=8,
+                    family="monospace")
+    ax.set_xlabel("along the belt $x$ (mm), belt moving to the right", fontsize=8)
+    ax.set_ylabel("across the belt $y$ (mm)", fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.set_title(title, fontsize=9, pad=14)
+    fig.tight_layout()
+
+    def draw(b):
+        for (k, _, x, y, th), body in zip(scene.part_poses(b), parts):
+            body.set_xy(_rotated(part.vertices, th) + np.array([x, y]))
+        ticks = np.arange(x_lo + b % (0.5 * a), x_hi, 0.5 * a)  # the belt's texture moves with it
+        marks.set_data(ticks, np.full_like(ticks, scene.belt_y[0] + 0.1 * a))
+        clock.set_text(f"belt travel {b:6.1f} mm")
+        return parts + [marks, clock]
+
+    return {"fig": fig, "ax": ax, "pins": pins, "parts": parts, "draw": draw}
+
+
+def station_title(part_name: str, scene: StationScene, what: str = "") -> str:
+    """Belt speed, pitch and the replay model, for the layout animation's title."""
+    if scene.model == "dynamic":
+        how = f"belt {scene.belt_speed:g} mm/s (dynamic model)"
+    elif scene.belt_speed is not None:
+        how = f"belt {scene.belt_speed:g} mm/s, replayed quasi-statically ({scene.model}) as the layout was"
+    else:
+        how = f"no belt speed: quasi-static replay ({scene.model})"
+    return f"{part_name}{': ' + what if what else ''}; {how}; pitch {scene.pitch:.1f} mm"
+
+
+def animate_layout(part, layout: dict, states: dict, mu_c, out, frames: int = 120, fps: int = 20,
+                   title: str | None = None, n_parts: int | None = None, what: str = "") -> dict:
+    """Write the animation of a laid-out feeder (:func:`station_scene`,
+    :func:`station_figure`) to ``out`` (.gif; .mp4 needs ffmpeg). Returns
+    ``{"out", "frames", "belt_travel", "outcomes", "pitch_mm", "model"}``."""
+    import matplotlib.pyplot as plt
+    from matplotlib import animation
+    out = Path(out)
+    suffix = out.suffix.lower()
+    if suffix not in (".gif", ".mp4"):
+        raise PinfeedError(f"--out {out}: write a .gif or an .mp4 file")
+    if suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
+        raise PinfeedError("writing MP4 needs ffmpeg, which is not installed here; write a .gif "
+                           "instead (--out plan.gif) or install ffmpeg")
+    if frames < 2 or fps < 1:
+        raise PinfeedError(f"--frames must be at least 2 and --fps at least 1, got {frames} and {fps}")
+    scene = station_scene(part, layout, states, mu_c, n_parts)
+    fig = station_figure(scene, title or station_title(part.name, scene, what))
+    B = np.linspace(0.0, scene.b_end, int(frames))
+    anim = animation.FuncAnimation(fig["fig"], lambda i: fig["draw"](B[i]), frames=len(B), blit=False)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    writer = animation.PillowWriter(fps=fps) if suffix == ".gif" else animation.FFMpegWriter(fps=fps)
+    anim.save(str(out), writer=writer, dpi=DPI)
+    plt.close(fig["fig"])
+    return {"out": str(out), "frames": int(len(B)), "belt_travel": float(scene.b_end),
+            "outcomes": {ln.label: ln.outcome for ln in scene.lanes}, "pitch_mm": scene.pitch,
+            "model": scene.model}

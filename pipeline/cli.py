@@ -580,7 +580,7 @@ def cmd_layout(args):
 
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
-    from .animate import animate_stored, plan_inputs
+    from .animate import animate_stored, layout_inputs, plan_inputs
     from .config import load_config
     from .stages import read_json
     config = load_config(args.config)
@@ -589,12 +589,30 @@ def cmd_animate(args):
         raise PinfeedError(f"no stored plan for {args.part} at {path}; "
                            f"{_plan_hint(config, args.part, path.parent.parent)} first")
     result = read_json(path)
-    inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
-    pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
-                       for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
-    print(f"animating the {inputs['what']} of {args.part}: {pins}; {len(inputs['states'])} initial "
-          f"states", flush=True)
-    done = animate_stored(result, config, args.out, args.plan, frames=args.frames, fps=args.fps)
+    stored_layout = path.parent.parent / f"layout_{args.part}.json"
+    if args.layout is not None:
+        if args.plan is not None:
+            raise PinfeedError("--layout animates the layout's own plan; leave out --plan")
+        layout_path = stored_layout if args.layout == "auto" else Path(args.layout)
+        if not layout_path.is_file():
+            raise PinfeedError(f"no layout at {layout_path}; run 'pinfeed layout --part {args.part}' "
+                               f"or the workflow first")
+        layout = read_json(layout_path)
+        inputs = layout_inputs(result, layout)  # fails early on a layout of another part or plan
+        pins = " -> ".join(f"{r['label']} at x {r['x_mm']:.1f}, y {r['y_mm']:g} mm" for r in layout["stations"])
+        print(f"animating the laid-out {inputs['what']} of {args.part}: {pins}; pitch "
+              f"{layout['pitch_mm']:.1f} mm; {len(inputs['states'])} initial states", flush=True)
+    else:
+        layout = None
+        inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
+        pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
+                           for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
+        print(f"animating the {inputs['what']} of {args.part}: {pins}; {len(inputs['states'])} initial "
+              f"states", flush=True)
+        if stored_layout.is_file():
+            print(f"(a layout is stored at {stored_layout}: add --layout to draw its stations and pitch)")
+    done = animate_stored(result, config, args.out, args.plan, frames=args.frames, fps=args.fps,
+                          layout=layout)
     outcomes = ", ".join(f"{k}: {v}" for k, v in done["outcomes"].items())
     print(f"wrote {done['out']}: {done['frames']} frames over {done['belt_travel']:.0f} mm of belt "
           f"travel ({outcomes})")
@@ -941,6 +959,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plan", type=_plan_choice, default=None,
                    help="which plan: 'tight' (the tight planner's recommended plan) or N (paper "
                    "mode's Nth best; 1 = best); default: the tight one if any, else 1")
+    p.add_argument("--layout", nargs="?", const="auto", default=None, metavar="LAYOUT.json",
+                   help="draw the feeder of a 'pinfeed layout' JSON instead: one belt, the pins at "
+                   "their stations, parts arriving at its pitch, each replayed with its model; "
+                   "without a path RESULTS/layout_NAME.json (the workflow's); animates the "
+                   "layout's own plan")
     p.add_argument("--out", required=True, help="animation file: .gif (Pillow) or .mp4 (needs ffmpeg)")
     p.add_argument("--frames", type=int, default=120, help="number of frames (default 120)")
     p.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")

@@ -382,12 +382,16 @@ def outline_figure(plan_result: dict, config: dict, out) -> Path:
     return plot_outline(part, out, source=config_part_source(config, part.name))
 
 
-def animate_part(plan_result: dict, config: dict, out, frames: int, fps: int) -> dict:
+def animate_part(plan_result: dict, config: dict, out, frames: int, fps: int,
+                 layout: dict | None = None) -> dict:
     """The part's recommended plan as an animation: the tight planner's
     recommended plan (first friction) if there is one, else paper mode's best;
-    with no plan at all, a one-frame note. Returns the summary (``plan``:
-    which one)."""
+    with no plan at all, a one-frame note. With ``layout`` (the layout stage's
+    JSON) that has stations, the laid-out plan on one belt instead: pins at the
+    stations, parts at the pitch. Returns the summary (``plan``: which one)."""
     from .animate import animate_stored, recommended_index
+    if layout is not None and layout.get("stations"):
+        return animate_stored(plan_result, config, out, frames=frames, fps=fps, layout=layout)
     which = recommended_index(plan_result)
     if which is None:
         _placeholder_gif(out, f"{plan_result['part']['name']}: no plan to animate")

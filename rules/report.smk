@@ -50,6 +50,8 @@ rule outline:
 rule animate:
     input:
         plan=rules.plan.output.plan,
+        # the feeder's stations and pitch (rules/layout.smk, which needs only the plan)
+        layout=rules.layout.output.layout,
     output:
         animation=report(f"{RESULTS}/animations/{{name}}.gif", caption="report/animation.rst",
                          category="Animations"),

@@ -1,4 +1,5 @@
-"""Snakemake script: the animation of one part's recommended plan (GIF)."""
+"""Snakemake script: the animation of one part's laid-out plan (GIF): pins at the layout's
+stations, parts at its pitch; the recommended plan in lanes when there is no layout."""
 import sys
 from pathlib import Path
 
@@ -10,7 +11,10 @@ from pipeline.stages import animate_part, read_json
 
 with log_to(snakemake.log[0]):  # noqa: F821
     p = snakemake.params  # noqa: F821
+    # The layout stage's JSON: the feeder at its stations and pitch (a part with no
+    # layout-able plan gets a JSON without stations and the plain animation).
+    layout = read_json(snakemake.input.layout)  # noqa: F821
     done = animate_part(read_json(snakemake.input.plan), snakemake.config,  # noqa: F821
-                        snakemake.output.animation, p.frames, p.fps)  # noqa: F821
+                        snakemake.output.animation, p.frames, p.fps, layout=layout)  # noqa: F821
     print(f"wrote {done['out']}: {done['frames']} frames of the {done.get('what', 'no plan')}; "
           f"outcomes {done['outcomes']}")
