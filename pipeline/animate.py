@@ -9,6 +9,10 @@ travel B (mm); a pin stands at station X_k and, if it moves, its height is
 ``h_k + v_k * (x_free - X_k)`` with ``x_free`` the centroid's belt-carried
 station (spec section 3's convention for d). Between pins the part rides the
 belt unchanged. One lane per initial state, all on the same clock.
+
+A laid-out feeder (``pinfeed layout``'s JSON; :func:`animate_layout`) is drawn
+on one belt instead: the pins at the layout's stations, parts arriving at its
+pitch, each replaying its state's passage with the layout's model.
 """
 from __future__ import annotations
 
@@ -590,7 +594,7 @@ def station_figure(scene: StationScene, title: str) -> dict:
     ax.set_xlabel("along the belt $x$ (mm), belt moving to the right", fontsize=8)
     ax.set_ylabel("across the belt $y$ (mm)", fontsize=8)
     ax.tick_params(labelsize=7)
-    ax.set_title(title, fontsize=9, pad=14)
+    ax.set_title(title, fontsize=9, pad=18)
     fig.tight_layout()
 
     def draw(b):
