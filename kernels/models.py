@@ -361,6 +361,45 @@ def _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max):
 
 
 @jit
+def _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
+                     wvx, wvy, wom, side):
+    """Sliding twist on cone side ``side`` continued past separation.
+
+    For a pin that moves away (``n . v_p <= 0``) the physical answer is no
+    force and no motion (``_contact_twist`` returns ``SEPARATE``). The
+    integrator wants a smooth right-hand side within a step, so inside a
+    step that crosses the separation it uses this continuation instead.
+
+    Returns ``(vx, vy, om)``: the model's sliding twist for the cone edge
+    ``e`` of ``side``, rescaled so that ``n . u(c) = n . v_p`` (a factor
+    <= 0 here), or zeros if that twist has no normal contact velocity.
+
+    Notes
+    -----
+    Before separation a sliding contact moves by ``k xi_e`` with
+    ``k = (n . v_p) / (n . u_e(c))``, where ``xi_e`` is the twist for a force
+    along ``e`` and depends smoothly on the contact. Keeping the same formula
+    for ``n . v_p <= 0`` extends the right-hand side smoothly through the
+    separation, which is a root of ``n . v_p``; the event location then
+    finds the crossing on a smooth path. Cutting to zero instead leaves a
+    kink in the right-hand side within the step, whose error estimate
+    scales like ``h^2`` and makes the step control reject step after step.
+    """
+    ex, ey = _cone_edge(nx, ny, mu, side)
+    if model == MINPOWER:
+        vx, vy, om, _, _, _ = _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom)
+    elif model == TIP:
+        vx, vy, om = _tip_twist_for_line(cx, cy, ex, ey)
+    else:
+        vx, vy, om = ex, ey, (cx * ey - cy * ex) / (m_max * m_max)
+    ucn = (vx - om * cy) * nx + (vy + om * cx) * ny
+    if ucn <= 1e-14 * (abs(vx) + abs(vy) + abs(om)):
+        return 0.0, 0.0, 0.0
+    k = (vpx * nx + vpy * ny) / ucn
+    return k * vx, k * vy, k * om
+
+
+@jit
 def _contact_twist(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
                    wvx, wvy, wom, hint):
     """Twist and pin force for one contact under ``model`` (see module doc).

@@ -29,7 +29,7 @@ import numpy as np
 from ._numba import jit
 from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
                        _ray_first_contact)
-from .models import SEPARATE, TWIST_OK, _contact_twist
+from .models import SEPARATE, SLIDE_NEG, SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide
 from .support import _fan_quadrature, _max_moment
 
 OK = 0
@@ -49,6 +49,12 @@ JAM_REASONS = ("", "no rotation", "notch", "travel limit", "no pushing solution"
                "step budget")
 
 _EVENT_TOL = 1e-10  # event functions may dip this far below zero (units of a)
+# Event location stops within this of the crossing (units of a, or of the
+# event function). Every event is a point where the right-hand side stays
+# continuous (the contact normal is continuous from an edge to its vertex,
+# and the sliding twist scales with n . v_p down to zero at separation), so
+# ending the feature delta early or late moves the end state by O(delta^2).
+_LOCATE_TOL = 1e-8
 _SAME_FEATURE = 1e-3  # contact points closer than this (units of a) are one feature
 _NOTCH_TOL = 1e-6  # a second contact counts when this much closer than r_pin
 _JAM_ANGLE = 1e-5  # radians
@@ -144,6 +150,12 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, s
     twist is smooth in the travel within a contact feature, so the start is
     off by O(ds^2) rather than O(ds), which saves Newton iterations. The
     answer does not depend on the start (the solve converges from anywhere).
+
+    Where the pin moves away (mode ``SEPARATE``) after sliding, the slope is
+    that of the sliding contact continued past the separation
+    (``models._continued_slide``), so that a step crossing it sees a smooth
+    right-hand side; the rollout ends the contact at the located crossing
+    and never integrates past it.
     """
     cx, cy, nx, ny, _, _ = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
@@ -160,7 +172,13 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, s
     st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
                                                   nx, ny, vpx, vpy, mu, wvx, wvy, wom,
                                                   int(warm[3]))
-    if st == TWIST_OK and mode != SEPARATE:
+    if mode == SEPARATE and warm[9] >= 1.0 and (warm[3] == SLIDE_POS or warm[3] == SLIDE_NEG):
+        # Past a separation within a step: the smooth continuation of the
+        # sliding contact (see models._continued_slide); the mode stays
+        # SEPARATE, so a step that starts here still ends the contact.
+        vx, vy, om = _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx,
+                                      vpy, mu, wvx, wvy, wom, int(warm[3]))
+    elif st == TWIST_OK and mode != SEPARATE:
         if sp != warm[4] or warm[9] < 1.0:
             warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
             warm[9] = min(warm[9] + 1.0, 2.0)
@@ -349,9 +367,9 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
             if mask[j] == 0.0 and g[j] < -_EVENT_TOL:
                 mask[j] = 1.0  # an earlier event than the ones seen so far
         f = _min_over(g, mask)
-        # Close enough when within the integrator's own event tolerance; a
-        # state a hair past the crossing (f >= -_EVENT_TOL / 10) is kept too.
-        close = -0.1 * _EVENT_TOL <= f <= _EVENT_TOL
+        # Close enough when within _LOCATE_TOL of the crossing; a state a
+        # hair past it (f >= -_LOCATE_TOL / 10) is kept too.
+        close = -0.1 * _LOCATE_TOL <= f <= _LOCATE_TOL
         if f < 0.0:
             hi = alpha
         else:
@@ -365,10 +383,18 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
         if prev_alpha >= 0.0 and f != prev_f and it < 8:
             nxt = alpha - f * (alpha - prev_alpha) / (f - prev_f)
         else:
-            # First refinement: the interpolant's slope at the guess.
-            _hermite(y0, k1, y1, k_end, h, alpha + 1e-7, yi)
-            _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
-            slope = (_min_over(g, mask) - f) / 1e-7 if it < 8 else 0.0
+            # First refinement: a Newton step with the interpolant's slope at
+            # the guess (a difference of two interpolated values: the real
+            # value f differs from the interpolated one by the interpolation
+            # error, which would swamp a difference over 1e-7).
+            slope = 0.0
+            if it < 8:
+                _hermite(y0, k1, y1, k_end, h, alpha + 1e-7, yi)
+                _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
+                f_up = _min_over(g, mask)
+                _hermite(y0, k1, y1, k_end, h, alpha, yi)
+                _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
+                slope = (f_up - _min_over(g, mask)) / 1e-7
             nxt = alpha - f / slope if slope < 0.0 else 0.5 * (lo + hi)
         prev_alpha, prev_f = alpha, f
         # Aim slightly early so the kept state lies before the crossing.
