@@ -87,7 +87,7 @@ _W_Y, _W_YNEW, _W_K1, _W_KEND, _W_YLOC, _W_TMP, _W_YI, _W_YTRY = 0, 1, 2, 3, 4, 
 _W_KS = 8  # six rows: the Runge-Kutta stages
 _W_GEND, _W_GWORK, _W_MASK, _W_WARM = 14, 15, 16, 17
 _W_ROWS = 18
-_W_COLS = 10
+_W_COLS = 14
 
 
 @jit
@@ -162,7 +162,18 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, s
     vpx = cs * vpwx + sn * vpwy
     vpy = -sn * vpwx + cs * vpwy
     wvx, wvy, wom = warm[0], warm[1], warm[2]
-    if warm[9] >= 2.0:
+    if warm[9] >= 3.0:
+        sa, sb, sc = warm[4], warm[8], warm[13]
+        dab, dac, dbc = sa - sb, sa - sc, sb - sc
+        span = max(abs(dab), abs(dac))
+        if dab != 0.0 and dac != 0.0 and dbc != 0.0 and abs(sp - sa) <= 1.5 * span:
+            la = (sp - sb) * (sp - sc) / (dab * dac)
+            lb = -(sp - sa) * (sp - sc) / (dab * dbc)
+            lc = (sp - sa) * (sp - sb) / (dac * dbc)
+            wvx = la * warm[0] + lb * warm[5] + lc * warm[10]
+            wvy = la * warm[1] + lb * warm[6] + lc * warm[11]
+            wom = la * warm[2] + lb * warm[7] + lc * warm[12]
+    elif warm[9] >= 2.0:
         span = warm[4] - warm[8]
         r = (sp - warm[4]) / span if span != 0.0 else 0.0
         if -1.5 <= r <= 1.5:
@@ -180,8 +191,9 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, s
                                       vpy, mu, wvx, wvy, wom, int(warm[3]))
     elif st == TWIST_OK and mode != SEPARATE:
         if sp != warm[4] or warm[9] < 1.0:
+            warm[10], warm[11], warm[12], warm[13] = warm[5], warm[6], warm[7], warm[8]
             warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
-            warm[9] = min(warm[9] + 1.0, 2.0)
+            warm[9] = min(warm[9] + 1.0, 3.0)
         warm[0], warm[1], warm[2], warm[3], warm[4] = vx, vy, om, mode, sp
     out[0] = om
     out[1] = vpx - (vx - om * y[2])
