@@ -21,6 +21,9 @@ The pin is projected back to distance ``r_pin`` after every step to stop
 drift. Feature
 changes, separation and second contacts are events located by the Illinois
 method on the step fraction, so the step never straddles one.
+
+Lengths are ``sqrt(x*x + y*y)`` rather than ``math.hypot`` (twice as slow),
+safe in units of a.
 """
 import math
 
@@ -112,7 +115,7 @@ def _contact_geometry(verts, kind, idx, qx, qy):
     if kind == EDGE:
         k = (idx + 1) % n
         ex, ey = verts[k, 0] - verts[idx, 0], verts[k, 1] - verts[idx, 1]
-        length = math.hypot(ex, ey)
+        length = math.sqrt(ex * ex + ey * ey)
         ex /= length
         ey /= length
         t = (qx - verts[idx, 0]) * ex + (qy - verts[idx, 1]) * ey
@@ -121,12 +124,12 @@ def _contact_geometry(verts, kind, idx, qx, qy):
     k = (idx + 1) % n
     vx, vy = verts[idx, 0], verts[idx, 1]
     ox, oy = qx - vx, qy - vy
-    dist = math.hypot(ox, oy)
+    dist = math.sqrt(ox * ox + oy * oy)
     # Outward normals of the edges before and after the vertex.
     ax, ay = vx - verts[i, 0], vy - verts[i, 1]
-    la = math.hypot(ax, ay)
+    la = math.sqrt(ax * ax + ay * ay)
     bx, by = verts[k, 0] - vx, verts[k, 1] - vy
-    lb = math.hypot(bx, by)
+    lb = math.sqrt(bx * bx + by * by)
     mpx, mpy = ay / la, -ax / la
     mnx, mny = by / lb, -bx / lb
     g_prev = (mpx * oy - mpy * ox) / dist
@@ -210,14 +213,14 @@ def _project(verts, kind, idx, rp, y):
     if kind == EDGE:
         k = (idx + 1) % n
         ex, ey = verts[k, 0] - verts[idx, 0], verts[k, 1] - verts[idx, 1]
-        length = math.hypot(ex, ey)
+        length = math.sqrt(ex * ex + ey * ey)
         mx, my = ey / length, -ex / length
         off = rp - ((y[1] - verts[idx, 0]) * mx + (y[2] - verts[idx, 1]) * my)
         y[1] += off * mx
         y[2] += off * my
     else:
         ox, oy = y[1] - verts[idx, 0], y[2] - verts[idx, 1]
-        dist = math.hypot(ox, oy)
+        dist = math.sqrt(ox * ox + oy * oy)
         y[1] = verts[idx, 0] + rp * ox / dist
         y[2] = verts[idx, 1] + rp * oy / dist
 
@@ -564,7 +567,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         fwx, fwy = cs * fx - sn * fy, sn * fx + cs * fy
         if mode == SEPARATE:
             fwx, fwy = 0.0, 0.0
-        peak = max(peak, math.hypot(fwx, fwy))
+        peak = max(peak, math.sqrt(fwx * fwx + fwy * fwy))
         if record:
             force[n_force, 0], force[n_force, 1], force[n_force, 2] = s * a, -fwx, -fwy
             n_force += 1
@@ -594,7 +597,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         if abs(k1[0]) * h > _DTHETA_CAP:
             h = _DTHETA_CAP / abs(k1[0])
         if kind == VERTEX:
-            turn = math.hypot(k1[1], k1[2]) / rp
+            turn = math.sqrt(k1[1] * k1[1] + k1[2] * k1[2]) / rp
             if turn * h > _DTHETA_CAP:
                 h = _DTHETA_CAP / turn
         rejected = False
