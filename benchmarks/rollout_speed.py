@@ -18,12 +18,19 @@ import os
 import platform
 import time
 
+import sys
+from pathlib import Path
+
 import numba
 import numpy as np
 
-from pipeline import simulate
-from pipeline.cli import PAPER_D
-from pipeline.parts import Part
+# The checkout this script lives in, not whichever pinfeed the environment
+# has installed (an editable install of another worktree would win otherwise).
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from pipeline import simulate  # noqa: E402
+from pipeline.cli import PAPER_D  # noqa: E402
+from pipeline.parts import Part  # noqa: E402
 
 TRIANGLE = [(0, 0), (60, 0), (15, 35)]
 
@@ -56,6 +63,8 @@ def main():
                     help="GPU grid: this many times more theta_i (default 100)")
     args = ap.parse_args()
     nt = args.threads
+    import kernels
+    print(f"kernels from {Path(kernels.__file__).parent}")
     part = Part.from_vertices(TRIANGLE, name="scalene")
     cpu = platform.processor() or platform.machine()
     print(f"{datetime.date.today()} | {platform.node()} | {cpu} | {os.cpu_count()} cores | "
