@@ -147,12 +147,19 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, s
 
     Notes
     -----
-    ``warm`` holds the last two solved twists and the travel at which they
-    were solved: ``(vx, vy, om, mode, s, vx', vy', om', s', count)``. The
-    minpower solve starts from their linear extrapolation to ``sp``: the
-    twist is smooth in the travel within a contact feature, so the start is
-    off by O(ds^2) rather than O(ds), which saves Newton iterations. The
-    answer does not depend on the start (the solve converges from anywhere).
+    ``warm`` holds the last three solved twists and the travel at which
+    they were solved: ``(vx, vy, om, mode, s, vx', vy', om', s', count,
+    vx'', vy'', om'', s'')``. The minpower solve starts from their quadratic
+    (Lagrange) extrapolation to ``sp`` when the three travels differ and
+    ``sp`` lies within 1.5 times their spread of the latest; with only two
+    solves so far, from the linear extrapolation (within 1.5 spans); else
+    from the last twist. The twist is
+    smooth in the travel within a contact feature; the stage states of a
+    Runge-Kutta step are off the trajectory by O(ds^2), which caps what any
+    extrapolation in ``s`` can gain: the median relative error of the start
+    is ~3e-4 (quadratic) against ~9e-4 (linear), 2.38 instead of 2.56
+    evaluations per solve. The answer does not depend on the start (the
+    solve converges from anywhere).
 
     Where the pin moves away (mode ``SEPARATE``) after sliding, the slope is
     that of the sliding contact continued past the separation
