@@ -21,6 +21,9 @@ The pin is projected back to distance ``r_pin`` after every step to stop
 drift. Feature
 changes, separation and second contacts are events located by the Illinois
 method on the step fraction, so the step never straddles one.
+
+Lengths are ``sqrt(x*x + y*y)`` rather than ``math.hypot`` (twice as slow),
+safe in units of a.
 """
 import math
 
@@ -29,7 +32,7 @@ import numpy as np
 from ._numba import jit
 from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
                        _ray_first_contact)
-from .models import SEPARATE, TWIST_OK, _contact_twist
+from .models import SEPARATE, SLIDE_NEG, SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide
 from .support import _fan_quadrature, _max_moment
 
 OK = 0
@@ -49,6 +52,12 @@ JAM_REASONS = ("", "no rotation", "notch", "travel limit", "no pushing solution"
                "step budget")
 
 _EVENT_TOL = 1e-10  # event functions may dip this far below zero (units of a)
+# Event location stops within this of the crossing (units of a, or of the
+# event function). Every event is a point where the right-hand side stays
+# continuous (the contact normal is continuous from an edge to its vertex,
+# and the sliding twist scales with n . v_p down to zero at separation), so
+# ending the feature delta early or late moves the end state by O(delta^2).
+_LOCATE_TOL = 1e-8
 _SAME_FEATURE = 1e-3  # contact points closer than this (units of a) are one feature
 _NOTCH_TOL = 1e-6  # a second contact counts when this much closer than r_pin
 _JAM_ANGLE = 1e-5  # radians
@@ -81,7 +90,7 @@ _W_Y, _W_YNEW, _W_K1, _W_KEND, _W_YLOC, _W_TMP, _W_YI, _W_YTRY = 0, 1, 2, 3, 4, 
 _W_KS = 8  # six rows: the Runge-Kutta stages
 _W_GEND, _W_GWORK, _W_MASK, _W_WARM = 14, 15, 16, 17
 _W_ROWS = 18
-_W_COLS = 10
+_W_COLS = 14
 
 
 @jit
@@ -106,7 +115,7 @@ def _contact_geometry(verts, kind, idx, qx, qy):
     if kind == EDGE:
         k = (idx + 1) % n
         ex, ey = verts[k, 0] - verts[idx, 0], verts[k, 1] - verts[idx, 1]
-        length = math.hypot(ex, ey)
+        length = math.sqrt(ex * ex + ey * ey)
         ex /= length
         ey /= length
         t = (qx - verts[idx, 0]) * ex + (qy - verts[idx, 1]) * ey
@@ -115,12 +124,12 @@ def _contact_geometry(verts, kind, idx, qx, qy):
     k = (idx + 1) % n
     vx, vy = verts[idx, 0], verts[idx, 1]
     ox, oy = qx - vx, qy - vy
-    dist = math.hypot(ox, oy)
+    dist = math.sqrt(ox * ox + oy * oy)
     # Outward normals of the edges before and after the vertex.
     ax, ay = vx - verts[i, 0], vy - verts[i, 1]
-    la = math.hypot(ax, ay)
+    la = math.sqrt(ax * ax + ay * ay)
     bx, by = verts[k, 0] - vx, verts[k, 1] - vy
-    lb = math.hypot(bx, by)
+    lb = math.sqrt(bx * bx + by * by)
     mpx, mpy = ay / la, -ax / la
     mnx, mny = by / lb, -bx / lb
     g_prev = (mpx * oy - mpy * ox) / dist
@@ -138,19 +147,43 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, s
 
     Notes
     -----
-    ``warm`` holds the last two solved twists and the travel at which they
-    were solved: ``(vx, vy, om, mode, s, vx', vy', om', s', count)``. The
-    minpower solve starts from their linear extrapolation to ``sp``: the
-    twist is smooth in the travel within a contact feature, so the start is
-    off by O(ds^2) rather than O(ds), which saves Newton iterations. The
-    answer does not depend on the start (the solve converges from anywhere).
+    ``warm`` holds the last three solved twists and the travel at which
+    they were solved: ``(vx, vy, om, mode, s, vx', vy', om', s', count,
+    vx'', vy'', om'', s'')``. The minpower solve starts from their quadratic
+    (Lagrange) extrapolation to ``sp`` when the three travels differ and
+    ``sp`` lies within 1.5 times their spread of the latest; with only two
+    solves so far, from the linear extrapolation (within 1.5 spans); else
+    from the last twist. The twist is
+    smooth in the travel within a contact feature; the stage states of a
+    Runge-Kutta step are off the trajectory by O(ds^2), which caps what any
+    extrapolation in ``s`` can gain: the median relative error of the start
+    is ~3e-4 (quadratic) against ~9e-4 (linear), 2.38 instead of 2.56
+    evaluations per solve. The answer does not depend on the start (the
+    solve converges from anywhere).
+
+    Where the pin moves away (mode ``SEPARATE``) after sliding, the slope is
+    that of the sliding contact continued past the separation
+    (``models._continued_slide``), so that a step crossing it sees a smooth
+    right-hand side; the rollout ends the contact at the located crossing
+    and never integrates past it.
     """
     cx, cy, nx, ny, _, _ = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     vpx = cs * vpwx + sn * vpwy
     vpy = -sn * vpwx + cs * vpwy
     wvx, wvy, wom = warm[0], warm[1], warm[2]
-    if warm[9] >= 2.0:
+    if warm[9] >= 3.0:
+        sa, sb, sc = warm[4], warm[8], warm[13]
+        dab, dac, dbc = sa - sb, sa - sc, sb - sc
+        span = max(abs(dab), abs(dac))
+        if dab != 0.0 and dac != 0.0 and dbc != 0.0 and abs(sp - sa) <= 1.5 * span:
+            la = (sp - sb) * (sp - sc) / (dab * dac)
+            lb = -(sp - sa) * (sp - sc) / (dab * dbc)
+            lc = (sp - sa) * (sp - sb) / (dac * dbc)
+            wvx = la * warm[0] + lb * warm[5] + lc * warm[10]
+            wvy = la * warm[1] + lb * warm[6] + lc * warm[11]
+            wom = la * warm[2] + lb * warm[7] + lc * warm[12]
+    elif warm[9] >= 2.0:
         span = warm[4] - warm[8]
         r = (sp - warm[4]) / span if span != 0.0 else 0.0
         if -1.5 <= r <= 1.5:
@@ -160,10 +193,17 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, s
     st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
                                                   nx, ny, vpx, vpy, mu, wvx, wvy, wom,
                                                   int(warm[3]))
-    if st == TWIST_OK and mode != SEPARATE:
+    if mode == SEPARATE and warm[9] >= 1.0 and (warm[3] == SLIDE_POS or warm[3] == SLIDE_NEG):
+        # Past a separation within a step: the smooth continuation of the
+        # sliding contact (see models._continued_slide); the mode stays
+        # SEPARATE, so a step that starts here still ends the contact.
+        vx, vy, om = _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx,
+                                      vpy, mu, wvx, wvy, wom, int(warm[3]))
+    elif st == TWIST_OK and mode != SEPARATE:
         if sp != warm[4] or warm[9] < 1.0:
+            warm[10], warm[11], warm[12], warm[13] = warm[5], warm[6], warm[7], warm[8]
             warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
-            warm[9] = min(warm[9] + 1.0, 2.0)
+            warm[9] = min(warm[9] + 1.0, 3.0)
         warm[0], warm[1], warm[2], warm[3], warm[4] = vx, vy, om, mode, sp
     out[0] = om
     out[1] = vpx - (vx - om * y[2])
@@ -180,14 +220,14 @@ def _project(verts, kind, idx, rp, y):
     if kind == EDGE:
         k = (idx + 1) % n
         ex, ey = verts[k, 0] - verts[idx, 0], verts[k, 1] - verts[idx, 1]
-        length = math.hypot(ex, ey)
+        length = math.sqrt(ex * ex + ey * ey)
         mx, my = ey / length, -ex / length
         off = rp - ((y[1] - verts[idx, 0]) * mx + (y[2] - verts[idx, 1]) * my)
         y[1] += off * mx
         y[2] += off * my
     else:
         ox, oy = y[1] - verts[idx, 0], y[2] - verts[idx, 1]
-        dist = math.hypot(ox, oy)
+        dist = math.sqrt(ox * ox + oy * oy)
         y[1] = verts[idx, 0] + rp * ox / dist
         y[2] = verts[idx, 1] + rp * oy / dist
 
@@ -349,9 +389,9 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
             if mask[j] == 0.0 and g[j] < -_EVENT_TOL:
                 mask[j] = 1.0  # an earlier event than the ones seen so far
         f = _min_over(g, mask)
-        # Close enough when within the integrator's own event tolerance; a
-        # state a hair past the crossing (f >= -_EVENT_TOL / 10) is kept too.
-        close = -0.1 * _EVENT_TOL <= f <= _EVENT_TOL
+        # Close enough when within _LOCATE_TOL of the crossing; a state a
+        # hair past it (f >= -_LOCATE_TOL / 10) is kept too.
+        close = -0.1 * _LOCATE_TOL <= f <= _LOCATE_TOL
         if f < 0.0:
             hi = alpha
         else:
@@ -365,10 +405,18 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
         if prev_alpha >= 0.0 and f != prev_f and it < 8:
             nxt = alpha - f * (alpha - prev_alpha) / (f - prev_f)
         else:
-            # First refinement: the interpolant's slope at the guess.
-            _hermite(y0, k1, y1, k_end, h, alpha + 1e-7, yi)
-            _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
-            slope = (_min_over(g, mask) - f) / 1e-7 if it < 8 else 0.0
+            # First refinement: a Newton step with the interpolant's slope at
+            # the guess (a difference of two interpolated values: the real
+            # value f differs from the interpolated one by the interpolation
+            # error, which would swamp a difference over 1e-7).
+            slope = 0.0
+            if it < 8:
+                _hermite(y0, k1, y1, k_end, h, alpha + 1e-7, yi)
+                _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
+                f_up = _min_over(g, mask)
+                _hermite(y0, k1, y1, k_end, h, alpha, yi)
+                _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
+                slope = (f_up - _min_over(g, mask)) / 1e-7
             nxt = alpha - f / slope if slope < 0.0 else 0.5 * (lo + hi)
         prev_alpha, prev_f = alpha, f
         # Aim slightly early so the kept state lies before the crossing.
@@ -526,7 +574,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         fwx, fwy = cs * fx - sn * fy, sn * fx + cs * fy
         if mode == SEPARATE:
             fwx, fwy = 0.0, 0.0
-        peak = max(peak, math.hypot(fwx, fwy))
+        peak = max(peak, math.sqrt(fwx * fwx + fwy * fwy))
         if record:
             force[n_force, 0], force[n_force, 1], force[n_force, 2] = s * a, -fwx, -fwy
             n_force += 1
@@ -556,7 +604,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         if abs(k1[0]) * h > _DTHETA_CAP:
             h = _DTHETA_CAP / abs(k1[0])
         if kind == VERTEX:
-            turn = math.hypot(k1[1], k1[2]) / rp
+            turn = math.sqrt(k1[1] * k1[1] + k1[2] * k1[2]) / rp
             if turn * h > _DTHETA_CAP:
                 h = _DTHETA_CAP / turn
         rejected = False

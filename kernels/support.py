@@ -47,17 +47,29 @@ _GL_W = 0.5 * _GL_W
 
 
 @jit
-def _edge_support(px, py, r1, qx, qy, r2):
-    """Signed E, G, N of the triangle (0, p, q); coordinates relative to r,
-    ``r1 = |p|`` and ``r2 = |q|`` (shared with the neighbouring edges).
+def _edge_support(px, py, r1, i1, qx, qy, r2, i2, ex, ey):
+    """Scaled signed E, G, N of the triangle (0, p, q); coordinates relative
+    to r, ``r1 = |p|``, ``i1 = 1 / r1`` (likewise ``r2``, ``i2`` for q; both
+    shared with the neighbouring edges) and ``(ex, ey)`` the unit direction
+    from p to q.
 
-    Returns ``(E, Gx, Gy, Nxx, Nxy, Nyy)``.
+    Returns ``(6 E, 2 Gx, 2 Gy, Nxx, Nxy, Nyy)``; ``_support_sum`` applies
+    the factors 1/6 and 1/2 once for the whole polygon.
+
+    Notes
+    -----
+    With ``m = (e_y, -e_x)``, ``h = cross(p, e)``, ``t = (p . e, q . e)`` and
+    ``[S] = log((t_2 + r_2) / (t_1 + r_1))`` (module notes)::
+
+        6 E = h [t R] + h^3 [S]
+        2 G = h [R] e + h^2 [S] m
+        N   = c_ee e e^T + c_em (e m^T + m e^T) + c_mm m m^T
+        c_ee = h ([S] - [t/R]),  c_em = -h^2 [1/R],  c_mm = h [t/R]
+
+    Written out with ``m`` in terms of ``e``, the off-diagonal and diagonal
+    entries need no further products of unit vectors. Only multiplications
+    by the reciprocal distances remain: no division by a distance per edge.
     """
-    ex, ey = qx - px, qy - py
-    inv = 1.0 / math.sqrt(ex * ex + ey * ey)
-    ex *= inv
-    ey *= inv
-    mx, my = ey, -ex
     h = px * ey - py * ex
     if abs(h) <= 1e-15 * (r1 + r2):
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -68,21 +80,68 @@ def _edge_support(px, py, r1, qx, qy, r2):
     hh = h * h
     p1 = t1 + r1 if t1 >= 0.0 else hh / (r1 - t1)
     p2 = t2 + r2 if t2 >= 0.0 else hh / (r2 - t2)
-    ds = math.log(p2 / p1)
-    dtr = t2 * r2 - t1 * r1
-    dr = r2 - r1
-    dtor = t2 / r2 - t1 / r1
-    dinv = 1.0 / r2 - 1.0 / r1
-    e_val = h * dtr / 6.0 + hh * h * ds / 6.0
-    gx = 0.5 * h * (ex * dr + h * mx * ds)
-    gy = 0.5 * h * (ey * dr + h * my * ds)
-    cee = h * (ds - dtor)
-    cem = -hh * dinv
+    hds = h * math.log(p2 / p1)
+    dtor = t2 * i2 - t1 * i1
+    e6 = h * (t2 * r2 - t1 * r1) + hh * hds
+    a = h * (r2 - r1)
+    gx2 = a * ex + h * hds * ey
+    gy2 = a * ey - h * hds * ex
+    cee = hds - h * dtor
+    cem = -hh * (i2 - i1)
     cmm = h * dtor
-    nxx = cee * ex * ex + 2.0 * cem * ex * mx + cmm * mx * mx
-    nxy = cee * ex * ey + cem * (ex * my + mx * ey) + cmm * mx * my
-    nyy = cee * ey * ey + 2.0 * cem * ey * my + cmm * my * my
-    return e_val, gx, gy, nxx, nxy, nyy
+    exx, eyy, exy = ex * ex, ey * ey, ex * ey
+    nxx = cee * exx + 2.0 * cem * exy + cmm * eyy
+    nxy = (cee - cmm) * exy + cem * (eyy - exx)
+    nyy = cee * eyy - 2.0 * cem * exy + cmm * exx
+    return e6, gx2, gy2, nxx, nxy, nyy
+
+
+@jit
+def _support_sum(verts, quad, rx, ry):
+    """E(r), G(r), N(r) of the counter-clockwise polygon ``verts``, with the
+    edges' unit directions read from the last ``n`` rows of ``quad`` (as
+    ``_fan_quadrature`` builds it), or computed here if ``quad`` has fewer
+    than ``n`` rows.
+
+    Returns ``(E, Gx, Gy, Nxx, Nxy, Nyy)``.
+
+    Notes
+    -----
+    Per vertex one square root and one reciprocal; per edge one logarithm
+    and, only for an edge end behind the foot of the perpendicular, one
+    division (see ``_edge_support``). The unit directions do not depend on
+    r, so the prepared table saves a square root and a division per edge.
+    """
+    n = verts.shape[0]
+    base = quad.shape[0] - n
+    e_val = gx = gy = nxx = nxy = nyy = 0.0
+    x0, y0 = verts[0, 0] - rx, verts[0, 1] - ry
+    r0 = math.sqrt(x0 * x0 + y0 * y0)
+    i0 = 1.0 / r0
+    px, py, r1, i1 = x0, y0, r0, i0
+    for j in range(n):
+        if j + 1 < n:
+            qx, qy = verts[j + 1, 0] - rx, verts[j + 1, 1] - ry
+            r2 = math.sqrt(qx * qx + qy * qy)
+            i2 = 1.0 / r2
+        else:
+            qx, qy, r2, i2 = x0, y0, r0, i0
+        if base >= 0:
+            ex, ey = quad[base + j, 0], quad[base + j, 1]
+        else:
+            ex, ey = qx - px, qy - py
+            inv = 1.0 / math.sqrt(ex * ex + ey * ey)
+            ex *= inv
+            ey *= inv
+        a0, a1, a2, a3, a4, a5 = _edge_support(px, py, r1, i1, qx, qy, r2, i2, ex, ey)
+        e_val += a0
+        gx += a1
+        gy += a2
+        nxx += a3
+        nxy += a4
+        nyy += a5
+        px, py, r1, i1 = qx, qy, r2, i2
+    return e_val / 6.0, 0.5 * gx, 0.5 * gy, nxx, nxy, nyy
 
 
 @jit
@@ -91,39 +150,25 @@ def _support(verts, rx, ry):
 
     Returns ``(E, Gx, Gy, Nxx, Nxy, Nyy)``.
     """
-    n = verts.shape[0]
-    e_val = gx = gy = nxx = nxy = nyy = 0.0
-    px, py = verts[0, 0] - rx, verts[0, 1] - ry
-    r_first = math.sqrt(px * px + py * py)
-    r1 = r_first
-    for j in range(n):
-        if j + 1 < n:
-            qx, qy = verts[j + 1, 0] - rx, verts[j + 1, 1] - ry
-            r2 = math.sqrt(qx * qx + qy * qy)
-        else:
-            qx, qy = verts[0, 0] - rx, verts[0, 1] - ry
-            r2 = r_first
-        a0, a1, a2, a3, a4, a5 = _edge_support(px, py, r1, qx, qy, r2)
-        e_val += a0
-        gx += a1
-        gy += a2
-        nxx += a3
-        nxy += a4
-        nyy += a5
-        px, py, r1 = qx, qy, r2
-    return e_val, gx, gy, nxx, nxy, nyy
+    return _support_sum(verts, verts[:0], rx, ry)
 
 
 @jit
 def _fan_quadrature(verts):
-    """Collapsed Gauss-Legendre rule over the centroid fan of ``verts``.
+    """Collapsed Gauss-Legendre rule over the centroid fan of ``verts``, and
+    the edges' unit directions.
 
-    Returns an ``(m, 3)`` array of ``(x, y, weight)``; weights are signed, so
-    the rule integrates smooth functions over non-convex polygons too.
+    Returns an ``(n g^2 + n, 3)`` array (``g = _GL_N``): rows of ``(x, y,
+    weight)`` with signed weights, so the rule integrates smooth functions
+    over non-convex polygons too, then one row ``(e_x, e_y, 0)`` per edge
+    ``j`` (vertex ``j`` to ``j + 1``), unit direction, weight zero, so a sum
+    over all rows is still the quadrature. ``_power`` reads the directions
+    from there (see ``_support_sum``) instead of normalising every edge in
+    every evaluation.
     """
     n = verts.shape[0]
     g = _GL_X.shape[0]
-    out = np.empty((n * g * g, 3))
+    out = np.empty((n * g * g + n, 3))
     m = 0
     for j in range(n):
         k = (j + 1) % n
@@ -138,6 +183,13 @@ def _fan_quadrature(verts):
                 out[m, 1] = u * (py + v * (qy - py))
                 out[m, 2] = _GL_W[a] * _GL_W[b] * u * jac
                 m += 1
+    for j in range(n):
+        k = (j + 1) % n
+        ex, ey = verts[k, 0] - verts[j, 0], verts[k, 1] - verts[j, 1]
+        length = math.sqrt(ex * ex + ey * ey)
+        out[m + j, 0] = ex / length
+        out[m + j, 1] = ey / length
+        out[m + j, 2] = 0.0
     return out
 
 
@@ -150,11 +202,11 @@ def _power(verts, quad, area, vx, vy, om):
 
     Returns ``(P, gx, gy, gw, Hxx, Hxy, Hxw, Hyy, Hyw, Hww)``.
     """
-    speed = math.hypot(vx, vy)
-    if abs(om) * _R_FAR > speed and om != 0.0:
-        # Rotation about r = z x v / omega: closed forms.
-        rx, ry = -vy / om, vx / om
-        e_val, gx, gy, nxx, nxy, nyy = _support(verts, rx, ry)
+    if om * om * (_R_FAR * _R_FAR) > vx * vx + vy * vy and om != 0.0:
+        # Rotation about r = z x v / omega within _R_FAR: closed forms.
+        inv_om = 1.0 / om
+        rx, ry = -vy * inv_om, vx * inv_om
+        e_val, gx, gy, nxx, nxy, nyy = _support_sum(verts, quad, rx, ry)
         s = 1.0 if om > 0.0 else -1.0
         p_val = abs(om) * e_val / area
         f = s / area
@@ -169,7 +221,7 @@ def _power(verts, quad, area, vx, vy, om):
                 k * (px * npx + py * npy))
     p_val = g0 = g1 = g2 = 0.0
     h00 = h01 = h02 = h11 = h12 = h22 = 0.0
-    for i in range(quad.shape[0]):
+    for i in range(quad.shape[0] - verts.shape[0]):  # the last n rows are edges
         wx, wy, wt = quad[i, 0], quad[i, 1], quad[i, 2]
         ux = vx - om * wy
         uy = vy + om * wx
