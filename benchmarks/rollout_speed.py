@@ -19,9 +19,9 @@ import time
 import numba
 import numpy as np
 
-from pipeline import simulate
+from pipeline.maps import simulate
 from pipeline.cli import PAPER_D
-from pipeline.parts import Part
+from pipeline.parts.part import Part
 
 TRIANGLE = [(0, 0), (60, 0), (15, 35)]
 

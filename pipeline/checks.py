@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import PinfeedError
+from pipeline.errors import PinfeedError
 
 MAX_VALUES = 100_000
 MAX_MAP = 1_000_000  # rollouts in one map (d x theta_i): about half an hour on one core

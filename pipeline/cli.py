@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import PinfeedError
+from pipeline.errors import PinfeedError
 
 PAPER_D = [-0.9, -0.8, -0.7, -0.6, -0.5, -0.4, -0.3, -0.2, -0.1,
            0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]
@@ -30,7 +30,7 @@ def _print_json(obj, **kw):
 def parse_values(text: str, what: str) -> np.ndarray:
     """``"a,b,c"`` or an inclusive range ``"start:stop:step"``: finite, distinct,
     at most ``checks.MAX_VALUES`` values (refused before anything is allocated)."""
-    from .checks import check_grid_size, check_values, range_size
+    from pipeline.checks import check_grid_size, check_values, range_size
     bad = PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
                        f"of finite numbers with step > 0")
     try:
@@ -52,9 +52,9 @@ def parse_values(text: str, what: str) -> np.ndarray:
 
 def _part_from_args(args):
     """The part of ``--vertices`` or ``--outline`` (saying how many vertices a CAD outline gave)."""
-    from .parts import Part, parse_vertices
+    from pipeline.parts.part import Part, parse_vertices
     if getattr(args, "outline", None):
-        from .outlines import read_outline
+        from pipeline.parts.outlines import read_outline
         out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol)
         print(f"outline {out.describe()}", file=sys.stderr)
         name = args.name or re.sub(r"[^A-Za-z0-9_]", "_", Path(args.outline).stem) or "part"
@@ -99,7 +99,7 @@ def _add_physics(p, d_required=True, belt=False):
 
 
 def cmd_rollout(args):
-    from . import simulate
+    from pipeline.maps import simulate
     part = _part_from_args(args)
     belt = {}
     if args.model in simulate.BELT_MODELS:
@@ -158,10 +158,10 @@ def _print_trajectory(row, n_rows: int = 11):
 
 
 def cmd_map(args):
-    from . import simulate
-    from .checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
-    from .io import write_atomic
-    from .provenance import provenance_attrs
+    from pipeline.maps import simulate
+    from pipeline.checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
+    from pipeline.maps.io import write_atomic
+    from pipeline.provenance import provenance_attrs
     part = _part_from_args(args)
     d = parse_values(args.d, "--d")
     if not args.theta_step > 0 or args.theta_step > 360:
@@ -191,9 +191,9 @@ def _bands_option(text):
 
 
 def cmd_plot_map(args):
-    from .checks import IMAGE_SUFFIXES, check_out_path
-    from .figures.maps import plot_map
-    from .io import read_map
+    from pipeline.checks import IMAGE_SUFFIXES, check_out_path
+    from pipeline.present.figures.maps import plot_map
+    from pipeline.maps.io import read_map
     check_out_path(args.out, IMAGE_SUFFIXES)
     out = plot_map(read_map(args.map), args.out, bands=_bands_option(args.bands))
     print(f"wrote {out}")
@@ -203,11 +203,11 @@ def cmd_demo(args):
     """The main job until the workflow lands: one map set of a default triangle."""
     from pathlib import Path
 
-    from . import simulate
-    from .figures.maps import plot_map
-    from .io import write_atomic
-    from .parts import Part, parse_vertices
-    from .provenance import provenance_attrs
+    from pipeline.maps import simulate
+    from pipeline.present.figures.maps import plot_map
+    from pipeline.maps.io import write_atomic
+    from pipeline.parts.part import Part, parse_vertices
+    from pipeline.provenance import provenance_attrs
     part = Part.from_vertices(parse_vertices(DEFAULT_TRIANGLE), name="triangle")
     theta = np.arange(0.0, 360.0, 1.0)
     print(f"computing {len(PAPER_D)} x {theta.size} minpower rollouts of {part.id} ...", flush=True)
@@ -220,7 +220,7 @@ def cmd_demo(args):
 
 
 def _catalog(args):
-    from .catalog import Catalog
+    from pipeline.maps.catalog import Catalog
     cat = Catalog.open(args.catalog)
     for problem in cat.problems:
         print(f"pinfeed: warning: {problem} (not served)", file=sys.stderr)
@@ -228,7 +228,7 @@ def _catalog(args):
 
 
 def cmd_catalog_index(args):
-    from .catalog import Catalog
+    from pipeline.maps.catalog import Catalog
     cat = Catalog.rebuild(args.catalog)
     print(f"indexed {len(cat.entries)} shards under {args.catalog}")
     for problem in cat.problems:
@@ -280,7 +280,7 @@ def _query(args):
 
 
 def cmd_catalog_query(args):
-    from .simulate import status_names
+    from pipeline.maps.simulate import status_names
     ds = _query(args).load()
     rows = []
     for mu in ds["mu_c"].values:
@@ -301,8 +301,8 @@ def cmd_catalog_query(args):
 
 
 def cmd_catalog_plot(args):
-    from .checks import IMAGE_SUFFIXES, check_out_path
-    from .figures.maps import plot_map
+    from pipeline.checks import IMAGE_SUFFIXES, check_out_path
+    from pipeline.present.figures.maps import plot_map
     check_out_path(args.out, IMAGE_SUFFIXES)
     ds = _query(args)
     if ds.sizes["mu_c"] != 1:
@@ -314,8 +314,8 @@ def cmd_catalog_plot(args):
 
 
 def cmd_sweep(args):
-    from .config import load_config
-    from .sweep import run_sweep
+    from pipeline.config import load_config
+    from pipeline.maps.sweep import run_sweep
     config = load_config(args.config)
     if args.catalog:
         config["catalog_dir"] = args.catalog
@@ -326,8 +326,8 @@ def cmd_sweep(args):
 
 
 def cmd_plan(args):
-    from .config import load_config
-    from .planning import parse_friction
+    from pipeline.config import load_config
+    from pipeline.planning.plan import parse_friction
     config = load_config(args.config)
     if args.catalog:
         config["catalog_dir"] = args.catalog
@@ -351,7 +351,7 @@ def cmd_plan(args):
             raise PinfeedError("--mu-s is the belt friction of the dynamic model: give --belt-speed too")
         pc["mu_s"] = args.mu_s
     part = _plan_part_arg(args, config)
-    from .planning import planner_belt
+    from pipeline.planning.plan import planner_belt
     belt_speed, _ = planner_belt(config, part)  # a bad belt: a one-line error before any work
     if belt_speed is not None and args.mode != "tight":
         raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
@@ -359,7 +359,7 @@ def cmd_plan(args):
     if args.mode == "tight":
         result = _plan_tight_only(part, config, progress=None if args.json else _progress)
     else:
-        from .stages import ensure_maps, plan_part
+        from pipeline.workflow.stages import ensure_maps, plan_part
         cat = ensure_maps(config, part)
         if args.mode == "paper":
             config = dict(config, planner=dict(pc, mu_c=pc["mu_c"], frictions=[]))
@@ -368,7 +368,7 @@ def cmd_plan(args):
         if args.mode == "paper":
             result.pop("tight")
     if args.out:
-        from .stages import write_json
+        from pipeline.workflow.stages import write_json
         write_json(result, args.out)
     if args.json:
         _print_json(_plan_json(result, args.mode), default=float)
@@ -394,8 +394,8 @@ def _plan_dynamic_args(args, dynamic):
 
 
 def _plan_part_arg(args, config):
-    from .families import family_parts
-    from .parts import Part
+    from pipeline.parts.families import family_parts
+    from pipeline.parts.part import Part
     if args.vertices or args.outline:
         return _part_from_args(args)
     if not args.part:
@@ -404,16 +404,16 @@ def _plan_part_arg(args, config):
              if args.part in (p.name, p.id)]
     if found:
         return found[0]
-    from .catalog import Catalog
+    from pipeline.maps.catalog import Catalog
     cat = Catalog.open(config["catalog_dir"])
     e = cat._entries_for(args.part)[0]  # raises 'unknown part' with the known names
     return Part.from_vertices(e["part_vertices"], name=e["part_name"])
 
 
 def _plan_tight_only(part, config, progress=None) -> dict:
-    from .stages import plan_tight_all
-    from .provenance import provenance_attrs
-    from .planning import planner_belt
+    from pipeline.workflow.stages import plan_tight_all
+    from pipeline.provenance import provenance_attrs
+    from pipeline.planning.plan import planner_belt
     belt_speed, mu_s = planner_belt(config, part)
     belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
     return {"part": part.to_dict(), "model": config["planner"]["model"], **belt,
@@ -461,8 +461,8 @@ def _plan_json(result, mode) -> dict:
 
 
 def _print_plan_result(result, part, config, mode):
-    from .arcs import format_arcs
-    from .planning import mechanics_label, planner_belt
+    from pipeline.planning.arcs import format_arcs
+    from pipeline.planning.plan import mechanics_label, planner_belt
     pc = config["planner"]
     print(f"part {part.id}: model {mechanics_label(pc['model'], *planner_belt(config))}, depth {pc['depth']}")
     for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
@@ -495,15 +495,15 @@ def _print_plan_result(result, part, config, mode):
 
 def _results_arg(args, config) -> Path:
     """The results folder of stored plans and sensing: --results, else the config's."""
-    from .config import results_folder
+    from pipeline.config import results_folder
     return Path(args.results) if args.results else results_folder(config)
 
 
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
-    from .config import load_config
-    from .speed_limit import stored_plan_speed
-    from .stages import read_json
+    from pipeline.config import load_config
+    from pipeline.planning.speed_limit import stored_plan_speed
+    from pipeline.workflow.stages import read_json
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
@@ -527,15 +527,15 @@ def cmd_speed(args):
 
 def _pick_tight_plan(result: dict, n: int, mu_text):
     """See :func:`pipeline.planning.pick_tight_plan` (shared with ``pinfeed layout``)."""
-    from .planning import pick_tight_plan
+    from pipeline.planning.plan import pick_tight_plan
     return pick_tight_plan(result, n, mu_text)
 
 
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
-    from .config import load_config
-    from .layout import check_drawing_path, layout_stored, write_drawing
-    from .stages import read_json
+    from pipeline.config import load_config
+    from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
+    from pipeline.workflow.stages import read_json
     config = load_config(args.config)
     if args.out:
         check_drawing_path(args.out)  # before minutes of trials
@@ -580,9 +580,9 @@ def cmd_layout(args):
 
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
-    from .animate import animate_stored, plan_inputs
-    from .config import load_config
-    from .stages import read_json
+    from pipeline.present.animate import animate_stored, plan_inputs
+    from pipeline.config import load_config
+    from pipeline.workflow.stages import read_json
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
@@ -641,9 +641,9 @@ def _classify_part(args, config, root):
     (the config's outline wins over older ones stored under the same name),
     else from a stored sensing or plan result of that name under ``root`` (a
     part planned with --vertices has refinement shards only)."""
-    from .catalog import Catalog
-    from .parts import Part
-    from .stages import config_part_id, read_json
+    from pipeline.maps.catalog import Catalog
+    from pipeline.parts.part import Part
+    from pipeline.workflow.stages import config_part_id, read_json
     try:
         cat = Catalog.open(args.catalog or config["catalog_dir"])
         wanted = config_part_id(config, args.part)
@@ -665,7 +665,7 @@ def _classify_pin(args, stored, plan, root, name):
     stored sensor plan's first pin, else the first pin of the stored recommended
     tight plan (first planned friction), else that of paper mode's best
     fixed-pin plan, else --y-pin (which always wins)."""
-    from .planning import tight_entry
+    from pipeline.planning.plan import tight_entry
     entry = tight_entry(plan) if plan is not None and plan.get("tight") else None
     plan_path = root / "plans" / f"{name}.json"
     if args.y_pin is not None:
@@ -686,11 +686,11 @@ def _classify_pin(args, stored, plan, root, name):
 
 
 def cmd_sense_classify(args):
-    from .config import load_config
-    from .planning import parse_friction
-    from .sensing import (Sensor, classify, read_profile_csv, reference_profiles, resample,
+    from pipeline.config import load_config
+    from pipeline.planning.plan import parse_friction
+    from pipeline.sensing.profiles import (Sensor, classify, read_profile_csv, reference_profiles, resample,
                           sign_matrix)
-    from .sensor_plan import (PLAN_SCHEMA, count_sets, describe_sets, final_for_verdict,
+    from pipeline.sensing.sensor_plan import (PLAN_SCHEMA, count_sets, describe_sets, final_for_verdict,
                               read_checked_json, sensing_frictions, stored_sensor_plan)
     config = load_config(args.config)
     root = _results_arg(args, config)  # stored plans and sensor plans
@@ -994,7 +994,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(_join_signed_values(sys.argv[1:] if argv is None else list(argv)))
     try:
-        from .provenance import source_date_epoch
+        from pipeline.provenance import source_date_epoch
         source_date_epoch()  # before numpy's f2py reads it (and crashes on a bad value)
         args.func(args)
     except PinfeedError as exc:

@@ -18,9 +18,9 @@ import pytest
 import xarray as xr
 
 from conftest import TRIANGLE, circular_diff
-from pipeline import simulate
+from pipeline.maps import simulate
 from pipeline.cli import main
-from pipeline.parts import Part
+from pipeline.parts.part import Part
 
 VERTS = "0,0 60,0 15,35"
 BASE = ["rollout", "--vertices", VERTS, "--d", "0.3", "--mu-c", "0.2", "--pin-radius", "3"]

@@ -3,7 +3,7 @@ import io
 
 import pytest
 
-from pipeline.bands import format_arc, format_arcs
+from pipeline.planning.bands import format_arc, format_arcs
 from pipeline.cli import build_parser, main
 from pipeline.progress import progress
 
@@ -80,9 +80,9 @@ def test_sense_hint_names_pinfeed_plan_for_an_ad_hoc_part(tmp_path):
 def test_plot_map_bands_option(tmp_path, capsys):
     import numpy as np
 
-    from pipeline import simulate
-    from pipeline.io import write_atomic
-    from pipeline.parts import Part
+    from pipeline.maps import simulate
+    from pipeline.maps.io import write_atomic
+    from pipeline.parts.part import Part
     part = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
     write_atomic(simulate.map(part, np.arange(0, 360, 30.0), [0.3], 0.2, 3.0), tmp_path / "m.h5")
     assert main(["plot-map", str(tmp_path / "m.h5"), "--out", str(tmp_path / "m.png"),

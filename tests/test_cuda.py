@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from conftest import circular_diff
-from pipeline import simulate
+from pipeline.maps import simulate
 from pipeline.cli import main
 from pipeline.errors import PinfeedError
 

@@ -6,7 +6,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
 
 from pipeline.logs import log_to
-from pipeline.stages import animate_part, read_json
+from pipeline.workflow.stages import animate_part, read_json
 
 with log_to(snakemake.log[0]):  # noqa: F821
     p = snakemake.params  # noqa: F821

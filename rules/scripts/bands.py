@@ -6,7 +6,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
 
 from pipeline.logs import log_to
-from pipeline.stages import shard_bands, write_json
+from pipeline.workflow.stages import shard_bands, write_json
 
 with log_to(snakemake.log[0]):  # noqa: F821
     b = snakemake.params.bands  # noqa: F821

@@ -5,9 +5,9 @@ from pathlib import Path
 # The repository is the workflow: make its pipeline importable under --use-conda too.
 sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
 
-from pipeline.catalog import Catalog
+from pipeline.maps.catalog import Catalog
 from pipeline.logs import log_to
-from pipeline.stages import plan_part, write_json
+from pipeline.workflow.stages import plan_part, write_json
 
 with log_to(snakemake.log[0]):  # noqa: F821
     cat = Catalog.open(snakemake.config["catalog_dir"])  # noqa: F821

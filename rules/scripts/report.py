@@ -6,7 +6,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
 
 from pipeline.logs import log_to
-from pipeline.stages import make_report
+from pipeline.workflow.stages import make_report
 
 with log_to(snakemake.log[0]):  # noqa: F821
     make_report(snakemake.config, snakemake.input.plans, snakemake.input.verify,  # noqa: F821

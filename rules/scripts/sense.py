@@ -7,8 +7,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
 
 from pipeline.logs import log_to
-from pipeline.sensor_plan import sense_part
-from pipeline.stages import write_json
+from pipeline.sensing.sensor_plan import sense_part
+from pipeline.workflow.stages import write_json
 
 with log_to(snakemake.log[0]):  # noqa: F821
     result = sense_part(snakemake.input.plan, snakemake.config)  # noqa: F821

@@ -5,9 +5,9 @@ from pathlib import Path
 # The repository is the workflow: make its pipeline importable under --use-conda too.
 sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
 
-from pipeline.figures.sensing import sensing_figures
+from pipeline.present.figures.sensing import sensing_figures
 from pipeline.logs import log_to
-from pipeline.stages import read_json
+from pipeline.workflow.stages import read_json
 
 with log_to(snakemake.log[0]):  # noqa: F821
     out = snakemake.output  # noqa: F821

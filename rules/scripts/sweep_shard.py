@@ -1,4 +1,4 @@
-"""Snakemake script: compute one shard (thin: the work is in pipeline.sweep)."""
+"""Snakemake script: compute one shard (thin: the work is in pipeline.maps.sweep)."""
 import sys
 from pathlib import Path
 
@@ -6,7 +6,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
 
 from pipeline.logs import log_to
-from pipeline.sweep import find_job, write_shard
+from pipeline.maps.sweep import find_job, write_shard
 
 w = snakemake.wildcards  # noqa: F821 (injected by Snakemake)
 with log_to(snakemake.log[0]):  # noqa: F821
