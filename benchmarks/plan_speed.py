@@ -17,7 +17,7 @@ import time
 from pipeline.config import load_config
 from pipeline.parts.families import family_parts
 from pipeline.planning.plan import parse_friction
-from pipeline.workflow.stages import plan_tight_all
+from pipeline.planning.plan import plan_tight_all
 
 
 def main() -> None:

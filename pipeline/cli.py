@@ -249,7 +249,7 @@ def cmd_catalog_list(args):
 
 def cmd_catalog_show(args):
     cat = _catalog(args)
-    entries = cat._entries_for(args.part)
+    entries = cat.entries_for(args.part)
     e0 = entries[0]
     info = {k: e0[k] for k in ("family", "part_id", "part_name", "part_vertices", "pin_radius",
                                "d", "theta_step", "config_hash", "pinfeed_version", "git_commit")}
@@ -359,7 +359,7 @@ def cmd_plan(args):
     if args.mode == "tight":
         result = _plan_tight_only(part, config, progress=None if args.json else _progress)
     else:
-        from pipeline.workflow.stages import ensure_maps, plan_part
+        from pipeline.workflow.plan import ensure_maps, plan_part
         cat = ensure_maps(config, part)
         if args.mode == "paper":
             config = dict(config, planner=dict(pc, mu_c=pc["mu_c"], frictions=[]))
@@ -368,7 +368,7 @@ def cmd_plan(args):
         if args.mode == "paper":
             result.pop("tight")
     if args.out:
-        from pipeline.workflow.stages import write_json
+        from pipeline.maps.io import write_json
         write_json(result, args.out)
     if args.json:
         _print_json(_plan_json(result, args.mode), default=float)
@@ -406,12 +406,12 @@ def _plan_part_arg(args, config):
         return found[0]
     from pipeline.maps.catalog import Catalog
     cat = Catalog.open(config["catalog_dir"])
-    e = cat._entries_for(args.part)[0]  # raises 'unknown part' with the known names
+    e = cat.entries_for(args.part)[0]  # raises 'unknown part' with the known names
     return Part.from_vertices(e["part_vertices"], name=e["part_name"])
 
 
 def _plan_tight_only(part, config, progress=None) -> dict:
-    from pipeline.workflow.stages import plan_tight_all
+    from pipeline.planning.plan import plan_tight_all
     from pipeline.provenance import provenance_attrs
     from pipeline.planning.plan import planner_belt
     belt_speed, mu_s = planner_belt(config, part)
@@ -503,7 +503,7 @@ def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from pipeline.config import load_config
     from pipeline.planning.speed_limit import stored_plan_speed
-    from pipeline.workflow.stages import read_json
+    from pipeline.maps.io import read_json
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
@@ -535,7 +535,7 @@ def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.config import load_config
     from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
-    from pipeline.workflow.stages import read_json
+    from pipeline.maps.io import read_json
     config = load_config(args.config)
     if args.out:
         check_drawing_path(args.out)  # before minutes of trials
@@ -582,7 +582,7 @@ def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
     from pipeline.present.animate import animate_stored, plan_inputs
     from pipeline.config import load_config
-    from pipeline.workflow.stages import read_json
+    from pipeline.maps.io import read_json
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
@@ -643,13 +643,14 @@ def _classify_part(args, config, root):
     part planned with --vertices has refinement shards only)."""
     from pipeline.maps.catalog import Catalog
     from pipeline.parts.part import Part
-    from pipeline.workflow.stages import config_part_id, read_json
+    from pipeline.maps.io import read_json
+    from pipeline.parts.families import config_part_id
     try:
         cat = Catalog.open(args.catalog or config["catalog_dir"])
         wanted = config_part_id(config, args.part)
         if wanted != args.part and not any(e["part_id"] == wanted for e in cat.entries):
             wanted = args.part  # the config's outline is not stored: use what the catalog has
-        entry = cat._entries_for(wanted)[0]  # unknown part: says how to list them
+        entry = cat.entries_for(wanted)[0]  # unknown part: says how to list them
         return Part.from_vertices(entry["part_vertices"], name=entry["part_name"]), float(entry["pin_radius"])
     except PinfeedError:
         for kind in ("sensing", "plans"):

@@ -143,7 +143,7 @@ def _check_planner_belt(cfg: dict) -> None:
     speed = cfg["planner"].get("belt_speed")
     if speed is None:
         return
-    from pipeline.maps.simulate import check_belt
+    from pipeline.checks import check_belt
     for family, spec in cfg["families"].items():
         for part in family_parts(family, spec):
             if part.name in cfg["planner"]["parts"]:

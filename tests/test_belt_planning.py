@@ -131,7 +131,8 @@ def test_replay_at_belt_speed_equals_passages_one_by_one():
 
 
 def test_speed_stage_json_and_figure(planned, tmp_path):
-    from pipeline.workflow.stages import read_json, speed_figure, speed_part
+    from pipeline.maps.io import read_json
+    from pipeline.workflow.speed import speed_figure, speed_part
     tmp, cfg = planned
     config = load_config(cfg)
     result = speed_part(read_json(tmp / "res" / "plans" / "tri.json"), config)

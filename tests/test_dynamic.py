@@ -29,7 +29,7 @@ from hypothesis import strategies as st
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.planning.paper import Planner, load_maps, pins_from_config
-from pipeline.workflow.stages import dynamic_label
+from pipeline.planning.paper import dynamic_label
 from pipeline.planning.verify import verify_plan
 from test_invariants import (R_PIN, _contact_fraction, assert_maps_agree, d_values, models,
                              mu_values, parts, theta_grid)

@@ -39,6 +39,9 @@ from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_json
 
 INDEX_NAME = "index.json"
+# The planner's refinement shards (pipeline.planning.lattice_store) live under
+# ROOT/refine/PART_ID/...: listed by the index apart from the maps.
+REFINE_FOLDER = "refine"
 INDEX_VERSION = 1
 
 _NUM = {"type": "number"}
@@ -79,7 +82,7 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _entry_from_file(root: Path, path: Path) -> dict:
+def entry_from_file(root: Path, path: Path) -> dict:
     """Index entry from a shard's own attributes; raises PinfeedError for foreign/corrupt files."""
     try:
         ds = xr.open_dataset(path, engine="h5netcdf", phony_dims="sort")
@@ -120,7 +123,7 @@ def _entry_from_file(root: Path, path: Path) -> dict:
     }
 
 
-def _read_index(index: Path, root: Path) -> dict:
+def read_index(index: Path, root: Path) -> dict:
     """The index as a dict, checked against :data:`INDEX_SCHEMA`."""
     hint = f"rebuild it with 'pinfeed catalog index --catalog {root}'"
     try:
@@ -138,7 +141,7 @@ def _read_index(index: Path, root: Path) -> dict:
     return data
 
 
-def _disk_problem(path: Path, e: dict) -> str | None:
+def disk_problem(path: Path, e: dict) -> str | None:
     """Why an index entry no longer matches its file, or None. Cheap: the file is
     hashed only when its modification time differs from the indexed one."""
     if not path.is_file():
@@ -149,6 +152,22 @@ def _disk_problem(path: Path, e: dict) -> str | None:
     if st.st_mtime_ns != e.get("mtime_ns") and _sha256(path) != e["sha256"]:
         return f"{path}: changed since it was indexed (checksum)"
     return None
+
+
+def refinement_fields(relative_path) -> dict:
+    """What a refinement file's path (relative to the catalog) says it holds:
+    ``part_id``, ``model``, ``v_pin``, ``belt_speed`` (``None``: quasi-static)
+    and ``mu_s``, for the catalog index."""
+    parts = Path(relative_path).parts
+    fields = dict(item.split("=", 1) for item in
+                  Path(relative_path).stem.replace("_belt=", "|belt=").replace("_mu_s=", "|mu_s=").split("|")
+                  if "=" in item)
+    try:
+        return {"part_id": parts[1], "model": parts[2], "v_pin": float(fields["v_pin"]),
+                "belt_speed": float(fields["belt"]) if "belt" in fields else None,
+                "mu_s": float(fields["mu_s"]) if "mu_s" in fields else None}
+    except (IndexError, KeyError, ValueError):
+        return {}  # not named by lattice_path: listed by file only
 
 
 class Catalog:
@@ -173,15 +192,14 @@ class Catalog:
         for path in sorted(root.rglob("*.h5")):
             if path.name.startswith("."):
                 continue  # an unfinished atomic write
-            if path.relative_to(root).parts[0] == "refine":
+            if path.relative_to(root).parts[0] == REFINE_FOLDER:
                 # the planner's on-demand rollouts (pipeline.planning.lattice_store), not maps
-                from pipeline.planning.lattice_store import refinement_fields
                 rel = path.relative_to(root)
                 refinements.append({"file": rel.as_posix(), **refinement_fields(rel),
                                     "sha256": _sha256(path)})
                 continue
             try:
-                entries.append(_entry_from_file(root, path))
+                entries.append(entry_from_file(root, path))
             except PinfeedError as exc:
                 problems.append(str(exc))
         write_json({"index_version": INDEX_VERSION, "entries": entries, "problems": problems,
@@ -197,10 +215,10 @@ class Catalog:
         if not index.is_file():
             raise PinfeedError(f"no catalog index at {index}; run the workflow ('make run') "
                                f"or 'pinfeed catalog index --catalog {root}'")
-        data = _read_index(index, root)
+        data = read_index(index, root)
         entries, problems = [], list(data.get("problems", []))
         for e in data["entries"]:
-            problem = _disk_problem(root / e["file"], e)
+            problem = disk_problem(root / e["file"], e)
             if problem:
                 problems.append(problem)
             else:
@@ -223,7 +241,7 @@ class Catalog:
         return [dict(r, models=sorted(r["models"]), mu_c=sorted(r["mu_c"]), v_pin=sorted(r["v_pin"]))
                 for r in rows.values()]
 
-    def _entries_for(self, part: str) -> list[dict]:
+    def entries_for(self, part: str) -> list[dict]:
         found = [e for e in self.entries if part in (e["part_id"], e["part_name"])]
         if not found:
             known = sorted({e["part_name"] for e in self.entries})
@@ -268,9 +286,9 @@ class Catalog:
         if method not in ("nearest", "bracket"):
             raise PinfeedError(f"unknown selection method {method!r}; use nearest or bracket")
         _check_finite(mu_c=mu_c, d=d, v_pin=v_pin)
-        found = [e for e in self._entries_for(part) if e["model"] == model]
+        found = [e for e in self.entries_for(part) if e["model"] == model]
         if not found:
-            models = sorted({e["model"] for e in self._entries_for(part)})
+            models = sorted({e["model"] for e in self.entries_for(part)})
             raise PinfeedError(f"part {part!r} has no {model} maps; stored models: {', '.join(models)}")
         belts = sorted({e.get("belt_speed", 0.0) for e in found})
         found = [e for e in found if e.get("belt_speed", 0.0) == float(belt_speed)]

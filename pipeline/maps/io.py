@@ -1,4 +1,4 @@
-"""Reading and writing map files (HDF5 through xarray's h5netcdf engine).
+"""Reading and writing map files (HDF5 through xarray's h5netcdf engine) and result JSON.
 
 Writes are atomic: the file is written under a temporary name in the same
 folder and renamed into place, so an interrupted run never leaves a
@@ -75,6 +75,18 @@ def write_text_atomic(text: str, path) -> Path:
 
 def write_json(obj, path) -> Path:
     return write_text_atomic(json.dumps(obj, indent=1, sort_keys=True, default=float) + "\n", path)
+
+
+def read_json(path) -> dict:
+    """A result file (plan, verification, sensing, speed, layout JSON), checked:
+    a missing or corrupt file raises :class:`PinfeedError` saying what to do."""
+    path = Path(path)
+    if not path.is_file():
+        raise PinfeedError(f"no result file at {path}; run the workflow ('make run') first")
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError:
+        raise PinfeedError(f"{path} is corrupt; delete it and re-run the workflow") from None
 
 
 def read_map(path) -> xr.Dataset:

@@ -23,7 +23,7 @@ from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NA
                              _rollout, max_steps_for)
 
 from pipeline import __version__
-from pipeline.checks import check_kernel_settings, check_pin_ratio
+from pipeline.checks import check_belt, check_kernel_settings, check_pin_ratio
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 
@@ -339,36 +339,6 @@ def status_names(codes) -> np.ndarray:
 # (pipeline.maps.mujoco_rig, an independent engine). Quasi-static models above.
 
 BELT_MODELS = ("dynamic", "mujoco")
-G_MM_S2 = 9810.0
-MU_S_MAX = 5.0
-# Largest v^2 / (mu_s g a): beyond it a plastic impact at belt speed sends the
-# part sliding more than Fr a / 2 = 5 a ahead of the pin: thrown, not pushed.
-FROUDE_MAX = 10.0
-
-
-def froude(part: Part, belt_speed: float, mu_s: float = 0.5) -> float:
-    """``v_b^2 / (mu_s g a)`` with ``v_b`` in mm/s and the part in millimetres."""
-    return float(belt_speed) ** 2 / (float(mu_s) * G_MM_S2 * part.a)
-
-
-def check_belt(part: Part, belt_speed, mu_s) -> float:
-    """Raise :class:`PinfeedError` for a bad belt speed or belt friction; return Fr."""
-    if not (isinstance(belt_speed, (int, float, np.floating, np.integer))
-            and math.isfinite(belt_speed)) or belt_speed <= 0:
-        raise PinfeedError(f"belt speed must be a finite number > 0 (mm/s), got {belt_speed!r}")
-    if not (isinstance(mu_s, (int, float, np.floating, np.integer)) and math.isfinite(mu_s)) \
-            or mu_s <= 0 or mu_s > MU_S_MAX:
-        raise PinfeedError(f"belt friction mu_s must be in (0, {MU_S_MAX:g}], got {mu_s!r}")
-    fr = froude(part, belt_speed, mu_s)
-    if fr > FROUDE_MAX:
-        raise PinfeedError(
-            f"belt speed {belt_speed:g} mm/s is too fast for this part: v^2/(mu_s g a) = {fr:.3g} "
-            f"> {FROUDE_MAX:g}, so the pin throws the part (it slides about {0.5 * fr * part.a:.0f} mm "
-            f"after the impact) rather than pushing it; slow the belt below "
-            f"{math.sqrt(FROUDE_MAX * mu_s * G_MM_S2 * part.a):.0f} mm/s")
-    return fr
-
-
 def dynamic_rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float,
                     belt_speed: float, mu_s: float = 0.5, model: str = "dynamic",
                     v_pin: float = 0.0, restitution: float = 0.0,

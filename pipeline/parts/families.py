@@ -93,3 +93,26 @@ def family_parts(name: str, spec: dict) -> list[Part]:
     if not parts:
         raise PinfeedError(f"family {name} has no parts; add 'parts' or 'generators'")
     return parts
+
+
+# ---------------------------------------------------------------------- config parts by name
+
+
+def config_part_id(config: dict, name: str) -> str:
+    """The id of the config's part called ``name`` (the catalog may also hold
+    older outlines under the same name), or ``name`` itself if the config
+    has no such part."""
+    for family, spec in config.get("families", {}).items():
+        for part in family_parts(family, spec):
+            if name in (part.name, part.id):
+                return part.id
+    return name
+
+
+def config_part_source(config: dict, name: str) -> str | None:
+    """The CAD outline file a config part was read from (None for vertices)."""
+    for spec in config.get("families", {}).values():
+        for p in spec.get("parts", []) if isinstance(spec, dict) else []:
+            if isinstance(p, dict) and p.get("name") == name:
+                return p.get("outline")
+    return None

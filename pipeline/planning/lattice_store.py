@@ -25,12 +25,13 @@ import xarray as xr
 
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
 
+from pipeline.maps.catalog import REFINE_FOLDER
 from pipeline.maps.io import write_atomic
 from pipeline.parts.part import Part
 from pipeline.planning.propagate import UNITS, OutcomeLattice
 from pipeline.provenance import provenance_attrs
 
-FOLDER = "refine"
+FOLDER = REFINE_FOLDER
 
 
 def lattice_path(root, part: Part, model: str, v_pin: float, belt_speed: float | None = None,
@@ -41,22 +42,6 @@ def lattice_path(root, part: Part, model: str, v_pin: float, belt_speed: float |
     if belt_speed is None:
         return folder / model / f"v_pin={float(v_pin):g}.h5"
     return folder / "dynamic" / f"v_pin={float(v_pin):g}_belt={float(belt_speed):g}_mu_s={float(mu_s):g}.h5"
-
-
-def refinement_fields(relative_path) -> dict:
-    """What a refinement file's path (relative to the catalog) says it holds:
-    ``part_id``, ``model``, ``v_pin``, ``belt_speed`` (``None``: quasi-static)
-    and ``mu_s``, for the catalog index."""
-    parts = Path(relative_path).parts
-    fields = dict(item.split("=", 1) for item in
-                  Path(relative_path).stem.replace("_belt=", "|belt=").replace("_mu_s=", "|mu_s=").split("|")
-                  if "=" in item)
-    try:
-        return {"part_id": parts[1], "model": parts[2], "v_pin": float(fields["v_pin"]),
-                "belt_speed": float(fields["belt"]) if "belt" in fields else None,
-                "mu_s": float(fields["mu_s"]) if "mu_s" in fields else None}
-    except (IndexError, KeyError, ValueError):
-        return {}  # not named by lattice_path: listed by file only
 
 
 def _settings(lattice: OutcomeLattice) -> dict:

@@ -36,10 +36,15 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 from pipeline.planning.arcs import in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
 from pipeline.planning.bands import band_lookup, extract_bands
 from pipeline.errors import PinfeedError
+from pipeline.maps.catalog import Catalog
+from pipeline.parts.families import config_part_id
 from pipeline.parts.part import Part
+from pipeline.planning.plan import nominal_friction, parse_friction
 
 
 @dataclass(frozen=True)
+
+
 class Step:
     pin: str
     y_pin: float
@@ -52,6 +57,8 @@ class Step:
 
 
 @dataclass(frozen=True)
+
+
 class State:
     arc: tuple  # (start, width), degrees
     y_lo: float
@@ -63,6 +70,8 @@ class State:
 
 
 @dataclass
+
+
 class MapData:
     """One stored map (one d) with its bands, as the planner needs it."""
     d: float
@@ -75,6 +84,8 @@ class MapData:
 
 
 @dataclass
+
+
 class Plan:
     pins: tuple  # labels in order
     n_sets: int
@@ -333,3 +344,51 @@ def _dedupe(states):
 def pins_from_config(values) -> dict:
     """Global pin labels ``P1, P2, ...`` for the configured heights (mm above the fence)."""
     return {f"P{k}": float(y) for k, y in enumerate(values, start=1)}
+
+
+# ---------------------------------------------------------------------- a catalog part's planner
+
+
+def catalog_part(cat: Catalog, name: str) -> Part:
+    e = cat.entries_for(name)[0]
+    return Part.from_vertices(e["part_vertices"], name=e["part_name"])
+
+
+def build_planner(cat: Catalog, name: str, config: dict, dynamic: bool = True):
+    """The planner of one catalog part: static maps at the planner's mu_c, plus
+    (``dynamic``) the maps of every moving-pin speed the config allows
+    (``planner.dynamic``)."""
+    pc, bc = config["planner"], config["bands"]
+    name = config_part_id(config, name)
+    part = catalog_part(cat, name)
+    ds = cat.query(name, model=pc["model"], mu_c=nominal_friction(parse_friction(pc["mu_c"])))
+    selection = ds.attrs["selection"]
+    mu_used = float(ds["mu_c"][0])
+    maps = load_maps(ds.isel(mu_c=0).load(), bc["threshold_T"], bc["factor_c"])
+    static = pins_from_config(pc["pins"])
+    speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if dynamic else []
+    dynamic_maps = {}
+    for v in speeds:
+        dv = cat.query(name, model=pc["model"], mu_c=mu_used, v_pin=v)
+        if float(dv["mu_c"][0]) != mu_used:
+            raise PinfeedError(f"{name}: the maps at v_pin/v_b = {v:g} have no mu_c = {mu_used:g} (the "
+                               f"static maps' friction); add it to the sweep or re-run the workflow")
+        dv = dv.isel(mu_c=0).load()
+        dynamic_maps[v] = load_maps(dv, bc["threshold_T"], bc["factor_c"])
+    moving = {dynamic_label(label, v): (y, v) for label, y in static.items() for v in speeds}
+    planner = Planner(part, maps, static, pc["d_min"], pc["d_max"],
+                      coverage=pc.get("coverage", "bracket"), dynamic=moving,
+                      dynamic_maps=dynamic_maps)
+    return part, planner, mu_used, selection
+
+
+def dynamic_label(static_label: str, v_pin: float) -> str:
+    """Label of a moving pin: its static label and speed ratio, e.g. ``P23v-2``."""
+    return f"{static_label}v{v_pin:+g}"
+
+
+def paper_depth(config: dict) -> int:
+    """Depth of the paper-mode planner: ``planner.paper_depth``, at most
+    ``planner.depth`` (the sensor planner reads the stored tight plans instead)."""
+    pc = config["planner"]
+    return int(min(pc["depth"], pc.get("paper_depth", 3)))

@@ -25,10 +25,12 @@ import math
 from pipeline.planning.arcs import format_arcs
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
+from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.propagate import Tolerances, Uncertainty
 from pipeline.planning.search import TightPlanner
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import verify_plan
+
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
 
@@ -79,7 +81,7 @@ def planner_belt(config: dict, part: Part | None = None):
     if speed is None:
         return None, float(mu_s)
     if part is not None:
-        from pipeline.maps.simulate import check_belt
+        from pipeline.checks import check_belt
         check_belt(part, speed, mu_s)
     return float(speed), float(mu_s)
 
@@ -205,3 +207,38 @@ def pick_tight_plan(result: dict, n: int, mu_text):
         raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
     mu = entry["mu_c"]
     return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
+
+
+# ---------------------------------------------------------------------- every configured friction
+
+
+def plan_frictions(config: dict) -> list:
+    """The frictions the workflow plans at: ``planner.mu_c`` (a value or a range
+    ``LO:HI``; the recommended plan) first, then each of ``planner.frictions``."""
+    pc = config["planner"]
+    out = [parse_friction(pc["mu_c"])]
+    for f in pc.get("frictions", []):
+        f = parse_friction(f)
+        if f not in out:
+            out.append(f)
+    return out
+
+
+def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progress=None) -> list:
+    """Tight plans at every friction of :func:`plan_frictions` (the first is the
+    recommended one), at ``planner.belt_speed`` when it is set; the planner's
+    rollouts are stored in the catalog (keyed by model, pin speed and belt)."""
+    sweep, model = config["sweep"], config["planner"]["model"]
+    belt_speed, mu_s = planner_belt(config, part)
+    speeds = [0.0] + [float(v) for v in config["planner"].get("dynamic", {}).get("speeds", [])]
+    lattices = {v: load_lattice(catalog_root, part, model, v, sweep["pin_radius"], sweep.get("kernel"),
+                                belt_speed=belt_speed, mu_s=mu_s)
+                for v in speeds}
+    out = []
+    for mu_c in plan_frictions(config):
+        res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep, progress=progress)
+        res.pop("lattices")
+        out.append(res)
+    for lattice in lattices.values():
+        save_lattice(catalog_root, lattice)
+    return out

@@ -156,7 +156,7 @@ class TightPlanner:
         if not pins:
             raise PinfeedError("the planner needs at least one candidate pin")
         if belt_speed is not None:
-            from pipeline.maps.simulate import check_belt
+            from pipeline.checks import check_belt
             check_belt(part, belt_speed, mu_s)
         self.belt_speed = None if belt_speed is None else float(belt_speed)
         self.mu_s = float(mu_s)

@@ -22,7 +22,7 @@ import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
-from pipeline.maps.simulate import FROUDE_MAX, G_MM_S2, check_belt
+from pipeline.checks import FROUDE_MAX, G_MM_S2, check_belt
 
 DEFAULT_SPEEDS = (10.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
 
@@ -119,7 +119,7 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
         ``{"theta_deg": .., "y_mm": .., "pin_mm": ..}``.
     trials : random trials per initial state (plus its four corners).
     speeds : coarse grid of belt speeds, mm/s (capped where the pin would
-        throw the part, see ``simulate.FROUDE_MAX``).
+        throw the part, see ``checks.FROUDE_MAX``).
 
     Returns
     -------

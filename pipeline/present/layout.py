@@ -561,10 +561,10 @@ def _note_drawings(note: str, outputs: dict) -> None:
     import ezdxf
 
     from pipeline.maps.io import atomic_target
-    from pipeline.workflow.stages import _placeholder
+    from pipeline.present.figures import placeholder
     for key in ("svg", "png"):
         with atomic_target(outputs[key]) as tmp:
-            _placeholder(tmp + "." + key, note)
+            placeholder(tmp + "." + key, note)
             import os
             os.replace(tmp + "." + key, tmp)
     doc = ezdxf.new("R2010")

@@ -285,7 +285,7 @@ def sense_part(plan_path, config: dict, log=print, friction=None) -> dict:
     from pipeline.parts.part import Part
     from pipeline.planning.plan import tight_entry
     from pipeline.provenance import provenance_attrs
-    from pipeline.workflow.stages import read_json
+    from pipeline.maps.io import read_json
     sc, sweep = config["sensing"], config["sweep"]
     stored = read_json(plan_path)
     entry = tight_entry(stored, friction)
@@ -344,7 +344,7 @@ def read_checked_json(path, schema: dict, what: str) -> dict:
     is a :class:`PinfeedError` that says to delete it and re-run the workflow."""
     import jsonschema
 
-    from pipeline.workflow.stages import read_json
+    from pipeline.maps.io import read_json
     data = read_json(path)
     err = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(schema).iter_errors(data))
     if err is not None:

@@ -41,10 +41,10 @@ SNAKEMAKE_LOCKS = Path(".snakemake") / "locks"
 
 def _shard_readable(path: Path) -> bool:
     """True if ``path`` still opens as a complete pinfeed shard."""
-    from pipeline.maps.catalog import _entry_from_file
+    from pipeline.maps.catalog import entry_from_file
     from pipeline.maps.io import read_map
     try:
-        _entry_from_file(path.parent, path)
+        entry_from_file(path.parent, path)
         read_map(path)
     except PinfeedError:
         return False
@@ -54,21 +54,21 @@ def _shard_readable(path: Path) -> bool:
 def reconcile_catalog(config: dict) -> list[str]:
     """Make the catalog index honest before Snakemake plans its jobs; return one
     line per action taken (empty if the index matches the disk)."""
-    from pipeline.maps.catalog import INDEX_NAME, _disk_problem, _read_index
+    from pipeline.maps.catalog import INDEX_NAME, disk_problem, read_index
     from pipeline.maps.sweep import shard_jobs
     root = Path(config["catalog_dir"])
     index = root / INDEX_NAME
     if not index.is_file():
         return []
     try:
-        entries = _read_index(index, root)["entries"]
+        entries = read_index(index, root)["entries"]
     except PinfeedError:
         index.unlink()
         return [f"{index} was unreadable; removed, the workflow rebuilds it"]
     notes = []
     for e in entries:
         path = root / e["file"]
-        problem = _disk_problem(path, e)
+        problem = disk_problem(path, e)
         if problem is None or not path.is_file():
             if problem:
                 notes.append(problem)

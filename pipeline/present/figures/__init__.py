@@ -17,6 +17,26 @@ def save_figure(fig, out, dpi=130, **kwargs) -> Path:
     return out
 
 
+def placeholder(path, text) -> Path:
+    """A small figure at ``path`` that only says ``text`` (a result with nothing
+    to draw: no plan, no speed limit, nothing verified)."""
+    fig, ax = plt.subplots(figsize=(6, 1.5))
+    ax.axis("off")
+    ax.text(0.5, 0.5, text, ha="center", va="center")
+    return save_figure(fig, path, dpi=100)
+
+
+def placeholder_gif(path, text) -> Path:
+    """A one-frame GIF at ``path`` saying ``text`` (a part with no plan to animate)."""
+    from PIL import Image
+    png = Path(path).with_name(Path(path).stem + ".note.png")
+    placeholder(png, text)
+    with Image.open(png) as im:
+        im.convert("RGB").save(path, format="GIF")
+    png.unlink()
+    return Path(path)
+
+
 def circle_axes(ax):
     """Both axes 0..360 degrees with ticks every 90: theta_i on x, theta_f on y."""
     ax.set_xlim(0, 360)

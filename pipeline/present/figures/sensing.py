@@ -95,9 +95,9 @@ def sensing_figures(result: dict, out_profiles, out_scores) -> tuple[Path, Path]
     part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
     name = part.name
     if not result.get("found"):
-        from pipeline.workflow.stages import _placeholder
+        from pipeline.present.figures import placeholder
         for path in (out_profiles, out_scores):
-            _placeholder(path, f"{name}: no allowed plan within depth {result['depth']}: no sensor plan")
+            placeholder(path, f"{name}: no allowed plan within depth {result['depth']}: no sensor plan")
         return Path(out_profiles), Path(out_scores)
     sensor = Sensor.from_config(result["sensor"])
     table = result["score_table"]
