@@ -19,8 +19,8 @@ import time
 import numba
 import numpy as np
 
-from pipeline.maps import simulate
 from pipeline.cli import PAPER_D
+from pipeline.maps import simulate
 from pipeline.parts.part import Part
 
 TRIANGLE = [(0, 0), (60, 0), (15, 35)]

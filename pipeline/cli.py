@@ -158,8 +158,8 @@ def _print_trajectory(row, n_rows: int = 11):
 
 
 def cmd_map(args):
-    from pipeline.maps import simulate
     from pipeline.checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
+    from pipeline.maps import simulate
     from pipeline.maps.io import write_atomic
     from pipeline.provenance import provenance_attrs
     part = _part_from_args(args)
@@ -192,8 +192,8 @@ def _bands_option(text):
 
 def cmd_plot_map(args):
     from pipeline.checks import IMAGE_SUFFIXES, check_out_path
-    from pipeline.present.figures.maps import plot_map
     from pipeline.maps.io import read_map
+    from pipeline.present.figures.maps import plot_map
     check_out_path(args.out, IMAGE_SUFFIXES)
     out = plot_map(read_map(args.map), args.out, bands=_bands_option(args.bands))
     print(f"wrote {out}")
@@ -204,9 +204,9 @@ def cmd_demo(args):
     from pathlib import Path
 
     from pipeline.maps import simulate
-    from pipeline.present.figures.maps import plot_map
     from pipeline.maps.io import write_atomic
     from pipeline.parts.part import Part, parse_vertices
+    from pipeline.present.figures.maps import plot_map
     from pipeline.provenance import provenance_attrs
     part = Part.from_vertices(parse_vertices(DEFAULT_TRIANGLE), name="triangle")
     theta = np.arange(0.0, 360.0, 1.0)
@@ -412,8 +412,8 @@ def _plan_part_arg(args, config):
 
 def _plan_tight_only(part, config, progress=None) -> dict:
     from pipeline.planning.plan import plan_tight_all
-    from pipeline.provenance import provenance_attrs
     from pipeline.planning.plan import planner_belt
+    from pipeline.provenance import provenance_attrs
     belt_speed, mu_s = planner_belt(config, part)
     belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
     return {"part": part.to_dict(), "model": config["planner"]["model"], **belt,
@@ -502,8 +502,8 @@ def _results_arg(args, config) -> Path:
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from pipeline.config import load_config
-    from pipeline.planning.speed_limit import stored_plan_speed
     from pipeline.maps.io import read_json
+    from pipeline.planning.speed_limit import stored_plan_speed
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
@@ -534,8 +534,8 @@ def _pick_tight_plan(result: dict, n: int, mu_text):
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.config import load_config
-    from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
     from pipeline.maps.io import read_json
+    from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
     config = load_config(args.config)
     if args.out:
         check_drawing_path(args.out)  # before minutes of trials
@@ -580,9 +580,9 @@ def cmd_layout(args):
 
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
-    from pipeline.present.animate import animate_stored, plan_inputs
     from pipeline.config import load_config
     from pipeline.maps.io import read_json
+    from pipeline.present.animate import animate_stored, plan_inputs
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
@@ -642,9 +642,9 @@ def _classify_part(args, config, root):
     else from a stored sensing or plan result of that name under ``root`` (a
     part planned with --vertices has refinement shards only)."""
     from pipeline.maps.catalog import Catalog
-    from pipeline.parts.part import Part
     from pipeline.maps.io import read_json
     from pipeline.parts.families import config_part_id
+    from pipeline.parts.part import Part
     try:
         cat = Catalog.open(args.catalog or config["catalog_dir"])
         wanted = config_part_id(config, args.part)

@@ -4,9 +4,9 @@ import json
 import numpy as np
 import pytest
 
-from pipeline.present.animate import _gap, _rotated, animate_plan, plan_inputs, roll_plan
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
+from pipeline.present.animate import _gap, _rotated, animate_plan, plan_inputs, roll_plan
 
 PART = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 STATES = {f"state {k}": (float(th), float(y)) for k, (th, y) in enumerate(PART.stable_states(), 1)}

@@ -10,12 +10,12 @@ import pytest
 import xarray as xr
 import yaml
 
-from pipeline.maps import simulate
 from pipeline.cli import main
 from pipeline.config import load_config
 from pipeline.errors import PinfeedError
-from pipeline.planning.lattice_store import lattice_path, load_lattice
+from pipeline.maps import simulate
 from pipeline.parts.part import Part
+from pipeline.planning.lattice_store import lattice_path, load_lattice
 from pipeline.planning.propagate import UNITS
 from pipeline.planning.verify import replay
 

@@ -3,8 +3,8 @@ import io
 
 import pytest
 
-from pipeline.planning.bands import format_arc, format_arcs
 from pipeline.cli import build_parser, main
+from pipeline.planning.bands import format_arc, format_arcs
 from pipeline.progress import progress
 
 

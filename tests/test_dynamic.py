@@ -174,8 +174,8 @@ def test_dynamic_pins_bring_default_triangles_to_one_orientation(default_planner
 # ------------------------------------------------------------------ command line
 
 def test_cli_plan_with_a_moving_pin_stores_its_maps(tmp_path, capsys):
-    from pipeline.maps.catalog import Catalog
     from pipeline.cli import main
+    from pipeline.maps.catalog import Catalog
     cat = tmp_path / "cat"
     base = ["plan", "--vertices", "0,0 40,0 40,20 0,20", "--name", "rect", "--catalog", str(cat),
             "--depth", "1", "--pins=-5,5,15,25,35", "--mode", "paper"]

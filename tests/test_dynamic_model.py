@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from pipeline.maps import simulate
 from pipeline.cli import main
 from pipeline.errors import PinfeedError
+from pipeline.maps import simulate
 from pipeline.parts.part import Part
 
 ASYM = Part.from_vertices(np.array([[0.0, 0.0], [60.0, 0.0], [15.0, 35.0]]), "asym")
@@ -229,8 +229,8 @@ def test_dynamic_map_matches_single_rollouts_for_any_thread_count():
 def test_belt_speed_is_a_catalog_dimension(tmp_path):
     from pathlib import Path
 
-    from pipeline.maps.catalog import Catalog
     from pipeline.config import validate_config
+    from pipeline.maps.catalog import Catalog
     from pipeline.maps.sweep import run_sweep
     cfg = validate_config({
         "families": {"fam": {"parts": [{"name": "tri", "vertices": [[0, 0], [60, 0], [15, 35]]}]}},

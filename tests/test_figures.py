@@ -110,9 +110,9 @@ def test_map_figure_fits_its_labels(n_d, ncols):
 
 # ---------------------------------------------------------------- sequence diagrams
 
+from pipeline.parts.part import Part  # noqa: E402
 from pipeline.present.figures import text_problems  # noqa: E402
 from pipeline.present.figures.sequence import sequence_figure  # noqa: E402
-from pipeline.parts.part import Part  # noqa: E402
 
 
 def _sequence(speeds=None):

@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 import yaml
 
-from pipeline.maps import simulate
-from pipeline.maps.catalog import Catalog
 from pipeline.cli import main
 from pipeline.config import validate_config
 from pipeline.errors import PinfeedError
+from pipeline.maps import simulate
+from pipeline.maps.catalog import Catalog
 from pipeline.maps.io import read_map
-from pipeline.parts.part import MAX_VERTICES, Part, PolygonError
 from pipeline.maps.sweep import run_sweep, shard_jobs
+from pipeline.parts.part import MAX_VERTICES, Part, PolygonError
 
 ROOT = Path(__file__).resolve().parent.parent
 VENV_BIN = Path(sys.executable).parent

@@ -11,12 +11,12 @@ import math
 import numpy as np
 import pytest
 
-from pipeline.maps import simulate
 from pipeline.cli import main
 from pipeline.config import load_config
 from pipeline.errors import PinfeedError
-from pipeline.present.layout import check_layout_settings, layout_stored
+from pipeline.maps import simulate
 from pipeline.parts.part import Part
+from pipeline.present.layout import check_layout_settings, layout_stored
 
 TRIANGLE = "0,0 60,0 15,35"
 SPEED = 100.0
@@ -208,8 +208,8 @@ def test_two_parts_replay_apart_at_pitch_touch_when_closer(stored):
 def test_dxf_entities_stand_where_the_json_says(stored, tmp_path):
     import ezdxf
 
-    from pipeline.present.layout import write_drawing
     from pipeline.parts.outlines import read_outline
+    from pipeline.present.layout import write_drawing
     out = stored["layout"]
     path = write_drawing(out, tmp_path / "feeder.dxf")
     doc = ezdxf.readfile(str(path))

@@ -7,10 +7,10 @@ import pytest
 import xarray as xr
 
 from kernels.rollout import JAMMED, MISS, OK
-from pipeline.maps import simulate
-from pipeline.planning.bands import circular_mean_std, extract_bands, in_arc
 from pipeline.errors import PinfeedError
+from pipeline.maps import simulate
 from pipeline.parts.part import Part
+from pipeline.planning.bands import circular_mean_std, extract_bands, in_arc
 from pipeline.planning.paper import Planner, State, load_maps, merge_arcs
 from pipeline.planning.verify import verify_plan
 

@@ -14,8 +14,8 @@ import pytest
 import xarray as xr
 
 from conftest import QUAD, RECTANGLE, TRIANGLE, circular_diff
-from pipeline.maps import simulate
 from pipeline.errors import PinfeedError
+from pipeline.maps import simulate
 from pipeline.parts.part import Part
 
 R_PIN = 3.0

@@ -363,8 +363,8 @@ def test_final_sets_per_verdict_hold_in_full_rollout_replay(sensed):
     # Every state of a verdict's group, replayed past the sensor plan's pins by
     # perturbed full rollouts (the verify stage's sizes, random trials and every
     # corner of the box), ends in that verdict's final sets.
-    from pipeline.planning.arcs import in_arc
     from pipeline.parts.part import Part
+    from pipeline.planning.arcs import in_arc
     from pipeline.planning.verify import DEFAULTS, corner_inputs, perturbed_batch, replay
     res = sensed["partial"]
     kernel = _sense_config()["sweep"]["kernel"]  # the verify stage's rollout settings

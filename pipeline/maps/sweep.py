@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.maps import simulate
 from pipeline.config import config_hash, mu_label, theta_grid
-from pipeline.parts.families import family_parts
+from pipeline.maps import simulate
 from pipeline.maps.io import write_atomic
+from pipeline.parts.families import family_parts
 from pipeline.parts.part import Part
 from pipeline.provenance import provenance_attrs
 

@@ -33,12 +33,12 @@ import numpy as np
 
 from kernels.rollout import JAMMED, MISS, TRUNCATED
 
-from pipeline.planning.arcs import in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
-from pipeline.planning.bands import band_lookup, extract_bands
 from pipeline.errors import PinfeedError
 from pipeline.maps.catalog import Catalog
 from pipeline.parts.families import config_part_id
 from pipeline.parts.part import Part
+from pipeline.planning.arcs import in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
+from pipeline.planning.bands import band_lookup, extract_bands
 from pipeline.planning.plan import nominal_friction, parse_friction
 
 

@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import math
 
-from pipeline.planning.arcs import format_arcs
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
+from pipeline.planning.arcs import format_arcs
 from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.propagate import Tolerances, Uncertainty
 from pipeline.planning.search import TightPlanner

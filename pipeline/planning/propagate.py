@@ -47,8 +47,8 @@ import numpy as np
 
 from kernels.rollout import JAMMED, MISS, TRUNCATED
 
-from pipeline.planning.arcs import merge_arcs
 from pipeline.parts.part import Part
+from pipeline.planning.arcs import merge_arcs
 
 # Lattice units: theta in 1/64 deg, d in 1/3200, mu in 1/1600.
 UNITS = (1.0 / 64.0, 1.0 / 3200.0, 1.0 / 1600.0)

@@ -28,9 +28,9 @@ import math
 import time
 from dataclasses import dataclass, field
 
-from pipeline.planning.arcs import merge_arcs, merge_modulo
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
+from pipeline.planning.arcs import merge_arcs, merge_modulo
 from pipeline.planning.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
                         initial_state_sets, propagate)
 

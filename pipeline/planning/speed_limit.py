@@ -20,9 +20,9 @@ import time
 
 import numpy as np
 
+from pipeline.checks import FROUDE_MAX, G_MM_S2, check_belt
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
-from pipeline.checks import FROUDE_MAX, G_MM_S2, check_belt
 
 DEFAULT_SPEEDS = (10.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
 

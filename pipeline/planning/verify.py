@@ -26,8 +26,8 @@ import numpy as np
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, JAMMED, MISS, TRUNCATED
 
 from pipeline.maps import simulate
-from pipeline.planning.arcs import in_arc, merge_arcs
 from pipeline.parts.part import Part
+from pipeline.planning.arcs import in_arc, merge_arcs
 
 PERTURB_DEFAULTS = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 DEFAULTS = {"trials": 300, "corners": True, **PERTURB_DEFAULTS, "seed": 1}

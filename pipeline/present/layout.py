@@ -49,9 +49,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pipeline.present.animate import Lane, _lane, _rotated, pin_reach
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
+from pipeline.present.animate import Lane, _lane, _rotated, pin_reach
 
 LAYOUT_DEFAULTS = {
     "trials": 20,
@@ -443,8 +443,8 @@ def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None
     """
     from pipeline.maps import simulate
     from pipeline.planning.plan import friction_label, pick_tight_plan
-    from pipeline.provenance import provenance_attrs
     from pipeline.planning.speed_limit import DEFAULT_SPEEDS, perturbation_from_verify, speed_curve
+    from pipeline.provenance import provenance_attrs
     cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})
     plan, mu_c, entry = pick_tight_plan(result, int(plan_number), mu_text)
     speeds = [float(v) for v in plan.get("pin_speeds") or []]

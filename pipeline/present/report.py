@@ -13,8 +13,8 @@ from pathlib import Path
 
 from pipeline import __version__
 from pipeline.config import config_hash
-from pipeline.present.figures.tables import HEADER, verification_rows
 from pipeline.maps.io import write_text_atomic
+from pipeline.present.figures.tables import HEADER, verification_rows
 from pipeline.provenance import creation_time, git_commit
 
 SECTIONS = (("outline", "Outline"), ("maps", "Configuration maps"), ("plans", "Plans"),

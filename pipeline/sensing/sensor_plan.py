@@ -60,10 +60,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pipeline.planning.arcs import in_arc, merge_arcs, merge_modulo
 from pipeline.errors import PinfeedError
-from pipeline.sensing.profiles import PERTURB_DEFAULTS, Sensor, score_table
+from pipeline.planning.arcs import in_arc, merge_arcs, merge_modulo
 from pipeline.planning.verify import predicted_sets
+from pipeline.sensing.profiles import PERTURB_DEFAULTS, Sensor, score_table
 
 
 def sensing_frictions(entry: dict):
@@ -231,10 +231,10 @@ def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor
     box's corners are not replayed here (``corners`` is stored as false)."""
     import numpy as np
 
-    from pipeline.progress import progress
-    from pipeline.sensing.profiles import classify, measure, profile_from_rollout, sign_matrix
     from pipeline.maps.simulate import rollout
     from pipeline.planning.verify import DEFAULTS, perturbed_inputs
+    from pipeline.progress import progress
+    from pipeline.sensing.profiles import classify, measure, profile_from_rollout, sign_matrix
     cfg = dict(DEFAULTS, **(settings or {}))
     cfg["corners"] = False
     kernel = {k: v for k, v in (kernel or {}).items() if k in ("ds_max", "tol")}
@@ -282,10 +282,10 @@ def sense_part(plan_path, config: dict, log=print, friction=None) -> dict:
     stored tight plans at ``friction`` (default the first planned), the score
     table at its first pin, the per-verdict final sets and their end-to-end
     check, with provenance."""
+    from pipeline.maps.io import read_json
     from pipeline.parts.part import Part
     from pipeline.planning.plan import tight_entry
     from pipeline.provenance import provenance_attrs
-    from pipeline.maps.io import read_json
     sc, sweep = config["sensing"], config["sweep"]
     stored = read_json(plan_path)
     entry = tight_entry(stored, friction)

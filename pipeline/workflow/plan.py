@@ -23,6 +23,9 @@ from pipeline.provenance import provenance_attrs
 
 
 def shard_bands(shard, threshold_T, factor_c) -> dict:
+    """The bands of every map (every d) in one shard, with provenance: B_j, the
+    kernels K_j as all their arcs, COM intervals and the bands adjusted by
+    ``factor_c`` standard deviations (threshold ``threshold_T``)."""
     ds = read_map(shard)
     bands = map_bands(ds, threshold_T, factor_c)
     return {"part_id": ds.attrs["part_id"], "model": ds.attrs["model"], "mu_c": ds.attrs["mu_c"],
@@ -37,7 +40,7 @@ def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=Non
     """Plans for one part: the paper's adjusted-band planner (``plans``,
     ``best_static``: fixed pins, then moving pins) at the stored friction
     nearest the planner's, and the tight planner (``tight``) at every
-    friction of :func:`plan_frictions`, each verified by full rollouts."""
+    friction of :func:`~pipeline.planning.plan.plan_frictions`, each verified by full rollouts."""
     pc = config["planner"]
     part, planner, mu_used, selection = build_planner(cat, name, config)
     dyn = pc.get("dynamic", {})

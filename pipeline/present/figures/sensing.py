@@ -7,8 +7,8 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from pipeline.sensing.profiles import Sensor, processed, sign_matrix
 from pipeline.present.figures import save_figure
+from pipeline.sensing.profiles import Sensor, processed, sign_matrix
 
 _ROWS = (("fx", r"$F_x$ ($\mu_s m g$)"), ("fy", r"$F_y$ ($\mu_s m g$)"),
          ("dfx", r"$dF_x/dt$ ($\mu_s m g$/s)"), ("dfy", r"$dF_y/dt$ ($\mu_s m g$/s)"))
