@@ -535,6 +535,7 @@ def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.config import load_config
     from pipeline.maps.io import read_json
+    from pipeline.planning.plan import plan_hint
     from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
     config = load_config(args.config)
     if args.out:
@@ -549,7 +550,7 @@ def cmd_layout(args):
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; "
-                           f"{_plan_hint(config, args.part, path.parent.parent)} first")
+                           f"{plan_hint(config, args.part, path.parent.parent)} first")
     out = layout_stored(read_json(path), config, args.plan, args.mu_c, belt_speed=args.belt_speed,
                         mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
     for warning in out["warnings"]:
@@ -582,12 +583,13 @@ def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
     from pipeline.config import load_config
     from pipeline.maps.io import read_json
+    from pipeline.planning.plan import plan_hint
     from pipeline.present.animate import animate_stored, plan_inputs
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; "
-                           f"{_plan_hint(config, args.part, path.parent.parent)} first")
+                           f"{plan_hint(config, args.part, path.parent.parent)} first")
     result = read_json(path)
     inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
     pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
@@ -620,166 +622,42 @@ profile is resampled to the sensor rate of the stored sensor plan (or of the
 config) before it is smoothed."""
 
 
-def _best_fixed_plan(plan_result: dict):
-    """The best plan of fixed pins only in a stored plan result (None if none)."""
-    if plan_result.get("best_static"):
-        return plan_result["best_static"]
-    return next((p for p in plan_result["plans"] if not p.get("n_dynamic_pins", 0)), None)
-
-
-def _plan_hint(config: dict, name: str, root) -> str:
-    """How to make the stored plan of ``name`` under results folder ``root``: the
-    workflow plans the config's parts; a part planned from --vertices or
-    --outline needs 'pinfeed plan'."""
-    if name in config["planner"]["parts"]:
-        return "run the workflow ('make run')"
-    return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
-
-
-def _classify_part(args, config, root):
-    """The part to classify for: ``(part, pin_radius or None)`` from the catalog
-    (the config's outline wins over older ones stored under the same name),
-    else from a stored sensing or plan result of that name under ``root`` (a
-    part planned with --vertices has refinement shards only)."""
-    from pipeline.maps.catalog import Catalog
-    from pipeline.maps.io import read_json
-    from pipeline.parts.families import config_part_id
-    from pipeline.parts.part import Part
-    try:
-        cat = Catalog.open(args.catalog or config["catalog_dir"])
-        wanted = config_part_id(config, args.part)
-        if wanted != args.part and not any(e["part_id"] == wanted for e in cat.entries):
-            wanted = args.part  # the config's outline is not stored: use what the catalog has
-        entry = cat.entries_for(wanted)[0]  # unknown part: says how to list them
-        return Part.from_vertices(entry["part_vertices"], name=entry["part_name"]), float(entry["pin_radius"])
-    except PinfeedError:
-        for kind in ("sensing", "plans"):
-            path = root / kind / f"{args.part}.json"
-            if path.is_file():
-                stored = read_json(path)["part"]
-                return Part.from_vertices(stored["vertices"], name=stored["name"]), None
-        raise
-
-
-def _classify_pin(args, stored, plan, root, name):
-    """``(y_pin, first_pin, source, plan_entry)``: where the sensor sits. The
-    stored sensor plan's first pin, else the first pin of the stored recommended
-    tight plan (first planned friction), else that of paper mode's best
-    fixed-pin plan, else --y-pin (which always wins)."""
-    from pipeline.planning.plan import tight_entry
-    entry = tight_entry(plan) if plan is not None and plan.get("tight") else None
-    plan_path = root / "plans" / f"{name}.json"
-    if args.y_pin is not None:
-        if not math.isfinite(args.y_pin):
-            raise PinfeedError(f"--y-pin must be a finite height in mm, got {args.y_pin}")
-        return float(args.y_pin), None, "--y-pin", entry
-    if stored is not None:
-        return float(stored["y_pin"]), stored["first_pin"], f"sensor plan {root / 'sensing' / (name + '.json')}", entry
-    if entry is not None and entry.get("recommended"):
-        rec = entry["recommended"]
-        return (float(rec["pin_heights_mm"][0]), rec["pins"][0],
-                f"first pin of the recommended tight plan at mu_c {entry['friction']} {plan_path}", entry)
-    if plan is not None and plan.get("pins") and _best_fixed_plan(plan):
-        first_pin = _best_fixed_plan(plan)["pins"][0]  # the sensor sits on a fixed pin
-        return (float(plan["pins"][first_pin]), first_pin,
-                f"first pin of the best fixed-pin plan {plan_path}", entry)
-    return None, None, None, entry
-
-
 def cmd_sense_classify(args):
+    """Classify a measured profile (see :func:`pipeline.sensing.measured.classify_measured`)."""
     from pipeline.config import load_config
-    from pipeline.planning.plan import parse_friction
-    from pipeline.sensing.profiles import (Sensor, classify, read_profile_csv, reference_profiles, resample,
-                          sign_matrix)
-    from pipeline.sensing.sensor_plan import (PLAN_SCHEMA, count_sets, describe_sets, final_for_verdict,
-                              read_checked_json, sensing_frictions, stored_sensor_plan)
+    from pipeline.sensing.measured import classify_measured
+    from pipeline.sensing.sensor_plan import describe_sets
     config = load_config(args.config)
-    root = _results_arg(args, config)  # stored plans and sensor plans
-    part, catalog_radius = _classify_part(args, config, root)
-    name = part.name
-    stored = stored_sensor_plan(root, name)
-    if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
-        stored = None  # no sensor plan, or one for another outline of that name
-    plan_path = root / "plans" / f"{name}.json"
-    plan = read_checked_json(plan_path, PLAN_SCHEMA, "pinfeed plan result") if plan_path.is_file() else None
-    if plan is not None and plan["part"].get("id", part.id) != part.id:
-        plan = None
-    y_pin, first_pin, source, entry = _classify_pin(args, stored, plan, root, name)
-    if y_pin is None:
-        raise PinfeedError(f"no sensor pin for {name}: no stored sensor plan and no recommended plan under "
-                           f"{root}; {_plan_hint(config, name, root)} or give the sensor pin's height with "
-                           f"--y-pin MM")
-    # The friction, resolved once (sensor_plan.sensing_frictions): as planned, and
-    # the one value of the simulated profiles (a range's middle).
-    if stored is not None:
-        sensor = Sensor.from_config(stored["sensor"])
-        mu_planned, model = stored["mu_c"], stored["model"]
-        mu_profiles = float(stored["mu_c_profiles"])
-    else:
-        sensor = Sensor.from_config(config["sensing"]["sensor"])
-        if entry is not None:
-            friction = entry
-        elif plan is not None and "mu_c" in plan:
-            friction = {"mu_c": plan["mu_c"]}
-        else:
-            friction = {"mu_c": parse_friction(config["planner"]["mu_c"])}
-        mu_planned, mu_profiles = sensing_frictions(friction)
-        mu_planned = list(mu_planned) if isinstance(mu_planned, tuple) else mu_planned
-        model = plan.get("model", config["planner"]["model"]) if plan else config["planner"]["model"]
-    if stored is not None:
-        pin_radius = float(stored["pin_radius"])
-    else:
-        pin_radius = catalog_radius if catalog_radius is not None else float(config["sweep"]["pin_radius"])
-    raw = read_profile_csv(args.profile)
-    measured = resample(raw, sensor.rate_hz)
-    if measured.t.size < sensor.regions:
-        raise PinfeedError(f"{args.profile}: the profile spans {raw.t[-1] - raw.t[0]:.3g} s, fewer than "
-                           f"{sensor.regions} samples at {sensor.rate_hz:g} Hz; give the whole contact")
-    states = {f"state {k}": {"theta": float(th), "y_c": float(y)}
-              for k, (th, y) in enumerate(part.stable_states(), start=1)}
-    refs = {k: sign_matrix(p, sensor) for k, p in
-            reference_profiles(part, states, y_pin, mu_profiles, pin_radius, model, sensor).items()}
-    signs = sign_matrix(measured, sensor)
-    verdict = classify(signs, refs, sensor.margin)
-    on_plan = stored is not None and abs(y_pin - float(stored["y_pin"])) < 1e-9
-    final = final_for_verdict(stored, verdict["candidates"]) if on_plan else None
-    known = None
-    if final is not None:  # one physical orientation (modulo the part's symmetry)
-        known = count_sets([(f["start"], f["width"]) for f in final], stored["symmetry_order"]) == 1
-    result = {"part": name, "part_id": part.id, "profile": str(args.profile), "y_pin": y_pin,
-              "y_pin_source": source, "first_pin": first_pin if args.y_pin is None else None,
-              "model": model, "mu_c": mu_planned, "mu_c_profiles": mu_profiles, "pin_radius": pin_radius,
-              "sensor": sensor.to_dict(), "samples": int(measured.t.size), "duration": float(measured.t[-1]),
-              "elements": int(signs.size), "margin": sensor.margin, "scores": verdict["scores"],
-              "best": verdict["best"], "candidates": verdict["candidates"],
-              "decided": verdict["decided"], "measured_signs": signs.tolist(),
-              "sensor_plan": stored["plan"]["pins"] if on_plan else None,
-              "final_sets": final, "final_known": known}
+    result, context = classify_measured(config, args.part, args.profile, _results_arg(args, config),
+                                        catalog=args.catalog, y_pin=args.y_pin)
     if args.json:
         _print_json(result)
         return
+    stored, final = context["stored"], result["final_sets"]
+    mu_planned, margin = result["mu_c"], result["margin"]
     planned = f"{mu_planned[0]:g}:{mu_planned[1]:g}" if isinstance(mu_planned, list) else f"{mu_planned:g}"
-    print(f"part {part.id}: sensor pin at y = {y_pin:g} mm ({source}); model {model}, mu_c {planned} "
-          f"(profiles simulated at {mu_profiles:g}), pin radius {pin_radius:g} mm")
-    print(f"profile {args.profile}: {measured.t.size} samples over {measured.t[-1]:.3f} s at "
-          f"{sensor.rate_hz:g} Hz")
-    if verdict.get("note"):
-        print(f"verdict: undecided ({verdict['note']})")
-    elif verdict["decided"]:
-        print(f"verdict: {verdict['best']} (decided: every other state scores at least "
-              f"{sensor.margin} elements lower)")
+    print(f"part {result['part_id']}: sensor pin at y = {result['y_pin']:g} mm ({result['y_pin_source']}); "
+          f"model {result['model']}, mu_c {planned} (profiles simulated at {result['mu_c_profiles']:g}), "
+          f"pin radius {result['pin_radius']:g} mm")
+    print(f"profile {args.profile}: {result['samples']} samples over {result['duration']:.3f} s at "
+          f"{result['sensor']['rate_hz']:g} Hz")
+    if context["note"]:
+        print(f"verdict: undecided ({context['note']})")
+    elif result["decided"]:
+        print(f"verdict: {result['best']} (decided: every other state scores at least "
+              f"{margin} elements lower)")
     else:
-        print(f"verdict: undecided between {', '.join(verdict['candidates'])} (scores within "
-              f"{sensor.margin} elements of the best)")
-    print(f"scores (equal elements of {signs.size}):")
-    for k, v in verdict["scores"].items():
-        print(f"  {k}: {v}" + ("  <- best" if k == verdict["best"] else ""))
+        print(f"verdict: undecided between {', '.join(result['candidates'])} (scores within "
+              f"{margin} elements of the best)")
+    print(f"scores (equal elements of {result['elements']}):")
+    for k, v in result["scores"].items():
+        print(f"  {k}: {v}" + ("  <- best" if k == result["best"] else ""))
     if final is None and stored is None:
         print("final orientation: unknown (no sensor plan stored; the workflow's sense stage makes one)")
     elif final is None:
         print(f"final orientation: unknown (the stored sensor plan reads pin {stored['first_pin']} "
               f"at y = {stored['y_pin']:g} mm, not this one)")
-    elif known:
+    elif result["final_known"]:
         print(f"final orientation: {describe_sets(final)} (sensor plan {' -> '.join(stored['plan']['pins'])})")
     else:
         print(f"final orientation: one of {describe_sets(final)} (the verdict does not decide it)")

@@ -70,10 +70,10 @@ def test_rollout_trajectory_table(capsys):
 
 
 def test_sense_hint_names_pinfeed_plan_for_an_ad_hoc_part(tmp_path):
-    from pipeline.cli import _plan_hint
+    from pipeline.planning.plan import plan_hint
     config = {"planner": {"parts": ["asym_triangle"]}}
-    assert "make run" in _plan_hint(config, "asym_triangle", tmp_path)
-    hint = _plan_hint(config, "bracket", tmp_path)
+    assert "make run" in plan_hint(config, "asym_triangle", tmp_path)
+    hint = plan_hint(config, "bracket", tmp_path)
     assert hint == f"run 'pinfeed plan --part bracket --out {tmp_path / 'plans' / 'bracket.json'}'"
 
 

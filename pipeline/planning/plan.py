@@ -21,6 +21,7 @@ replays with the dynamic model at the same speed.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
@@ -207,6 +208,22 @@ def pick_tight_plan(result: dict, n: int, mu_text):
         raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
     mu = entry["mu_c"]
     return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
+
+
+def best_fixed_plan(plan_result: dict):
+    """The best plan of fixed pins only in a stored plan result (None if none)."""
+    if plan_result.get("best_static"):
+        return plan_result["best_static"]
+    return next((p for p in plan_result["plans"] if not p.get("n_dynamic_pins", 0)), None)
+
+
+def plan_hint(config: dict, name: str, root) -> str:
+    """How to make the stored plan of ``name`` under results folder ``root``: the
+    workflow plans the config's parts; a part planned from --vertices or
+    --outline needs 'pinfeed plan'."""
+    if name in config["planner"]["parts"]:
+        return "run the workflow ('make run')"
+    return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
 
 
 # ---------------------------------------------------------------------- every configured friction
