@@ -16,7 +16,7 @@ $(STAMP): pyproject.toml
 # (config/config.yaml). Resumes an interrupted run; does nothing if up to date.
 # Ends by printing the path of the report (results/<config name>/report.html).
 # After a killed run it removes Snakemake's stale lock and temporary files
-# when no other run is alive (pipeline/workflow.py), saying so in one line.
+# when no other run is alive (pipeline/workflow/runner.py), saying so in one line.
 run: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pipeline.workflow run --cores all --rerun-incomplete
 	@$(BIN)/python -c 'from pipeline.config import load_config, results_folder; \

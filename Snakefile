@@ -9,7 +9,7 @@ import sys
 from snakemake.utils import min_version
 
 from pipeline.config import config_name, validate_config
-from pipeline.workflow import reconcile_catalog
+from pipeline.workflow.runner import reconcile_catalog
 
 min_version("8.0")
 
@@ -37,7 +37,7 @@ report: "rules/report/workflow.rst"
 
 # The catalog against disk, before Snakemake plans its jobs: a deleted or
 # damaged shard removes the stale index, so this run recomputes it
-# (pipeline/workflow.py says why Snakemake would not).
+# (pipeline/workflow/runner.py says why Snakemake would not).
 if workflow.is_main_process:
     for note in reconcile_catalog(config):
         print(f"pinfeed: {note}", file=sys.stderr)

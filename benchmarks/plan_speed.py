@@ -15,9 +15,9 @@ import tempfile
 import time
 
 from pipeline.config import load_config
-from pipeline.families import family_parts
-from pipeline.planning import parse_friction
-from pipeline.stages import plan_tight_all
+from pipeline.parts.families import family_parts
+from pipeline.planning.plan import parse_friction
+from pipeline.planning.plan import plan_tight_all
 
 
 def main() -> None:

@@ -28,9 +28,9 @@ import numpy as np
 # has installed (an editable install of another worktree would win otherwise).
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from pipeline import simulate  # noqa: E402
 from pipeline.cli import PAPER_D  # noqa: E402
-from pipeline.parts import Part  # noqa: E402
+from pipeline.maps import simulate  # noqa: E402
+from pipeline.parts.part import Part  # noqa: E402
 
 TRIANGLE = [(0, 0), (60, 0), (15, 35)]
 

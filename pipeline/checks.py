@@ -12,7 +12,10 @@ allocating without bound (issue 12, "Hardening"):
 * the pin radius is at most ``MAX_PIN_RATIO`` times the part's size a (the
   time of a rollout grows with r_pin / a; a pin ten times the part is no
   longer a feeder);
-* output files have a known suffix and a folder that exists or can be made.
+* output files have a known suffix and a folder that exists or can be made;
+* a belt speed is slow enough that the pin pushes the part rather than
+  throwing it (Froude number at most ``FROUDE_MAX``), and belt friction
+  ``mu_s`` lies in (0, ``MU_S_MAX``] (issue 18).
 """
 from __future__ import annotations
 
@@ -22,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import PinfeedError
+from pipeline.errors import PinfeedError
 
 MAX_VALUES = 100_000
 MAX_MAP = 1_000_000  # rollouts in one map (d x theta_i): about half an hour on one core
@@ -106,3 +109,34 @@ def check_finite_tree(obj, where: str = "") -> None:
     elif isinstance(obj, list):
         for k, v in enumerate(obj):
             check_finite_tree(v, f"{where}/{k}")
+
+
+# Belt speed and belt friction (issue 18), for the models at belt speed.
+G_MM_S2 = 9810.0
+MU_S_MAX = 5.0
+# Largest v^2 / (mu_s g a): beyond it a plastic impact at belt speed sends the
+# part sliding more than Fr a / 2 = 5 a ahead of the pin: thrown, not pushed.
+FROUDE_MAX = 10.0
+
+
+def froude(part, belt_speed: float, mu_s: float = 0.5) -> float:
+    """``v_b^2 / (mu_s g a)`` with ``v_b`` in mm/s and the part in millimetres."""
+    return float(belt_speed) ** 2 / (float(mu_s) * G_MM_S2 * part.a)
+
+
+def check_belt(part, belt_speed, mu_s) -> float:
+    """Raise :class:`PinfeedError` for a bad belt speed or belt friction; return Fr."""
+    if not (isinstance(belt_speed, (int, float, np.floating, np.integer))
+            and math.isfinite(belt_speed)) or belt_speed <= 0:
+        raise PinfeedError(f"belt speed must be a finite number > 0 (mm/s), got {belt_speed!r}")
+    if not (isinstance(mu_s, (int, float, np.floating, np.integer)) and math.isfinite(mu_s)) \
+            or mu_s <= 0 or mu_s > MU_S_MAX:
+        raise PinfeedError(f"belt friction mu_s must be in (0, {MU_S_MAX:g}], got {mu_s!r}")
+    fr = froude(part, belt_speed, mu_s)
+    if fr > FROUDE_MAX:
+        raise PinfeedError(
+            f"belt speed {belt_speed:g} mm/s is too fast for this part: v^2/(mu_s g a) = {fr:.3g} "
+            f"> {FROUDE_MAX:g}, so the pin throws the part (it slides about {0.5 * fr * part.a:.0f} mm "
+            f"after the impact) rather than pushing it; slow the belt below "
+            f"{math.sqrt(FROUDE_MAX * mu_s * G_MM_S2 * part.a):.0f} mm/s")
+    return fr

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import PinfeedError
+from pipeline.errors import PinfeedError
 
 PAPER_D = [-0.9, -0.8, -0.7, -0.6, -0.5, -0.4, -0.3, -0.2, -0.1,
            0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]
@@ -30,7 +30,7 @@ def _print_json(obj, **kw):
 def parse_values(text: str, what: str) -> np.ndarray:
     """``"a,b,c"`` or an inclusive range ``"start:stop:step"``: finite, distinct,
     at most ``checks.MAX_VALUES`` values (refused before anything is allocated)."""
-    from .checks import check_grid_size, check_values, range_size
+    from pipeline.checks import check_grid_size, check_values, range_size
     bad = PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
                        f"of finite numbers with step > 0")
     try:
@@ -52,9 +52,9 @@ def parse_values(text: str, what: str) -> np.ndarray:
 
 def _part_from_args(args):
     """The part of ``--vertices`` or ``--outline`` (saying how many vertices a CAD outline gave)."""
-    from .parts import Part, parse_vertices
+    from pipeline.parts.part import Part, parse_vertices
     if getattr(args, "outline", None):
-        from .outlines import read_outline
+        from pipeline.parts.outlines import read_outline
         out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol)
         print(f"outline {out.describe()}", file=sys.stderr)
         name = args.name or re.sub(r"[^A-Za-z0-9_]", "_", Path(args.outline).stem) or "part"
@@ -99,7 +99,7 @@ def _add_physics(p, d_required=True, belt=False):
 
 
 def cmd_rollout(args):
-    from . import simulate
+    from pipeline.maps import simulate
     part = _part_from_args(args)
     belt = {}
     if args.model in simulate.BELT_MODELS:
@@ -158,10 +158,10 @@ def _print_trajectory(row, n_rows: int = 11):
 
 
 def cmd_map(args):
-    from . import simulate
-    from .checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
-    from .io import write_atomic
-    from .provenance import provenance_attrs
+    from pipeline.checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
+    from pipeline.maps import simulate
+    from pipeline.maps.io import write_atomic
+    from pipeline.provenance import provenance_attrs
     part = _part_from_args(args)
     d = parse_values(args.d, "--d")
     if not args.theta_step > 0 or args.theta_step > 360:
@@ -191,9 +191,9 @@ def _bands_option(text):
 
 
 def cmd_plot_map(args):
-    from .checks import IMAGE_SUFFIXES, check_out_path
-    from .figures.maps import plot_map
-    from .io import read_map
+    from pipeline.checks import IMAGE_SUFFIXES, check_out_path
+    from pipeline.maps.io import read_map
+    from pipeline.present.figures.maps import plot_map
     check_out_path(args.out, IMAGE_SUFFIXES)
     out = plot_map(read_map(args.map), args.out, bands=_bands_option(args.bands))
     print(f"wrote {out}")
@@ -203,11 +203,11 @@ def cmd_demo(args):
     """The main job until the workflow lands: one map set of a default triangle."""
     from pathlib import Path
 
-    from . import simulate
-    from .figures.maps import plot_map
-    from .io import write_atomic
-    from .parts import Part, parse_vertices
-    from .provenance import provenance_attrs
+    from pipeline.maps import simulate
+    from pipeline.maps.io import write_atomic
+    from pipeline.parts.part import Part, parse_vertices
+    from pipeline.present.figures.maps import plot_map
+    from pipeline.provenance import provenance_attrs
     part = Part.from_vertices(parse_vertices(DEFAULT_TRIANGLE), name="triangle")
     theta = np.arange(0.0, 360.0, 1.0)
     print(f"computing {len(PAPER_D)} x {theta.size} minpower rollouts of {part.id} ...", flush=True)
@@ -220,7 +220,7 @@ def cmd_demo(args):
 
 
 def _catalog(args):
-    from .catalog import Catalog
+    from pipeline.maps.catalog import Catalog
     cat = Catalog.open(args.catalog)
     for problem in cat.problems:
         print(f"pinfeed: warning: {problem} (not served)", file=sys.stderr)
@@ -228,7 +228,7 @@ def _catalog(args):
 
 
 def cmd_catalog_index(args):
-    from .catalog import Catalog
+    from pipeline.maps.catalog import Catalog
     cat = Catalog.rebuild(args.catalog)
     print(f"indexed {len(cat.entries)} shards under {args.catalog}")
     for problem in cat.problems:
@@ -249,7 +249,7 @@ def cmd_catalog_list(args):
 
 def cmd_catalog_show(args):
     cat = _catalog(args)
-    entries = cat._entries_for(args.part)
+    entries = cat.entries_for(args.part)
     e0 = entries[0]
     info = {k: e0[k] for k in ("family", "part_id", "part_name", "part_vertices", "pin_radius",
                                "d", "theta_step", "config_hash", "pinfeed_version", "git_commit")}
@@ -280,7 +280,7 @@ def _query(args):
 
 
 def cmd_catalog_query(args):
-    from .simulate import status_names
+    from pipeline.maps.simulate import status_names
     ds = _query(args).load()
     rows = []
     for mu in ds["mu_c"].values:
@@ -301,8 +301,8 @@ def cmd_catalog_query(args):
 
 
 def cmd_catalog_plot(args):
-    from .checks import IMAGE_SUFFIXES, check_out_path
-    from .figures.maps import plot_map
+    from pipeline.checks import IMAGE_SUFFIXES, check_out_path
+    from pipeline.present.figures.maps import plot_map
     check_out_path(args.out, IMAGE_SUFFIXES)
     ds = _query(args)
     if ds.sizes["mu_c"] != 1:
@@ -314,8 +314,8 @@ def cmd_catalog_plot(args):
 
 
 def cmd_sweep(args):
-    from .config import load_config
-    from .sweep import run_sweep
+    from pipeline.config import load_config
+    from pipeline.maps.sweep import run_sweep
     config = load_config(args.config)
     if args.catalog:
         config["catalog_dir"] = args.catalog
@@ -326,8 +326,8 @@ def cmd_sweep(args):
 
 
 def cmd_plan(args):
-    from .config import load_config
-    from .planning import parse_friction
+    from pipeline.config import load_config
+    from pipeline.planning.plan import parse_friction
     config = load_config(args.config)
     if args.catalog:
         config["catalog_dir"] = args.catalog
@@ -351,7 +351,7 @@ def cmd_plan(args):
             raise PinfeedError("--mu-s is the belt friction of the dynamic model: give --belt-speed too")
         pc["mu_s"] = args.mu_s
     part = _plan_part_arg(args, config)
-    from .planning import planner_belt
+    from pipeline.planning.plan import planner_belt
     belt_speed, _ = planner_belt(config, part)  # a bad belt: a one-line error before any work
     if belt_speed is not None and args.mode != "tight":
         raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
@@ -359,7 +359,7 @@ def cmd_plan(args):
     if args.mode == "tight":
         result = _plan_tight_only(part, config, progress=None if args.json else _progress)
     else:
-        from .stages import ensure_maps, plan_part
+        from pipeline.workflow.plan import ensure_maps, plan_part
         cat = ensure_maps(config, part)
         if args.mode == "paper":
             config = dict(config, planner=dict(pc, mu_c=pc["mu_c"], frictions=[]))
@@ -368,7 +368,7 @@ def cmd_plan(args):
         if args.mode == "paper":
             result.pop("tight")
     if args.out:
-        from .stages import write_json
+        from pipeline.maps.io import write_json
         write_json(result, args.out)
     if args.json:
         _print_json(_plan_json(result, args.mode), default=float)
@@ -394,8 +394,8 @@ def _plan_dynamic_args(args, dynamic):
 
 
 def _plan_part_arg(args, config):
-    from .families import family_parts
-    from .parts import Part
+    from pipeline.parts.families import family_parts
+    from pipeline.parts.part import Part
     if args.vertices or args.outline:
         return _part_from_args(args)
     if not args.part:
@@ -404,16 +404,16 @@ def _plan_part_arg(args, config):
              if args.part in (p.name, p.id)]
     if found:
         return found[0]
-    from .catalog import Catalog
+    from pipeline.maps.catalog import Catalog
     cat = Catalog.open(config["catalog_dir"])
-    e = cat._entries_for(args.part)[0]  # raises 'unknown part' with the known names
+    e = cat.entries_for(args.part)[0]  # raises 'unknown part' with the known names
     return Part.from_vertices(e["part_vertices"], name=e["part_name"])
 
 
 def _plan_tight_only(part, config, progress=None) -> dict:
-    from .stages import plan_tight_all
-    from .provenance import provenance_attrs
-    from .planning import planner_belt
+    from pipeline.planning.plan import plan_tight_all
+    from pipeline.planning.plan import planner_belt
+    from pipeline.provenance import provenance_attrs
     belt_speed, mu_s = planner_belt(config, part)
     belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
     return {"part": part.to_dict(), "model": config["planner"]["model"], **belt,
@@ -461,8 +461,8 @@ def _plan_json(result, mode) -> dict:
 
 
 def _print_plan_result(result, part, config, mode):
-    from .arcs import format_arcs
-    from .planning import mechanics_label, planner_belt
+    from pipeline.planning.arcs import format_arcs
+    from pipeline.planning.plan import mechanics_label, planner_belt
     pc = config["planner"]
     print(f"part {part.id}: model {mechanics_label(pc['model'], *planner_belt(config))}, depth {pc['depth']}")
     for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
@@ -495,15 +495,15 @@ def _print_plan_result(result, part, config, mode):
 
 def _results_arg(args, config) -> Path:
     """The results folder of stored plans and sensing: --results, else the config's."""
-    from .config import results_folder
+    from pipeline.config import results_folder
     return Path(args.results) if args.results else results_folder(config)
 
 
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
-    from .config import load_config
-    from .speed_limit import stored_plan_speed
-    from .stages import read_json
+    from pipeline.config import load_config
+    from pipeline.maps.io import read_json
+    from pipeline.planning.speed_limit import stored_plan_speed
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
@@ -527,15 +527,16 @@ def cmd_speed(args):
 
 def _pick_tight_plan(result: dict, n: int, mu_text):
     """See :func:`pipeline.planning.pick_tight_plan` (shared with ``pinfeed layout``)."""
-    from .planning import pick_tight_plan
+    from pipeline.planning.plan import pick_tight_plan
     return pick_tight_plan(result, n, mu_text)
 
 
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
-    from .config import load_config
-    from .layout import check_drawing_path, layout_stored, write_drawing
-    from .stages import read_json
+    from pipeline.config import load_config
+    from pipeline.maps.io import read_json
+    from pipeline.planning.plan import plan_hint
+    from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
     config = load_config(args.config)
     if args.out:
         check_drawing_path(args.out)  # before minutes of trials
@@ -549,7 +550,7 @@ def cmd_layout(args):
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; "
-                           f"{_plan_hint(config, args.part, path.parent.parent)} first")
+                           f"{plan_hint(config, args.part, path.parent.parent)} first")
     out = layout_stored(read_json(path), config, args.plan, args.mu_c, belt_speed=args.belt_speed,
                         mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
     for warning in out["warnings"]:
@@ -580,14 +581,15 @@ def cmd_layout(args):
 
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
-    from .animate import animate_stored, layout_inputs, plan_inputs
-    from .config import load_config
-    from .stages import read_json
+    from pipeline.config import load_config
+    from pipeline.maps.io import read_json
+    from pipeline.planning.plan import plan_hint
+    from pipeline.present.animate import animate_stored, layout_inputs, plan_inputs
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; "
-                           f"{_plan_hint(config, args.part, path.parent.parent)} first")
+                           f"{plan_hint(config, args.part, path.parent.parent)} first")
     result = read_json(path)
     stored_layout = path.parent.parent / f"layout_{args.part}.json"
     if args.layout is not None:
@@ -638,165 +640,42 @@ profile is resampled to the sensor rate of the stored sensor plan (or of the
 config) before it is smoothed."""
 
 
-def _best_fixed_plan(plan_result: dict):
-    """The best plan of fixed pins only in a stored plan result (None if none)."""
-    if plan_result.get("best_static"):
-        return plan_result["best_static"]
-    return next((p for p in plan_result["plans"] if not p.get("n_dynamic_pins", 0)), None)
-
-
-def _plan_hint(config: dict, name: str, root) -> str:
-    """How to make the stored plan of ``name`` under results folder ``root``: the
-    workflow plans the config's parts; a part planned from --vertices or
-    --outline needs 'pinfeed plan'."""
-    if name in config["planner"]["parts"]:
-        return "run the workflow ('make run')"
-    return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
-
-
-def _classify_part(args, config, root):
-    """The part to classify for: ``(part, pin_radius or None)`` from the catalog
-    (the config's outline wins over older ones stored under the same name),
-    else from a stored sensing or plan result of that name under ``root`` (a
-    part planned with --vertices has refinement shards only)."""
-    from .catalog import Catalog
-    from .parts import Part
-    from .stages import config_part_id, read_json
-    try:
-        cat = Catalog.open(args.catalog or config["catalog_dir"])
-        wanted = config_part_id(config, args.part)
-        if wanted != args.part and not any(e["part_id"] == wanted for e in cat.entries):
-            wanted = args.part  # the config's outline is not stored: use what the catalog has
-        entry = cat._entries_for(wanted)[0]  # unknown part: says how to list them
-        return Part.from_vertices(entry["part_vertices"], name=entry["part_name"]), float(entry["pin_radius"])
-    except PinfeedError:
-        for kind in ("sensing", "plans"):
-            path = root / kind / f"{args.part}.json"
-            if path.is_file():
-                stored = read_json(path)["part"]
-                return Part.from_vertices(stored["vertices"], name=stored["name"]), None
-        raise
-
-
-def _classify_pin(args, stored, plan, root, name):
-    """``(y_pin, first_pin, source, plan_entry)``: where the sensor sits. The
-    stored sensor plan's first pin, else the first pin of the stored recommended
-    tight plan (first planned friction), else that of paper mode's best
-    fixed-pin plan, else --y-pin (which always wins)."""
-    from .planning import tight_entry
-    entry = tight_entry(plan) if plan is not None and plan.get("tight") else None
-    plan_path = root / "plans" / f"{name}.json"
-    if args.y_pin is not None:
-        if not math.isfinite(args.y_pin):
-            raise PinfeedError(f"--y-pin must be a finite height in mm, got {args.y_pin}")
-        return float(args.y_pin), None, "--y-pin", entry
-    if stored is not None:
-        return float(stored["y_pin"]), stored["first_pin"], f"sensor plan {root / 'sensing' / (name + '.json')}", entry
-    if entry is not None and entry.get("recommended"):
-        rec = entry["recommended"]
-        return (float(rec["pin_heights_mm"][0]), rec["pins"][0],
-                f"first pin of the recommended tight plan at mu_c {entry['friction']} {plan_path}", entry)
-    if plan is not None and plan.get("pins") and _best_fixed_plan(plan):
-        first_pin = _best_fixed_plan(plan)["pins"][0]  # the sensor sits on a fixed pin
-        return (float(plan["pins"][first_pin]), first_pin,
-                f"first pin of the best fixed-pin plan {plan_path}", entry)
-    return None, None, None, entry
-
-
 def cmd_sense_classify(args):
-    from .config import load_config
-    from .planning import parse_friction
-    from .sensing import (Sensor, classify, read_profile_csv, reference_profiles, resample,
-                          sign_matrix)
-    from .sensor_plan import (PLAN_SCHEMA, count_sets, describe_sets, final_for_verdict,
-                              read_checked_json, sensing_frictions, stored_sensor_plan)
+    """Classify a measured profile (see :func:`pipeline.sensing.measured.classify_measured`)."""
+    from pipeline.config import load_config
+    from pipeline.sensing.measured import classify_measured
+    from pipeline.sensing.sensor_plan import describe_sets
     config = load_config(args.config)
-    root = _results_arg(args, config)  # stored plans and sensor plans
-    part, catalog_radius = _classify_part(args, config, root)
-    name = part.name
-    stored = stored_sensor_plan(root, name)
-    if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
-        stored = None  # no sensor plan, or one for another outline of that name
-    plan_path = root / "plans" / f"{name}.json"
-    plan = read_checked_json(plan_path, PLAN_SCHEMA, "pinfeed plan result") if plan_path.is_file() else None
-    if plan is not None and plan["part"].get("id", part.id) != part.id:
-        plan = None
-    y_pin, first_pin, source, entry = _classify_pin(args, stored, plan, root, name)
-    if y_pin is None:
-        raise PinfeedError(f"no sensor pin for {name}: no stored sensor plan and no recommended plan under "
-                           f"{root}; {_plan_hint(config, name, root)} or give the sensor pin's height with "
-                           f"--y-pin MM")
-    # The friction, resolved once (sensor_plan.sensing_frictions): as planned, and
-    # the one value of the simulated profiles (a range's middle).
-    if stored is not None:
-        sensor = Sensor.from_config(stored["sensor"])
-        mu_planned, model = stored["mu_c"], stored["model"]
-        mu_profiles = float(stored["mu_c_profiles"])
-    else:
-        sensor = Sensor.from_config(config["sensing"]["sensor"])
-        if entry is not None:
-            friction = entry
-        elif plan is not None and "mu_c" in plan:
-            friction = {"mu_c": plan["mu_c"]}
-        else:
-            friction = {"mu_c": parse_friction(config["planner"]["mu_c"])}
-        mu_planned, mu_profiles = sensing_frictions(friction)
-        mu_planned = list(mu_planned) if isinstance(mu_planned, tuple) else mu_planned
-        model = plan.get("model", config["planner"]["model"]) if plan else config["planner"]["model"]
-    if stored is not None:
-        pin_radius = float(stored["pin_radius"])
-    else:
-        pin_radius = catalog_radius if catalog_radius is not None else float(config["sweep"]["pin_radius"])
-    raw = read_profile_csv(args.profile)
-    measured = resample(raw, sensor.rate_hz)
-    if measured.t.size < sensor.regions:
-        raise PinfeedError(f"{args.profile}: the profile spans {raw.t[-1] - raw.t[0]:.3g} s, fewer than "
-                           f"{sensor.regions} samples at {sensor.rate_hz:g} Hz; give the whole contact")
-    states = {f"state {k}": {"theta": float(th), "y_c": float(y)}
-              for k, (th, y) in enumerate(part.stable_states(), start=1)}
-    refs = {k: sign_matrix(p, sensor) for k, p in
-            reference_profiles(part, states, y_pin, mu_profiles, pin_radius, model, sensor).items()}
-    signs = sign_matrix(measured, sensor)
-    verdict = classify(signs, refs, sensor.margin)
-    on_plan = stored is not None and abs(y_pin - float(stored["y_pin"])) < 1e-9
-    final = final_for_verdict(stored, verdict["candidates"]) if on_plan else None
-    known = None
-    if final is not None:  # one physical orientation (modulo the part's symmetry)
-        known = count_sets([(f["start"], f["width"]) for f in final], stored["symmetry_order"]) == 1
-    result = {"part": name, "part_id": part.id, "profile": str(args.profile), "y_pin": y_pin,
-              "y_pin_source": source, "first_pin": first_pin if args.y_pin is None else None,
-              "model": model, "mu_c": mu_planned, "mu_c_profiles": mu_profiles, "pin_radius": pin_radius,
-              "sensor": sensor.to_dict(), "samples": int(measured.t.size), "duration": float(measured.t[-1]),
-              "elements": int(signs.size), "margin": sensor.margin, "scores": verdict["scores"],
-              "best": verdict["best"], "candidates": verdict["candidates"],
-              "decided": verdict["decided"], "measured_signs": signs.tolist(),
-              "sensor_plan": stored["plan"]["pins"] if on_plan else None,
-              "final_sets": final, "final_known": known}
+    result, context = classify_measured(config, args.part, args.profile, _results_arg(args, config),
+                                        catalog=args.catalog, y_pin=args.y_pin)
     if args.json:
         _print_json(result)
         return
+    stored, final = context["stored"], result["final_sets"]
+    mu_planned, margin = result["mu_c"], result["margin"]
     planned = f"{mu_planned[0]:g}:{mu_planned[1]:g}" if isinstance(mu_planned, list) else f"{mu_planned:g}"
-    print(f"part {part.id}: sensor pin at y = {y_pin:g} mm ({source}); model {model}, mu_c {planned} "
-          f"(profiles simulated at {mu_profiles:g}), pin radius {pin_radius:g} mm")
-    print(f"profile {args.profile}: {measured.t.size} samples over {measured.t[-1]:.3f} s at "
-          f"{sensor.rate_hz:g} Hz")
-    if verdict.get("note"):
-        print(f"verdict: undecided ({verdict['note']})")
-    elif verdict["decided"]:
-        print(f"verdict: {verdict['best']} (decided: every other state scores at least "
-              f"{sensor.margin} elements lower)")
+    print(f"part {result['part_id']}: sensor pin at y = {result['y_pin']:g} mm ({result['y_pin_source']}); "
+          f"model {result['model']}, mu_c {planned} (profiles simulated at {result['mu_c_profiles']:g}), "
+          f"pin radius {result['pin_radius']:g} mm")
+    print(f"profile {args.profile}: {result['samples']} samples over {result['duration']:.3f} s at "
+          f"{result['sensor']['rate_hz']:g} Hz")
+    if context["note"]:
+        print(f"verdict: undecided ({context['note']})")
+    elif result["decided"]:
+        print(f"verdict: {result['best']} (decided: every other state scores at least "
+              f"{margin} elements lower)")
     else:
-        print(f"verdict: undecided between {', '.join(verdict['candidates'])} (scores within "
-              f"{sensor.margin} elements of the best)")
-    print(f"scores (equal elements of {signs.size}):")
-    for k, v in verdict["scores"].items():
-        print(f"  {k}: {v}" + ("  <- best" if k == verdict["best"] else ""))
+        print(f"verdict: undecided between {', '.join(result['candidates'])} (scores within "
+              f"{margin} elements of the best)")
+    print(f"scores (equal elements of {result['elements']}):")
+    for k, v in result["scores"].items():
+        print(f"  {k}: {v}" + ("  <- best" if k == result["best"] else ""))
     if final is None and stored is None:
         print("final orientation: unknown (no sensor plan stored; the workflow's sense stage makes one)")
     elif final is None:
         print(f"final orientation: unknown (the stored sensor plan reads pin {stored['first_pin']} "
               f"at y = {stored['y_pin']:g} mm, not this one)")
-    elif known:
+    elif result["final_known"]:
         print(f"final orientation: {describe_sets(final)} (sensor plan {' -> '.join(stored['plan']['pins'])})")
     else:
         print(f"final orientation: one of {describe_sets(final)} (the verdict does not decide it)")
@@ -1017,7 +896,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(_join_signed_values(sys.argv[1:] if argv is None else list(argv)))
     try:
-        from .provenance import source_date_epoch
+        from pipeline.provenance import source_date_epoch
         source_date_epoch()  # before numpy's f2py reads it (and crashes on a bad value)
         args.func(args)
     except PinfeedError as exc:

@@ -19,10 +19,10 @@ from pathlib import Path
 import jsonschema
 import yaml
 
-from .checks import MAX_MAP, check_finite_tree, check_grid_size, check_pin_ratio
-from .errors import PinfeedError
-from .families import family_parts
-from .provenance import source_date_epoch
+from pipeline.checks import MAX_MAP, check_finite_tree, check_grid_size, check_pin_ratio
+from pipeline.errors import PinfeedError
+from pipeline.parts.families import family_parts
+from pipeline.provenance import source_date_epoch
 
 SCHEMA_PATH = Path(__file__).resolve().parent.parent / "config" / "schema.yaml"
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config" / "config.yaml"
@@ -143,7 +143,7 @@ def _check_planner_belt(cfg: dict) -> None:
     speed = cfg["planner"].get("belt_speed")
     if speed is None:
         return
-    from .simulate import check_belt
+    from pipeline.checks import check_belt
     for family, spec in cfg["families"].items():
         for part in family_parts(family, spec):
             if part.name in cfg["planner"]["parts"]:

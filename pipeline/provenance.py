@@ -7,8 +7,8 @@ import os
 import subprocess
 from pathlib import Path
 
-from . import __version__
-from .errors import PinfeedError
+from pipeline import __version__
+from pipeline.errors import PinfeedError
 
 
 @functools.lru_cache(maxsize=1)

@@ -1,5 +1,5 @@
 # Shared helpers: the shard list and per-shard parameters, from the config.
-from pipeline.sweep import shard_jobs
+from pipeline.maps.sweep import shard_jobs
 
 CATALOG = config["catalog_dir"]
 JOBS = {str(job.path(CATALOG)): job for job in shard_jobs(config)}

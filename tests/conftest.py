@@ -62,7 +62,7 @@ def rollout_vectors():
 def _part_fixture(vertices, name):
     @pytest.fixture(scope="session")
     def part():
-        from pipeline.parts import Part
+        from pipeline.parts.part import Part
         return Part.from_vertices(vertices, name=name)
     return part
 
@@ -77,7 +77,7 @@ v_notch = _part_fixture(V_NOTCH, "v-notch")
 def warm_kernels(triangle):
     """Compile (or load from cache) the rollout and grid kernels once, so that
     tests timing a single rollout do not measure the JIT compilation."""
-    from pipeline import simulate
+    from pipeline.maps import simulate
     simulate.rollout(triangle, 30.0, 0.3, 0.2, 3.0)
     simulate.rollout(triangle, 30.0, 0.3, 0.2, 3.0, trajectory=True)
     simulate.map(triangle, [0.0], [0.3], 0.2, 3.0)

@@ -14,7 +14,7 @@ import itertools
 
 import numpy as np
 
-from pipeline import simulate
+from pipeline.maps import simulate
 
 
 def trial_inputs(part, n_pins, n_random, seed, theta_half=2.0, y_half=0.5, mu=(0.0, 0.04),

@@ -4,9 +4,9 @@ import json
 import numpy as np
 import pytest
 
-from pipeline.animate import _gap, _rotated, animate_plan, plan_inputs, roll_plan
 from pipeline.errors import PinfeedError
-from pipeline.parts import Part
+from pipeline.parts.part import Part
+from pipeline.present.animate import _gap, _rotated, animate_plan, plan_inputs, roll_plan
 
 PART = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 STATES = {f"state {k}": (float(th), float(y)) for k, (th, y) in enumerate(PART.stable_states(), 1)}
@@ -14,7 +14,7 @@ HEIGHTS, SPEEDS = [10.0, 25.0], [0.0, 0.0]
 
 
 def test_lanes_follow_the_kernel_and_touch_the_pins():
-    from pipeline import simulate
+    from pipeline.maps import simulate
     lanes, stations, b_end = roll_plan(PART, HEIGHTS, SPEEDS, STATES, 0.15, "minpower", 3.0)
     assert len(lanes) == len(STATES) and b_end > stations[-1]
     for lane in lanes:
@@ -75,7 +75,7 @@ def test_plan_inputs_heights_from_plan_or_config():
 def test_plan_inputs_prefers_the_tight_recommended_plan():
     """The recommended plan is the tight planner's (first friction): its own
     heights, speeds and the friction range's middle."""
-    from pipeline.animate import recommended_index
+    from pipeline.present.animate import recommended_index
     config = {"planner": {"pins": [0.0, 5.0, 10.0, 15.0, 20.0]}, "sweep": {"pin_radius": 3.0}}
     stored = _stored()
     stored["tight"] = [{"friction": "0.1:0.3", "mu_c": [0.1, 0.3],
@@ -113,7 +113,7 @@ def test_cli_animate(tmp_path, capsys):
 
 
 def test_moving_pin_touches_at_its_height_on_the_clock():
-    from pipeline.animate import pin_height
+    from pipeline.present.animate import pin_height
     speeds = [0.0, 1.0]
     lanes, stations, _ = roll_plan(PART, HEIGHTS, speeds, STATES, 0.15, "minpower", 3.0)
     touched = 0

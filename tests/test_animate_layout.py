@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from pipeline import simulate
-from pipeline.animate import _gap, _rotated, animate_layout, station_figure, station_scene
+from pipeline.maps import simulate
+from pipeline.present.animate import _gap, _rotated, animate_layout, station_figure, station_scene
 from pipeline.errors import PinfeedError
-from pipeline.parts import Part
+from pipeline.parts.part import Part
 
 PART = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 STATES = {f"state {k}": (float(th), float(y)) for k, (th, y) in enumerate(PART.stable_states(), 1)}
@@ -109,7 +109,7 @@ def test_gif_frames_title_and_model(tmp_path, monkeypatch):
         seen.update(kw, heights=list(heights), model=model)
         raise RuntimeError("stop")
 
-    monkeypatch.setattr("pipeline.layout.run_trials", spy)
+    monkeypatch.setattr("pipeline.present.layout.run_trials", spy)
     with pytest.raises(RuntimeError, match="stop"):
         station_scene(PART, _layout(model="dynamic", speed=150.0), STATES, MU)
     assert seen["belt_speed"] == 150.0 and seen["mu_s"] == 0.5 and seen["nominal"]
@@ -119,7 +119,7 @@ def test_gif_frames_title_and_model(tmp_path, monkeypatch):
 
 
 def test_title_says_how_the_passages_were_replayed():
-    from pipeline.animate import StationScene, station_title
+    from pipeline.present.animate import StationScene, station_title
     sc = StationScene(PART, [], [], 130.0, 40.0, 3, 0.0, -30.0, (0.0, 50.0), 150.0, "dynamic")
     assert station_title("tri", sc) == "tri; belt 150 mm/s (dynamic model); pitch 130.0 mm"
     sc.model, sc.belt_speed = "minpower", None

@@ -10,14 +10,14 @@ import pytest
 import xarray as xr
 import yaml
 
-from pipeline import simulate
 from pipeline.cli import main
 from pipeline.config import load_config
 from pipeline.errors import PinfeedError
-from pipeline.lattice_store import lattice_path, load_lattice
-from pipeline.parts import Part
-from pipeline.propagate import UNITS
-from pipeline.verify import replay
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
+from pipeline.planning.lattice_store import lattice_path, load_lattice
+from pipeline.planning.propagate import UNITS
+from pipeline.planning.verify import replay
 
 TRI = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 BELT = 150.0
@@ -64,7 +64,7 @@ def test_belt_speed_shards_are_apart_from_quasi_static_ones(planned):
     quasi_keys = set(load_lattice(tmp / "cat", TRI, "minpower", 0.0, 3.0).known)
     assert quasi_keys
     # The catalog index lists both refinement files.
-    from pipeline.catalog import Catalog
+    from pipeline.maps.catalog import Catalog
     Catalog.rebuild(tmp / "cat")
     listed = {r["file"]: r for r in json.loads((tmp / "cat" / "index.json").read_text())["refinements"]}
     quasi_entry = listed[quasi.relative_to(tmp / "cat").as_posix()]
@@ -131,7 +131,8 @@ def test_replay_at_belt_speed_equals_passages_one_by_one():
 
 
 def test_speed_stage_json_and_figure(planned, tmp_path):
-    from pipeline.stages import read_json, speed_figure, speed_part
+    from pipeline.maps.io import read_json
+    from pipeline.workflow.speed import speed_figure, speed_part
     tmp, cfg = planned
     config = load_config(cfg)
     result = speed_part(read_json(tmp / "res" / "plans" / "tri.json"), config)
@@ -147,8 +148,8 @@ def test_speed_stage_json_and_figure(planned, tmp_path):
 
 
 def test_speed_figure_has_labelled_axes_legend_and_marked_limit():
-    from pipeline.figures import text_problems
-    from pipeline.figures.speed import speed_curve_figure
+    from pipeline.present.figures import text_problems
+    from pipeline.present.figures.speed import speed_curve_figure
     result = {"part": "tri", "pin_labels": ["P1", "P2"], "friction": "0.2", "mu_s": 0.5,
               "required": 0.99, "speed_limit_mm_s": 215.0, "trials_per_speed": 64,
               "curve": [[10.0, 1.0], [200.0, 1.0], [215.0, 0.995], [220.0, 0.97], [300.0, 0.8]]}
@@ -192,7 +193,7 @@ def test_config_belt_speed_where_the_part_is_thrown_is_refused():
 
 
 def test_batched_success_fraction_equals_passages_one_at_a_time():
-    from pipeline.speed_limit import _draws, success_fraction
+    from pipeline.planning.speed_limit import _draws, success_fraction
     heights, arcs = [27.5, 7.5], [(0.0, 40.0), (120.0, 30.0)]
     draws = _draws(TRI, heights, [(0.0, 11.67), (217.9, 12.28)], (0.1, 0.3),
                    {"theta_deg": 2.0, "y_mm": 0.5, "pin_mm": 0.3}, 3, seed=5)

@@ -20,7 +20,7 @@ from conftest import TRIANGLE
 from kernels.models import ELLIPSOID, MINPOWER, TIP
 from kernels.rollout import (JAM_REASONS, JAMMED, MAX_STEPS, MIN_STEPS, OK, TRUNC_STEP_BUDGET,
                              TRUNCATED, _prepare, _rollout, _rollout_budget, max_steps_for)
-from pipeline import simulate
+from pipeline.maps import simulate
 from strategies import convex_polygons, star_polygons, triangles
 
 LOCATE_STEPS = 61  # one event location may run past the budget

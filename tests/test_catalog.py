@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 import yaml
 
-from pipeline import simulate
-from pipeline.catalog import Catalog
 from pipeline.config import load_config, validate_config
 from pipeline.errors import PinfeedError
-from pipeline.parts import Part
-from pipeline.sweep import run_sweep, shard_jobs, write_shard
+from pipeline.maps import simulate
+from pipeline.maps.catalog import Catalog
+from pipeline.maps.sweep import run_sweep, shard_jobs, write_shard
+from pipeline.parts.part import Part
 
 ROOT = Path(__file__).resolve().parent.parent
 VENV_BIN = Path(sys.executable).parent

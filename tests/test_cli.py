@@ -18,9 +18,9 @@ import pytest
 import xarray as xr
 
 from conftest import TRIANGLE, circular_diff
-from pipeline import simulate
 from pipeline.cli import main
-from pipeline.parts import Part
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
 
 VERTS = "0,0 60,0 15,35"
 BASE = ["rollout", "--vertices", VERTS, "--d", "0.3", "--mu-c", "0.2", "--pin-radius", "3"]
@@ -51,7 +51,11 @@ def with_options(pairs):
 
 
 def run_script(args, cwd):
+    # PYTHONPATH: the script runs this checkout's package even where the
+    # editable install points at another checkout (a git worktree).
     env = {k: v for k, v in os.environ.items() if k != "PYTHONWARNINGS"}
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parent.parent),
+                                         *filter(None, [env.get("PYTHONPATH")])])
     return subprocess.run([str(PINFEED), *args], capture_output=True, text=True, cwd=cwd,
                           timeout=300, env=env)
 

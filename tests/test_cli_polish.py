@@ -3,8 +3,8 @@ import io
 
 import pytest
 
-from pipeline.bands import format_arc, format_arcs
 from pipeline.cli import build_parser, main
+from pipeline.planning.bands import format_arc, format_arcs
 from pipeline.progress import progress
 
 
@@ -70,19 +70,19 @@ def test_rollout_trajectory_table(capsys):
 
 
 def test_sense_hint_names_pinfeed_plan_for_an_ad_hoc_part(tmp_path):
-    from pipeline.cli import _plan_hint
+    from pipeline.planning.plan import plan_hint
     config = {"planner": {"parts": ["asym_triangle"]}}
-    assert "make run" in _plan_hint(config, "asym_triangle", tmp_path)
-    hint = _plan_hint(config, "bracket", tmp_path)
+    assert "make run" in plan_hint(config, "asym_triangle", tmp_path)
+    hint = plan_hint(config, "bracket", tmp_path)
     assert hint == f"run 'pinfeed plan --part bracket --out {tmp_path / 'plans' / 'bracket.json'}'"
 
 
 def test_plot_map_bands_option(tmp_path, capsys):
     import numpy as np
 
-    from pipeline import simulate
-    from pipeline.io import write_atomic
-    from pipeline.parts import Part
+    from pipeline.maps import simulate
+    from pipeline.maps.io import write_atomic
+    from pipeline.parts.part import Part
     part = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
     write_atomic(simulate.map(part, np.arange(0, 360, 30.0), [0.3], 0.2, 3.0), tmp_path / "m.h5")
     assert main(["plot-map", str(tmp_path / "m.h5"), "--out", str(tmp_path / "m.png"),

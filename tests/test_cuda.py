@@ -23,9 +23,9 @@ import numpy as np
 import pytest
 
 from conftest import circular_diff
-from pipeline import simulate
 from pipeline.cli import main
 from pipeline.errors import PinfeedError
+from pipeline.maps import simulate
 
 HAVE_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
 needs_cuda_extra = pytest.mark.skipif(not HAVE_NUMBA_CUDA,

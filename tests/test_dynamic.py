@@ -26,11 +26,11 @@ import yaml
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from pipeline import simulate
-from pipeline.parts import Part
-from pipeline.planner import Planner, load_maps, pins_from_config
-from pipeline.stages import dynamic_label
-from pipeline.verify import verify_plan
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
+from pipeline.planning.paper import Planner, load_maps, pins_from_config
+from pipeline.planning.paper import dynamic_label
+from pipeline.planning.verify import verify_plan
 from test_invariants import (R_PIN, _contact_fraction, assert_maps_agree, d_values, models,
                              mu_values, parts, theta_grid)
 
@@ -174,8 +174,8 @@ def test_dynamic_pins_bring_default_triangles_to_one_orientation(default_planner
 # ------------------------------------------------------------------ command line
 
 def test_cli_plan_with_a_moving_pin_stores_its_maps(tmp_path, capsys):
-    from pipeline.catalog import Catalog
     from pipeline.cli import main
+    from pipeline.maps.catalog import Catalog
     cat = tmp_path / "cat"
     base = ["plan", "--vertices", "0,0 40,0 40,20 0,20", "--name", "rect", "--catalog", str(cat),
             "--depth", "1", "--pins=-5,5,15,25,35", "--mode", "paper"]

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from pipeline import simulate
 from pipeline.cli import main
 from pipeline.errors import PinfeedError
-from pipeline.parts import Part
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
 
 ASYM = Part.from_vertices(np.array([[0.0, 0.0], [60.0, 0.0], [15.0, 35.0]]), "asym")
 SYM = Part.from_vertices(np.array([[0.0, 0.0], [50.0, 0.0], [25.0, 43.3]]), "sym")
@@ -180,7 +180,7 @@ def test_dynamic_agrees_with_mujoco(v, cases):
 
 
 def test_mujoco_kinematics_do_not_depend_on_mass():
-    from pipeline.mujoco_rig import mujoco_rollout
+    from pipeline.maps.mujoco_rig import mujoco_rollout
     light = mujoco_rollout(ASYM, 200.0, -0.5, 0.3, R_PIN, 300.0, mass=0.002)
     heavy = mujoco_rollout(ASYM, 200.0, -0.5, 0.3, R_PIN, 300.0, mass=0.2)
     assert light[0] == heavy[0] == 0
@@ -195,7 +195,7 @@ def test_speed_limit_of_a_small_plan_holds_on_replay():
     final set is the quasi-static outcome +- 3 deg. The limit is found by
     bisection to 5 mm/s, the next 5 mm/s fail, and a replay with fresh random
     draws at the limit holds (99% in-sample; 97% allows for sampling noise)."""
-    from pipeline.speed_limit import _draws, speed_curve, success_fraction
+    from pipeline.planning.speed_limit import _draws, speed_curve, success_fraction
     theta, yc = ASYM.stable_states()[1]
     y_pin = yc - 0.3 * ASYM.a
     ref = qs(ASYM, theta, -0.3, 0.3)
@@ -229,9 +229,9 @@ def test_dynamic_map_matches_single_rollouts_for_any_thread_count():
 def test_belt_speed_is_a_catalog_dimension(tmp_path):
     from pathlib import Path
 
-    from pipeline.catalog import Catalog
     from pipeline.config import validate_config
-    from pipeline.sweep import run_sweep
+    from pipeline.maps.catalog import Catalog
+    from pipeline.maps.sweep import run_sweep
     cfg = validate_config({
         "families": {"fam": {"parts": [{"name": "tri", "vertices": [[0, 0], [60, 0], [15, 35]]}]}},
         "sweep": {"models": ["minpower"], "mu_c": [0.2], "d": [-0.4, 0.3], "theta_step": 45,

@@ -8,7 +8,7 @@ import pytest  # noqa: E402
 import xarray as xr  # noqa: E402
 
 from kernels.rollout import JAMMED, MISS, OK  # noqa: E402
-from pipeline.figures.bands import MIN_THICKNESS, band_maps_figure, draw_map_panel  # noqa: E402
+from pipeline.present.figures.bands import MIN_THICKNESS, band_maps_figure, draw_map_panel  # noqa: E402
 
 THETA = np.arange(360.0)
 
@@ -86,15 +86,15 @@ def test_band_map_figure_labels_legend_and_ticks():
         fig.canvas.draw()
         assert all(lbl.get_visible() and lbl.get_text() for lbl in ax.get_xticklabels())
         assert ax.get_xlabel() == r"$\theta_i$ (deg)"
-    from pipeline.figures import text_problems
+    from pipeline.present.figures import text_problems
     assert text_problems(fig) == []
     plt.close(fig)
 
 
 @pytest.mark.parametrize("n_d, ncols", [(4, 2), (18, 6), (1, 6)])
 def test_map_figure_fits_its_labels(n_d, ncols):
-    from pipeline.figures import text_problems
-    from pipeline.figures.maps import map_figure
+    from pipeline.present.figures import text_problems
+    from pipeline.present.figures.maps import map_figure
     tf, dy, st = _synthetic_map()
     ds = xr.Dataset({"theta_f": (("d", "theta_i"), np.tile(tf, (n_d, 1))),
                      "dy": (("d", "theta_i"), np.tile(dy, (n_d, 1))),
@@ -110,9 +110,9 @@ def test_map_figure_fits_its_labels(n_d, ncols):
 
 # ---------------------------------------------------------------- sequence diagrams
 
-from pipeline.figures import text_problems  # noqa: E402
-from pipeline.figures.sequence import sequence_figure  # noqa: E402
-from pipeline.parts import Part  # noqa: E402
+from pipeline.parts.part import Part  # noqa: E402
+from pipeline.present.figures import text_problems  # noqa: E402
+from pipeline.present.figures.sequence import sequence_figure  # noqa: E402
 
 
 def _sequence(speeds=None):
@@ -152,8 +152,8 @@ def test_text_problems_finds_an_overlap_and_a_clip():
 
 
 def test_sensor_figures_labels_never_overlap_nor_clip(monkeypatch):
-    from pipeline.figures import sensing as fs
-    from pipeline.sensing import Profile, Sensor
+    from pipeline.present.figures import sensing as fs
+    from pipeline.sensing.profiles import Profile, Sensor
     figs = []
     monkeypatch.setattr(fs, "save_figure", lambda fig, out, **kw: figs.append(fig))
     t = np.arange(0, 2, 1 / 200)
@@ -174,7 +174,7 @@ def test_sensor_figures_labels_never_overlap_nor_clip(monkeypatch):
 
 
 def test_verification_figure_counts_and_highlights_failures():
-    from pipeline.figures.tables import verification_figure
+    from pipeline.present.figures.tables import verification_figure
     ok = {"kind": "fixed pins", "plan": ["P1", "P4"], "rows": [
         {"state": "state 1", "trials": 30, "successes": 30, "failures": 0, "reasons": {}}]}
     bad = {"kind": "with dynamic pins", "plan": ["P1", "P4v+2"], "rows": [
@@ -201,7 +201,7 @@ def test_verification_figure_counts_and_highlights_failures():
 
 
 def test_outline_figure_fences_touch_the_part():
-    from pipeline.figures.outline import outline_figure
+    from pipeline.present.figures.outline import outline_figure
     part = Part.from_vertices([[0, 0], [60, 0], [60, 10], [10, 10], [10, 40], [0, 40]], name="bracket")
     fig = outline_figure(part, "cad/bracket.dxf")
     fences = {ln.get_gid(): np.transpose(ln.get_data()) for ln in fig.axes[0].lines if ln.get_gid()}

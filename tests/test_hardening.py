@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 import yaml
 
-from pipeline import simulate
-from pipeline.catalog import Catalog
 from pipeline.cli import main
 from pipeline.config import validate_config
 from pipeline.errors import PinfeedError
-from pipeline.io import read_map
-from pipeline.parts import MAX_VERTICES, Part, PolygonError
-from pipeline.sweep import run_sweep, shard_jobs
+from pipeline.maps import simulate
+from pipeline.maps.catalog import Catalog
+from pipeline.maps.io import read_map
+from pipeline.maps.sweep import run_sweep, shard_jobs
+from pipeline.parts.part import MAX_VERTICES, Part, PolygonError
 
 ROOT = Path(__file__).resolve().parent.parent
 VENV_BIN = Path(sys.executable).parent
@@ -215,7 +215,7 @@ def test_part_id_is_canonical():
 
 
 def test_sensing_inputs_are_bounded(tmp_path):
-    from pipeline.sensing import read_profile_csv, resample
+    from pipeline.sensing.profiles import read_profile_csv, resample
     huge = tmp_path / "huge.csv"
     huge.write_text("t,fx,fy\n0,0,0\n1e12,1,1\n")
     with pytest.raises(PinfeedError, match="more than the limit of 1,000,000"):
@@ -240,7 +240,7 @@ def test_sensing_inputs_are_bounded(tmp_path):
       "model": "minpower", "plan": {"pins": []}, "states": {}}, "(top level)"),  # before issue 11
 ])
 def test_sensing_json_of_the_wrong_shape_is_refused(tmp_path, content, where):
-    from pipeline.sensor_plan import stored_sensor_plan
+    from pipeline.sensing.sensor_plan import stored_sensor_plan
     (tmp_path / "sensing").mkdir()
     (tmp_path / "sensing" / "p.json").write_text(json.dumps(content))
     with pytest.raises(PinfeedError, match="not a pinfeed sensing result") as info:
@@ -249,7 +249,7 @@ def test_sensing_json_of_the_wrong_shape_is_refused(tmp_path, content, where):
 
 
 def test_all_zero_profile_is_undecided():
-    from pipeline.sensing import Profile, Sensor, classify, sign_matrix
+    from pipeline.sensing.profiles import Profile, Sensor, classify, sign_matrix
     sensor = Sensor()
     t = np.arange(400) / sensor.rate_hz
     zero = sign_matrix(Profile(t, np.zeros_like(t), np.zeros_like(t)), sensor)
@@ -271,7 +271,7 @@ def test_all_zero_profile_is_undecided():
 
 def test_unreachable_dask_scheduler_times_out(tiny_cfg, monkeypatch):
     pytest.importorskip("distributed")
-    monkeypatch.setattr("pipeline.sweep.SCHEDULER_TIMEOUT", 1)
+    monkeypatch.setattr("pipeline.maps.sweep.SCHEDULER_TIMEOUT", 1)
     t0 = time.monotonic()
     with pytest.raises(PinfeedError, match="cannot reach the dask scheduler at tcp://127.0.0.1:9"):
         run_sweep(tiny_cfg, scheduler="tcp://127.0.0.1:9", progress=False)
@@ -337,7 +337,7 @@ def test_plan_depth_zero_is_refused(capsys):
 
 
 def test_deleted_or_damaged_shard_drops_the_stale_index(swept):
-    from pipeline.workflow import reconcile_catalog
+    from pipeline.workflow.runner import reconcile_catalog
     root = Path(swept["catalog_dir"])
     assert reconcile_catalog(swept) == []  # consistent: nothing done
     gone, damaged = (j.path(root) for j in shard_jobs(swept))
@@ -352,8 +352,8 @@ def test_deleted_or_damaged_shard_drops_the_stale_index(swept):
 
 
 def test_stale_lock_and_temp_files_are_cleared_only_when_no_run_is_alive(tmp_path):
-    from pipeline.io import remove_stale_temps
-    from pipeline.workflow import clear_stale_lock
+    from pipeline.maps.io import remove_stale_temps
+    from pipeline.workflow.runner import clear_stale_lock
     locks = tmp_path / ".snakemake" / "locks"
     locks.mkdir(parents=True)
     (locks / "0.input.lock").write_text("x")

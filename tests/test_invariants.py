@@ -24,8 +24,8 @@ from hypothesis import note as _hypothesis_note
 from hypothesis import strategies as st
 
 from conftest import circular_diff
-from pipeline import simulate
-from pipeline.parts import Part, PolygonError
+from pipeline.maps import simulate
+from pipeline.parts.part import Part, PolygonError
 
 R_PIN = 3.0
 THETA_TOL = 0.05  # degrees: integrator accuracy is far better (see test_rollout)

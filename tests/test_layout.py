@@ -3,7 +3,7 @@
 The replay checks below rebuild the world-frame motion of two consecutive
 parts past two consecutive pins from the public rollout API, with their own
 first-touch search and their own polygon/disc intersection tests (a simple
-reference, independent of ``pipeline.layout``'s slab and reach geometry).
+reference, independent of ``pipeline.present.layout``'s slab and reach geometry).
 """
 import json
 import math
@@ -11,12 +11,12 @@ import math
 import numpy as np
 import pytest
 
-from pipeline import simulate
 from pipeline.cli import main
 from pipeline.config import load_config
 from pipeline.errors import PinfeedError
-from pipeline.layout import check_layout_settings, layout_stored
-from pipeline.parts import Part
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
+from pipeline.present.layout import check_layout_settings, layout_stored
 
 TRIANGLE = "0,0 60,0 15,35"
 SPEED = 100.0
@@ -208,8 +208,8 @@ def test_two_parts_replay_apart_at_pitch_touch_when_closer(stored):
 def test_dxf_entities_stand_where_the_json_says(stored, tmp_path):
     import ezdxf
 
-    from pipeline.layout import write_drawing
-    from pipeline.outlines import read_outline
+    from pipeline.parts.outlines import read_outline
+    from pipeline.present.layout import write_drawing
     out = stored["layout"]
     path = write_drawing(out, tmp_path / "feeder.dxf")
     doc = ezdxf.readfile(str(path))
@@ -234,7 +234,7 @@ def test_dxf_entities_stand_where_the_json_says(stored, tmp_path):
 
 
 def test_svg_and_png_drawings(stored, tmp_path):
-    from pipeline.layout import write_drawing
+    from pipeline.present.layout import write_drawing
     for suffix in (".svg", ".png"):
         path = write_drawing(stored["layout"], tmp_path / f"feeder{suffix}")
         assert path.stat().st_size > 1000

@@ -8,8 +8,8 @@ import pytest
 ezdxf = pytest.importorskip("ezdxf")
 pytest.importorskip("svgelements")
 
-from pipeline.outlines import OutlineError, read_outline  # noqa: E402
-from pipeline.parts import Part  # noqa: E402
+from pipeline.parts.outlines import OutlineError, read_outline  # noqa: E402
+from pipeline.parts.part import Part  # noqa: E402
 
 L, R = 40.0, 10.0  # rounded slot: centre distance, end radius
 SLOT_AREA = 2 * R * L + math.pi * R * R
@@ -157,7 +157,7 @@ def test_config_family_outline_relative_to_config_file(tmp_path, monkeypatch):
 
     from pipeline.config import DEFAULT_CONFIG, load_config
     from pipeline.errors import PinfeedError
-    from pipeline.families import family_parts
+    from pipeline.parts.families import family_parts
     (tmp_path / "cad").mkdir()
     _dxf(tmp_path / "cad" / "l.dxf", _bracket)
     cfg = yaml.safe_load(DEFAULT_CONFIG.read_text())

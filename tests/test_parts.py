@@ -17,7 +17,7 @@ from scipy.spatial import ConvexHull
 
 from conftest import QUAD, TRIANGLE, circular_diff
 from pipeline.errors import PinfeedError
-from pipeline.parts import Part, PolygonError, parse_vertices
+from pipeline.parts.part import Part, PolygonError, parse_vertices
 from reference import centroid
 from reference import signed_area as shoelace
 
@@ -175,7 +175,7 @@ def test_id_is_stable_and_tracks_geometry():
 
 
 def test_id_is_the_same_in_a_fresh_process(triangle):
-    code = ("from pipeline.parts import Part; "
+    code = ("from pipeline.parts.part import Part; "
             f"print(Part.from_vertices({TRIANGLE!r}, name='triangle').id)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=120, check=True).stdout.strip()

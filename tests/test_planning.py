@@ -7,12 +7,12 @@ import pytest
 import xarray as xr
 
 from kernels.rollout import JAMMED, MISS, OK
-from pipeline import simulate
-from pipeline.bands import circular_mean_std, extract_bands, in_arc
 from pipeline.errors import PinfeedError
-from pipeline.parts import Part
-from pipeline.planner import Planner, State, load_maps, merge_arcs
-from pipeline.verify import verify_plan
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
+from pipeline.planning.bands import circular_mean_std, extract_bands, in_arc
+from pipeline.planning.paper import Planner, State, load_maps, merge_arcs
+from pipeline.planning.verify import verify_plan
 
 GRID = np.arange(0.0, 360.0, 1.0)
 
@@ -233,7 +233,7 @@ def test_cli_plan_for_new_outline(tmp_path, capsys):
     res = json.loads(out.read_text())
     assert res["part"]["name"] == "rect" and res["plans"]
     # The maps it needed are now stored and indexed.
-    from pipeline.catalog import Catalog
+    from pipeline.maps.catalog import Catalog
     assert any(e["part_name"] == "rect" for e in Catalog.open(tmp_path / "cat").entries)
     assert main(["plan", "--catalog", str(tmp_path / "cat"), "--part", "nope"]) == 2
 

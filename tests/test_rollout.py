@@ -14,9 +14,9 @@ import pytest
 import xarray as xr
 
 from conftest import QUAD, RECTANGLE, TRIANGLE, circular_diff
-from pipeline import simulate
 from pipeline.errors import PinfeedError
-from pipeline.parts import Part
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
 
 R_PIN = 3.0
 STATUS = {name: code for code, name in enumerate(simulate.STATUSES)}

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from pipeline.errors import PinfeedError
-from pipeline.sensing import (Profile, Sensor, classify, measure, profile_from_rollout, read_profile_csv,
+from pipeline.sensing.profiles import (Profile, Sensor, classify, measure, profile_from_rollout, read_profile_csv,
                               score, sensor_groups, sign_matrix)
 
 S = Sensor(window=1, regions=4, dead_zone=0.05, margin=2, rate_hz=100.0)
@@ -86,8 +86,8 @@ def test_score_table_groups_a_state_that_touches_apart_from_ones_that_miss():
     # A pin high above the asymmetric triangle's first two resting states misses
     # them (an all-zero sign matrix) and pushes the third: noise-free and
     # unperturbed, the sensor must tell the third apart and only the third.
-    from pipeline.parts import Part
-    from pipeline.sensing import score_table
+    from pipeline.parts.part import Part
+    from pipeline.sensing.profiles import score_table
     part = Part.from_vertices([(0, 0), (60, 0), (15, 35)], name="asym")
     states = {f"state {k}": {"theta": th, "y_c": y}
               for k, (th, y) in enumerate(part.stable_states(), start=1)}
@@ -196,8 +196,8 @@ def test_score_table_accuracy_on_the_asymmetric_triangle():
     # measurements are classified right and decided in at least ACCURACY_FLOOR of
     # the trials, wrongly in at most 5 %, and the table is the paper's Table 4.
     from pipeline.config import load_config
-    from pipeline.parts import Part
-    from pipeline.sensing import PERTURB_DEFAULTS, score_table
+    from pipeline.parts.part import Part
+    from pipeline.sensing.profiles import PERTURB_DEFAULTS, score_table
     cfg = load_config()["sensing"]
     part = Part.from_vertices([(0, 0), (60, 0), (15, 35)], name="asym")
     states = {f"state {k}": {"theta": th, "y_c": y} for k, (th, y) in enumerate(part.stable_states(), 1)}
@@ -216,7 +216,7 @@ def test_score_table_accuracy_on_the_asymmetric_triangle():
 
 def _stored_plan(finals: dict, pins=("P1",), heights=(10.0,), n_sets=None):
     """A plan shaped like a stored tight plan: per state, one branch per final arc."""
-    from pipeline.arcs import merge_arcs
+    from pipeline.planning.arcs import merge_arcs
     step = {"pin": pins[-1], "y_pin": heights[-1], "v_pin": 0.0, "d_range": [0.2, 0.3]}
     branches = {lab: [[dict(step, band={"start": s, "width": 5.0})] for s in starts]
                 for lab, starts in finals.items()}
@@ -227,7 +227,7 @@ def _stored_plan(finals: dict, pins=("P1",), heights=(10.0,), n_sets=None):
 
 
 def test_sensor_ranking_counts_final_sets_per_verdict():
-    from pipeline.sensor_plan import group_arcs, sensor_rank_key, verdict_outcome, worst_sets
+    from pipeline.sensing.sensor_plan import group_arcs, sensor_rank_key, verdict_outcome, worst_sets
     groups = [["s1"], ["s2", "s3"]]
     a = _stored_plan({"s1": [10.0], "s2": [100.0], "s3": [100.0]})  # 2 sets, 1 per verdict
     b = _stored_plan({"s1": [10.0], "s2": [10.0], "s3": [200.0]})  # 2 sets, 2 for s2/s3
@@ -255,7 +255,7 @@ def test_sensor_ranking_counts_final_sets_per_verdict():
 
 
 def test_friction_is_resolved_once_for_the_profiles():
-    from pipeline.sensor_plan import sensing_frictions
+    from pipeline.sensing.sensor_plan import sensing_frictions
     assert sensing_frictions({"mu_c": [0.1, 0.3]}) == ((0.1, 0.3), pytest.approx(0.2))
     assert sensing_frictions({"mu_c": 0.15}) == (0.15, 0.15)
 
@@ -263,7 +263,7 @@ def test_friction_is_resolved_once_for_the_profiles():
 def test_synthetic_measurement_draws_a_friction_range_uniformly(monkeypatch):
     # Over a planned range the measurements' friction spreads over the whole range
     # (as verification draws it), not around one value.
-    from pipeline import sensing
+    from pipeline.sensing import profiles as sensing
 
     class Drawn(Exception):
         pass
@@ -320,8 +320,8 @@ def _sense_config(**sensing):
 @pytest.fixture(scope="module")
 def sensed(stored_tri):
     """The sensing stage on both stored files, written where classify finds them."""
-    from pipeline.io import write_json
-    from pipeline.sensor_plan import sense_part
+    from pipeline.maps.io import write_json
+    from pipeline.sensing.sensor_plan import sense_part
     out = {}
     for kind in ("full", "partial"):
         res = sense_part(stored_tri[kind] / "plans" / "tri.json", _sense_config(), log=lambda *a: None)
@@ -363,9 +363,9 @@ def test_final_sets_per_verdict_hold_in_full_rollout_replay(sensed):
     # Every state of a verdict's group, replayed past the sensor plan's pins by
     # perturbed full rollouts (the verify stage's sizes, random trials and every
     # corner of the box), ends in that verdict's final sets.
-    from pipeline.arcs import in_arc
-    from pipeline.parts import Part
-    from pipeline.verify import DEFAULTS, corner_inputs, perturbed_batch, replay
+    from pipeline.parts.part import Part
+    from pipeline.planning.arcs import in_arc
+    from pipeline.planning.verify import DEFAULTS, corner_inputs, perturbed_batch, replay
     res = sensed["partial"]
     kernel = _sense_config()["sweep"]["kernel"]  # the verify stage's rollout settings
     part = Part.from_vertices(res["part"]["vertices"])
@@ -391,7 +391,7 @@ def test_final_sets_per_verdict_hold_in_full_rollout_replay(sensed):
 
 
 def test_sensor_stage_without_a_verified_plan(stored_tri, tmp_path):
-    from pipeline.sensor_plan import sense_part
+    from pipeline.sensing.sensor_plan import sense_part
     stored = json.loads((stored_tri["partial"] / "plans" / "tri.json").read_text())
     stored["tight"][0].update(plans=[], recommended=None, warning="no plan passed verification: test")
     path = tmp_path / "plans" / "tri.json"
@@ -435,9 +435,9 @@ def test_cli_classify_reads_a_profile_and_names_the_final_orientation(stored_tri
     # The noise-free simulated profile of one state, written in other units, with a
     # time offset and an extra column, must score 40/40 against that state. The
     # part is known from the stored results (the catalog holds refinements only).
-    from pipeline.parts import Part
-    from pipeline.sensing import reference_profiles
-    from pipeline.sensor_plan import final_for_verdict
+    from pipeline.parts.part import Part
+    from pipeline.sensing.profiles import reference_profiles
+    from pipeline.sensing.sensor_plan import final_for_verdict
     res = sensed["partial"]
     part = Part.from_vertices(res["part"]["vertices"])
     sensor = Sensor.from_config(res["sensor"])
@@ -532,7 +532,7 @@ def test_cli_module_entry_point():
 
 
 def test_sensing_figures_are_written(sensed, tmp_path):
-    from pipeline.figures.sensing import sensing_figures
+    from pipeline.present.figures.sensing import sensing_figures
     prof, scores = sensing_figures(sensed["partial"], tmp_path / "profiles.png", tmp_path / "scores.png")
     for path in (prof, scores):
         assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000

@@ -12,15 +12,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from oracle import n_clusters, one_set_sequences, replay_sequence, trial_inputs
-from pipeline import simulate
-from pipeline.arcs import format_arc, in_arc, merge_modulo
 from pipeline.errors import PinfeedError
-from pipeline.lattice_store import lattice_path, load_lattice, save_lattice
-from pipeline.parts import Part
-from pipeline.planning import parse_friction
-from pipeline.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Uncertainty, initial_state_sets,
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
+from pipeline.planning.arcs import format_arc, in_arc, merge_modulo
+from pipeline.planning.lattice_store import lattice_path, load_lattice, save_lattice
+from pipeline.planning.plan import parse_friction
+from pipeline.planning.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Uncertainty, initial_state_sets,
                                 propagate)
-from pipeline.search import TightPlanner
+from pipeline.planning.search import TightPlanner
 
 ASYM = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="asym_triangle")
 
@@ -227,7 +227,7 @@ def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys):
     assert main(["speed", "--part", "nope", "--results", str(tmp_path / "res")]) == 2
     assert main(["speed", "--part", "tri", "--results", str(tmp_path / "res"), "--mu-c", "0.2"]) == 2
     # A tight-only plan file animates too (its resting states live in the friction entry).
-    from pipeline.animate import plan_inputs
     from pipeline.config import load_config
+    from pipeline.present.animate import plan_inputs
     inputs = plan_inputs(json.loads(stored.read_text()), None, load_config(None))
     assert inputs["labels"] == out["plans"][0]["pins"] and len(inputs["states"]) == 3

@@ -13,8 +13,8 @@ import json
 import pytest
 
 from conftest import DATA_DIR, circular_diff
-from pipeline import simulate
-from pipeline.parts import Part
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
 
 THETA_TOL = 0.1  # degrees, circular
 DY_TOL = 0.05  # mm

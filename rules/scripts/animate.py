@@ -1,20 +1,11 @@
 """Snakemake script: the animation of one part's laid-out plan (GIF): pins at the layout's
 stations, parts at its pitch; the recommended plan in lanes when there is no layout."""
-import sys
-from pathlib import Path
-
-# The repository is the workflow: make its pipeline importable under --use-conda too.
-sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
-
 from pipeline.logs import log_to
-from pipeline.stages import animate_part, read_json
+from pipeline.workflow.report import animate
 
 with log_to(snakemake.log[0]):  # noqa: F821
     p = snakemake.params  # noqa: F821
-    # The layout stage's JSON: the feeder at its stations and pitch (a part with no
-    # layout-able plan gets a JSON without stations and the plain animation).
-    layout = read_json(snakemake.input.layout)  # noqa: F821
-    done = animate_part(read_json(snakemake.input.plan), snakemake.config,  # noqa: F821
-                        snakemake.output.animation, p.frames, p.fps, layout=layout)  # noqa: F821
+    done = animate(snakemake.input.plan, snakemake.config, snakemake.output.animation,  # noqa: F821
+                   p.frames, p.fps, layout_path=snakemake.input.layout)  # noqa: F821
     print(f"wrote {done['out']}: {done['frames']} frames of the {done.get('what', 'no plan')}; "
           f"outcomes {done['outcomes']}")

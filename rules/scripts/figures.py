@@ -1,12 +1,6 @@
 """Snakemake script: band maps, sequence diagrams and the verification table."""
-import sys
-from pathlib import Path
-
-# The repository is the workflow: make its pipeline importable under --use-conda too.
-sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
-
 from pipeline.logs import log_to
-from pipeline.stages import make_figures
+from pipeline.workflow.report import make_figures
 
 with log_to(snakemake.log[0]):  # noqa: F821
     out = snakemake.output  # noqa: F821

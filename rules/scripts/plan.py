@@ -1,17 +1,8 @@
 """Snakemake script: the fixed-pins planner for one part."""
-import sys
-from pathlib import Path
-
-# The repository is the workflow: make its pipeline importable under --use-conda too.
-sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
-
-from pipeline.catalog import Catalog
 from pipeline.logs import log_to
-from pipeline.stages import plan_part, write_json
+from pipeline.workflow.plan import plan
 
 with log_to(snakemake.log[0]):  # noqa: F821
-    cat = Catalog.open(snakemake.config["catalog_dir"])  # noqa: F821
-    result = plan_part(cat, snakemake.wildcards.name, snakemake.config)  # noqa: F821
-    write_json(result, snakemake.output.plan)  # noqa: F821
-    for plan in result["plans"]:
-        print(plan["pins"], plan["n_final_sets"], plan["final_sets"], plan["margin"])
+    result = plan(snakemake.config, snakemake.wildcards.name, snakemake.output.plan)  # noqa: F821
+    for p in result["plans"]:
+        print(p["pins"], p["n_final_sets"], p["final_sets"], p["margin"])

@@ -1,12 +1,6 @@
 """Snakemake script: the HTML page linking every result."""
-import sys
-from pathlib import Path
-
-# The repository is the workflow: make its pipeline importable under --use-conda too.
-sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
-
 from pipeline.logs import log_to
-from pipeline.stages import make_report
+from pipeline.workflow.report import make_report
 
 with log_to(snakemake.log[0]):  # noqa: F821
     make_report(snakemake.config, snakemake.input.plans, snakemake.input.verify,  # noqa: F821

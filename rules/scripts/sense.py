@@ -1,18 +1,10 @@
 """Snakemake script: the force/torque sensor on the first pin for one planned part
 (reads the part's stored plan result; no search of its own)."""
-import sys
-from pathlib import Path
-
-# The repository is the workflow: make its pipeline importable under --use-conda too.
-sys.path.insert(0, str(Path(snakemake.scriptdir).resolve().parents[1]))  # noqa: F821
-
 from pipeline.logs import log_to
-from pipeline.sensor_plan import sense_part
-from pipeline.stages import write_json
+from pipeline.workflow.sense import sense
 
 with log_to(snakemake.log[0]):  # noqa: F821
-    result = sense_part(snakemake.input.plan, snakemake.config)  # noqa: F821
-    write_json(result, snakemake.output.sensing)  # noqa: F821
+    result = sense(snakemake.input.plan, snakemake.config, snakemake.output.sensing)  # noqa: F821
     if result["found"]:
         print(f"mu_c {result['friction']} (profiles at {result['mu_c_profiles']:g}): sensor on "
               f"{result['first_pin']} ({result['y_pin']:g} mm), stored plan #{result['plan_rank']} "

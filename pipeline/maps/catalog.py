@@ -1,0 +1,376 @@
+"""The map database: an index of every shard under ``catalog/``, checked against disk.
+
+The index (``catalog/index.json``) is rebuilt from the shards' own
+attributes, never edited by hand, and written atomically. Opening a catalog
+checks each entry against its file: entries whose files are gone or changed
+are reported in :attr:`Catalog.problems` and never served; a re-index drops
+them. Foreign or corrupt ``.h5`` files are reported by name.
+
+Queries return lazy (dask-backed) xarray objects::
+
+    cat = Catalog.open("catalog")
+    ds = cat.query(part="asym_triangle", model="minpower", mu_c=0.2, d=0.3)
+    ds.attrs["selection"]   # e.g. "mu_c 0.2 -> nearest stored 0.15; d 0.3 -> 0.3"
+    moving = cat.query("asym_triangle", mu_c=0.15, v_pin=-2)   # a dynamic pin's maps
+    cube = cat.cube("paper_triangles")   # dims (part, model, mu_c, v_pin, d, theta_i)
+
+Shards written before dynamic pins existed have no ``v_pin`` attribute and
+count as static pins (v_pin = 0).
+
+Integrity: each entry records the shard's SHA-256, size and modification
+time. Opening a catalog (``catalog list/show``, every query) compares size and
+time with the disk and re-hashes only the shards whose time changed, so a
+shard overwritten with same-size garbage is flagged without hashing the whole
+catalog; serving a shard always checks its hash (once per opened catalog).
+The index itself is checked against :data:`INDEX_SCHEMA`; a malformed one is
+refused with the command that rebuilds it.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import jsonschema
+import numpy as np
+import xarray as xr
+
+from pipeline.errors import PinfeedError
+from pipeline.maps.io import write_json
+
+INDEX_NAME = "index.json"
+# The planner's refinement shards (pipeline.planning.lattice_store) live under
+# ROOT/refine/PART_ID/...: listed by the index apart from the maps.
+REFINE_FOLDER = "refine"
+INDEX_VERSION = 1
+
+_NUM = {"type": "number"}
+_STR = {"type": "string"}
+INDEX_SCHEMA = {
+    "type": "object",
+    "required": ["index_version", "entries"],
+    "properties": {
+        "index_version": {"const": INDEX_VERSION},
+        "problems": {"type": "array", "items": _STR},
+        "entries": {"type": "array", "items": {
+            "type": "object",
+            "required": ["file", "sha256", "size", "family", "part_id", "part_name", "part_vertices",
+                         "model", "mu_c", "pin_radius", "d", "theta_step", "n_theta"],
+            "properties": {
+                # Relative, inside the catalog, an .h5 file.
+                "file": {"type": "string", "pattern": r"^(?!/)(?!.*(^|/)\.\.(/|$)).+\.h5$"},
+                "sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+                "size": {"type": "integer", "minimum": 0},
+                "mtime_ns": {"type": "integer"},
+                "family": _STR, "part_id": _STR, "part_name": _STR, "model": _STR,
+                "part_vertices": {"type": "array", "minItems": 3,
+                                  "items": {"type": "array", "minItems": 2, "maxItems": 2, "items": _NUM}},
+                "mu_c": _NUM, "pin_radius": _NUM, "v_pin": _NUM, "theta_step": _NUM,
+                "d": {"type": "array", "items": _NUM},
+                "n_theta": {"type": "integer", "minimum": 1},
+            },
+        }},
+    },
+}
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def entry_from_file(root: Path, path: Path) -> dict:
+    """Index entry from a shard's own attributes; raises PinfeedError for foreign/corrupt files."""
+    try:
+        ds = xr.open_dataset(path, engine="h5netcdf", phony_dims="sort")
+    except Exception as exc:
+        raise PinfeedError(f"{path}: cannot read as HDF5 (corrupt or not a map file): "
+                           f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+    with ds:
+        attrs = dict(ds.attrs)
+        if ("catalog_schema_version" not in attrs or "part_id" not in attrs
+                or "d" not in ds.coords or "theta_i" not in ds.coords):
+            raise PinfeedError(f"{path}: foreign file, not a pinfeed shard (no catalog attributes)")
+        d = [float(x) for x in ds["d"].values]
+        n_theta = int(ds.sizes["theta_i"])
+    verts = np.asarray(attrs["part_vertices"], float).reshape(-1, 2).tolist()
+    return {
+        "file": path.relative_to(root).as_posix(),
+        "sha256": _sha256(path),
+        "size": path.stat().st_size,
+        "mtime_ns": path.stat().st_mtime_ns,
+        "family": str(attrs["family"]),
+        "part_id": str(attrs["part_id"]),
+        "part_name": str(attrs["part_name"]),
+        "part_vertices": verts,
+        "model": str(attrs["model"]),
+        "mu_c": float(attrs["mu_c"]),
+        "pin_radius": float(attrs["pin_radius"]),
+        "v_pin": float(attrs.get("v_pin", 0.0)),
+        "belt_speed": float(attrs.get("belt_speed", 0.0)),
+        "mu_s": float(attrs.get("mu_s", 0.5)),
+        "d": d,
+        "theta_step": float(attrs["theta_step"]),
+        "n_theta": n_theta,
+        "config_hash": str(attrs["config_hash"]),
+        "pinfeed_version": str(attrs["pinfeed_version"]),
+        "git_commit": str(attrs.get("git_commit", "unknown")),
+        "created": str(attrs.get("created", "")),
+        "schema_version": int(attrs["catalog_schema_version"]),
+    }
+
+
+def read_index(index: Path, root: Path) -> dict:
+    """The index as a dict, checked against :data:`INDEX_SCHEMA`."""
+    hint = f"rebuild it with 'pinfeed catalog index --catalog {root}'"
+    try:
+        with open(index) as fh:
+            data = json.load(fh)
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise PinfeedError(f"{index} is corrupt; {hint}") from None
+    except OSError as exc:
+        raise PinfeedError(f"cannot read {index}: {exc.strerror}; check its permissions") from None
+    err = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(INDEX_SCHEMA).iter_errors(data))
+    if err is not None:
+        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
+        raise PinfeedError(f"{index} is not a pinfeed catalog index (at {where}: "
+                           f"{err.message[:120]}); {hint}")
+    return data
+
+
+def disk_problem(path: Path, e: dict) -> str | None:
+    """Why an index entry no longer matches its file, or None. Cheap: the file is
+    hashed only when its modification time differs from the indexed one."""
+    if not path.is_file():
+        return f"{path}: listed in the index but gone from disk"
+    st = path.stat()
+    if st.st_size != e["size"]:
+        return f"{path}: changed since it was indexed (size)"
+    if st.st_mtime_ns != e.get("mtime_ns") and _sha256(path) != e["sha256"]:
+        return f"{path}: changed since it was indexed (checksum)"
+    return None
+
+
+def refinement_fields(relative_path) -> dict:
+    """What a refinement file's path (relative to the catalog) says it holds:
+    ``part_id``, ``model``, ``v_pin``, ``belt_speed`` (``None``: quasi-static)
+    and ``mu_s``, for the catalog index."""
+    parts = Path(relative_path).parts
+    fields = dict(item.split("=", 1) for item in
+                  Path(relative_path).stem.replace("_belt=", "|belt=").replace("_mu_s=", "|mu_s=").split("|")
+                  if "=" in item)
+    try:
+        return {"part_id": parts[1], "model": parts[2], "v_pin": float(fields["v_pin"]),
+                "belt_speed": float(fields["belt"]) if "belt" in fields else None,
+                "mu_s": float(fields["mu_s"]) if "mu_s" in fields else None}
+    except (IndexError, KeyError, ValueError):
+        return {}  # not named by lattice_path: listed by file only
+
+
+class Catalog:
+    """An opened catalog: verified entries plus the problems found on disk."""
+
+    def __init__(self, root: Path, entries: list[dict], problems: list[str]):
+        self.root = Path(root)
+        self.entries = entries
+        self.problems = problems
+        self._verified = set()  # files whose checksum was checked when served
+
+    # ------------------------------------------------------------------ building
+
+    @classmethod
+    def rebuild(cls, root="catalog") -> "Catalog":
+        """Scan every shard under ``root``, write a fresh index atomically."""
+        root = Path(root)
+        if not root.is_dir():
+            raise PinfeedError(f"no catalog folder at {root}; run the workflow ('make run') first")
+        entries, problems = [], []
+        refinements = []
+        for path in sorted(root.rglob("*.h5")):
+            if path.name.startswith("."):
+                continue  # an unfinished atomic write
+            if path.relative_to(root).parts[0] == REFINE_FOLDER:
+                # the planner's on-demand rollouts (pipeline.planning.lattice_store), not maps
+                rel = path.relative_to(root)
+                refinements.append({"file": rel.as_posix(), **refinement_fields(rel),
+                                    "sha256": _sha256(path)})
+                continue
+            try:
+                entries.append(entry_from_file(root, path))
+            except PinfeedError as exc:
+                problems.append(str(exc))
+        write_json({"index_version": INDEX_VERSION, "entries": entries, "problems": problems,
+                    "refinements": refinements}, root / INDEX_NAME)
+        return cls(root, entries, problems)
+
+    @classmethod
+    def open(cls, root="catalog") -> "Catalog":
+        """Read the index and check it against the files on disk (size and presence;
+        contents are checksummed when an entry is served)."""
+        root = Path(root)
+        index = root / INDEX_NAME
+        if not index.is_file():
+            raise PinfeedError(f"no catalog index at {index}; run the workflow ('make run') "
+                               f"or 'pinfeed catalog index --catalog {root}'")
+        data = read_index(index, root)
+        entries, problems = [], list(data.get("problems", []))
+        for e in data["entries"]:
+            problem = disk_problem(root / e["file"], e)
+            if problem:
+                problems.append(problem)
+            else:
+                entries.append(e)
+        return cls(root, entries, problems)
+
+    # ------------------------------------------------------------------ queries
+
+    def parts(self) -> list[dict]:
+        """One row per part: family, id, name, models and frictions stored."""
+        rows = {}
+        for e in self.entries:
+            r = rows.setdefault(e["part_id"], {"family": e["family"], "part_id": e["part_id"],
+                                               "part_name": e["part_name"], "n_vertices": len(e["part_vertices"]),
+                                               "models": set(), "mu_c": set(), "v_pin": set(),
+                                               "n_d": len(e["d"]), "n_theta": e["n_theta"]})
+            r["models"].add(e["model"])
+            r["mu_c"].add(e["mu_c"])
+            r["v_pin"].add(e.get("v_pin", 0.0))
+        return [dict(r, models=sorted(r["models"]), mu_c=sorted(r["mu_c"]), v_pin=sorted(r["v_pin"]))
+                for r in rows.values()]
+
+    def entries_for(self, part: str) -> list[dict]:
+        found = [e for e in self.entries if part in (e["part_id"], e["part_name"])]
+        if not found:
+            known = sorted({e["part_name"] for e in self.entries})
+            raise PinfeedError(f"unknown part {part!r}; known parts: {', '.join(known) or 'none'} "
+                               f"('pinfeed catalog list' shows them)")
+        ids = sorted({e["part_id"] for e in found})
+        families = sorted({e["family"] for e in found})
+        if len(families) > 1:
+            raise PinfeedError(f"part {part!r} is stored in several families ({', '.join(families)}); "
+                               f"rename it in one of them and re-run the workflow")
+        if len(ids) > 1:
+            raise PinfeedError(f"part name {part!r} matches several parts ({', '.join(ids)}); give the id")
+        return found
+
+    def _open_entry(self, e: dict) -> xr.Dataset:
+        path = self.root / e["file"]
+        if not path.is_file():
+            raise PinfeedError(f"{path} is gone from disk; re-run the workflow to recompute it")
+        if path not in self._verified:
+            if _sha256(path) != e["sha256"]:
+                raise PinfeedError(f"{path} changed since it was indexed (checksum); re-run the "
+                                   f"workflow ('make run') to recompute it")
+            self._verified.add(path)
+        return xr.open_dataset(path, engine="h5netcdf", chunks={})
+
+    def query(self, part: str, model: str = "minpower", mu_c=None, d=None,
+              method: str = "nearest", v_pin: float = 0.0,
+              belt_speed: float = 0.0) -> xr.Dataset:
+        """Maps of one part, model and pin speed, lazily.
+
+        ``mu_c`` and ``d`` select stored values: ``method="nearest"`` takes the
+        nearest stored value, ``"bracket"`` the stored values on either side (or
+        the exact one). ``None`` keeps all. ``v_pin`` (speed ratio v_pin / v_b,
+        default 0: static pins) must be stored exactly, since maps of different
+        speeds are not interpolated. ``attrs["selection"]`` says what was
+        chosen. ``belt_speed`` (mm/s, default 0: quasi-static) selects the
+        dynamic model's maps at that speed, stored exactly (``model`` is then
+        ``"dynamic"``). Returns dims ``(mu_c, d, theta_i)``.
+        """
+        if float(belt_speed) > 0.0:
+            model = "dynamic"
+        if method not in ("nearest", "bracket"):
+            raise PinfeedError(f"unknown selection method {method!r}; use nearest or bracket")
+        _check_finite(mu_c=mu_c, d=d, v_pin=v_pin)
+        found = [e for e in self.entries_for(part) if e["model"] == model]
+        if not found:
+            models = sorted({e["model"] for e in self.entries_for(part)})
+            raise PinfeedError(f"part {part!r} has no {model} maps; stored models: {', '.join(models)}")
+        belts = sorted({e.get("belt_speed", 0.0) for e in found})
+        found = [e for e in found if e.get("belt_speed", 0.0) == float(belt_speed)]
+        if not found:
+            raise PinfeedError(f"part {part!r} has no {model} maps at belt speed {float(belt_speed):g} mm/s; "
+                               f"stored belt speeds: {', '.join(f'{v:g}' for v in belts)} "
+                               f"(add it to sweep.belt_speed)")
+        speeds = sorted({e.get("v_pin", 0.0) for e in found})
+        found = [e for e in found if e.get("v_pin", 0.0) == float(v_pin)]
+        if not found:
+            raise PinfeedError(f"part {part!r} has no {model} maps at v_pin/v_b = {float(v_pin):g}; "
+                               f"stored speeds: {', '.join(f'{v:g}' for v in speeds)} (add it to sweep.v_pin)")
+        notes = [] if float(v_pin) == 0.0 else [f"v_pin {float(v_pin):g} stored exactly"]
+        stored_mu = sorted({e["mu_c"] for e in found})
+        if mu_c is not None:
+            chosen = _select(stored_mu, float(mu_c), method)
+            notes.append(f"mu_c {float(mu_c):g} -> {_describe(chosen, float(mu_c), method)}")
+            found = [e for e in found if e["mu_c"] in chosen]
+        found.sort(key=lambda e: e["mu_c"])
+        parts = [self._open_entry(e).expand_dims(mu_c=[e["mu_c"]]) for e in found]
+        ds = xr.concat(parts, dim="mu_c", combine_attrs="drop_conflicts")
+        ds["mu_c"].attrs.update(units="1", long_name="pin-part friction coefficient")
+        if d is not None:
+            stored_d = [float(x) for x in ds["d"].values]
+            picks = []
+            for want in np.atleast_1d(d):
+                chosen = _select(stored_d, float(want), method)
+                notes.append(f"d {float(want):g} -> {_describe(chosen, float(want), method)}")
+                picks.extend(c for c in chosen if c not in picks)
+            ds = ds.sel(d=picks)
+        ds.attrs["selection"] = "; ".join(notes) if notes else "all stored mu_c and d"
+        return ds
+
+    def cube(self, family: str) -> xr.Dataset:
+        """All maps of a family as one lazy cube (part, model, mu_c, v_pin, d, theta_i)."""
+        # Quasi-static maps only: dynamic maps at belt speed > 0 are queried
+        # one speed at a time (``query(..., belt_speed=...)``).
+        found = [e for e in self.entries if e["family"] == family and not e.get("belt_speed", 0.0)]
+        if not found:
+            fams = sorted({e["family"] for e in self.entries})
+            raise PinfeedError(f"unknown family {family!r}; known families: {', '.join(fams) or 'none'}")
+        pieces = []
+        for e in found:
+            ds = self._open_entry(e)
+            ds = ds.drop_attrs() if hasattr(ds, "drop_attrs") else ds.assign_attrs({})
+            pieces.append(ds.expand_dims(part=[e["part_id"]], model=[e["model"]], mu_c=[e["mu_c"]],
+                                         v_pin=[e.get("v_pin", 0.0)]))
+        cube = xr.combine_by_coords(pieces, combine_attrs="drop", join="outer")  # missing speeds: NaN
+        cube.attrs.update(family=family, title=f"pinfeed map cube of family {family}")
+        cube["v_pin"].attrs.update(units="1", long_name="pin speed across the belt over belt speed")
+        return cube
+
+
+def _check_finite(**values) -> None:
+    """Refuse NaN and infinity: every comparison with NaN is false, so 'nearest'
+    would silently serve the first stored value."""
+    for name, value in values.items():
+        if value is None:
+            continue
+        try:
+            arr = np.atleast_1d(np.asarray(value, dtype=float))
+        except (TypeError, ValueError):
+            raise PinfeedError(f"{name} must be a number, got {value!r}") from None
+        if not np.all(np.isfinite(arr)):
+            raise PinfeedError(f"{name} must be a finite number, got {value!r}")
+
+
+def _select(stored: list[float], want: float, method: str) -> list[float]:
+    stored = sorted(stored)
+    if method == "nearest" or want in stored:
+        return [min(stored, key=lambda s: (abs(s - want), s))]
+    below = [s for s in stored if s < want]
+    above = [s for s in stored if s > want]
+    if not below or not above:
+        return [below[-1] if below else above[0]]  # outside the stored range: the end
+    return [below[-1], above[0]]
+
+
+def _describe(chosen, want, method) -> str:
+    if len(chosen) == 1 and chosen[0] == want:
+        return "stored exactly"
+    if len(chosen) == 1:
+        how = "nearest stored" if method == "nearest" else "outside the stored range, end"
+        return f"{how} {chosen[0]:g}"
+    return f"bracketed by {chosen[0]:g} and {chosen[1]:g}"

@@ -1,0 +1,410 @@
+"""Public wrappers around the rollout kernels: validate, call, pack into xarray.
+
+Angles a person reads or writes are degrees; lengths are in the part's unit
+(``length_unit``, millimetres by default); forces in units of ``mu_s m g``.
+
+``d`` for a moving pin (``v_pin != 0``) is the pin's offset as it passes the
+centroid's starting station along the belt (for a static pin, simply its
+offset).
+"""
+from __future__ import annotations
+
+import math
+from contextlib import contextmanager
+
+import numba
+import numpy as np
+import xarray as xr
+
+from kernels.batch import _rollout_grid, blocks_for
+from kernels.points import _rollout_points
+from kernels.models import MODEL_NAMES
+from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
+                             _rollout, max_steps_for)
+
+from pipeline import __version__
+from pipeline.checks import check_belt, check_kernel_settings, check_pin_ratio
+from pipeline.errors import PinfeedError
+from pipeline.parts.part import Part
+
+MODELS = MODEL_NAMES
+STATUSES = STATUS_NAMES
+
+STATUS_ATTRS = {
+    "long_name": "rollout status",
+    "flag_values": np.arange(len(STATUS_NAMES), dtype=np.int8),
+    "flag_meanings": " ".join(STATUS_NAMES),
+}
+JAM_ATTRS = {
+    "long_name": "why a rollout was declared jammed, or 'step budget' for a truncated "
+                 "rollout that ran out of integration steps",
+    "flag_values": np.arange(len(JAM_REASONS), dtype=np.int8),
+    "flag_meanings": " ".join(["none"] + [r.replace(" ", "_") for r in JAM_REASONS[1:]]),
+}
+
+
+def check_parameters(mu_c, pin_radius, model="minpower", v_pin=0.0, max_travel=None):
+    """Raise :class:`PinfeedError` with a clear message for bad physical parameters."""
+    if not (isinstance(mu_c, (int, float, np.floating, np.integer)) and math.isfinite(mu_c)) or mu_c < 0:
+        raise PinfeedError(f"contact friction mu_c must be a finite number >= 0, got {mu_c!r}")
+    if not (isinstance(pin_radius, (int, float, np.floating, np.integer)) and math.isfinite(pin_radius)) \
+            or pin_radius <= 0:
+        raise PinfeedError(f"pin radius must be a finite number > 0, got {pin_radius!r}")
+    if model not in MODELS:
+        raise PinfeedError(f"unknown model {model!r}; choose one of {', '.join(MODELS)}")
+    if not math.isfinite(v_pin):
+        raise PinfeedError(f"pin speed ratio v_pin must be finite, got {v_pin!r}")
+    if max_travel is not None and not (max_travel > 0):
+        raise PinfeedError(f"max travel must be > 0, got {max_travel!r}")
+
+
+def _angles(values, what) -> np.ndarray:
+    arr = np.atleast_1d(np.asarray(values, dtype=np.float64))
+    if arr.ndim != 1 or not np.all(np.isfinite(arr)):
+        raise PinfeedError(f"{what} must be finite numbers, got {values!r}")
+    return arr
+
+
+@contextmanager
+def _threads(n):
+    if n is None:
+        yield numba.get_num_threads()
+        return
+    old = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
+    try:
+        yield numba.get_num_threads()
+    finally:
+        numba.set_num_threads(old)
+
+
+def _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, length_unit):
+    return {
+        "part_name": part.name,
+        "part_id": part.id,
+        "part_vertices": np.asarray(part.vertices).ravel(),
+        "part_a": part.a,
+        "model": model,
+        "mu_c": float(mu_c),
+        "pin_radius": float(pin_radius),
+        "v_pin": float(v_pin),
+        "length_unit": length_unit,
+        "kernel_ds_max": float(ds_max),
+        "kernel_tol": float(tol),
+        "pinfeed_version": __version__,
+    }
+
+
+def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float,
+            model: str = "minpower", v_pin: float = 0.0, max_travel: float | None = None,
+            trajectory: bool = False, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
+            length_unit: str = "mm", belt_speed: float | None = None,
+            mu_s: float = 0.5) -> xr.Dataset:
+    """One passage of ``part`` past one pin (spec section 4).
+
+    Parameters
+    ----------
+    theta_i : initial orientation, degrees.
+    d : contact parameter ``(y_pin - y_com) / a``.
+    mu_c : pin-part friction coefficient (>= 0).
+    pin_radius : pin radius, in the part's length unit (> 0).
+    model : ``"minpower"`` (default), ``"tip"`` or ``"ellipsoid"``
+        (quasi-static); ``"dynamic"`` or ``"mujoco"`` need ``belt_speed``
+        (mm/s) and take ``mu_s`` (see :func:`dynamic_rollout`).
+    v_pin : pin speed across the belt over belt speed (0 for a static pin).
+    max_travel : stop after this belt travel since first contact (status
+        ``truncated``); ``None`` runs to the end.
+    trajectory : also return the trajectory (dim ``step``: ``s``, ``x``,
+        ``y``, ``theta``) and the force on the pin (dim ``sample``).
+
+    Returns
+    -------
+    xarray.Dataset
+        Scalars ``status`` (a string), ``theta_f`` (degrees, [0, 360)),
+        ``dy``, ``contact_travel``, ``feature_changes``, ``peak_force``,
+        ``jam_reason``.
+    """
+    if model in BELT_MODELS:
+        if belt_speed is None:
+            raise PinfeedError(f"model {model!r} needs a belt speed (mm/s)")
+        return dynamic_rollout(part, theta_i, d, mu_c, pin_radius, belt_speed, mu_s, model=model,
+                               v_pin=v_pin, max_travel=max_travel, trajectory=trajectory)
+    check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
+    check_pin_ratio(part, pin_radius)
+    check_kernel_settings(ds_max, tol)
+    theta = float(_angles(theta_i, "theta_i")[0])
+    dd = float(_angles(d, "d")[0])
+    cap = np.inf if max_travel is None else float(max_travel)
+    res = _rollout(*part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
+                   math.radians(theta), dd, float(v_pin), cap, float(ds_max), float(tol),
+                   bool(trajectory))
+    status, reason, theta_f, dy, travel, changes, peak, traj, force = res
+    unit = length_unit
+    ds = xr.Dataset(
+        {
+            "status": ((), STATUS_NAMES[status], {"long_name": "rollout status"}),
+            "jam_reason": ((), JAM_REASONS[reason] or "none",
+                           {"long_name": "why jammed (or truncated by the step budget)"}),
+            "theta_f": ((), _wrap_deg(math.degrees(theta_f)),
+                        {"units": "degree", "long_name": "final orientation"}),
+            "dy": ((), dy, {"units": unit, "long_name": "centroid displacement across the belt"}),
+            "contact_travel": ((), travel, {"units": unit, "long_name": "pin travel in contact"}),
+            "feature_changes": ((), int(changes), {"long_name": "contact feature changes"}),
+            "peak_force": ((), peak, {"units": "mu_s m g", "long_name": "peak force on the pin"}),
+        },
+        coords={"theta_i": ((), theta, {"units": "degree", "long_name": "initial orientation"}),
+                "d": ((), dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"})},
+        attrs=_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit),
+    )
+    if trajectory:
+        ds["traj_s"] = ("step", traj[:, 0], {"units": unit, "long_name": "belt travel since first contact"})
+        ds["traj_x"] = ("step", traj[:, 1], {"units": unit, "long_name": "centroid displacement along the belt"})
+        ds["traj_y"] = ("step", traj[:, 2], {"units": unit, "long_name": "centroid displacement across the belt"})
+        ds["traj_theta"] = ("step", np.degrees(traj[:, 3]), {"units": "degree", "long_name": "orientation (unwrapped)"})
+        ds["force_s"] = ("sample", force[:, 0], {"units": unit, "long_name": "belt travel since first contact"})
+        ds["force_x"] = ("sample", force[:, 1], {"units": "mu_s m g", "long_name": "force on the pin along the belt"})
+        ds["force_y"] = ("sample", force[:, 2], {"units": "mu_s m g", "long_name": "force on the pin across the belt"})
+    return ds
+
+
+def _wrap_deg(x):
+    """Wrap degrees to [0, 360) without returning 360.0 for tiny negatives."""
+    w = np.mod(x, 360.0)
+    return np.where(w >= 360.0, 0.0, w) if np.ndim(w) else (0.0 if w >= 360.0 else float(w))
+
+
+BACKENDS = ("cpu", "cuda")
+
+
+def cuda_grid():
+    """The GPU grid function, or a one-line :class:`PinfeedError` saying why
+    the ``cuda`` backend cannot run here."""
+    try:
+        from numba import cuda
+    except ImportError:  # pragma: no cover - numba ships numba.cuda or numba-cuda
+        cuda = None
+    if cuda is None or not _cuda_installed():
+        raise PinfeedError("backend 'cuda' needs numba-cuda: pip install '.[cuda]' "
+                           "(or use backend 'cpu')")
+    from kernels import cuda as kcuda
+    if not kcuda.available():
+        raise PinfeedError("backend 'cuda': no usable NVIDIA GPU or driver found here; "
+                           "use backend 'cpu'")
+    return kcuda.rollout_grid
+
+
+def _cuda_installed() -> bool:
+    import importlib.util
+    return importlib.util.find_spec("numba_cuda") is not None
+
+
+def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "minpower",
+        v_pin: float = 0.0, max_travel: float | None = None, threads: int | None = None,
+        ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
+        length_unit: str = "mm", belt_speed: float | None = None,
+        mu_s: float = 0.5, backend: str = "cpu") -> xr.Dataset:
+    """Configuration map set: rollouts over ``d x theta_i`` (paper eq. 2).
+
+    ``model="dynamic"`` needs ``belt_speed`` (mm/s; the part in mm) and takes
+    ``mu_s``; its ``jam_reason`` flags add ``step_budget``.
+
+    Runs in parallel on ``threads`` Numba threads (default: all Numba has),
+    or with ``backend="cuda"`` one rollout per GPU thread (numba-cuda, same
+    kernel code; ``threads`` is then ignored; quasi-static models only).
+    Returns a Dataset with dims ``(d, theta_i)`` and variables ``theta_f``,
+    ``dy``, ``status`` (int8 flags, see its ``flag_meanings``), ``jam_reason``,
+    ``contact_travel``, ``feature_changes`` and ``peak_force``.
+    """
+    dynamic = model == "dynamic"
+    if model == "mujoco":
+        raise PinfeedError("the MuJoCo rig is for single passages (seconds each), not maps")
+    if dynamic:
+        if belt_speed is None:
+            raise PinfeedError("model 'dynamic' needs a belt speed (mm/s)")
+        fr = check_belt(part, belt_speed, mu_s)
+    check_parameters(mu_c, pin_radius, "minpower" if dynamic else model, v_pin, max_travel)
+    check_pin_ratio(part, pin_radius)
+    check_kernel_settings(ds_max, tol)
+    if backend not in BACKENDS:
+        raise PinfeedError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
+    if backend == "cuda" and dynamic:
+        raise PinfeedError("the cuda backend runs the quasi-static models; use backend cpu for model dynamic")
+    th = _angles(theta_i, "theta_i")
+    dd = _angles(d, "d")
+    cap = np.inf if max_travel is None else float(max_travel)
+    prep = part.prepared()
+    if backend == "cuda":
+        status, reason, theta_f, dy, travel, changes, peak = cuda_grid()(
+            *prep, MODELS.index(model), float(mu_c), float(pin_radius), np.radians(th), dd,
+            float(v_pin), cap, float(ds_max), float(tol), max_steps_for(prep[0].shape[0]))
+    else:
+        with _threads(threads) as n:
+            if dynamic:
+                from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
+                                             _dyn_rollout_grid)
+                verts, area, a, quad, _, convex = prep
+                status, reason, theta_f, dy, travel, changes, peak = _dyn_rollout_grid(
+                    verts, area, a, quad, convex, float(mu_c), float(pin_radius), np.radians(th), dd,
+                    float(v_pin), fr, 0.0, DEFAULT_V_REG / float(belt_speed), DEFAULT_H, cap,
+                    DEFAULT_MAX_STEPS, n)
+            else:
+                status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
+                    *prep, MODELS.index(model), float(mu_c), float(pin_radius),
+                    np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol),
+                    blocks_for(n, th.size * dd.size))
+    unit = length_unit
+    jam_attrs = dict(JAM_ATTRS)
+    attrs = _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit)
+    if dynamic:
+        from kernels.dynamic import DYN_REASONS
+        jam_attrs = {"long_name": "why a rollout was declared jammed or truncated",
+                     "flag_values": np.arange(len(DYN_REASONS), dtype=np.int8),
+                     "flag_meanings": " ".join(["none"] + [r.replace(" ", "_") for r in DYN_REASONS[1:]])}
+        attrs.update(belt_speed=float(belt_speed), mu_s=float(mu_s), froude=fr)
+    return xr.Dataset(
+        {
+            "theta_f": (("d", "theta_i"), _wrap_deg(np.degrees(theta_f)),
+                        {"units": "degree", "long_name": "final orientation"}),
+            "dy": (("d", "theta_i"), dy, {"units": unit, "long_name": "centroid displacement across the belt"}),
+            "status": (("d", "theta_i"), status, dict(STATUS_ATTRS)),
+            "jam_reason": (("d", "theta_i"), reason, jam_attrs),
+            "contact_travel": (("d", "theta_i"), travel, {"units": unit, "long_name": "pin travel in contact"}),
+            "feature_changes": (("d", "theta_i"), changes, {"long_name": "contact feature changes"}),
+            "peak_force": (("d", "theta_i"), peak, {"units": "mu_s m g", "long_name": "peak force on the pin"}),
+        },
+        coords={
+            "d": ("d", dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"}),
+            "theta_i": ("theta_i", th, {"units": "degree", "long_name": "initial orientation"}),
+        },
+        attrs=dict(attrs, kernel_backend=backend),
+    )
+
+
+def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str = "minpower",
+                   v_pin: float = 0.0, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
+                   threads: int | None = None, belt_speed: float | None = None,
+                   mu_s: float = 0.5) -> dict:
+    """Final states of independent rollouts at scattered points.
+
+    ``theta_i`` (degrees), ``d`` and ``mu_c`` are equal-length 1-D arrays (or
+    scalars, broadcast). Used by the planner's uncertainty propagation and by
+    verification, where the points are not a grid. ``model="dynamic"``
+    (``kernels.dynamic``) needs ``belt_speed`` (mm/s; the part in mm) and
+    takes the belt friction ``mu_s``; ``ds_max`` and ``tol`` are then unused.
+    Returns a dict of NumPy arrays: ``status`` (int8 codes, see
+    :data:`STATUSES`), ``jam_reason`` (int8, an index into
+    ``kernels.rollout.JAM_REASONS``, which the dynamic model shares),
+    ``theta_f`` (degrees, [0, 360)) and ``dy`` (the part's unit).
+    """
+    dynamic = model == "dynamic"
+    if dynamic:
+        if belt_speed is None:
+            raise PinfeedError("model 'dynamic' needs a belt speed (mm/s)")
+        fr = check_belt(part, belt_speed, mu_s)
+    elif belt_speed is not None:
+        raise PinfeedError(f"a belt speed needs model 'dynamic' (the {model} model is quasi-static)")
+    check_parameters(0.0, pin_radius, "minpower" if dynamic else model, v_pin)
+    th, dd, mu = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=np.float64))
+                                       for x in (theta_i, d, mu_c)))
+    for arr, what in ((th, "theta_i"), (dd, "d"), (mu, "mu_c")):
+        if arr.ndim != 1 or not np.all(np.isfinite(arr)):
+            raise PinfeedError(f"{what} must be finite numbers")
+    if np.any(mu < 0):
+        raise PinfeedError("contact friction mu_c must be >= 0")
+    with _threads(threads) as n:
+        if dynamic:
+            from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
+                                         _dyn_rollout_points)
+            verts, area, a, quad, _, convex = part.prepared()
+            status, reason, theta_f, dy = _dyn_rollout_points(
+                verts, area, a, quad, convex, np.ascontiguousarray(mu), float(pin_radius),
+                np.radians(th), np.ascontiguousarray(dd), float(v_pin), fr, 0.0,
+                DEFAULT_V_REG / float(belt_speed), DEFAULT_H, np.inf, DEFAULT_MAX_STEPS, n)
+        else:
+            status, reason, theta_f, dy = _rollout_points(
+                *part.prepared(), MODELS.index(model), np.ascontiguousarray(mu), float(pin_radius),
+                np.radians(th), np.ascontiguousarray(dd), float(v_pin), np.inf, float(ds_max),
+                float(tol), n)
+    return {"status": status, "jam_reason": reason,
+            "theta_f": _wrap_deg(np.degrees(theta_f)), "dy": dy}
+
+
+def status_names(codes) -> np.ndarray:
+    """Decode int8 status flags to their names."""
+    return np.asarray(STATUS_NAMES, dtype=object)[np.asarray(codes, dtype=int)]
+
+
+# ----------------------------------------------------------------------------
+# Models at belt speed (issue 18): "dynamic" (kernels.dynamic) and "mujoco"
+# (pipeline.maps.mujoco_rig, an independent engine). Quasi-static models above.
+
+BELT_MODELS = ("dynamic", "mujoco")
+def dynamic_rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float,
+                    belt_speed: float, mu_s: float = 0.5, model: str = "dynamic",
+                    v_pin: float = 0.0, restitution: float = 0.0,
+                    max_travel: float | None = None, trajectory: bool = False,
+                    h: float | None = None, max_steps: int | None = None) -> xr.Dataset:
+    """One passage at belt speed ``belt_speed`` (mm/s; the part in millimetres).
+
+    ``model`` is ``"dynamic"`` (``kernels.dynamic``) or ``"mujoco"`` (the
+    independent MuJoCo rig, ``pipeline.maps.mujoco_rig``). Same variables as
+    :func:`rollout`; with ``trajectory`` also the force on the pin and, for
+    ``dynamic``, the twist history (``twist_*``: belt-frame velocity in units
+    of the belt speed, omega in belt speeds per a, the relative normal
+    contact velocity and the normal impulse).
+    """
+    if model not in BELT_MODELS:
+        raise PinfeedError(f"unknown belt-speed model {model!r}; choose one of {', '.join(BELT_MODELS)}")
+    check_parameters(mu_c, pin_radius, "minpower", v_pin, max_travel)
+    fr = check_belt(part, belt_speed, mu_s)
+    if not (math.isfinite(restitution) and 0.0 <= restitution <= 1.0):
+        raise PinfeedError(f"restitution must be in [0, 1], got {restitution!r}")
+    theta = float(_angles(theta_i, "theta_i")[0])
+    dd = float(_angles(d, "d")[0])
+    cap = np.inf if max_travel is None else float(max_travel)
+    twist = None
+    if model == "dynamic":
+        from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG, DYN_REASONS,
+                                     _dyn_rollout)
+        verts, area, a, quad, _, convex = part.prepared()
+        res = _dyn_rollout(verts, area, a, quad, convex, float(mu_c), float(pin_radius),
+                           math.radians(theta), dd, float(v_pin), fr, float(restitution),
+                           DEFAULT_V_REG / float(belt_speed), float(h or DEFAULT_H), cap,
+                           int(max_steps or DEFAULT_MAX_STEPS), bool(trajectory))
+        status, reason, theta_f, dy, travel, changes, peak, traj, force, twist = res
+        reason_name = DYN_REASONS[reason] or "none"
+    else:
+        from pipeline.maps.mujoco_rig import mujoco_rollout
+        out = mujoco_rollout(part, theta, dd, float(mu_c), float(pin_radius), float(belt_speed),
+                             float(mu_s), v_pin=float(v_pin), max_travel=cap,
+                             trajectory=bool(trajectory))
+        status, reason_name, theta_f, dy, travel, changes, peak, traj, force = out
+    ds = xr.Dataset(
+        {
+            "status": ((), STATUS_NAMES[status], {"long_name": "rollout status"}),
+            "jam_reason": ((), reason_name, {"long_name": "why jammed or truncated"}),
+            "theta_f": ((), _wrap_deg(math.degrees(theta_f)),
+                        {"units": "degree", "long_name": "final orientation"}),
+            "dy": ((), dy, {"units": "mm", "long_name": "centroid displacement across the belt"}),
+            "contact_travel": ((), travel, {"units": "mm", "long_name": "pin travel in contact"}),
+            "feature_changes": ((), int(changes), {"long_name": "contact feature changes"}),
+            "peak_force": ((), peak, {"units": "mu_s m g", "long_name": "peak force on the pin"}),
+        },
+        coords={"theta_i": ((), theta, {"units": "degree", "long_name": "initial orientation"}),
+                "d": ((), dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"})},
+        attrs=dict(_common_attrs(part, model, mu_c, pin_radius, v_pin, 0.0, 0.0, "mm"),
+                   belt_speed=float(belt_speed), mu_s=float(mu_s), froude=fr,
+                   restitution=float(restitution)),
+    )
+    if trajectory:
+        ds["traj_s"] = ("step", traj[:, 0], {"units": "mm", "long_name": "belt travel since first contact"})
+        ds["traj_x"] = ("step", traj[:, 1], {"units": "mm", "long_name": "centroid displacement along the belt (belt frame)"})
+        ds["traj_y"] = ("step", traj[:, 2], {"units": "mm", "long_name": "centroid displacement across the belt"})
+        ds["traj_theta"] = ("step", np.degrees(traj[:, 3]), {"units": "degree", "long_name": "orientation (unwrapped)"})
+        ds["force_s"] = ("sample", force[:, 0], {"units": "mm", "long_name": "belt travel since first contact"})
+        ds["force_x"] = ("sample", force[:, 1], {"units": "mu_s m g", "long_name": "force on the pin along the belt"})
+        ds["force_y"] = ("sample", force[:, 2], {"units": "mu_s m g", "long_name": "force on the pin across the belt"})
+        if twist is not None:
+            for j, name in enumerate(("s", "vx", "vy", "omega", "vn", "impulse_n")):
+                ds[f"twist_{name}"] = ("step", twist[:, j])
+    return ds

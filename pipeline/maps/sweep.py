@@ -1,0 +1,189 @@
+"""The sweep: one shard per (family, part, model, mu_c, v_pin), each a map set over (d, theta_i).
+
+Static pins (v_pin = 0) keep the file name ``mu_c=MU.h5``, so catalogs
+written before dynamic pins existed stay valid; a moving pin's shard is
+``mu_c=MU_v_pin=V.h5`` (V the speed ratio v_pin / v_b). Belt speeds > 0
+(``sweep.belt_speed``) add shards of the dynamic model under
+``dynamic/mu_c=MU[_v_pin=V]_belt=S_mu_s=M.h5``.
+
+A shard is an HDF5 file (xarray, h5netcdf engine) that describes itself:
+CF-style variable attributes, the part's outline, every sweep parameter, the
+pinfeed version and git commit, the config hash and the creation time. Data
+is gzip-compressed and chunked so one map (one d) is one chunk.
+
+``run_sweep`` computes whatever shards are missing, locally or on a
+dask.distributed cluster (``scheduler`` address), then rebuilds the index.
+The Snakemake workflow calls :func:`write_shard` once per job instead.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pipeline.config import config_hash, mu_label, theta_grid
+from pipeline.maps import simulate
+from pipeline.maps.io import write_atomic
+from pipeline.parts.families import family_parts
+from pipeline.parts.part import Part
+from pipeline.provenance import provenance_attrs
+
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True)
+class ShardJob:
+    family: str
+    part: Part
+    model: str
+    mu_c: float
+    v_pin: float = 0.0
+    belt_speed: float = 0.0  # mm/s; > 0 only for the dynamic model
+    mu_s: float = 0.5
+
+    def path(self, catalog_dir) -> Path:
+        return shard_path(catalog_dir, self.family, self.part.id, self.model, self.mu_c, self.v_pin,
+                          self.belt_speed, self.mu_s)
+
+
+def shard_tag(mu_c, v_pin=0.0, belt_speed=0.0, mu_s=0.5) -> str:
+    """File stem of a shard: ``mu_c=0.15`` (static pin) or ``mu_c=0.15_v_pin=-2.0``;
+    dynamic maps add ``_belt=150.0_mu_s=0.5`` (belt speed in mm/s)."""
+    tag = f"mu_c={mu_label(mu_c)}"
+    tag = tag if float(v_pin) == 0.0 else f"{tag}_v_pin={mu_label(v_pin)}"
+    if float(belt_speed) > 0.0:
+        tag = f"{tag}_belt={mu_label(belt_speed)}_mu_s={mu_label(mu_s)}"
+    return tag
+
+
+def shard_path(catalog_dir, family, part_id, model, mu_c, v_pin=0.0, belt_speed=0.0,
+               mu_s=0.5) -> Path:
+    return Path(catalog_dir) / family / part_id / model / f"{shard_tag(mu_c, v_pin, belt_speed, mu_s)}.h5"
+
+
+def shard_jobs(config) -> list[ShardJob]:
+    """Every shard the config asks for, in a stable order."""
+    jobs = []
+    for family, spec in config["families"].items():
+        for part in family_parts(family, spec):
+            for model in config["sweep"]["models"]:
+                for mu in config["sweep"]["mu_c"]:
+                    for v in config["sweep"]["v_pin"]:
+                        jobs.append(ShardJob(family, part, model, float(mu), float(v)))
+            # Belt speeds > 0: one dynamic shard per (mu_c, v_pin, speed).
+            mu_s = float(config["sweep"].get("mu_s", 0.5))
+            for speed in config["sweep"].get("belt_speed", [0.0]):
+                if float(speed) <= 0.0:
+                    continue
+                for mu in config["sweep"]["mu_c"]:
+                    for v in config["sweep"]["v_pin"]:
+                        jobs.append(ShardJob(family, part, "dynamic", float(mu), float(v),
+                                             float(speed), mu_s))
+    return jobs
+
+
+def find_job(config, family, part_id, model, tag) -> ShardJob:
+    """The job of a shard named by its folder parts and file stem (``shard_tag``)."""
+    for job in shard_jobs(config):
+        if (job.family, job.part.id, job.model) == (family, part_id, model) \
+                and shard_tag(job.mu_c, job.v_pin, job.belt_speed, job.mu_s) == tag:
+            return job
+    from pipeline.errors import PinfeedError
+    raise PinfeedError(f"the config has no shard {family}/{part_id}/{model}/{tag}")
+
+
+def compute_shard(config, job: ShardJob, threads=None, backend=None):
+    """The map set of one shard as a self-describing Dataset.
+
+    ``backend`` (``"cpu"`` or ``"cuda"``) overrides the config's
+    ``sweep.backend`` (default ``"cpu"``)."""
+    sweep = config["sweep"]
+    kernel = sweep.get("kernel", {})
+    ds = simulate.map(job.part, theta_grid(config), np.asarray(sweep["d"], float), job.mu_c,
+                      sweep["pin_radius"], model=job.model, v_pin=job.v_pin, threads=threads,
+                      **({"belt_speed": job.belt_speed, "mu_s": job.mu_s} if job.belt_speed > 0 else {}),
+                      ds_max=kernel.get("ds_max", 0.1), tol=kernel.get("tol", 1e-7),
+                      backend=backend or sweep.get("backend", "cpu"))
+    ds.attrs.update(provenance_attrs())
+    ds.attrs.update({
+        "title": f"pinfeed configuration maps: {job.part.id}, {job.model}, mu_c={job.mu_c:g}, "
+                 f"v_pin/v_b={job.v_pin:g}"
+                 + (f", belt {job.belt_speed:g} mm/s, mu_s={job.mu_s:g}" if job.belt_speed > 0 else ""),
+        "family": job.family,
+        "theta_step": float(sweep["theta_step"]),
+        "config_hash": config_hash(config),
+        "catalog_schema_version": SCHEMA_VERSION,
+        "Conventions": "CF-1.10",
+    })
+    return ds
+
+
+def _encoding(ds):
+    nt = ds.sizes["theta_i"]
+    enc = {}
+    for name, var in ds.data_vars.items():
+        if var.dims == ("d", "theta_i"):
+            enc[name] = {"compression": "gzip", "compression_opts": 4, "shuffle": True,
+                         "chunksizes": (1, nt)}
+    return enc
+
+
+def write_shard(config, job: ShardJob, out=None, threads=None, backend=None) -> Path:
+    """Compute one shard and write it atomically (to ``out`` or its catalog path)."""
+    out = Path(out) if out else job.path(config["catalog_dir"])
+    ds = compute_shard(config, job, threads=threads, backend=backend)
+    return write_atomic(ds, out, encoding=_encoding(ds))
+
+
+def _write_job(config, job, threads, backend=None):
+    return str(write_shard(config, job, threads=threads, backend=backend))
+
+
+def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
+              progress: bool = True, backend: str | None = None) -> list[Path]:
+    """Compute every missing shard, then rebuild the catalog index.
+
+    With ``scheduler`` (a dask.distributed address such as ``tcp://host:8786``)
+    the shards run as tasks on that cluster; otherwise here, one after
+    another, each on ``threads`` Numba threads (or on this worker's GPU with
+    ``backend="cuda"``, overriding the config's ``sweep.backend``).
+    """
+    from pipeline.maps.catalog import Catalog
+    root = Path(config["catalog_dir"])
+    todo = [j for j in shard_jobs(config) if not j.path(root).is_file()]
+    written = []
+    if scheduler:
+        from distributed import as_completed
+        with _client(scheduler) as client:
+            futures = [client.submit(_write_job, config, j, threads, backend, pure=False)
+                       for j in todo]
+            for fut in _progress(as_completed(futures), len(futures), progress):
+                written.append(Path(fut.result()))
+    else:
+        for job in _progress(todo, len(todo), progress):
+            written.append(write_shard(config, job, threads=threads, backend=backend))
+    Catalog.rebuild(root)
+    return written
+
+
+SCHEDULER_TIMEOUT = 10  # seconds to reach a dask scheduler
+
+
+def _client(address: str):
+    """A dask.distributed client, or one clear error if the scheduler cannot be
+    reached within ``SCHEDULER_TIMEOUT`` seconds."""
+    from distributed import Client
+
+    from pipeline.errors import PinfeedError
+    try:
+        return Client(address, timeout=SCHEDULER_TIMEOUT)
+    except (OSError, TimeoutError, ValueError) as exc:
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise PinfeedError(f"cannot reach the dask scheduler at {address} within {SCHEDULER_TIMEOUT} s "
+                           f"({reason[:120]}); start it or drop --scheduler to run here") from None
+
+
+def _progress(it, total, enabled):
+    from pipeline.progress import progress
+    return progress(it, total, "sweep", unit="shard", enabled=enabled)

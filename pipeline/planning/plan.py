@@ -1,0 +1,261 @@
+"""Plans with tight propagation for one part and one friction, verified.
+
+This is what ``pinfeed plan`` and the workflow's plan stage call: it runs the
+search (``search.TightPlanner``), replays the best candidates by full
+rollouts (``verify.verify_plan``: the configured number of perturbed trials
+per initial state plus every corner of the perturbation box), re-ranks them
+with the verified success and recommends the best plan that fails at most
+``MAX_FAILURE`` of its trials. A plan that fails more is never recommended:
+a warning with the reason is returned instead.
+
+Outcomes computed for the propagation are kept in the catalog under
+``refine/PART_ID/MODEL/v_pin=V.h5`` (see :mod:`pipeline.planning.lattice_store`) and
+reused by later runs.
+
+With ``planner.belt_speed`` (mm/s) set, the planner plans with the dynamic
+model (``kernels.dynamic``) at that belt speed and belt friction
+``planner.mu_s``, stores its outcomes apart
+(``refine/PART_ID/dynamic/v_pin=V_belt=S_mu_s=M.h5``) and verification
+replays with the dynamic model at the same speed.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from pipeline.errors import PinfeedError
+from pipeline.parts.part import Part
+from pipeline.planning.arcs import format_arcs
+from pipeline.planning.lattice_store import load_lattice, save_lattice
+from pipeline.planning.propagate import Tolerances, Uncertainty
+from pipeline.planning.search import TightPlanner
+from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
+from pipeline.planning.verify import verify_plan
+
+
+MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
+
+
+def parse_friction(value):
+    """``0.15`` -> 0.15; ``"0.1:0.3"`` or ``[0.1, 0.3]`` -> ``(0.1, 0.3)``. Raises
+    :class:`PinfeedError` for negative, non-finite or reversed values."""
+    if isinstance(value, str):
+        parts = value.split(":")
+        try:
+            nums = [float(p) for p in parts]
+        except ValueError:
+            raise PinfeedError(f"friction {value!r} is not a number or a range LO:HI") from None
+    elif isinstance(value, (list, tuple)):
+        nums = [float(v) for v in value]
+    else:
+        nums = [float(value)]
+    if len(nums) not in (1, 2) or not all(math.isfinite(x) and x >= 0 for x in nums):
+        raise PinfeedError(f"friction (--mu-c, planner.mu_c) {value!r} must be a finite number >= 0 or a range LO:HI of such numbers")
+    if len(nums) == 2:
+        if nums[1] < nums[0]:
+            raise PinfeedError(f"friction range {value!r} has LO > HI; write it as LO:HI")
+        return (nums[0], nums[1]) if nums[1] > nums[0] else nums[0]
+    return nums[0]
+
+
+def friction_label(mu_c) -> str:
+    """``0.15`` -> ``'0.15'``; ``(0.1, 0.3)`` -> ``'0.1:0.3'``."""
+    if isinstance(mu_c, tuple):
+        return f"{mu_c[0]:g}:{mu_c[1]:g}"
+    return f"{mu_c:g}"
+
+
+def nominal_friction(mu_c) -> float:
+    """One friction value to draw nominal paths with: the value or the range's middle."""
+    return 0.5 * (mu_c[0] + mu_c[1]) if isinstance(mu_c, tuple) else float(mu_c)
+
+
+def planner_belt(config: dict, part: Part | None = None):
+    """``(belt_speed, mu_s)`` the planner plans at: ``planner.belt_speed`` (mm/s;
+    ``None`` = quasi-static) and ``planner.mu_s`` (default 0.5). With ``part``,
+    a bad belt (speed <= 0, mu_s out of range, a part thrown rather than
+    pushed) raises a one-line :class:`PinfeedError`."""
+    pc = config["planner"]
+    speed = pc.get("belt_speed")
+    mu_s = pc.get("mu_s")
+    mu_s = 0.5 if mu_s is None else mu_s
+    if speed is None:
+        return None, float(mu_s)
+    if part is not None:
+        from pipeline.checks import check_belt
+        check_belt(part, speed, mu_s)
+    return float(speed), float(mu_s)
+
+
+def mechanics_label(model: str, belt_speed: float | None, mu_s: float) -> str:
+    """What the plans were computed with: ``'minpower'`` or ``'dynamic at 150 mm/s, mu_s 0.5'``."""
+    return model if belt_speed is None else f"dynamic at {belt_speed:g} mm/s, mu_s {mu_s:g}"
+
+
+def planner_for(part: Part, config: dict, mu_c, lattices=None, moving: bool = False) -> TightPlanner:
+    """A :class:`TightPlanner` with the config's pins, limits, model and sizes
+    (and, with ``moving``, every candidate height at every ``planner.dynamic``
+    speed as a moving pin, labelled like ``P23v-2``); at ``planner.belt_speed``
+    when it is set (:func:`planner_belt`)."""
+    from pipeline.planning.paper import pins_from_config
+    pc, sweep = config["planner"], config["sweep"]
+    belt_speed, mu_s = planner_belt(config, part)
+    static = pins_from_config(pc["pins"])
+    speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if moving else []
+    moving_pins = {f"{k}v{v:+g}": (y, v) for k, y in static.items() for v in speeds}
+    verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
+    tol = Tolerances(**pc.get("tolerances", {}))
+    return TightPlanner(part, static, pc["d_min"], pc["d_max"], mu_c,
+                        sweep["pin_radius"], pc["model"], Uncertainty.from_verify(verify_cfg), tol,
+                        moving=moving_pins, lattices=lattices, kernel=sweep.get("kernel"),
+                        max_branches=pc.get("max_branches", 4),
+                        hard_limits=pc.get("hard_d_limits", False), belt_speed=belt_speed, mu_s=mu_s)
+
+
+def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None = None,
+               keep: int = 5, progress=None) -> dict:
+    """Search, verify and rank plans for ``part`` at friction ``mu_c`` (a value
+    or a range); returns a JSON-ready dict (``plans`` best first, each with
+    its ``verification``; ``recommended``; ``warning``; search statistics)."""
+    pc = config["planner"]
+    depth = int(depth if depth is not None else pc["depth"])
+    planner = planner_for(part, config, mu_c, lattices)
+    search = dict(keep=int(pc.get("candidates", 12)), complete_depth=int(pc.get("complete_depth", 2)),
+                  static_beam=int(pc.get("beam", 30)), progress=progress)
+    candidates = planner.search(depth, **search)
+    dyn = pc.get("dynamic", {})
+    if candidates and candidates[0].n_sets > 1 and dyn.get("depth", 0) and dyn.get("speeds"):
+        # Passive pins are not enough: let moving pins follow the static ones.
+        if progress:
+            progress(f"fixed pins leave {candidates[0].n_sets} sets: adding moving pins")
+        planner = planner_for(part, config, mu_c, planner.lattices, moving=True)
+        candidates = planner.search(depth, dynamic_depth=int(dyn["depth"]),
+                                    beam=int(dyn.get("beam", 30)), **search)
+    verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
+    states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
+    speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
+    for plan in candidates:
+        res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
+                          config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
+                          kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
+                          mu_s=planner.mu_s)
+        plan.verification = {"trials": res["trials"], "successes": res["successes"],
+                             "failures": res["failures"], "rows": res["rows"], "model": res["model"],
+                             **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}
+                                if "belt_speed" in res else {})}
+        if progress:
+            progress(f"verified {' '.join(plan.pins)}: {res['successes']}/{res['trials']} trials")
+    candidates.sort(key=lambda p: p.rank_key())
+    good = [p for p in candidates if p.verification["failures"] <= MAX_FAILURE * p.verification["trials"]]
+    warning = None
+    if not candidates:
+        warning = f"no allowed pin sequence within depth {depth}"
+    elif not good:
+        best = candidates[0]
+        warning = (f"no plan passed verification: the best prediction, {' '.join(best.pins)} "
+                   f"({format_arcs(best.final_sets)}), failed {best.verification['failures']} of "
+                   f"{best.verification['trials']} trials")
+    recommended = good[0] if good else None
+    return {
+        "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c,
+        "friction": friction_label(mu_c),
+        "belt_speed": planner.belt_speed, "mu_s": planner.mu_s if planner.belt_speed else None,
+        "mechanics": mechanics_label(pc["model"], planner.belt_speed, planner.mu_s),
+        "symmetry_order": planner.order,
+        "depth": depth, "complete_depth": int(pc.get("complete_depth", 2)),
+        "beam": int(pc.get("beam", 30)),
+        "plans": [p.to_dict() for p in good[:keep]],
+        "rejected": [p.to_dict() for p in candidates if p not in good][:keep],
+        "recommended": recommended.to_dict() if recommended else None,
+        "warning": warning,
+        "stats": {"transitions": planner.stats.transitions, "rollouts": planner.stats.rollouts,
+                  "joint_states": planner.stats.nodes, "seconds": round(planner.stats.seconds, 2),
+                  "pruned_branching": planner.stats.pruned_branching,
+                  "unresolved": planner.stats.unresolved,
+                  "per_level": planner.stats.per_level},
+        "initial_states": {k: {"theta": t, "y_c": y} for k, (t, y) in states.items()},
+        "lattices": planner.lattices,
+    }
+
+
+def planner_pin_heights(planner: TightPlanner) -> dict:
+    return {label: pin.y for label, pin in planner.pins.items()}
+
+
+def tight_entry(plan_result: dict, friction=None) -> dict:
+    """The stored tight-planner entry at ``friction`` (a value, a range or its
+    text ``LO:HI``; default the first planned friction, ``planner.mu_c``)."""
+    tight = plan_result.get("tight") or []
+    if not tight:
+        raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan' "
+                           "(--mode tight or both) or re-run the workflow")
+    if friction is None:
+        return tight[0]
+    want = friction_label(parse_friction(friction))
+    found = [t for t in tight if t["friction"] == want]
+    if not found:
+        raise PinfeedError(f"no stored plan at mu_c {want}; stored: {', '.join(t['friction'] for t in tight)}")
+    return found[0]
+
+
+def pick_tight_plan(result: dict, n: int, mu_text):
+    """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
+    (default: the first planned friction), that friction and its stored entry."""
+    entry = tight_entry(result, mu_text)
+    if not entry["plans"]:
+        raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
+    if not 1 <= n <= len(entry["plans"]):
+        raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
+    mu = entry["mu_c"]
+    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
+
+
+def best_fixed_plan(plan_result: dict):
+    """The best plan of fixed pins only in a stored plan result (None if none)."""
+    if plan_result.get("best_static"):
+        return plan_result["best_static"]
+    return next((p for p in plan_result["plans"] if not p.get("n_dynamic_pins", 0)), None)
+
+
+def plan_hint(config: dict, name: str, root) -> str:
+    """How to make the stored plan of ``name`` under results folder ``root``: the
+    workflow plans the config's parts; a part planned from --vertices or
+    --outline needs 'pinfeed plan'."""
+    if name in config["planner"]["parts"]:
+        return "run the workflow ('make run')"
+    return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
+
+
+# ---------------------------------------------------------------------- every configured friction
+
+
+def plan_frictions(config: dict) -> list:
+    """The frictions the workflow plans at: ``planner.mu_c`` (a value or a range
+    ``LO:HI``; the recommended plan) first, then each of ``planner.frictions``."""
+    pc = config["planner"]
+    out = [parse_friction(pc["mu_c"])]
+    for f in pc.get("frictions", []):
+        f = parse_friction(f)
+        if f not in out:
+            out.append(f)
+    return out
+
+
+def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progress=None) -> list:
+    """Tight plans at every friction of :func:`plan_frictions` (the first is the
+    recommended one), at ``planner.belt_speed`` when it is set; the planner's
+    rollouts are stored in the catalog (keyed by model, pin speed and belt)."""
+    sweep, model = config["sweep"], config["planner"]["model"]
+    belt_speed, mu_s = planner_belt(config, part)
+    speeds = [0.0] + [float(v) for v in config["planner"].get("dynamic", {}).get("speeds", [])]
+    lattices = {v: load_lattice(catalog_root, part, model, v, sweep["pin_radius"], sweep.get("kernel"),
+                                belt_speed=belt_speed, mu_s=mu_s)
+                for v in speeds}
+    out = []
+    for mu_c in plan_frictions(config):
+        res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep, progress=progress)
+        res.pop("lattices")
+        out.append(res)
+    for lattice in lattices.values():
+        save_lattice(catalog_root, lattice)
+    return out

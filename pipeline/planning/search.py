@@ -1,0 +1,336 @@
+"""Search over pin sequences with tight state propagation (``propagate.py``).
+
+Every initial resting state starts as its uncertainty box. A pin is allowed
+for a state only if the whole d range of the box stays on one side of the
+centroid (the pin never passes it on either side) and no jam is reachable;
+``d_min <= |d| <= d_max`` (for a moving pin: the offset of the pin's path,
+``|d| / sqrt(1 + v^2)``) sets the safety margin, and is a hard rule only with
+``hard_limits``; a pin that the
+state misses leaves it as it is (that is part of the propagation). A pin
+sequence is the same for every initial state.
+
+The search is complete up to ``depth`` over the static candidate pins:
+every sequence is tried, and sequences that reach a joint state (the carried
+sets of all initial states) already reached are merged, so a pin that changes
+nothing is never kept. Moving pins, if any, are appended after the static
+ones by a beam search (complete for one moving pin after the beam's plans).
+
+Plans are ranked by (1) the number of final orientation sets, counted modulo
+the part's rotational symmetry; then, once verified by full rollouts
+(``verify.py``), (2) the fraction of successful trials; (3) fewest pins;
+(4) fewest steps whose box straddles a jump; (5) the safety margin in d (the smallest distance of any d range that a pin
+touches from ``d_min`` and ``d_max``; negative inside them);
+(6) the total width of the final sets.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+from pipeline.errors import PinfeedError
+from pipeline.parts.part import Part
+from pipeline.planning.arcs import merge_arcs, merge_modulo
+from pipeline.planning.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
+                        initial_state_sets, propagate)
+
+
+@dataclass(frozen=True)
+class Pin:
+    """A candidate pin: label, height above the fence (mm), speed ratio v_pin / v_b."""
+    label: str
+    y: float
+    v_pin: float = 0.0
+
+
+@dataclass(frozen=True)
+class Step:
+    """What one pin did to one branch: the d range met and the set carried after it."""
+    pin: str
+    y_pin: float
+    v_pin: float
+    d_lo: float
+    d_hi: float
+    after: StateSet
+
+    def to_dict(self) -> dict:
+        return {"pin": self.pin, "y_pin": self.y_pin, "v_pin": self.v_pin,
+                "d_range": [self.d_lo, self.d_hi],
+                "band": {"start": self.after.start, "width": self.after.width},
+                "com_interval": [self.after.y_lo, self.after.y_hi],
+                "carried": self.after.to_dict()}
+
+
+@dataclass
+class TightPlan:
+    """A pin sequence with the sets it carries for every initial state."""
+    pins: tuple
+    pin_heights_mm: tuple
+    pin_speeds: tuple
+    final_sets: list  # merged final arcs [(start, width)] in [0, 360)
+    n_sets: int  # counted modulo the part's rotational symmetry
+    margin: float
+    jumps: int  # steps whose box straddled a jump
+    branches: dict  # initial-state label -> list of branches (each a list of Step)
+    initial: dict  # initial-state label -> StateSet
+    sets_after: tuple = ()
+    verification: dict | None = None  # filled in by verify
+
+    @property
+    def n_dynamic(self) -> int:
+        return sum(1 for v in self.pin_speeds if v != 0.0)
+
+    def success_fraction(self) -> float:
+        if not self.verification:
+            return 0.0
+        t = self.verification["trials"]
+        return self.verification["successes"] / t if t else 0.0
+
+    def rank_key(self):
+        return (self.n_sets, -round(self.success_fraction(), 6), len(self.pins), self.jumps,
+                -round(self.margin, 9), round(sum(w for _, w in self.final_sets), 6))
+
+    def predicted_sets(self, label: str) -> list:
+        """Final arcs predicted for one initial state."""
+        return merge_arcs([br[-1].after.arc if br else self.initial[label].arc
+                           for br in self.branches[label]])
+
+    def to_dict(self) -> dict:
+        return {
+            "mode": "tight",
+            "pins": list(self.pins), "pin_heights_mm": list(self.pin_heights_mm),
+            "pin_speeds": list(self.pin_speeds),
+            "n_final_sets": self.n_sets,
+            "final_sets": [{"start": s, "width": w} for s, w in self.final_sets],
+            "margin": self.margin if math.isfinite(self.margin) else None, "jump_steps": self.jumps,
+            "sets_after_each_pin": list(self.sets_after),
+            "n_dynamic_pins": self.n_dynamic,
+            "initial_sets": {k: v.to_dict() for k, v in self.initial.items()},
+            "initial_states": {label: [[st.to_dict() for st in br] for br in brs]
+                               for label, brs in self.branches.items()},
+            "verification": self.verification,
+        }
+
+
+@dataclass
+class SearchStats:
+    transitions: int = 0
+    rollouts: int = 0
+    nodes: int = 0
+    seconds: float = 0.0
+    pruned_branching: int = 0
+    unresolved: int = 0
+    per_level: list = field(default_factory=list)
+
+
+class TightPlanner:
+    """Pin sequences for one part under a stated uncertainty.
+
+    Parameters
+    ----------
+    part : the part.
+    pins : static candidate pins ``{label: height_mm}``.
+    mu_c : one friction value (widened by the verify stage's 2 sigma) or a
+        range ``(lo, hi)`` that every plan must cover.
+    moving : optional moving pins ``{label: (height_mm, v_pin)}``.
+    lattices : optional ``{v_pin: OutcomeLattice}`` holding stored outcomes.
+    max_branches : a node whose state has more branches than this is dropped
+        (reported in ``stats.pruned_branching``).
+    belt_speed : belt speed in mm/s (the part in mm): plan with the dynamic
+        model (``kernels.dynamic``) at that speed and belt friction ``mu_s``
+        instead of the quasi-static ``model``; ``None`` (default) is
+        quasi-static.
+    mu_s : belt friction for ``belt_speed``.
+    hard_limits : forbid pins whose d range leaves ``d_min <= |d| <= d_max``
+        (the paper's rule). By default these limits only set the margin
+        (negative inside them): the propagation itself sees what makes small
+        or large ``|d|`` risky (a jump between turning ways, a grazing miss) and
+        branches there, and verification replays every plan.
+    """
+
+    def __init__(self, part: Part, pins: dict, d_min: float, d_max: float, mu_c,
+                 pin_radius: float, model: str = "minpower", uncertainty: Uncertainty = Uncertainty(),
+                 tolerances: Tolerances = Tolerances(), moving: dict | None = None,
+                 lattices: dict | None = None, kernel: dict | None = None, max_branches: int = 4,
+                 hard_limits: bool = False, belt_speed: float | None = None, mu_s: float = 0.5):
+        if not pins:
+            raise PinfeedError("the planner needs at least one candidate pin")
+        if belt_speed is not None:
+            from pipeline.checks import check_belt
+            check_belt(part, belt_speed, mu_s)
+        self.belt_speed = None if belt_speed is None else float(belt_speed)
+        self.mu_s = float(mu_s)
+        self.part, self.model, self.pin_radius = part, model, float(pin_radius)
+        self.d_min, self.d_max = float(d_min), float(d_max)
+        self.mu_c, self.unc, self.tol = mu_c, uncertainty, tolerances
+        self.pins = {lab: Pin(lab, float(y), 0.0) for lab, y in pins.items()}
+        for lab, (y, v) in (moving or {}).items():
+            self.pins[lab] = Pin(lab, float(y), float(v))
+        kernel = kernel or {}
+        self.lattices = dict(lattices or {})
+        for v in {p.v_pin for p in self.pins.values()}:
+            if v not in self.lattices:
+                self.lattices[v] = OutcomeLattice(part, model, pin_radius, v,
+                                                  kernel.get("ds_max"), kernel.get("tol"),
+                                                  belt_speed=self.belt_speed, mu_s=self.mu_s)
+        for v, lattice in self.lattices.items():
+            if lattice.belt_speed != self.belt_speed or (
+                    self.belt_speed is not None and lattice.mu_s != self.mu_s):
+                raise PinfeedError(f"the stored outcomes at v_pin {v:g} are for another belt "
+                                   f"(speed {lattice.belt_speed}, mu_s {lattice.mu_s:g}) than the "
+                                   f"planner's ({self.belt_speed}, {self.mu_s:g})")
+        self.max_branches = int(max_branches)
+        self.hard_limits = bool(hard_limits)
+        self.order = part.symmetry_order()
+        self.stats = SearchStats()
+        self._cache: dict = {}
+
+    @property
+    def static_labels(self) -> list[str]:
+        return [k for k, p in self.pins.items() if p.v_pin == 0.0]
+
+    @property
+    def moving_labels(self) -> list[str]:
+        return [k for k, p in self.pins.items() if p.v_pin != 0.0]
+
+    def initial_states(self) -> dict[str, StateSet]:
+        return initial_state_sets(self.part, self.mu_c, self.unc)
+
+    def transition(self, state: StateSet, label: str):
+        """``(children, margin, d_lo, d_hi, jump)`` of ``state`` at pin ``label``,
+        or ``None`` if the pin is forbidden for it."""
+        key = (state, label)
+        if key not in self._cache:
+            self._cache[key] = self._transition(state, self.pins[label])
+        return self._cache[key]
+
+    def _transition(self, state: StateSet, pin: Pin):
+        a, h = self.part.a, self.unc.pin_halfwidth
+        d_lo, d_hi = (pin.y - h - state.y_hi) / a, (pin.y + h - state.y_lo) / a
+        shrink = 1.0 / math.sqrt(1.0 + pin.v_pin * pin.v_pin)
+        near, far = shrink * min(abs(d_lo), abs(d_hi)), shrink * max(abs(d_lo), abs(d_hi))
+        if d_lo < 0.0 < d_hi:
+            return None  # the pin may pass on either side of the centroid: metastable
+        if self.hard_limits and (near < self.d_min - 1e-12 or far > self.d_max + 1e-12):
+            return None
+        lattice = self.lattices[pin.v_pin]
+        before = lattice.n_computed
+        res = propagate(state, pin.y, self.part, lattice, h, self.tol)
+        self.stats.transitions += 1
+        self.stats.rollouts += lattice.n_computed - before
+        if res is UNRESOLVED:
+            self.stats.unresolved += 1
+            return None
+        if res is None:
+            return None
+        # A pin that misses the whole box is no risk, wherever it stands.
+        margin = min(near - self.d_min, self.d_max - far) if res.touched else math.inf
+        return res.children, margin, d_lo, d_hi, res.jump
+
+    # ------------------------------------------------------------------ search
+
+    def search(self, depth: int, keep: int = 10, dynamic_depth: int = 0, beam: int = 30,
+               complete_depth: int = 2, static_beam: int = 60, progress=None) -> list[TightPlan]:
+        """The ``keep`` best plans by predicted rank (before verification).
+
+        Levels up to ``complete_depth`` expand every joint state; deeper levels
+        expand the ``static_beam`` best (fewest sets, then fewest branches,
+        then narrowest sets), so the search is complete up to
+        ``complete_depth`` and a beam search beyond it."""
+        if depth < 1:
+            raise PinfeedError(f"depth must be >= 1, got {depth}")
+        t0 = time.perf_counter()
+        starts = self.initial_states()
+        self.labels = list(starts)
+        root = ((), tuple(((st, ()),) for st in starts.values()), math.inf, 0, ())
+        seen = {self._joint_key(root[1])}
+        nodes, frontier = [], [root]
+        for level in range(depth):
+            if level >= complete_depth:
+                frontier = sorted(frontier, key=self._beam_rank)[:static_beam]
+            frontier = self._expand(frontier, self.static_labels, seen)
+            nodes.extend(frontier)
+            self.stats.per_level.append(len(frontier))
+            if progress:
+                progress(f"level {level + 1}: {len(frontier)} new joint states, "
+                         f"{self.stats.rollouts} rollouts so far")
+        if dynamic_depth and self.moving_labels:
+            grown = [root] + nodes
+            for _ in range(dynamic_depth):
+                grown.sort(key=self._node_rank)
+                grown = self._expand(grown[:beam], self.moving_labels, seen)
+                nodes.extend(grown)
+        self.stats.nodes = len(nodes)
+        plans = [self._plan(node, starts) for node in nodes]
+        plans.sort(key=TightPlan.rank_key)
+        self.stats.seconds = time.perf_counter() - t0
+        return plans[:keep]
+
+    def _expand(self, frontier, labels, seen):
+        out = []
+        for seq, joint, margin, jumps, sets_after in frontier:
+            for label in labels:
+                child = self._apply(joint, label)
+                if child is None:
+                    continue
+                new_joint, step_margin, step_jumps = child
+                key = self._joint_key(new_joint)
+                if key in seen:
+                    continue
+                seen.add(key)
+                n_sets = self._count_sets(new_joint)
+                out.append((seq + (label,), new_joint, min(margin, step_margin),
+                            jumps + step_jumps, sets_after + (n_sets,)))
+        return out
+
+    def _apply(self, joint, label):
+        """The joint state after pin ``label``, or None if forbidden for a branch."""
+        pin = self.pins[label]
+        new_joint, margin, jumps = [], math.inf, 0
+        for branches in joint:
+            children = {}
+            for state, history in branches:
+                res = self.transition(state, label)
+                if res is None:
+                    return None
+                kids, m, d_lo, d_hi, jump = res
+                margin, jumps = min(margin, m), jumps + int(jump)
+                for kid in kids:
+                    children.setdefault(kid, history + (Step(label, pin.y, pin.v_pin, d_lo, d_hi,
+                                                             kid),))
+            if len(children) > self.max_branches:
+                self.stats.pruned_branching += 1
+                return None
+            new_joint.append(tuple(sorted(children.items())))
+        return tuple(new_joint), margin, jumps
+
+    def _count_sets(self, joint) -> int:
+        return len(merge_modulo([st.arc for branches in joint for st, _ in branches], self.order))
+
+    @staticmethod
+    def _joint_key(joint):
+        return tuple(tuple(st for st, _ in branches) for branches in joint)
+
+    @staticmethod
+    def _beam_rank(node):
+        seq, joint, margin, jumps, sets_after = node
+        branches = sum(len(b) for b in joint)
+        width = sum(st.width for b in joint for st, _ in b)
+        return (sets_after[-1] if sets_after else len(joint), branches, width,
+                -margin if math.isfinite(margin) else 0.0)
+
+    @staticmethod
+    def _node_rank(node):
+        seq, joint, margin, jumps, sets_after = node
+        n_sets = sets_after[-1] if sets_after else len(joint)
+        return (n_sets, len(seq), jumps, -margin if math.isfinite(margin) else 0.0)
+
+    def _plan(self, node, starts) -> TightPlan:
+        seq, joint, margin, jumps, sets_after = node
+        finals = merge_arcs([st.arc for branches in joint for st, _ in branches])
+        branches = {label: [list(history) for _, history in brs]
+                    for label, brs in zip(self.labels, joint)}
+        pins = [self.pins[p] for p in seq]
+        return TightPlan(seq, tuple(p.y for p in pins), tuple(p.v_pin for p in pins), finals,
+                         self._count_sets(joint), float(margin), int(jumps), branches,
+                         dict(starts), sets_after)

@@ -1,0 +1,217 @@
+"""How fast may a plan run? Success rate against belt speed, and the speed limit.
+
+:func:`speed_curve` takes plain inputs: a part, the pin heights of the
+sequence, their speed ratios, the initial states, the plan's predicted final
+arcs and the friction; :func:`stored_plan_speed` reads them from a stored
+plan file (``pinfeed speed`` and the workflow's speed stage). Each trial
+perturbs the initial state, the pin heights and mu_c, and replays the
+sequence with the dynamic model (``kernels.dynamic``; every trial past one
+pin in one parallel batch); a trial succeeds when every passage ends ok or
+misses and the final orientation lies in one of the final arcs. The same random draws
+are used at every speed (common random numbers), so the curve is not noisy
+from speed to speed. The speed limit is the highest speed at which at least
+``required`` of the trials succeed, found on the coarse grid and refined by
+bisection to ``resolution`` mm/s.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from pipeline.checks import FROUDE_MAX, G_MM_S2, check_belt
+from pipeline.errors import PinfeedError
+from pipeline.parts.part import Part
+
+DEFAULT_SPEEDS = (10.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
+
+
+def perturbation_from_verify(verify: dict) -> dict:
+    """The uniform half-widths of :func:`speed_curve` from a config's ``verify``
+    section: orientation +-2 sigma (verification truncates its normal there),
+    centroid height and pin position as verified."""
+    v = dict(verify or {})
+    return {"theta_deg": 2.0 * v.get("theta_sigma", 1.0), "y_mm": v.get("y_halfwidth", 0.5),
+            "pin_mm": v.get("pin_halfwidth", 0.3)}
+
+
+def _in_arcs(theta_deg, arcs) -> np.ndarray:
+    """Whether each orientation (degrees) lies in one of the arcs ``(start, width)``."""
+    theta_deg = np.asarray(theta_deg, float)
+    inside = np.zeros(theta_deg.shape, bool)
+    for start, width in arcs:
+        inside |= (theta_deg - start) % 360.0 <= width
+    return inside
+
+
+def _draws(part, pin_heights, states, mu_c, perturb, trials, seed):
+    rng = np.random.default_rng(seed)
+    lo, hi = (mu_c, mu_c) if np.isscalar(mu_c) else (float(mu_c[0]), float(mu_c[1]))
+    out = []
+    for theta, y_c in states:
+        n = int(trials)
+        th = theta + rng.uniform(-1, 1, n) * perturb.get("theta_deg", 0.0)
+        yc = y_c + rng.uniform(-1, 1, n) * perturb.get("y_mm", 0.0)
+        mu = rng.uniform(lo, hi, n)
+        pins = np.asarray(pin_heights, float)[None, :] + \
+            rng.uniform(-1, 1, (n, len(pin_heights))) * perturb.get("pin_mm", 0.0)
+        # The corners of the perturbation box of the initial state.
+        corners = [(theta + sa * perturb.get("theta_deg", 0.0), y_c + sb * perturb.get("y_mm", 0.0))
+                   for sa in (-1, 1) for sb in (-1, 1)]
+        th = np.concatenate([th, [c[0] for c in corners]])
+        yc = np.concatenate([yc, [c[1] for c in corners]])
+        mu = np.concatenate([mu, np.full(4, 0.5 * (lo + hi))])
+        pins = np.vstack([pins, np.repeat(np.asarray(pin_heights, float)[None, :], 4, axis=0)])
+        out.append((th, yc, mu, pins))
+    return out
+
+
+def success_fraction(part: Part, pin_heights, pin_speed_ratios, draws, final_arcs, belt_speed,
+                     mu_s=0.5, r_pin=1.0, threads=None):
+    """Fraction of the drawn trials that end in the final arcs at ``belt_speed``.
+
+    Every trial of every initial state is rolled past pin 1, then the
+    survivors past pin 2, and so on, one parallel batch per pin
+    (``kernels.dynamic._dyn_rollout_points`` through
+    :func:`pipeline.maps.simulate.rollout_points`); a jammed or truncated passage
+    fails the trial, a miss leaves the part as it was.
+    """
+    from kernels.dynamic import JAMMED, TRUNCATED
+
+    from pipeline.maps.simulate import rollout_points
+    check_belt(part, belt_speed, mu_s)
+    theta = np.concatenate([d[0] for d in draws])
+    y_c = np.concatenate([d[1] for d in draws])
+    mu = np.concatenate([d[2] for d in draws])
+    pins = np.vstack([d[3] for d in draws])
+    alive = np.ones(theta.size, bool)
+    for k, v_pin in enumerate(pin_speed_ratios):
+        idx = np.flatnonzero(alive)
+        if idx.size == 0:
+            break
+        res = rollout_points(part, theta[idx], (pins[idx, k] - y_c[idx]) / part.a, mu[idx], r_pin,
+                             "dynamic", v_pin=float(v_pin), threads=threads,
+                             belt_speed=float(belt_speed), mu_s=float(mu_s))
+        stuck = (res["status"] == JAMMED) | (res["status"] == TRUNCATED)
+        alive[idx[stuck]] = False
+        theta[idx] = res["theta_f"]
+        y_c[idx] = y_c[idx] + res["dy"]
+    good = alive & _in_arcs(theta % 360.0, final_arcs)
+    return float(good.sum()) / theta.size
+
+
+def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final_arcs, mu_c,
+                mu_s=0.5, perturb=None, trials=300, speeds=DEFAULT_SPEEDS, resolution=5.0,
+                required=0.99, r_pin=1.0, seed=0):
+    """Success fraction against belt speed and the plan's speed limit.
+
+    Parameters
+    ----------
+    part : the part (millimetres).
+    pin_heights : pin heights across the belt, mm, in passage order.
+    pin_speed_ratios : ``v_pin / v_b`` of each pin (0 for fixed pins).
+    initial_states : ``(theta_deg, y_c_mm)`` pairs.
+    final_arcs : the plan's final set as ``(start_deg, width_deg)`` arcs.
+    mu_c : contact friction, a number or a ``(lo, hi)`` range drawn uniformly.
+    mu_s : belt friction.
+    perturb : half-widths of the uniform perturbations,
+        ``{"theta_deg": .., "y_mm": .., "pin_mm": ..}``.
+    trials : random trials per initial state (plus its four corners).
+    speeds : coarse grid of belt speeds, mm/s (capped where the pin would
+        throw the part, see ``checks.FROUDE_MAX``).
+
+    Returns
+    -------
+    dict with ``curve`` (rows ``[speed_mm_s, success_fraction]``, sorted),
+    ``speed_limit_mm_s`` (``0.0`` if even the slowest speed fails; the
+    highest speed tried if none fails), ``trials_per_speed`` and
+    ``seconds`` (wall time).
+    """
+    if len(pin_heights) != len(pin_speed_ratios):
+        raise PinfeedError("give one speed ratio per pin")
+    if not initial_states or not final_arcs:
+        raise PinfeedError("give at least one initial state and one final arc")
+    perturb = dict(perturb or {"theta_deg": 1.0, "y_mm": 0.5, "pin_mm": 0.2})
+    v_thrown = math.sqrt(FROUDE_MAX * mu_s * G_MM_S2 * part.a)
+    grid = sorted(v for v in speeds if 0 < v <= v_thrown)
+    if not grid:
+        raise PinfeedError("no belt speed in the grid below the speed at which the part is thrown")
+    start_time = time.perf_counter()
+    draws = _draws(part, pin_heights, initial_states, mu_c, perturb, trials, seed)
+    curve = {}
+
+    def frac(v):
+        if v not in curve:
+            curve[v] = success_fraction(part, pin_heights, pin_speed_ratios, draws, final_arcs, v,
+                                        mu_s, r_pin)
+        return curve[v]
+
+    lo = None
+    hi = None
+    for v in grid:
+        if frac(v) >= required:
+            lo = v
+        else:
+            hi = v
+            break
+    if lo is None:
+        limit = 0.0
+    elif hi is None:
+        limit = lo
+    else:
+        while hi - lo > resolution:
+            mid = resolution * round(0.5 * (lo + hi) / resolution)
+            if mid <= lo or mid >= hi:
+                break
+            if frac(mid) >= required:
+                lo = mid
+            else:
+                hi = mid
+        limit = lo
+    return {"curve": [[v, curve[v]] for v in sorted(curve)], "speed_limit_mm_s": float(limit),
+            "trials_per_speed": int(sum(d[0].size for d in draws)),
+            "seconds": round(time.perf_counter() - start_time, 2)}
+
+
+def stored_plan_speed(result: dict, config: dict, plan: int = 1, mu_text=None, mu_s: float = 0.5,
+                      trials: int = 300, speeds=DEFAULT_SPEEDS, resolution: float = 5.0,
+                      required: float = 0.99, seed: int = 0) -> dict:
+    """The speed curve and speed limit of a stored tight plan (a plan file's
+    ``tight`` entry, see :func:`pick_tight_plan`), with the verify stage's
+    perturbation sizes (``config["verify"]``) and the sweep's pin radius.
+
+    Returns the JSON of ``pinfeed speed`` and the workflow's speed stage:
+    ``part``, ``pin_labels``, ``pin_heights_mm``, ``pin_speeds``,
+    ``final_set`` (``start``, ``width`` in degrees), ``mu_c``, ``mu_s``,
+    ``required``, ``speed_limit_mm_s``, ``curve`` (rows of speed in mm/s and
+    success fraction), ``planned_belt_speed`` (``None``: planned
+    quasi-static), ``trials``, ``trials_per_speed``, ``seconds`` and ``method``.
+    """
+    from pipeline.parts.part import Part
+    from pipeline.planning.plan import friction_label, pick_tight_plan
+    if not (isinstance(trials, int) and trials >= 1):
+        raise PinfeedError(f"trials must be a whole number >= 1, got {trials!r}")
+    chosen, mu_c, entry = pick_tight_plan(result, plan, mu_text)
+    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    perturb = perturbation_from_verify(config.get("verify", {}))
+    # A tight-only plan file keeps the resting states per friction entry.
+    stored_states = entry.get("initial_states") or result.get("initial_states") or {}
+    states = [(s["theta"], s["y_c"]) for s in stored_states.values()]
+    arcs = [(s["start"], s["width"]) for s in chosen["final_sets"]]
+    res = speed_curve(part, chosen["pin_heights_mm"], chosen["pin_speeds"], states, arcs, mu_c,
+                      mu_s=mu_s, perturb=perturb, trials=trials, speeds=speeds,
+                      resolution=resolution, required=required,
+                      r_pin=config["sweep"]["pin_radius"], seed=seed)
+    return {"part": part.name, "pin_labels": list(chosen["pins"]),
+            "pin_heights_mm": list(chosen["pin_heights_mm"]),
+            "pin_speeds": list(chosen["pin_speeds"]),
+            "final_set": [{"start": s, "width": w} for s, w in arcs],
+            "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c, "friction": friction_label(mu_c),
+            "mu_s": float(mu_s), "required": float(required),
+            "speed_limit_mm_s": res["speed_limit_mm_s"], "curve": res["curve"],
+            "planned_belt_speed": entry.get("belt_speed"), "trials": int(trials),
+            "trials_per_speed": res["trials_per_speed"], "seconds": res["seconds"],
+            "method": f"dynamic model, {trials} perturbed trials per initial state plus corners "
+                      f"at each speed; limit = highest speed with >= {100 * required:g} % in the "
+                      f"final set, {resolution:g} mm/s bisection"}

@@ -1,0 +1,204 @@
+"""Replay plans with full rollouts under perturbations (the paper's Table 2).
+
+Each trial starts from an initial resting state, perturbs the initial
+orientation and centroid height, the friction and every pin's position, then
+rolls the part past each pin of the plan in turn: ``theta`` and ``y_c`` carry
+over from one pin to the next. The perturbation box is the planner's
+(``propagate.Uncertainty``): orientation and friction are normal with the
+configured sigma, truncated at 2 sigma (a friction range ``(lo, hi)`` is
+sampled uniformly); centroid height and pin positions are uniform within
+their half-widths. Besides the random trials, every corner of the box is
+replayed (``corners``). This shares no arithmetic with the planner: it calls
+the public rollout API only.
+
+A trial succeeds when the final orientation lies in the final orientation
+sets the plan predicts for that initial state. Failures are counted by
+reason: ``jammed (<why>)``, ``missed a pin`` (the plan expected a contact
+and a pin missed, and the part ended elsewhere) and ``other band``.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+
+from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, JAMMED, MISS, TRUNCATED
+
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
+from pipeline.planning.arcs import in_arc, merge_arcs
+
+PERTURB_DEFAULTS = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
+DEFAULTS = {"trials": 300, "corners": True, **PERTURB_DEFAULTS, "seed": 1}
+TRUNCATE_SIGMA = 2.0
+
+
+def _truncated_normal(rng, sigma, n):
+    out = rng.normal(0.0, sigma, n)
+    bad = np.abs(out) > TRUNCATE_SIGMA * sigma
+    while np.any(bad):
+        out[bad] = rng.normal(0.0, sigma, int(bad.sum()))
+        bad = np.abs(out) > TRUNCATE_SIGMA * sigma
+    return out
+
+
+def perturbed_inputs(theta, y_c, mu_c, n_pins, cfg, rng):
+    """One trial's inputs: theta_i, y_c, mu_c and an offset for each of
+    ``n_pins`` pins, drawn from the perturbation box (sizes from ``cfg``)."""
+    th, yc, mu, offs = perturbed_batch(theta, y_c, mu_c, n_pins, cfg, rng, 1)
+    return float(th[0]), float(yc[0]), float(mu[0]), offs[0]
+
+
+def perturbed_batch(theta, y_c, mu_c, n_pins, cfg, rng, n):
+    """``n`` trials' inputs as arrays ``(theta (n,), y_c (n,), mu (n,), offsets (n, n_pins))``.
+    ``mu_c`` is a value (normal, truncated at 2 sigma, clipped at 0) or a range ``(lo, hi)``."""
+    th = theta + _truncated_normal(rng, cfg["theta_sigma"], n)
+    yc = y_c + rng.uniform(-cfg["y_halfwidth"], cfg["y_halfwidth"], n)
+    if isinstance(mu_c, (tuple, list)):
+        mu = rng.uniform(float(mu_c[0]), float(mu_c[1]), n)
+    else:
+        mu = np.maximum(0.0, mu_c + _truncated_normal(rng, cfg["mu_sigma"], n))
+    offs = rng.uniform(-cfg["pin_halfwidth"], cfg["pin_halfwidth"], (n, n_pins))
+    return th, yc, mu, offs
+
+
+def corner_inputs(theta, y_c, mu_c, n_pins, cfg):
+    """Every corner of the perturbation box, as arrays like :func:`perturbed_batch`."""
+    ts = TRUNCATE_SIGMA
+    if isinstance(mu_c, (tuple, list)):
+        mus = (float(mu_c[0]), float(mu_c[1]))
+    else:
+        mus = (max(0.0, mu_c - ts * cfg["mu_sigma"]), mu_c + ts * cfg["mu_sigma"])
+    h = cfg["pin_halfwidth"]
+    rows = list(itertools.product((-1.0, 1.0), (-1.0, 1.0), mus, *[(-h, h)] * n_pins))
+    arr = np.array([r[:3] for r in rows], dtype=float)
+    offs = np.array([r[3:] for r in rows], dtype=float).reshape(len(rows), n_pins)
+    return (theta + arr[:, 0] * ts * cfg["theta_sigma"], y_c + arr[:, 1] * cfg["y_halfwidth"],
+            arr[:, 2], offs)
+
+
+def _arc(step):
+    return (step["band"]["start"], step["band"]["width"])
+
+
+def predicted_sets(plan: dict, label: str):
+    """The final orientation sets a stored plan predicts for one initial state."""
+    return merge_arcs([_arc(branch[-1]) for branch in plan["initial_states"][label] if branch])
+
+
+def _expects_contact(plan: dict, label: str, k: int, start_arc) -> bool:
+    # A step whose orientation set differs from the one before it needed the pin to touch.
+    for branch in plan["initial_states"][label]:
+        if k < len(branch):
+            before = _arc(branch[k - 1]) if k > 0 else start_arc
+            if tuple(_arc(branch[k])) != tuple(before):
+                return True
+    return False
+
+
+def _start(state):
+    """``(theta, y_c)`` of an initial state given as a pair or as a planner state."""
+    if isinstance(state, (tuple, list)):
+        return float(state[0]), float(state[1])
+    return float(state.arc[0]), float(state.y_lo)
+
+
+def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
+           ds_max=DEFAULT_DS_MAX, tol=DEFAULT_TOL, path=None, belt_speed=None, mu_s=0.5):
+    """Roll every trial past every pin in turn (batched per pin).
+
+    ``belt_speed`` (mm/s) replays with the dynamic model at that speed and
+    belt friction ``mu_s`` (``model`` is then unused); ``None`` is
+    quasi-static ``model``.
+
+    Returns ``(theta_f, y_c, jam_reason_or_empty, missed)``: arrays over trials,
+    ``missed`` a boolean array ``(n_trials, n_pins)``. If ``path`` is a list,
+    ``(theta, y_c)`` arrays after each pin are appended to it."""
+    theta, y_c = np.array(theta, float), np.array(y_c, float)
+    n = theta.size
+    jam = np.full(n, "", dtype=object)
+    missed = np.zeros((n, len(pin_heights)), bool)
+    alive = np.ones(n, bool)
+    for k, (y_pin, v) in enumerate(zip(pin_heights, pin_speeds)):
+        idx = np.flatnonzero(alive)
+        if idx.size == 0:
+            break
+        d = (y_pin + offsets[idx, k] - y_c[idx]) / part.a
+        if belt_speed is None:
+            res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, model,
+                                          v_pin=float(v), ds_max=ds_max, tol=tol)
+        else:
+            res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, "dynamic",
+                                          v_pin=float(v), belt_speed=belt_speed, mu_s=mu_s)
+        st = res["status"]
+        stuck = (st == JAMMED) | (st == TRUNCATED)
+        for j in np.flatnonzero(stuck):
+            jam[idx[j]] = f"jammed ({JAM_REASONS[res['jam_reason'][j]] or 'truncated'})"
+        alive[idx[stuck]] = False
+        missed[idx, k] = st == MISS
+        theta[idx] = res["theta_f"]
+        y_c[idx] = y_c[idx] + res["dy"]
+        if path is not None:
+            path.append((np.where(alive, theta % 360.0, np.nan), np.where(alive, y_c, np.nan)))
+    return theta % 360.0, y_c, jam, missed
+
+
+def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, pin_radius: float,
+                model: str = "minpower", settings: dict | None = None,
+                speeds: dict | None = None, kernel: dict | None = None,
+                belt_speed: float | None = None, mu_s: float = 0.5) -> dict:
+    """Run the trials for a stored plan (``to_dict()`` of a plan).
+
+    ``belt_speed`` (mm/s) replays every trial with the dynamic model at that
+    belt speed and belt friction ``mu_s``; ``None`` (default) with the
+    quasi-static ``model``.
+
+    ``pins`` maps labels to heights (mm); ``speeds`` gives the speed ratio
+    v_pin / v_b of each moving pin's label (absent: a static pin); a perturbed
+    pin position shifts a moving pin's whole path. ``initial_states`` maps
+    labels to ``(theta_deg, y_c_mm)``. ``mu_c`` is a value or a range
+    ``(lo, hi)``. Returns per-state counts (``rows``), totals and every
+    trial's outcome."""
+    speeds = speeds or {}
+    cfg = dict(DEFAULTS, **(settings or {}))
+    kernel = kernel or {}
+    rng = np.random.default_rng(cfg["seed"])
+    labels = list(plan["pins"])
+    heights = [float(pins[p]) for p in labels]
+    vs = [float(speeds.get(p, 0.0)) for p in labels]
+    rows, trials = [], []
+    for label, state in initial_states.items():
+        theta0, yc0 = _start(state)
+        th, yc, mu, offs = perturbed_batch(theta0, yc0, mu_c, len(labels), cfg, rng, int(cfg["trials"]))
+        if cfg.get("corners", True):
+            corners = corner_inputs(theta0, yc0, mu_c, len(labels), cfg)
+            th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), corners[:3]))
+            offs = np.concatenate([offs, corners[3]])
+        tf, yf, jam, missed = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
+                                     kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL),
+                                     belt_speed=belt_speed, mu_s=mu_s)
+        finals = predicted_sets(plan, label)
+        first = plan.get("initial_sets", {}).get(label)
+        start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)
+        expected = [_expects_contact(plan, label, k, start_arc) for k in range(len(labels))]
+        counts = {"state": label, "trials": 0, "successes": 0, "failures": 0, "reasons": {}}
+        for j in range(tf.size):
+            reason = jam[j] or None
+            if reason is None and not any(in_arc(tf[j], s, w, 1e-6) for s, w in finals):
+                unexpected = any(missed[j, k] and expected[k] for k in range(len(labels)))
+                reason = "missed a pin" if unexpected else "other band"
+            counts["trials"] += 1
+            counts["successes" if reason is None else "failures"] += 1
+            if reason:
+                counts["reasons"][reason] = counts["reasons"].get(reason, 0) + 1
+            trials.append({"state": label, "final_theta": float(tf[j]), "final_y_c": float(yf[j]),
+                           "ok": reason is None, "reason": reason or "",
+                           "start": [float(th[j]) % 360.0, float(yc[j])], "mu_c": float(mu[j])})
+        rows.append(counts)
+    total = {k: sum(r[k] for r in rows) for k in ("trials", "successes", "failures")}
+    mu_out = list(mu_c) if isinstance(mu_c, (tuple, list)) else mu_c
+    belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
+    return {"plan": labels, "settings": cfg, "mu_c": mu_out,
+            "model": model if belt_speed is None else "dynamic", **belt, "rows": rows,
+            **total, "trials_detail": trials}

@@ -1,0 +1,190 @@
+"""The feeder drawing of a layout (``pipeline.present.layout``): a top view to build from.
+
+One geometry (:func:`drawing_items`), two writers: :func:`draw_feeder`
+(matplotlib: PNG or SVG) and :func:`write_dxf` (ezdxf, millimetres, layers
+BELT, FENCE, PINS, DIMENSIONS, PARTS and TITLE). World frame of the spec:
+x downstream (the belt moves to the right), y across the belt, the fence at
+y = 0, the first pin at x = 0.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from pipeline.maps.io import atomic_target
+
+LAYERS = {"BELT": 8, "FENCE": 7, "PINS": 1, "DIMENSIONS": 3, "PARTS": 5, "TITLE": 7}  # ACI colours
+TEXT_MM = 3.5
+
+
+def _fmt(value, unit="", digits=1) -> str:
+    return "n/a" if value is None else f"{value:.{digits}f}{unit}"
+
+
+def title_lines(layout: dict) -> list[str]:
+    """The title block, line by line: part, plan, frictions, belt speed, pitch,
+    throughput, pinfeed version and date (``SOURCE_DATE_EPOCH`` if set)."""
+    from pipeline import __version__
+    from pipeline.provenance import creation_time
+    plan = layout.get("plan") or {}
+    pins = " ".join(plan.get("pins") or layout.get("pins") or [])
+    mu_c = layout.get("mu_c")
+    mu_c = f"{mu_c[0]:g}:{mu_c[1]:g}" if isinstance(mu_c, list) else ("n/a" if mu_c is None else f"{mu_c:g}")
+    mu_s = layout.get("mu_s")
+    limit = layout.get("speed_limit_mm_s")
+    return [f"pinfeed feeder layout: {layout['part']}",
+            f"plan {plan.get('number', '-')}: {pins}",
+            f"mu_c {mu_c}   mu_s {'n/a' if mu_s is None else f'{mu_s:g}'}",
+            f"belt speed {_fmt(layout.get('belt_speed_mm_s'), ' mm/s')}"
+            f" (limit {_fmt(limit, ' mm/s')})",
+            f"pitch {_fmt(layout['pitch_mm'], ' mm')}   belt width {_fmt(layout['belt_width_mm'], ' mm')}",
+            f"throughput {_fmt(layout.get('throughput_per_min'), ' parts/min')}",
+            f"pinfeed {layout.get('pinfeed_version', __version__)}   "
+            f"{(layout.get('created') or creation_time())[:10]}   units mm"]
+
+
+def drawing_items(layout: dict) -> dict:
+    """Everything to draw, in mm: ``belt`` and ``fence`` segments, ``pins``
+    (centre, radius, label), ``dims`` (``(p1, p2, offset point, text, angle)``),
+    ``parts`` (closed outlines), ``arrow`` (tail, head), ``title`` (origin,
+    lines), ``extent`` (x_lo, x_hi, y_lo, y_hi)."""
+    stations = layout["stations"]
+    y_lo, y_hi = layout["belt_y_mm"]
+    parts = [np.asarray(p["outline"], float) for key in ("entry_parts", "exit_parts")
+             for p in layout["drawing"][key]]
+    xs = np.concatenate([p[:, 0] for p in parts] + [[s["x_mm"] for s in stations]])
+    x_lo, x_hi = float(xs.min()) - 15.0, float(xs.max()) + 15.0
+    pin_r = max(s["radius_mm"] for s in stations)
+    dims = []
+    # Stations: each pin's x from the first pin, stacked above the belt.
+    for k, s in enumerate(stations[1:], start=1):
+        y = y_hi + 8.0 + 7.0 * (k - 1)
+        dims.append(((stations[0]["x_mm"], s["y_mm"]), (s["x_mm"], s["y_mm"]), (0.0, y),
+                     f"{s['x_mm']:.1f}", 0.0))
+    # Heights: each pin's y from the fence line, just left of the pin.
+    for s in stations:
+        dims.append(((s["x_mm"], 0.0), (s["x_mm"], s["y_mm"]), (s["x_mm"] - pin_r - 3.0, 0.0),
+                     f"{s['y_mm']:.1f}", 90.0))
+    entry = layout["drawing"]["entry_parts"]
+    if len(entry) >= 2:
+        a, b = entry[1], entry[0]
+        dims.append(((a["x_mm"], a["y_mm"]), (b["x_mm"], b["y_mm"]), (0.0, y_lo - 8.0),
+                     f"pitch {layout['pitch_mm']:.1f}", 0.0))
+    dims.append(((x_lo, y_lo), (x_lo, y_hi), (x_lo - 6.0, 0.0),
+                 f"belt {layout['belt_width_mm']:.1f}", 90.0))
+    arrow_y = y_hi - 4.0
+    return {
+        "belt": [((x_lo, y_lo), (x_hi, y_lo)), ((x_lo, y_hi), (x_hi, y_hi))],
+        "fence": [((x_lo, layout["fence_y_mm"]), (layout["fence_end_x_mm"], layout["fence_y_mm"]))],
+        # Labels alternate above and below their pins, so close pins stay readable.
+        "pins": [((s["x_mm"], s["y_mm"]), s["radius_mm"], f"{s['label']} y={s['y_mm']:g}",
+                  1.0 if k % 2 == 0 else -1.0) for k, s in enumerate(stations)],
+        "dims": dims,
+        "parts": parts,
+        "arrow": ((x_lo + 5.0, arrow_y), (x_lo + 35.0, arrow_y)),
+        # The title block's top right corner, under the belt and its dimensions.
+        "title": ((x_hi, y_lo - 16.0), title_lines(layout)),
+        "extent": (x_lo - 12.0, x_hi, y_lo - 16.0, y_hi + 8.0 + 7.0 * len(stations)),
+    }
+
+
+def draw_feeder(layout: dict, out) -> Path:
+    """The drawing as PNG or SVG (by ``out``'s suffix), written atomically."""
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Polygon
+
+    from pipeline.present.figures import save_figure  # noqa: F401 (selects the Agg backend)
+    items = drawing_items(layout)
+    x0, x1, y0, y1 = items["extent"]
+    width = 11.0
+    y0 -= 1.2 * (x1 - x0) / (width - 1.0)  # about 1.2 inches for the title block
+    fig, ax = plt.subplots(figsize=(width, max(3.0, width * (y1 - y0) / (x1 - x0)) + 0.4))
+    for (a, b) in items["belt"]:
+        ax.plot([a[0], b[0]], [a[1], b[1]], color="0.4", lw=1.0)
+    for (a, b) in items["fence"]:
+        ax.plot([a[0], b[0]], [a[1], b[1]], color="k", lw=3.0)
+        ax.text(a[0] + 2, a[1] - 1.0, "fence", fontsize=7, va="top")
+    for k, poly in enumerate(items["parts"]):
+        ax.add_patch(Polygon(poly, closed=True, fc="tab:blue", ec="k", alpha=0.35, lw=0.8))
+    for centre, r, label, side in items["pins"]:
+        ax.add_patch(Circle(centre, r, color="tab:red", zorder=3))
+        ax.text(centre[0] + r + 1.0, centre[1] + side * (r + 0.5), label, fontsize=7, color="tab:red",
+                va="bottom" if side > 0 else "top")
+    for p1, p2, at, text, angle in items["dims"]:
+        if angle == 0.0:
+            a, b = (p1[0], at[1]), (p2[0], at[1])
+            ax.plot([p1[0], p1[0]], [p1[1], at[1]], color="tab:green", lw=0.4)
+            ax.plot([p2[0], p2[0]], [p2[1], at[1]], color="tab:green", lw=0.4)
+        else:
+            a, b = (at[0], p1[1]), (at[0], p2[1])
+        ax.annotate("", xy=b, xytext=a, arrowprops=dict(arrowstyle="<->", color="tab:green", lw=0.7))
+        ax.text(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), text, fontsize=6, color="tab:green",
+                rotation=angle, ha="center", va="bottom" if angle == 0.0 else "center",
+                bbox=dict(fc="white", ec="none", pad=0.5))
+    tail, head = items["arrow"]
+    ax.annotate("", xy=head, xytext=tail, arrowprops=dict(arrowstyle="-|>", color="0.3", lw=1.2))
+    ax.text(head[0] + 2.0, head[1], "belt direction", fontsize=7, va="center")
+    origin, lines = items["title"]
+    ax.text(origin[0], origin[1], "\n".join(lines), fontsize=7, family="monospace", va="top",
+            ha="right", multialignment="left", bbox=dict(fc="white", ec="k", lw=0.6))
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x along the belt (mm)", fontsize=8)
+    ax.set_ylabel("y across the belt (mm)", fontsize=8)
+    ax.tick_params(labelsize=7)
+    fig.tight_layout()
+    out = Path(out)
+    with atomic_target(out) as tmp:
+        fig.savefig(tmp, format=out.suffix.lower().lstrip("."), dpi=110)
+    plt.close(fig)
+    return out
+
+
+def write_dxf(layout: dict, out) -> Path:
+    """The drawing as a DXF (R2010, millimetres), written atomically: a CIRCLE
+    per pin at its station, each part outline a closed LWPOLYLINE on PARTS."""
+    import ezdxf
+    items = drawing_items(layout)
+    doc = ezdxf.new("R2010", setup=True)
+    doc.header["$INSUNITS"] = 4  # millimetres
+    for name, colour in LAYERS.items():
+        doc.layers.add(name, color=colour)
+    msp = doc.modelspace()
+    for a, b in items["belt"]:
+        msp.add_line(a, b, dxfattribs={"layer": "BELT"})
+    for a, b in items["fence"]:
+        msp.add_line(a, b, dxfattribs={"layer": "FENCE"})
+    for centre, r, label, side in items["pins"]:
+        msp.add_circle(centre, r, dxfattribs={"layer": "PINS"})
+        msp.add_text(label, height=TEXT_MM * 0.7, dxfattribs={"layer": "PINS"}).set_placement(
+            (centre[0] + r + 1.0, centre[1] + side * (r + 0.5) - (TEXT_MM if side < 0 else 0.0)))
+    for p1, p2, at, text, angle in items["dims"]:
+        base = (p1[0], at[1]) if angle == 0.0 else (at[0], p1[1])
+        dim = msp.add_linear_dim(base=base, p1=p1, p2=p2, angle=angle, text=text,
+                                 dxfattribs={"layer": "DIMENSIONS"},
+                                 override={"dimtxt": TEXT_MM * 0.7, "dimasz": 2.0})
+        dim.render()
+    for poly in items["parts"]:
+        msp.add_lwpolyline([tuple(p) for p in poly], close=True, dxfattribs={"layer": "PARTS"})
+    tail, head = items["arrow"]
+    msp.add_line(tail, head, dxfattribs={"layer": "BELT"})
+    msp.add_lwpolyline([head, (head[0] - 4.0, head[1] + 1.5), (head[0] - 4.0, head[1] - 1.5)],
+                       close=True, dxfattribs={"layer": "BELT"})
+    msp.add_text("belt direction", height=TEXT_MM * 0.7, dxfattribs={"layer": "BELT"}).set_placement(
+        (head[0] + 2.0, head[1] - 1.0))
+    origin, lines = items["title"]
+    step = TEXT_MM * 1.6
+    box_w = max(len(s) for s in lines) * TEXT_MM * 0.75 + 4.0
+    box_h = step * len(lines) + 2.0
+    origin = (origin[0] - box_w, origin[1])  # right-aligned under the belt
+    msp.add_lwpolyline([origin, (origin[0] + box_w, origin[1]), (origin[0] + box_w, origin[1] - box_h),
+                        (origin[0], origin[1] - box_h)], close=True, dxfattribs={"layer": "TITLE"})
+    for k, line in enumerate(lines):
+        msp.add_text(line, height=TEXT_MM * 0.8, dxfattribs={"layer": "TITLE"}).set_placement(
+            (origin[0] + 2.0, origin[1] - step * (k + 1)))
+    out = Path(out)
+    with atomic_target(out) as tmp:
+        doc.saveas(tmp)
+    return out

@@ -1,0 +1,303 @@
+"""One HTML page per config that links every result: a table of contents, then
+a section per part (outline, maps, plans, verification, animation, sensing).
+
+Every figure, JSON file and catalog shard is linked relatively from the page
+(``RESULTS_DIR/NAME/report.html``); warnings and failing verification rows
+come first, in red. Each table is shown once, its numbers read from the JSON
+it links."""
+from __future__ import annotations
+
+import html
+import os
+from pathlib import Path
+
+from pipeline import __version__
+from pipeline.config import config_hash
+from pipeline.maps.io import write_text_atomic
+from pipeline.present.figures.tables import HEADER, verification_rows
+from pipeline.provenance import creation_time, git_commit
+
+SECTIONS = (("outline", "Outline"), ("maps", "Configuration maps"), ("plans", "Plans"),
+            ("verification", "Verification"), ("animation", "Animation"), ("layout", "Feeder layout"),
+            ("sensing", "Sensing"))
+STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto}img{max-width:100%}"
+         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;font-size:90%}"
+         "tr.fail td{background:#f8d0d0}.files{font-size:90%}")
+
+
+def _rel(path, base):
+    return html.escape(os.path.relpath(path, base))
+
+
+def _anchor(name: str, section: str = "") -> str:
+    return html.escape(f"part-{name}" + (f"-{section}" if section else ""))
+
+
+def _link(path, base, text) -> str:
+    return f'<a href="{_rel(path, base)}">{html.escape(text)}</a>'
+
+
+def _figure(files: dict, kind: str, base, title: str) -> list[str]:
+    """A figure under a heading, the image linking to its file; nothing if absent."""
+    if kind not in files:
+        return []
+    src = _rel(files[kind], base)
+    return [f"<h4>{html.escape(title)}</h4>",
+            f'<a href="{src}"><img src="{src}" alt="{html.escape(title)}"></a>']
+
+
+def write_report(config, parts: dict, out, overview: dict | None = None, catalog=None) -> Path:
+    """``parts``: name -> {"plan", "verify", optional "sensing" (results), "files"
+    (kind -> path), "shards" (catalog entries)}; ``overview``: text -> path of the
+    all-parts files; ``catalog``: the catalog folder (shard links). Writes ``out``."""
+    out = Path(out)
+    base = out.parent
+    pc, bc = config["planner"], config["bands"]
+    p = ['<!doctype html><html><head><meta charset="utf-8">'
+         f"<title>pinfeed results: {html.escape(config.get('name', ''))}</title>"
+         f"<style>{STYLE}</style></head><body>",
+         f"<h1>pinfeed results: config {html.escape(config.get('name', ''))}</h1>",
+         f"<p>pinfeed {html.escape(__version__)} ({html.escape(git_commit())}), config "
+         f"{config_hash(config)}, made {creation_time()}. Planner: model "
+         f"{html.escape(pc['model'])}, mu_c {html.escape(str(pc['mu_c']))}, depth "
+         f"{pc['depth']}, d in [{pc['d_min']:g}, {pc['d_max']:g}], T = {bc['threshold_T']:g} deg, "
+         f"c = {bc['factor_c']:g}.</p>"]
+    p += _warnings({n: v["plan"] for n, v in parts.items()}, {n: v["verify"] for n, v in parts.items()})
+    p += _toc(parts)
+    if overview:
+        p.append('<p class="files">All parts: ' + ", ".join(
+            _link(path, base, text) for text, path in overview.items()) + "</p>")
+    for name, part in parts.items():
+        p += _part_section(name, part, base, catalog)
+    p.append("</body></html>")
+    return write_text_atomic("\n".join(p), out)
+
+
+def _toc(parts: dict) -> list[str]:
+    """The table of contents: one entry per part, its sections beneath."""
+    p = ['<nav id="toc"><h2>Contents</h2><ul>']
+    for name in parts:
+        subs = "".join(f'<li><a href="#{_anchor(name, key)}">{title}</a></li>' for key, title in SECTIONS
+                       if key not in ("sensing", "layout") or parts[name].get(key))
+        p.append(f'<li class="toc-part"><a href="#{_anchor(name)}">{html.escape(name)}</a><ul>{subs}</ul></li>')
+    return p + ["</ul></nav>"]
+
+
+def _part_section(name: str, part: dict, base, catalog) -> list[str]:
+    """One part: its files, then outline, maps, plans, verification, animation, sensing."""
+    res, ver, files = part["plan"], part["verify"], part["files"]
+    p = [f'<h2 id="{_anchor(name)}">{html.escape(name)}</h2>',
+         '<p class="files">Files: ' + ", ".join(
+             _link(files[k], base, f"{k} JSON") for k in ("plan", "verify", "sensing", "speed") if k in files) + "</p>"]
+    if part.get("shards") and catalog is not None:
+        p.append('<details class="files"><summary>Catalog shards of this part '
+                 f'({len(part["shards"])})</summary><ul>' + "".join(
+                     f"<li>{_link(Path(catalog) / e['file'], base, e['file'])}: {html.escape(e['model'])}, "
+                     f"mu_c {e['mu_c']:g}, v_pin/v_b {e.get('v_pin', 0.0):+g}</li>" for e in part["shards"])
+                 + "</ul></details>")
+    p.append(f'<h3 id="{_anchor(name, "outline")}">Outline</h3>')
+    p.append(f"<p>Part id {html.escape(res['part']['id'])}; initial states: " + ", ".join(
+        f"{html.escape(k)}: θ = {v['theta']:.1f}°, y_c = {v['y_c']:.2f} mm"
+        for k, v in res["initial_states"].items()) + "</p>")
+    p += _figure(files, "outline", base, "Outline, centroid and resting states")
+    p.append(f'<h3 id="{_anchor(name, "maps")}">Configuration maps</h3>')
+    p.append(f"<p>Maps: {html.escape(res['selection'])}.</p>")
+    p += _figure(files, "maps", base, "Configuration maps with bands (rows: models)")
+    p += _figure(files, "speeds", base, "Maps by pin speed (dynamic pins)")
+    p.append(f'<h3 id="{_anchor(name, "plans")}">Plans</h3>')
+    p += _side_by_side(res, ver, part.get("speed"))
+    p += _paper_plans(res)
+    p += _figure(files, "sequence", base, "Pin sequence: best plan of fixed pins")
+    p += _figure(files, "sequence_dynamic", base, "Pin sequence: best plan with dynamic pins")
+    p += _figure(files, "carried", base, "Carried sets against replayed rollouts (recommended tight plan)")
+    p += _figure(files, "speed_limit", base, "Success against belt speed (recommended tight plan, "
+                 "dynamic model) and its speed limit")
+    p.append(f'<h3 id="{_anchor(name, "verification")}">Verification</h3>')
+    p += _verification_table(name, ver)
+    p += _figure(files, "verification", base, "Verification by plan (failing states in red)")
+    p.append(f'<h3 id="{_anchor(name, "animation")}">Animation</h3>')
+    p += _animation(res, files, base)
+    if part.get("layout"):
+        p.append(f'<h3 id="{_anchor(name, "layout")}">Feeder layout</h3>')
+        p += _layout_section(part["layout"], files, base)
+    if "sensing" in part:
+        p.append(f'<h3 id="{_anchor(name, "sensing")}">Sensing</h3>')
+        p += _sensing_section(part["sensing"], files, base)
+    return p
+
+
+def _layout_section(lay: dict, files: dict, base) -> list[str]:
+    """The feeder to build: throughput, speed limit, pitch, stations, the drawing."""
+    if not lay.get("plan"):
+        return [f"<p>{html.escape(lay.get('note', 'no layout'))}</p>"]
+    tp, v = lay.get("throughput_per_min"), lay.get("belt_speed_mm_s")
+    p = [f"<p>Plan {lay['plan']['number']} ({html.escape(' '.join(lay['plan']['pins']))}): "
+         f"<b>throughput {'n/a' if tp is None else f'{tp:.1f}'} parts/min</b> at belt speed "
+         f"{'n/a' if v is None else f'{v:.1f}'} mm/s ({html.escape(lay['method']['belt_speed'])}); "
+         f"<b>speed limit {lay['speed_limit_mm_s']:g} mm/s</b>; pitch {lay['pitch_mm']:.1f} mm; belt "
+         f"width {lay['belt_width_mm']:.1f} mm; model {html.escape(lay['method']['model'])}, "
+         f"{lay['method']['trials']['replayed']} trials. Stations: " + ", ".join(
+             f"{html.escape(s['label'])} at x = {s['x_mm']:.1f} mm, y = {s['y_mm']:g} mm"
+             for s in lay["stations"]) + "</p>"]
+    p += [f'<p class="warn">{html.escape(w)}</p>' for w in lay.get("warnings", [])]
+    p.append('<p class="files">Drawing: ' + ", ".join(
+        _link(files[k], base, k.replace("layout_", "").upper()) for k in
+        ("layout_json", "layout_dxf", "layout_svg") if k in files) + "</p>")
+    return p + _figure(files, "layout_png", base, "Feeder drawing (top view)")
+
+
+def _paper_plans(res: dict) -> list[str]:
+    """Paper mode's ranked plans (adjusted bands), best first."""
+    from pipeline.planning.arcs import format_arcs
+    if not res["plans"]:
+        return ["<p>Paper mode: no allowed plan within the depth.</p>"]
+    p = ["<h4>Paper-mode plans (adjusted bands), best first</h4><table><tr><th>rank</th><th>pins</th>"
+         "<th>heights (mm) @ speed (v_pin/v_b)</th><th>sets after each pin</th>"
+         "<th>final sets</th><th>orientation sets</th><th>margin in d</th></tr>"]
+    speeds = res.get("pin_speeds", {})
+    for k, plan in enumerate(res["plans"], start=1):
+        sets = format_arcs([(s["start"], s["width"]) for s in plan["final_sets"]])
+        heights = ", ".join(f"{res['pins'][q]:g}" + (f" @ {speeds[q]:+g}" if q in speeds else "")
+                            for q in plan["pins"])
+        after = " → ".join(str(n) for n in plan.get("sets_after_each_pin", []))
+        p.append(f"<tr><td>{k}</td><td>{' → '.join(plan['pins'])}</td><td>{heights}</td>"
+                 f"<td>{after}</td><td>{plan['n_final_sets']}</td><td>{html.escape(sets)}</td>"
+                 f"<td>{plan['margin']:.3f}</td></tr>")
+    return p + ["</table>"]
+
+
+def _verification_table(name: str, ver: dict) -> list[str]:
+    """Every verified plan's rows (trials, successes, failures by reason); failing rows red."""
+    rows = verification_rows({name: ver})
+    if not rows:
+        return [f"<p>Nothing verified: {html.escape(ver.get('note', 'no plan'))}.</p>"]
+    fail = HEADER.index("failures")
+    p = ['<table class="verification"><tr>' + "".join(f"<th>{h}</th>" for h in HEADER[1:]) + "</tr>"]
+    for r in rows:
+        cls = ' class="fail"' if r[fail] != "0" else ""
+        p.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(c)}</td>" for c in r[1:]) + "</tr>")
+    return p + ["</table>"]
+
+
+def _animation(res: dict, files: dict, base) -> list[str]:
+    """The recommended plan's animation (the tight planner's, else paper mode's best)."""
+    from pipeline.present.animate import recommended_index
+    which = recommended_index(res)
+    if "animation" not in files:
+        return ["<p>No animation.</p>"]
+    what = {"tight": f"the tight planner's recommended plan (mu_c {(res.get('tight') or [{}])[0].get('friction')})",
+            1: "paper mode's best plan", None: "no plan"}[which]
+    src = _rel(files["animation"], base)
+    return [f"<p>Every initial state past the pins of {html.escape(what)}; "
+            f"'pinfeed animate --part {html.escape(res['part']['name'])}' makes a smoother one.</p>",
+            f'<a href="{src}"><img src="{src}" alt="animation"></a>']
+
+
+def _warnings(plans: dict, verifications: dict) -> list[str]:
+    """Warnings and failing verification rows, in red, for the top of the page."""
+    items = []
+    for name, res in plans.items():
+        for t in res.get("tight", []):
+            if t.get("warning"):
+                items.append(f"{name}, tight planner at mu_c {t['friction']}: {t['warning']}")
+    for name, ver in verifications.items():
+        for check in ver.get("checks", []):
+            for r in check["rows"]:
+                if r["failures"]:
+                    items.append(f"{name}, {check['kind']} ({' '.join(check['plan'])}), {r['state']}: "
+                                 f"{r['failures']} of {r['trials']} trials failed "
+                                 f"({'; '.join(f'{k}: {v}' for k, v in sorted(r['reasons'].items()))})")
+    if not items:
+        return []
+    return (['<div style="color:#b00"><h2>Warnings</h2><ul>'] +
+            [f"<li>{html.escape(t)}</li>" for t in items] + ["</ul></div>"])
+
+
+def _counts(check) -> str:
+    if check is None:
+        return "not verified"
+    t = sum(r["trials"] for r in check["rows"])
+    ok = sum(r["successes"] for r in check["rows"])
+    return f"{ok}/{t}"
+
+
+def _speed_cell(speed: dict | None, friction: str, pins) -> str:
+    """The speed limit of a tight plan, if the speed stage replayed this plan."""
+    if not speed or speed.get("speed_limit_mm_s") is None:
+        return "<td>n/a</td>"
+    if speed.get("friction") != friction or list(speed.get("pin_labels", [])) != list(pins):
+        return "<td>n/a</td>"
+    return f"<td>{speed['speed_limit_mm_s']:g}</td>"
+
+
+def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> list[str]:
+    """The paper-mode plan beside the tight planner's, with verification counts
+    and the speed limit (mm/s, dynamic model) of the plan the speed stage replayed."""
+    from pipeline.planning.arcs import format_arcs
+    checks = {c["kind"]: c for c in (ver or {}).get("checks", [])}
+    p = ['<h4>Paper mode beside the tight planner</h4><table class="side-by-side"><tr><th>planner</th>'
+         "<th>friction mu_c</th><th>pins (height, mm)</th><th>final sets</th>"
+         "<th>orientation sets</th><th>verified (successes/trials)</th>"
+         "<th>speed limit (mm/s)</th></tr>"]
+    static = res.get("best_static")
+    if static:
+        pins = ", ".join(f"{q} ({res['pins'][q]:g})" for q in static["pins"])
+        sets = format_arcs([(s["start"], s["width"]) for s in static["final_sets"]])
+        p.append(f"<tr><td>paper mode, fixed pins</td><td>{res['mu_c']:g} (stored maps)</td>"
+                 f"<td>{html.escape(pins)}</td><td>{static['n_final_sets']}</td><td>{sets}</td>"
+                 f"<td>{_counts(checks.get('paper mode, fixed pins'))}</td><td>n/a</td></tr>")
+    for t in res.get("tight", []):
+        plan = t["recommended"]
+        if plan is None:
+            p.append(f"<tr><td>tight</td><td>{t['friction']}</td><td colspan=5 style='color:#b00'>"
+                     f"{html.escape(t['warning'] or 'no plan')}</td></tr>")
+            continue
+        pins = ", ".join(f"{q} ({y:g})" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
+        sets = format_arcs([(s["start"], s["width"]) for s in plan["final_sets"]])
+        planner = "tight" + (f" at {t['belt_speed']:g} mm/s" if t.get("belt_speed") else "")
+        p.append(f"<tr><td>{planner}</td><td>{t['friction']}</td><td>{html.escape(pins)}</td>"
+                 f"<td>{plan['n_final_sets']}</td><td>{sets}</td>"
+                 f"<td>{_counts(checks.get('tight, mu_c ' + t['friction']))}</td>"
+                 f"{_speed_cell(speed, t['friction'], plan['pins'])}</tr>")
+    p.append("</table>")
+    return p
+
+
+def _sets(sets) -> str:
+    return ", ".join(f"[{s['start']:.0f}, {s['start'] + s['width']:.0f}]" for s in sets)
+
+
+def _sensing_section(res: dict, figs: dict, base) -> list[str]:
+    """Force/torque sensor on the first pin: the verdict table and the two figures."""
+    p = []
+    if not res.get("found"):
+        return p + [f"<p>No sensor plan: {html.escape(res.get('note', 'no stored verified plan'))}.</p>"]
+    t = res["score_table"]
+    known = ("a known final orientation for every initial state" if res["known_for_every_state"]
+             else f"up to {res['worst_sets']} final orientation sets for one verdict")
+    alone = res["without_sensor"]
+    p.append(f"<p>Sensor on {html.escape(res['first_pin'])} (y = {res['y_pin']:g} mm), stored tight "
+             f"plan #{res['plan_rank']} {html.escape(' → '.join(res['plan']['pins']))} at mu_c "
+             f"{html.escape(res['friction'])} (simulated profiles at mu_c {res['mu_c_profiles']:g}): "
+             f"{known}; {html.escape(res['note'])}. Without the sensor the recommended plan "
+             f"{html.escape(' → '.join(alone['pins']))} ({alone['moving_pins']} moving pin(s)) ends in "
+             f"{alone['n_final_sets']} set(s). Classification accuracy {100 * t['accuracy']:.0f} % "
+             f"(wrong {100 * t['wrong']:.0f} %) over {t['trials']} synthetic measurements per state.</p>")
+    p.append("<table><tr><th>sensor verdict (states it cannot tell apart)</th>"
+             "<th>final orientation set(s) (deg)</th><th>known</th></tr>")
+    for g in res["groups"]:
+        p.append(f"<tr><td>{html.escape(', '.join(g['states']))}</td><td>{_sets(g['final_sets'])}</td>"
+                 f"<td>{'yes' if g['known'] else 'no'}</td></tr>")
+    p.append("</table>")
+    if "verification" in res:
+        p.append("<p>End to end, perturbed full rollouts with the sensor reading the first pin "
+                 "(trials counted by what the verdict said about the final orientation):</p>")
+        p.append("<table><tr><th>initial state</th><th>trials</th><th>one set named, right</th>"
+                 "<th>one set named, wrong</th><th>several sets named</th><th>jammed</th></tr>")
+        for lab, r in res["verification"]["rows"].items():
+            p.append(f"<tr><td>{html.escape(lab)}</td><td>{r['trials']}</td><td>{r['right']}</td>"
+                     f"<td>{r['wrong']}</td><td>{r['ambiguous']}</td><td>{r['jammed']}</td></tr>")
+        p.append("</table>")
+    p += _figure(figs, "profiles", base, "Force/torque profiles on the first pin")
+    p += _figure(figs, "scores", base, "Score matrix")
+    return p

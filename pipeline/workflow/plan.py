@@ -1,0 +1,165 @@
+"""The functions of ``rules/plan.smk`` (bands, plan, verify) and the maps a
+plan needs (``ensure_maps``, for ``pinfeed plan`` on a part the catalog lacks).
+
+bands  -> one JSON per shard: B_j, K_j, COM_j and adjusted bands for every d
+plan   -> one JSON per planned part: paper mode's ranked plans and the tight plans
+verify -> one JSON per planned part: perturbed full rollouts of the plans to check
+All of it lives in the config's results folder (``results_dir/NAME``,
+:func:`pipeline.config.results_folder`; file names in
+:func:`pipeline.workflow.report.part_files`). All JSON is written atomically."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from pipeline.maps.catalog import Catalog
+from pipeline.maps.io import read_json, read_map, write_json
+from pipeline.maps.sweep import ShardJob, write_shard
+from pipeline.parts.part import Part
+from pipeline.planning.bands import map_bands
+from pipeline.planning.paper import build_planner, paper_depth
+from pipeline.planning.plan import nominal_friction, parse_friction, plan_tight_all
+from pipeline.planning.verify import verify_plan
+from pipeline.provenance import provenance_attrs
+
+
+def shard_bands(shard, threshold_T, factor_c) -> dict:
+    """The bands of every map (every d) in one shard, with provenance: B_j, the
+    kernels K_j as all their arcs, COM intervals and the bands adjusted by
+    ``factor_c`` standard deviations (threshold ``threshold_T``)."""
+    ds = read_map(shard)
+    bands = map_bands(ds, threshold_T, factor_c)
+    return {"part_id": ds.attrs["part_id"], "model": ds.attrs["model"], "mu_c": ds.attrs["mu_c"],
+            "v_pin": float(ds.attrs.get("v_pin", 0.0)),
+            "threshold_T": threshold_T, "factor_c": factor_c, "shard": str(shard),
+            "maps": {f"{d:g}": [b.to_dict() for b in bs] for d, bs in bands.items()},
+            **provenance_attrs()}
+
+
+def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=None,
+              tight: bool = True) -> dict:
+    """Plans for one part: the paper's adjusted-band planner (``plans``,
+    ``best_static``: fixed pins, then moving pins) at the stored friction
+    nearest the planner's, and the tight planner (``tight``) at every
+    friction of :func:`~pipeline.planning.plan.plan_frictions`, each verified by full rollouts."""
+    pc = config["planner"]
+    part, planner, mu_used, selection = build_planner(cat, name, config)
+    dyn = pc.get("dynamic", {})
+    plans = planner.search(paper_depth(config), keep=keep, dynamic_depth=dyn.get("depth", 0),
+                           dynamic_beam=dyn.get("beam", 50))
+    states = planner.initial_states()
+    static_only = [p for p in plans if p.n_dynamic == 0]
+    if planner.dynamic_labels and not static_only:
+        static_only = [p for p in planner.search(paper_depth(config), keep=1) if p.n_dynamic == 0]
+    return {
+        "part": part.to_dict(), "model": pc["model"], "mu_c": mu_used, "selection": selection,
+        "pins": planner.pins,
+        "pin_speeds": {k: v for k, v in planner.speeds.items() if v != 0.0},
+        "depth": paper_depth(config), "dynamic_depth": dyn.get("depth", 0) if planner.dynamic_labels else 0,
+        "d_min": pc["d_min"], "d_max": pc["d_max"],
+        "coverage": planner.coverage,
+        "best_static": static_only[0].to_dict() if static_only else None,
+        "initial_states": {k: {"theta": s.arc[0], "y_c": s.y_lo} for k, s in states.items()},
+        "plans": [p.to_dict() for p in plans],
+        "found": bool(plans),
+        "tight": plan_tight_all(part, config, cat.root, keep=keep, progress=progress) if tight else [],
+        **provenance_attrs(),
+    }
+
+
+def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:
+    """Make sure the catalog holds the maps the planner needs for ``part``:
+    the planner's model at its mu_c over the sweep's d grid, for a static pin
+    and for every dynamic speed the planner may use. Missing ones are
+    computed with the sweep settings, stored atomically and indexed."""
+    root = Path(config["catalog_dir"])
+    pc = config["planner"]
+    cat = Catalog.open(root) if (root / "index.json").is_file() else None
+    entries = cat.entries if cat else []
+    fam = next((e["family"] for e in entries if e["part_id"] == part.id), family)
+    mu = nominal_friction(parse_friction(pc["mu_c"]))
+    wrote = False
+    for v in [0.0] + [float(x) for x in pc.get("dynamic", {}).get("speeds", [])]:
+        have = any(e["part_id"] == part.id and e["model"] == pc["model"]
+                   and e["mu_c"] == mu and e.get("v_pin", 0.0) == v for e in entries)
+        if not have:
+            write_shard(config, ShardJob(fam, part, pc["model"], mu, v))
+            wrote = True
+    if wrote:
+        cat = Catalog.rebuild(root)
+    return cat
+
+
+def plans_to_check(plan_result: dict) -> dict:
+    """The plans the verify stage replays and the figures draw: ``"fixed pins"``
+    (the best plan of static pins only) and, when the best plan moves a pin,
+    ``"with dynamic pins"`` (the best plan overall)."""
+    plans = plan_result["plans"]
+    if not plans:
+        return {}
+    best = plans[0]
+    static = plan_result.get("best_static")
+    if static is None and not best.get("n_dynamic_pins", 0):
+        static = best
+    out = {"fixed pins": static} if static else {}
+    if best.get("n_dynamic_pins", 0):
+        out["with dynamic pins"] = best
+    return out
+
+
+def verify_part(plan_result: dict, config: dict) -> dict:
+    """Perturbed full rollouts of the paper-mode plans (best fixed-pin plan and
+    best plan with dynamic pins, if any) and of the tight planner's
+    recommended plan at every friction: ``{"part", "checks": [verify_plan
+    result + "kind"]}``."""
+    name = plan_result["part"]["name"]
+    out = {"part": name, "checks": [], **provenance_attrs()}
+    part = Part.from_vertices(plan_result["part"]["vertices"], name=name)
+    states = {k: (v["theta"], v["y_c"]) for k, v in plan_result["initial_states"].items()}
+    radius, kernel = config["sweep"]["pin_radius"], config["sweep"].get("kernel")
+    for kind, plan in plans_to_check(plan_result).items():
+        res = verify_plan(part, plan, plan_result["pins"], states, plan_result["mu_c"], radius,
+                          plan_result["model"], config.get("verify", {}),
+                          speeds=plan_result.get("pin_speeds", {}), kernel=kernel)
+        res.pop("trials_detail")
+        out["checks"].append({"kind": f"paper mode, {kind}", **res})
+    for tight in plan_result.get("tight", []):
+        plan = tight["recommended"]
+        if plan is None:
+            continue
+        mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
+        res = verify_plan(part, plan, dict(zip(plan["pins"], plan["pin_heights_mm"])), states, mu,
+                          radius, plan_result["model"], config.get("verify", {}), kernel=kernel,
+                          speeds=dict(zip(plan["pins"], plan["pin_speeds"])),
+                          belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
+        res.pop("trials_detail")
+        out["checks"].append({"kind": f"tight, mu_c {tight['friction']}", **res})
+    if not out["checks"]:
+        out["note"] = "no allowed plan within the depth"
+    return out
+
+
+# ---------------------------------------------------------------------- one function per rule
+
+
+def bands(shard, settings: dict, out) -> dict:
+    """Rule ``bands``: the bands of one shard with the config's ``bands``
+    settings (``threshold_T``, ``factor_c``), written to ``out``."""
+    result = shard_bands(shard, settings["threshold_T"], settings["factor_c"])
+    write_json(result, out)
+    return result
+
+
+def plan(config: dict, name: str, out) -> dict:
+    """Rule ``plan``: the plans of the config's part ``name`` from the catalog
+    (:func:`plan_part`), written to ``out``."""
+    result = plan_part(Catalog.open(config["catalog_dir"]), name, config)
+    write_json(result, out)
+    return result
+
+
+def verify(plan_path, config: dict, out) -> dict:
+    """Rule ``verify``: :func:`verify_part` of the stored plans at ``plan_path``,
+    written to ``out``."""
+    result = verify_part(read_json(plan_path), config)
+    write_json(result, out)
+    return result

@@ -1,0 +1,205 @@
+"""The functions of ``rules/report.smk``: figures, outline, animation and the
+HTML page that links every result of the planned parts (read from the
+results folder and the catalog; nothing is recomputed but the nominal paths
+and replays the figures draw)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from pipeline.maps import simulate
+from pipeline.maps.catalog import Catalog
+from pipeline.maps.io import read_json
+from pipeline.parts.families import config_part_source
+from pipeline.parts.part import Part
+from pipeline.present.animate import animate_stored, recommended_index
+from pipeline.present.figures import placeholder, placeholder_gif
+from pipeline.present.figures.bands import plot_band_maps
+from pipeline.present.figures.carried import plot_carried, replayed_paths
+from pipeline.present.figures.outline import plot_outline
+from pipeline.present.figures.sequence import plot_sequence
+from pipeline.present.figures.tables import markdown_table, plot_table, plot_verification, verification_rows
+from pipeline.present.report import write_report
+from pipeline.workflow.plan import plans_to_check
+
+
+def nominal_paths(plan_result: dict, config: dict, plan: dict | None = None) -> dict:
+    """Unperturbed rollouts of a plan (default: the best): (theta, y_c) before and after each pin."""
+    part = Part.from_vertices(plan_result["part"]["vertices"], name=plan_result["part"]["name"])
+    best = plan or plan_result["plans"][0]
+    speeds = plan_result.get("pin_speeds", {})
+    paths = {}
+    for label, s in plan_result["initial_states"].items():
+        theta, y = s["theta"], s["y_c"]
+        path = [(theta, y)]
+        for pin in best["pins"]:
+            r = simulate.rollout(part, theta, (plan_result["pins"][pin] - y) / part.a,
+                                 plan_result["mu_c"], config["sweep"]["pin_radius"],
+                                 model=plan_result["model"], v_pin=speeds.get(pin, 0.0))
+            theta, y = float(r.theta_f), y + float(r.dy)
+            path.append((theta, y))
+        paths[label] = path
+    return paths
+
+
+def make_figures(config, plan_paths, verify_paths, out: dict):
+    """Every figure of the planned parts. ``out`` holds lists (one path per
+    part, in plan order) under ``maps`` (models side by side), ``speeds``
+    (the planner's model at each pin speed), ``sequence`` (best fixed-pin
+    plan), ``sequence_dynamic`` (best plan with dynamic pins), and single
+    paths ``verification`` (PNG) and ``table`` (Markdown)."""
+    cat = Catalog.open(config["catalog_dir"])
+    bc, fc = config["bands"], config["figures"]
+    verifications = {}
+    for k, (plan_path, verify_path) in enumerate(zip(plan_paths, verify_paths)):
+        res = read_json(plan_path)
+        name, part_id = res["part"]["name"], res["part"]["id"]
+        maps = {model: cat.query(part_id, model=model, mu_c=res["mu_c"]).isel(mu_c=0).load()
+                for model in config["sweep"]["models"]}
+        plot_band_maps(maps, fc["d"], bc["threshold_T"], bc["factor_c"],
+                       f"{name}: configuration maps, $\\mu_c$ = {res['mu_c']:g} (rows: models)", out["maps"][k])
+        speeds = {f"$v_{{pin}}/v_b$ = {v:+g}": cat.query(part_id, model=res["model"], mu_c=res["mu_c"], v_pin=v)
+                  .isel(mu_c=0).load() for v in sorted(config["sweep"]["v_pin"])}
+        plot_band_maps(speeds, fc["d"], bc["threshold_T"], bc["factor_c"],
+                       f"{name}: {res['model']} maps by pin speed, $\\mu_c$ = {res['mu_c']:g} "
+                       f"(d at the centroid's station)", out["speeds"][k])
+        to_draw = plans_to_check(res)
+        _sequence_figure(config, res, to_draw.get("fixed pins"), "best fixed-pin plan", out["sequence"][k])
+        _sequence_figure(config, res, to_draw.get("with dynamic pins"), "best plan with dynamic pins",
+                         out["sequence_dynamic"][k])
+        if "carried" in out:
+            _carried_figure(config, res, out["carried"][k])
+        verifications[name] = read_json(verify_path)
+        if out.get("verification_plans"):  # optional: one figure per part, its plans stacked
+            _verification_figure(verifications[name], out["verification_plans"][k])
+    rows = verification_rows(verifications)
+    plot_table(rows, "Verification of the best plans by perturbed full rollouts", out["verification"])
+    Path(out["table"]).write_text(markdown_table(rows))
+
+
+def _verification_figure(result: dict, path):
+    """The verification figure of a part: every checked plan (``verify_part`` result)."""
+    if not result["checks"]:
+        placeholder(path, f"{result['part']}: {result.get('note', 'nothing verified')}")
+        return
+    plot_verification(result["checks"], f"{result['part']}: verification by perturbed rollouts", path)
+
+
+def _sequence_figure(config, res, plan, what, path):
+    name = res["part"]["name"]
+    if plan is None:
+        if not res["plans"]:
+            why = f"no allowed plan within depth {res['depth']}"
+        elif "fixed" in what:
+            why = "no allowed plan of fixed pins only"
+        else:
+            why = "no plan with dynamic pins beats the fixed pins (or none allowed)"
+        placeholder(path, f"{name}, {what}: {why}")
+        return
+    part = Part.from_vertices(res["part"]["vertices"], name=name)
+    plot_sequence(part, plan, res["pins"], nominal_paths(res, config, plan),
+                  config["sweep"]["pin_radius"], f"{name}: {what}", path,
+                  speeds=res.get("pin_speeds", {}))
+
+
+def _carried_figure(config, res, path):
+    """The tight planner's recommended plan (first friction): carried sets against replays."""
+    name = res["part"]["name"]
+    tight = (res.get("tight") or [None])[0]
+    if not tight or not tight["recommended"]:
+        placeholder(path, f"{name}: no recommended tight plan" + (f" ({tight['warning']})" if tight else ""))
+        return
+    plan = tight["recommended"]
+    part = Part.from_vertices(res["part"]["vertices"], name=name)
+    mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
+    starts = {k: (v["theta"], v["y_c"]) for k, v in res["initial_states"].items()}
+    replays = replayed_paths(part, plan, starts, mu, config["sweep"]["pin_radius"], res["model"],
+                             config.get("verify", {}), kernel=config["sweep"].get("kernel"),
+                             belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
+    plot_carried(plan, replays, f"{name}: carried sets of plan {' '.join(plan['pins'])} (mu_c "
+                 f"{tight['friction']}) against {len(next(iter(replays.values()))[0])} replayed "
+                 f"rollouts per state", path)
+
+
+def outline_figure(plan_result: dict, config: dict, out) -> Path:
+    """The outline figure of a planned part (from its plan JSON)."""
+    part = Part.from_vertices(plan_result["part"]["vertices"], name=plan_result["part"]["name"])
+    return plot_outline(part, out, source=config_part_source(config, part.name))
+
+
+def animate_part(plan_result: dict, config: dict, out, frames: int, fps: int,
+                 layout: dict | None = None) -> dict:
+    """The part's recommended plan as an animation: the tight planner's
+    recommended plan (first friction) if there is one, else paper mode's best;
+    with no plan at all, a one-frame note. With ``layout`` (the layout stage's
+    JSON) that has stations, the laid-out plan on one belt instead: pins at the
+    stations, parts at the pitch. Returns the summary (``plan``: which one)."""
+    if layout is not None and layout.get("stations"):
+        return animate_stored(plan_result, config, out, frames=frames, fps=fps, layout=layout)
+    which = recommended_index(plan_result)
+    if which is None:
+        placeholder_gif(out, f"{plan_result['part']['name']}: no plan to animate")
+        return {"out": str(out), "frames": 1, "plan": None, "outcomes": {}}
+    return animate_stored(plan_result, config, out, which, frames=frames, fps=fps)
+
+
+PART_FIGURES = ("outline", "maps", "speeds", "sequence", "sequence_dynamic", "carried", "verification",
+                "profiles", "scores", "speed_limit")
+
+
+def part_files(results, name: str) -> dict:
+    """Where the workflow writes a part's files under ``results`` (RESULTS_DIR/NAME):
+    JSON (``plan``, ``verify``, ``sensing``, ``speed``), figures
+    (:data:`PART_FIGURES`) and the ``animation``; the rules in rules/*.smk use
+    the same names."""
+    results = Path(results)
+    out = {kind: results / kind.replace("plan", "plans") / f"{name}.json"
+           for kind in ("plan", "verify", "sensing", "speed")}
+    out.update({kind: results / "figures" / f"{kind}_{name}.png" for kind in PART_FIGURES})
+    out["animation"] = results / "animations" / f"{name}.gif"
+    out.update({f"layout_{ext}": results / f"layout_{name}.{ext}" for ext in ("json", "png", "dxf", "svg")})
+    return out
+
+
+def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_paths=()):
+    """The HTML page (``out``, in the results folder) of the planned parts: their
+    results, every figure found beside them, and the catalog shards they use."""
+    results = Path(out).parent
+    cat = Catalog.open(config["catalog_dir"])
+    parts = {}
+    for plan_path, verify_path in zip(plan_paths, verify_paths):
+        plan = read_json(plan_path)
+        name = plan["part"]["name"]
+        files = {k: p for k, p in part_files(results, name).items() if Path(p).is_file()}
+        files.update(plan=Path(plan_path), verify=Path(verify_path))
+        if "layout_json" in files:  # the feeder layout (rules/layout.smk)
+            parts.setdefault(name, {})["layout"] = read_json(files["layout_json"])
+        parts[name] = {**parts.get(name, {}), "plan": plan, "verify": read_json(verify_path), "files": files,
+                       "shards": sorted((e for e in cat.entries if e["part_id"] == plan["part"]["id"]),
+                                        key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0)))}
+    for path in sensing_paths:  # force/torque sensor on the first pin (rules/sense.smk)
+        res = read_json(path)
+        parts[res["part"]["name"]]["sensing"] = res
+        parts[res["part"]["name"]]["files"]["sensing"] = Path(path)
+    for path in speed_paths:  # speed curve and limit of the recommended plan (rules/speed.smk)
+        res = read_json(path)
+        parts[res["part"]]["speed"] = res
+        parts[res["part"]]["files"]["speed"] = Path(path)
+    overview = {k: results / f for k, f in (("verification figure", "figures/verification.png"),
+                                            ("verification table", "verification.md"))
+                if (results / f).is_file()}
+    return write_report(config, parts, out, overview=overview, catalog=cat.root)
+
+
+# ---------------------------------------------------------------------- rules reading a plan file
+
+
+def outline(plan_path, config: dict, out) -> Path:
+    """Rule ``outline``: :func:`outline_figure` of the stored plans at ``plan_path``."""
+    return outline_figure(read_json(plan_path), config, out)
+
+
+def animate(plan_path, config: dict, out, frames: int, fps: int, layout_path=None) -> dict:
+    """Rule ``animate``: :func:`animate_part` of the stored plans at ``plan_path``,
+    on the feeder of the layout stage's JSON at ``layout_path`` when given."""
+    layout = read_json(layout_path) if layout_path else None
+    return animate_part(read_json(plan_path), config, out, frames, fps, layout=layout)

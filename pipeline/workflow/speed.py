@@ -1,0 +1,48 @@
+"""The function of ``rules/speed.smk``: how fast may a part's recommended plan run."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from pipeline.maps.io import read_json, write_json
+from pipeline.planning.speed_limit import stored_plan_speed
+from pipeline.present.figures import placeholder
+from pipeline.present.figures.speed import plot_speed_curve
+from pipeline.provenance import provenance_attrs
+
+
+def speed_part(plan_result: dict, config: dict) -> dict:
+    """The speed curve and speed limit of a part's recommended tight plan (first
+    friction), with the settings of ``config["speed"]`` (trials per state,
+    ``mu_s``, speed grid, resolution, required fraction, seed): the JSON of
+    ``speed_limit.stored_plan_speed`` plus provenance. A part without a
+    recommended plan gets ``speed_limit_mm_s: None`` and a ``note``."""
+    sc = config.get("speed", {})
+    name = plan_result["part"]["name"]
+    tight = (plan_result.get("tight") or [None])[0]
+    if not tight or not tight.get("plans"):
+        why = tight["warning"] if tight else "no tight plan"
+        return {"part": name, "speed_limit_mm_s": None, "curve": [], "note": why,
+                **provenance_attrs()}
+    res = stored_plan_speed(plan_result, config, plan=1, mu_s=float(sc.get("mu_s", 0.5)),
+                            trials=int(sc.get("trials", 30)),
+                            speeds=[float(v) for v in sc.get("speeds", (10, 50, 100, 150, 200, 300, 400, 500))],
+                            resolution=float(sc.get("resolution", 5.0)),
+                            required=float(sc.get("required", 0.99)), seed=int(sc.get("seed", 0)))
+    return {**res, **provenance_attrs()}
+
+
+def speed_figure(result: dict, out) -> Path:
+    """The speed curve figure of a :func:`speed_part` result (a note if no plan)."""
+    if result.get("speed_limit_mm_s") is None:
+        placeholder(out, f"{result['part']}: no speed limit ({result.get('note', 'no plan')})")
+        return Path(out)
+    return plot_speed_curve(result, out)
+
+
+def speed(plan_path, config: dict, out, figure) -> dict:
+    """Rule ``speed``: :func:`speed_part` of the stored plans at ``plan_path``,
+    written to ``out``, and its figure (:func:`speed_figure`) to ``figure``."""
+    result = speed_part(read_json(plan_path), config)
+    write_json(result, out)
+    speed_figure(result, figure)
+    return result
