@@ -722,6 +722,17 @@ def build_parser() -> argparse.ArgumentParser:
                      "on a conveyor with overhead pins.")
     sub = parser.add_subparsers(dest="command", required=True)
 
+    _add_map_commands(sub)
+    _add_sweep_plan_commands(sub)
+    _add_catalog_commands(sub)
+    _add_sense_commands(sub)
+    _add_stored_plan_commands(sub)
+    _add_layout_commands(sub)
+    return parser
+
+
+def _add_map_commands(sub) -> None:
+    """``rollout``, ``map`` and ``plot-map``: one passage, one map set, its drawing."""
     p = sub.add_parser("rollout", help="roll a part past one pin for some initial orientations")
     _add_physics(p, belt=True)
     p.add_argument("--theta-i", required=True, help="initial orientations, degrees: 'a,b,c' or 'start:stop:step'")
@@ -750,6 +761,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also draw the bands B_j x K_j and adjusted bands: threshold T (deg) and factor c")
     p.set_defaults(func=cmd_plot_map)
 
+
+def _add_sweep_plan_commands(sub) -> None:
+    """``sweep`` (catalog shards of a config) and ``plan`` (pin sequences)."""
     p = sub.add_parser("sweep", help="compute missing catalog shards of a config (locally or on dask)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--catalog", default=None, help="catalog folder (default: the config's catalog_dir)")
@@ -787,6 +801,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plan)
 
+
+def _add_catalog_commands(sub) -> None:
+    """``catalog index|list|show|query|plot``: the map database."""
     cat = sub.add_parser("catalog", help="the map database: list, show, query, plot, index")
     csub = cat.add_subparsers(dest="catalog_command", required=True)
 
@@ -822,6 +839,9 @@ def build_parser() -> argparse.ArgumentParser:
             q.add_argument("--bands", default=None, metavar="T,C",
                            help="also draw the bands: threshold T (deg) and factor c, e.g. 5,2")
 
+
+def _add_sense_commands(sub) -> None:
+    """``sense classify``: which initial state a measured force profile comes from."""
     sense = sub.add_parser("sense", help="force/torque sensor on the first pin: classify a measured profile")
     ssub = sense.add_subparsers(dest="sense_command", required=True)
     q = ssub.add_parser("classify", help="which initial state a measured force profile comes from",
@@ -844,6 +864,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
 
+
+def _add_stored_plan_commands(sub) -> None:
+    """``animate`` and ``speed``: a stored plan's animation and its belt-speed limit."""
     p = sub.add_parser("animate", help="animate a stored plan: every initial state past the pins")
     p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
     p.add_argument("--plan", type=_plan_choice, default=None,
@@ -874,6 +897,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_speed)
 
+
+def _add_layout_commands(sub) -> None:
+    """``layout`` (a feeder to build) and ``demo`` (one map set of a default triangle)."""
     p = sub.add_parser("layout", help="a feeder to build: pin stations, part pitch, belt width, "
                        "throughput and a drawing (DXF, SVG, PNG)")
     p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
@@ -900,7 +926,6 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")
     p.set_defaults(func=cmd_demo)
-    return parser
 
 
 def main(argv=None) -> int:
