@@ -39,13 +39,13 @@ def rate(part, model, mu_c, threads, repeat, backend="cpu", scale=1):
     """Rollouts per second: ``(by wall time, by the process's CPU time)``,
     each the best of ``repeat`` timings."""
     theta = np.arange(0.0, 360.0, 1.0 / scale)
-    simulate.map(part, theta[:4], PAPER_D[:2], mu_c, 3.0, model=model, threads=threads,
-                 backend=backend)
+    simulate.compute_map(part, theta[:4], PAPER_D[:2], mu_c, 3.0, model=model, threads=threads,
+                         backend=backend)
     wall = cpu = np.inf
     for _ in range(repeat):
         t0, c0 = time.perf_counter(), time.process_time()
-        simulate.map(part, theta, PAPER_D, mu_c, 3.0, model=model, threads=threads,
-                     backend=backend)
+        simulate.compute_map(part, theta, PAPER_D, mu_c, 3.0, model=model, threads=threads,
+                             backend=backend)
         wall = min(wall, time.perf_counter() - t0)
         cpu = min(cpu, time.process_time() - c0)
     n = theta.size * len(PAPER_D)

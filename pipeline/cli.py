@@ -99,6 +99,7 @@ def _add_physics(p, d_required=True, belt=False):
 
 
 def cmd_rollout(args):
+    """``pinfeed rollout``: roll a part past one pin and print one row (or JSON) per orientation."""
     from pipeline.maps import simulate
     part = _part_from_args(args)
     belt = {}
@@ -158,6 +159,7 @@ def _print_trajectory(row, n_rows: int = 11):
 
 
 def cmd_map(args):
+    """``pinfeed map``: compute one map set (dims ``d x theta_i``) and write it to HDF5."""
     from pipeline.checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
     from pipeline.maps import simulate
     from pipeline.maps.io import write_atomic
@@ -170,8 +172,8 @@ def cmd_map(args):
     check_grid_size(d.size * math.ceil(360.0 / args.theta_step), "the map (d x theta_i)", MAX_MAP)
     check_out_path(args.out, MAP_SUFFIXES)
     theta = np.arange(0.0, 360.0 - 1e-9, args.theta_step)
-    ds = simulate.map(part, theta, d, args.mu_c, args.pin_radius, model=args.model,
-                      v_pin=args.v_pin, threads=args.threads, backend=args.backend)
+    ds = simulate.compute_map(part, theta, d, args.mu_c, args.pin_radius, model=args.model,
+                              v_pin=args.v_pin, threads=args.threads, backend=args.backend)
     ds.attrs.update(provenance_attrs())
     write_atomic(ds, args.out)
     counts = {name: int((ds.status.values == k).sum()) for k, name in enumerate(simulate.STATUSES)}
@@ -191,6 +193,7 @@ def _bands_option(text):
 
 
 def cmd_plot_map(args):
+    """``pinfeed plot-map``: draw a stored map file to an image."""
     from pipeline.checks import IMAGE_SUFFIXES, check_out_path
     from pipeline.maps.io import read_map
     from pipeline.present.figures.maps import plot_map
@@ -211,7 +214,7 @@ def cmd_demo(args):
     part = Part.from_vertices(parse_vertices(DEFAULT_TRIANGLE), name="triangle")
     theta = np.arange(0.0, 360.0, 1.0)
     print(f"computing {len(PAPER_D)} x {theta.size} minpower rollouts of {part.id} ...", flush=True)
-    ds = simulate.map(part, theta, PAPER_D, 0.2, 3.0)
+    ds = simulate.compute_map(part, theta, PAPER_D, 0.2, 3.0)
     ds.attrs.update(provenance_attrs())
     out = Path(args.out)
     write_atomic(ds, out / "map.h5")
@@ -228,6 +231,7 @@ def _catalog(args):
 
 
 def cmd_catalog_index(args):
+    """``pinfeed catalog index``: rebuild the catalog index from the shards on disk."""
     from pipeline.maps.catalog import Catalog
     cat = Catalog.rebuild(args.catalog)
     print(f"indexed {len(cat.entries)} shards under {args.catalog}")
@@ -236,6 +240,7 @@ def cmd_catalog_index(args):
 
 
 def cmd_catalog_list(args):
+    """``pinfeed catalog list``: one row per stored part (or JSON)."""
     rows = _catalog(args).parts()
     if args.json:
         _print_json(rows, indent=1)
@@ -248,6 +253,7 @@ def cmd_catalog_list(args):
 
 
 def cmd_catalog_show(args):
+    """``pinfeed catalog show``: a part's stored shards and provenance."""
     cat = _catalog(args)
     entries = cat.entries_for(args.part)
     e0 = entries[0]
@@ -280,6 +286,7 @@ def _query(args):
 
 
 def cmd_catalog_query(args):
+    """``pinfeed catalog query``: outcomes of one part at the asked mu_c, d and theta_i."""
     from pipeline.maps.simulate import status_names
     ds = _query(args).load()
     rows = []
@@ -301,6 +308,7 @@ def cmd_catalog_query(args):
 
 
 def cmd_catalog_plot(args):
+    """``pinfeed catalog plot``: draw one part's stored map at one friction."""
     from pipeline.checks import IMAGE_SUFFIXES, check_out_path
     from pipeline.present.figures.maps import plot_map
     check_out_path(args.out, IMAGE_SUFFIXES)
@@ -314,6 +322,7 @@ def cmd_catalog_plot(args):
 
 
 def cmd_sweep(args):
+    """``pinfeed sweep``: compute the shards a config asks for into the catalog."""
     from pipeline.config import load_config
     from pipeline.maps.sweep import run_sweep
     config = load_config(args.config)
@@ -326,6 +335,7 @@ def cmd_sweep(args):
 
 
 def cmd_plan(args):
+    """``pinfeed plan``: plan (and verify) pin sequences for the config's parts."""
     from pipeline.config import load_config
     from pipeline.planning.plan import parse_friction
     config = load_config(args.config)
@@ -707,10 +717,22 @@ def _join_signed_values(argv):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``pinfeed`` argument parser, one subcommand per command."""
     parser = _Parser(prog="pinfeed", description="pinfeed: design part feeders that orient flat parts "
                      "on a conveyor with overhead pins.")
     sub = parser.add_subparsers(dest="command", required=True)
 
+    _add_map_commands(sub)
+    _add_sweep_plan_commands(sub)
+    _add_catalog_commands(sub)
+    _add_sense_commands(sub)
+    _add_stored_plan_commands(sub)
+    _add_layout_commands(sub)
+    return parser
+
+
+def _add_map_commands(sub) -> None:
+    """``rollout``, ``map`` and ``plot-map``: one passage, one map set, its drawing."""
     p = sub.add_parser("rollout", help="roll a part past one pin for some initial orientations")
     _add_physics(p, belt=True)
     p.add_argument("--theta-i", required=True, help="initial orientations, degrees: 'a,b,c' or 'start:stop:step'")
@@ -739,6 +761,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also draw the bands B_j x K_j and adjusted bands: threshold T (deg) and factor c")
     p.set_defaults(func=cmd_plot_map)
 
+
+def _add_sweep_plan_commands(sub) -> None:
+    """``sweep`` (catalog shards of a config) and ``plan`` (pin sequences)."""
     p = sub.add_parser("sweep", help="compute missing catalog shards of a config (locally or on dask)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--catalog", default=None, help="catalog folder (default: the config's catalog_dir)")
@@ -776,6 +801,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plan)
 
+
+def _add_catalog_commands(sub) -> None:
+    """``catalog index|list|show|query|plot``: the map database."""
     cat = sub.add_parser("catalog", help="the map database: list, show, query, plot, index")
     csub = cat.add_subparsers(dest="catalog_command", required=True)
 
@@ -811,6 +839,9 @@ def build_parser() -> argparse.ArgumentParser:
             q.add_argument("--bands", default=None, metavar="T,C",
                            help="also draw the bands: threshold T (deg) and factor c, e.g. 5,2")
 
+
+def _add_sense_commands(sub) -> None:
+    """``sense classify``: which initial state a measured force profile comes from."""
     sense = sub.add_parser("sense", help="force/torque sensor on the first pin: classify a measured profile")
     ssub = sense.add_subparsers(dest="sense_command", required=True)
     q = ssub.add_parser("classify", help="which initial state a measured force profile comes from",
@@ -833,6 +864,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
 
+
+def _add_stored_plan_commands(sub) -> None:
+    """``animate`` and ``speed``: a stored plan's animation and its belt-speed limit."""
     p = sub.add_parser("animate", help="animate a stored plan: every initial state past the pins")
     p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
     p.add_argument("--plan", type=_plan_choice, default=None,
@@ -863,6 +897,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_speed)
 
+
+def _add_layout_commands(sub) -> None:
+    """``layout`` (a feeder to build) and ``demo`` (one map set of a default triangle)."""
     p = sub.add_parser("layout", help="a feeder to build: pin stations, part pitch, belt width, "
                        "throughput and a drawing (DXF, SVG, PNG)")
     p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
@@ -889,10 +926,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("demo", help="compute and plot one map set of a default triangle")
     p.add_argument("--out", default="results/demo", help="output folder")
     p.set_defaults(func=cmd_demo)
-    return parser
 
 
 def main(argv=None) -> int:
+    """Run the ``pinfeed`` command; returns the exit status.
+
+    Parameters
+    ----------
+    argv : the arguments after the program name (default ``sys.argv[1:]``).
+    """
     parser = build_parser()
     args = parser.parse_args(_join_signed_values(sys.argv[1:] if argv is None else list(argv)))
     try:

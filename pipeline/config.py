@@ -193,6 +193,7 @@ def config_hash(config: dict) -> str:
 
 
 def theta_grid(config: dict):
+    """The sweep's theta_i grid, degrees: ``0, step, ...`` below 360 (``sweep.theta_step``)."""
     import numpy as np
     step = config["sweep"]["theta_step"]
     return np.round(np.arange(int(round(360.0 / step))) * step, 10)

@@ -50,5 +50,6 @@ def creation_time() -> str:
 
 
 def provenance_attrs() -> dict:
+    """Version, git commit and creation time to store with a result."""
     return {"pinfeed_version": __version__, "git_commit": git_commit(),
             "created": creation_time()}

@@ -80,5 +80,5 @@ def warm_kernels(triangle):
     from pipeline.maps import simulate
     simulate.rollout(triangle, 30.0, 0.3, 0.2, 3.0)
     simulate.rollout(triangle, 30.0, 0.3, 0.2, 3.0, trajectory=True)
-    simulate.map(triangle, [0.0], [0.3], 0.2, 3.0)
+    simulate.compute_map(triangle, [0.0], [0.3], 0.2, 3.0)
     return True

@@ -51,7 +51,7 @@ def test_catalog_answer_equals_direct_kernel_call(swept):
     assert len(cat.entries) == 2 * 2 * 2  # parts x models x mu_c
     q = cat.query("tri", model="minpower", mu_c=0.2, d=0.3).load()
     part = Part.from_vertices(TINY["families"]["fam"]["parts"][0]["vertices"], name="tri")
-    direct = simulate.map(part, np.arange(0, 360, 45.0), [0.3], 0.2, 3.0, model="minpower")
+    direct = simulate.compute_map(part, np.arange(0, 360, 45.0), [0.3], 0.2, 3.0, model="minpower")
     np.testing.assert_array_equal(q["theta_f"].values[0], direct["theta_f"].values)
     np.testing.assert_array_equal(q["dy"].values[0], direct["dy"].values)
     np.testing.assert_array_equal(q["status"].values[0], direct["status"].values)
@@ -91,8 +91,8 @@ def test_dynamic_pin_speeds_are_a_catalog_dimension(tmp_path):
     assert names == ["mu_c=0.2.h5", "mu_c=0.2_v_pin=-1.5.h5"]  # static shards keep their names
     part = Part.from_vertices(TINY["families"]["fam"]["parts"][0]["vertices"], name="tri")
     moving = cat.query("tri", model="ellipsoid", mu_c=0.2, v_pin=-1.5).load()
-    direct = simulate.map(part, np.arange(0, 360, 45.0), [-0.4, 0.3], 0.2, 3.0, model="ellipsoid",
-                          v_pin=-1.5)
+    direct = simulate.compute_map(part, np.arange(0, 360, 45.0), [-0.4, 0.3], 0.2, 3.0, model="ellipsoid",
+                                  v_pin=-1.5)
     np.testing.assert_array_equal(moving["theta_f"].values[0], direct["theta_f"].values)
     static = cat.query("tri", model="ellipsoid", mu_c=0.2).load()
     assert not np.array_equal(static["theta_f"].values, moving["theta_f"].values)

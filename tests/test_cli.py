@@ -221,8 +221,8 @@ def test_map_and_plot_round_trip(tmp_path, capsys):
     np.testing.assert_allclose(ds.d.values, [0.3, 0.5])
     np.testing.assert_allclose(ds.theta_i.values, np.arange(0.0, 360.0, 30.0))
     assert ds.theta_f.dims == ("d", "theta_i")
-    want = simulate.map(Part.from_vertices(TRIANGLE), np.arange(0.0, 360.0, 30.0), [0.3, 0.5],
-                        0.2, 3.0)
+    want = simulate.compute_map(Part.from_vertices(TRIANGLE), np.arange(0.0, 360.0, 30.0), [0.3, 0.5],
+                                0.2, 3.0)
     np.testing.assert_array_equal(ds.theta_f.values, want.theta_f.values)
     np.testing.assert_array_equal(ds.dy.values, want.dy.values)
     np.testing.assert_array_equal(ds.status.values, want.status.values)

@@ -84,7 +84,7 @@ def test_plot_map_bands_option(tmp_path, capsys):
     from pipeline.maps.io import write_atomic
     from pipeline.parts.part import Part
     part = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
-    write_atomic(simulate.map(part, np.arange(0, 360, 30.0), [0.3], 0.2, 3.0), tmp_path / "m.h5")
+    write_atomic(simulate.compute_map(part, np.arange(0, 360, 30.0), [0.3], 0.2, 3.0), tmp_path / "m.h5")
     assert main(["plot-map", str(tmp_path / "m.h5"), "--out", str(tmp_path / "m.png"),
                  "--bands", "5,2"]) == 0
     assert (tmp_path / "m.png").is_file()

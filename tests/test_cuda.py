@@ -77,7 +77,7 @@ def test_kernel_compiles_to_ptx_for_hopper(monkeypatch):
 
 def test_unknown_backend_is_a_clear_error(triangle):
     with pytest.raises(PinfeedError, match="unknown backend 'tpu'"):
-        simulate.map(triangle, [0.0], [0.3], 0.2, 3.0, backend="tpu")
+        simulate.compute_map(triangle, [0.0], [0.3], 0.2, 3.0, backend="tpu")
 
 
 def _gpu_usable():
@@ -90,7 +90,7 @@ def _gpu_usable():
 @pytest.mark.skipif(_gpu_usable(), reason="this machine has a GPU")
 def test_cuda_without_a_gpu_is_a_one_line_error(triangle, capsys, tmp_path):
     with pytest.raises(PinfeedError) as exc:
-        simulate.map(triangle, [0.0], [0.3], 0.2, 3.0, backend="cuda")
+        simulate.compute_map(triangle, [0.0], [0.3], 0.2, 3.0, backend="cuda")
     msg = str(exc.value)
     assert "\n" not in msg and "cuda" in msg and "cpu" in msg
     rc = main(["map", "--vertices", "0,0 60,0 15,35", "--d", "0.3", "--mu-c", "0.2",

@@ -42,9 +42,9 @@ speeds = st.floats(0.3, 2.5).flatmap(lambda v: st.sampled_from([v, -v]))
 
 @given(part=parts(), theta=theta_grid(30.0), d=d_values(), mu_c=mu_values, model=models)
 def test_speed_zero_is_the_static_pin_bit_for_bit(part, theta, d, mu_c, model):
-    static = simulate.map(part, theta, d, mu_c, R_PIN, model=model)
+    static = simulate.compute_map(part, theta, d, mu_c, R_PIN, model=model)
     for v in (0.0, -0.0):
-        zero = simulate.map(part, theta, d, mu_c, R_PIN, model=model, v_pin=v)
+        zero = simulate.compute_map(part, theta, d, mu_c, R_PIN, model=model, v_pin=v)
         for name in ("status", "theta_f", "dy", "contact_travel", "peak_force"):
             np.testing.assert_array_equal(zero[name].values, static[name].values, err_msg=name)
 
@@ -53,9 +53,9 @@ def test_speed_zero_is_the_static_pin_bit_for_bit(part, theta, d, mu_c, model):
 def test_mirror_negates_the_pin_speed(part, theta, d, mu_c, model, v):
     # Reflecting y -> -y maps the part to its mirror at -theta_i, the pin to
     # -d moving at -v, and the outcome to -theta_f, -dy.
-    base = simulate.map(part, theta, d, mu_c, R_PIN, model=model, v_pin=v)
+    base = simulate.compute_map(part, theta, d, mu_c, R_PIN, model=model, v_pin=v)
     assume(_contact_fraction(base) > 0.3)
-    got = simulate.map(part.mirrored(), np.mod(-theta, 360.0), -d, mu_c, R_PIN, model=model, v_pin=-v)
+    got = simulate.compute_map(part.mirrored(), np.mod(-theta, 360.0), -d, mu_c, R_PIN, model=model, v_pin=-v)
     assert_maps_agree(base, part, mu_c, model, R_PIN, -base.theta_f.values, -base.dy.values, got,
                       v_pin=v)
 
@@ -63,10 +63,10 @@ def test_mirror_negates_the_pin_speed(part, theta, d, mu_c, model, v):
 @given(part=parts(), theta=theta_grid(30.0), d=d_values(), mu_c=mu_values, model=models, v=speeds)
 def test_moving_pin_is_a_static_pin_in_a_rotated_frame(part, theta, d, mu_c, model, v):
     beta = math.degrees(math.atan(v))
-    moving = simulate.map(part, theta, d, mu_c, R_PIN, model=model, v_pin=v)
+    moving = simulate.compute_map(part, theta, d, mu_c, R_PIN, model=model, v_pin=v)
     assume(_contact_fraction(moving) > 0.3)
     d_static = d / math.sqrt(1.0 + v * v)
-    rotated = [simulate.map(part, [(t + beta) % 360.0], d_static, mu_c, R_PIN, model=model)
+    rotated = [simulate.compute_map(part, [(t + beta) % 360.0], d_static, mu_c, R_PIN, model=model)
                for t in theta]
     got = moving.copy(deep=True)
     got["status"].values[:] = np.stack([r.status.values[:, 0] for r in rotated], axis=1)
@@ -136,7 +136,7 @@ def default_planners():
         part = _default_part(name)
 
         def maps(v, part=part):
-            ds = simulate.map(part, theta, sw["d"], PAPER_MU, sw["pin_radius"], model=pc["model"], v_pin=v)
+            ds = simulate.compute_map(part, theta, sw["d"], PAPER_MU, sw["pin_radius"], model=pc["model"], v_pin=v)
             return load_maps(ds, bc["threshold_T"], bc["factor_c"])
 
         static = pins_from_config(pc["pins"])

@@ -215,7 +215,7 @@ def test_speed_limit_of_a_small_plan_holds_on_replay():
 
 def test_dynamic_map_matches_single_rollouts_for_any_thread_count():
     th, d = [10.0, 100.0, 200.0, 300.0], [-0.5, 0.3]
-    maps = [simulate.map(ASYM, th, d, 0.3, R_PIN, model="dynamic", belt_speed=200.0, threads=t)
+    maps = [simulate.compute_map(ASYM, th, d, 0.3, R_PIN, model="dynamic", belt_speed=200.0, threads=t)
             for t in (1, 2)]
     for name in ("theta_f", "dy", "status", "peak_force"):
         np.testing.assert_array_equal(maps[0][name].values, maps[1][name].values)
@@ -242,8 +242,8 @@ def test_belt_speed_is_a_catalog_dimension(tmp_path):
     names = sorted(Path(e["file"]).as_posix().split("/", 2)[-1] for e in cat.entries)
     assert names == ["dynamic/mu_c=0.2_belt=250.0_mu_s=0.4.h5", "minpower/mu_c=0.2.h5"]
     fast = cat.query("tri", mu_c=0.2, belt_speed=250.0).load()
-    direct = simulate.map(ASYM, np.arange(0, 360, 45.0), [-0.4, 0.3], 0.2, 1.0, model="dynamic",
-                          belt_speed=250.0, mu_s=0.4)
+    direct = simulate.compute_map(ASYM, np.arange(0, 360, 45.0), [-0.4, 0.3], 0.2, 1.0, model="dynamic",
+                                  belt_speed=250.0, mu_s=0.4)
     np.testing.assert_array_equal(fast["theta_f"].values[0], direct["theta_f"].values)
     slow = cat.query("tri", mu_c=0.2).load()
     assert slow.attrs["model"] == "minpower"

@@ -175,7 +175,7 @@ def test_inputs_that_would_run_without_end_are_refused():
     with pytest.raises(PinfeedError, match="more than the limit of 10"):
         simulate.rollout(part, 0, 0.3, 0.2, pin_radius=100 * part.a)
     with pytest.raises(PinfeedError, match=r"ds_max must be in \[0.001, 1\]"):
-        simulate.map(part, [0], [0.3], 0.2, 3.0, ds_max=1e-9)
+        simulate.compute_map(part, [0], [0.3], 0.2, 3.0, ds_max=1e-9)
     with pytest.raises(PinfeedError, match=r"tol must be in \[1e-12, 0.001\]"):
         simulate.rollout(part, 0, 0.3, 0.2, 3.0, tol=1e-30)
     with pytest.raises(PolygonError, match="smaller than the limit of 0.001 mm"):

@@ -106,7 +106,7 @@ models = st.sampled_from(MODELS)
 def _near_jump(part, theta_i, d, mu_c, model, r_pin, v_pin=0.0):
     th = [theta_i - 0.05, theta_i, theta_i + 0.05]
     dd = [d - 0.002, d, d + 0.002]
-    m = simulate.map(part, th, dd, mu_c, r_pin, model=model, v_pin=v_pin)
+    m = simulate.compute_map(part, th, dd, mu_c, r_pin, model=model, v_pin=v_pin)
     s = m.status.values
     t = m.theta_f.values
     y = m.dy.values
@@ -149,9 +149,9 @@ def test_mirror(part, theta, d, mu_c, model):
     # Reflecting the whole scene in the belt's centre line (y -> -y) maps the
     # part to its mirror image at -theta_i, the pin to -d, and the outcome to
     # -theta_f, -dy; Coulomb friction and the support are symmetric.
-    base = simulate.map(part, theta, d, mu_c, R_PIN, model=model)
+    base = simulate.compute_map(part, theta, d, mu_c, R_PIN, model=model)
     assume(_contact_fraction(base) > 0.3)
-    got = simulate.map(part.mirrored(), np.mod(-theta, 360.0), -d, mu_c, R_PIN, model=model)
+    got = simulate.compute_map(part.mirrored(), np.mod(-theta, 360.0), -d, mu_c, R_PIN, model=model)
     assert_maps_agree(base, part, mu_c, model, R_PIN, -base.theta_f.values, -base.dy.values, got)
 
 
@@ -160,11 +160,11 @@ def test_mirror(part, theta, d, mu_c, model):
 def test_scale(part, theta, d, mu_c, model, k):
     # Quasi-static motion has no length scale but the part and the pin: scaling
     # both by k leaves angles unchanged and scales displacements by k.
-    base = simulate.map(part, theta, d, mu_c, R_PIN, model=model)
+    base = simulate.compute_map(part, theta, d, mu_c, R_PIN, model=model)
     assume(_contact_fraction(base) > 0.3)
     big = part.scaled(k)
     assert math.isclose(big.a, k * part.a, rel_tol=1e-12)
-    got = simulate.map(big, theta, d, mu_c, k * R_PIN, model=model)
+    got = simulate.compute_map(big, theta, d, mu_c, k * R_PIN, model=model)
     assert_maps_agree(base, part, mu_c, model, R_PIN, base.theta_f.values, k * base.dy.values,
                       got, dy_tol=DY_TOL * max(k, 1.0))
 
@@ -198,7 +198,7 @@ def test_k_fold_symmetry(sym, d, mu_c, model, offset):
     per = 8  # grid points per period
     step = 360.0 / k / per
     theta = offset + np.arange(k * per) * step
-    m = simulate.map(part, theta, d, mu_c, R_PIN, model=model)
+    m = simulate.compute_map(part, theta, d, mu_c, R_PIN, model=model)
     assume(_contact_fraction(m) > 0.3)
     # Compare each point with the one a period later (wrapping around).
     shift = np.roll(np.arange(theta.size), -per)
@@ -213,7 +213,7 @@ def test_drawing_frame(part, theta, d, mu_c, model, phi):
     # (counter-clockwise) means the rotated part at orientation theta has the
     # world shape of the original at theta + phi. So the map shifts by phi on
     # both axes: theta_f_rot(theta_i - phi) = theta_f(theta_i) - phi, same dy.
-    base = simulate.map(part, theta, d, mu_c, R_PIN, model=model)
+    base = simulate.compute_map(part, theta, d, mu_c, R_PIN, model=model)
     assume(_contact_fraction(base) > 0.3)
     rot = part.rotated(phi)
     c, s = math.cos(math.radians(phi)), math.sin(math.radians(phi))
@@ -221,7 +221,7 @@ def test_drawing_frame(part, theta, d, mu_c, model, phi):
     assert np.allclose(rot.vertices, by_hand, atol=1e-9) or any(
         np.allclose(np.roll(rot.vertices, j, axis=0), by_hand, atol=1e-9)
         for j in range(len(by_hand)))
-    got = simulate.map(rot, np.mod(theta - phi, 360.0), d, mu_c, R_PIN, model=model)
+    got = simulate.compute_map(rot, np.mod(theta - phi, 360.0), d, mu_c, R_PIN, model=model)
     assert_maps_agree(base, part, mu_c, model, R_PIN, base.theta_f.values - phi, base.dy.values,
                       got)
 
@@ -237,8 +237,8 @@ def test_comparison_rejects_a_wrong_transformation():
     part = Part.from_vertices([(0, 0), (60, 0), (15, 35)])
     theta = np.arange(0.0, 360.0, 15.0) + 2.0
     d = np.array([-0.6, 0.3, 0.5])
-    base = simulate.map(part, theta, d, 0.15, R_PIN)
-    got = simulate.map(part.mirrored(), np.mod(-theta, 360.0), -d, 0.15, R_PIN)
+    base = simulate.compute_map(part, theta, d, 0.15, R_PIN)
+    got = simulate.compute_map(part.mirrored(), np.mod(-theta, 360.0), -d, 0.15, R_PIN)
     with pytest.raises(AssertionError):
         assert_maps_agree(base, part, 0.15, "minpower", R_PIN, base.theta_f.values,
                           -base.dy.values, got)

@@ -30,7 +30,7 @@ def test_band_wrapping_through_360():
     assert wrap.start == pytest.approx(355.0) and wrap.width == pytest.approx(179 / 18.0)
     assert wrap.wraps
     assert circ_close(wrap.mean, 355.0 + 179 / 36.0)
-    assert wrap.kernel == [(0.0, 179.0)]
+    assert wrap.kernel_arcs == [(0.0, 179.0)]
 
 
 def circ_close(a, b, tol=1e-6):
@@ -45,7 +45,7 @@ def test_kernel_made_of_several_arcs_and_com_interval():
     bands = _bands(theta_f, dy=dy)
     b = [b for b in bands if b.start < 50][0]
     # [350, 359] and [0, 30] join across 0/360; [180, 210] is separate.
-    assert sorted(b.kernel) == [(180.0, 30.0), (350.0, 40.0)]
+    assert sorted(b.kernel_arcs) == [(180.0, 30.0), (350.0, 40.0)]
     assert b.com_min == pytest.approx(0.0) and b.com_max == pytest.approx(35.9)
     other = [b for b in bands if b.start >= 190][0]
     assert other.com_min == other.com_max == -1.0
@@ -57,13 +57,13 @@ def test_single_sample_band_and_all_miss_map():
     bands = _bands(theta_f)
     single = [b for b in bands if b.n == 1]
     assert len(single) == 1 and single[0].width == 0.0 and single[0].sigma == 0.0
-    assert single[0].kernel == [(90.0, 0.0)]
+    assert single[0].kernel_arcs == [(90.0, 0.0)]
     assert _bands(GRID.copy(), status=np.full(GRID.size, MISS)) == []
 
 
 def test_band_covering_the_whole_circle():
     bands = _bands(GRID.copy(), T=5.0)  # identity map: every gap is 1 degree
-    assert len(bands) == 1 and bands[0].width == 360.0 and bands[0].kernel == [(0.0, 360.0)]
+    assert len(bands) == 1 and bands[0].width == 360.0 and bands[0].kernel_arcs == [(0.0, 360.0)]
 
 
 def test_adjusted_band_is_mean_plus_minus_c_sigma():
@@ -181,7 +181,7 @@ TRIANGLE = Part.from_vertices([(0, 0), (60, 0), (15, 35)], name="asym_triangle")
 @pytest.fixture(scope="module")
 def triangle_plan():
     d = [-0.9, -0.8, -0.7, -0.6, -0.5, -0.4, -0.3, -0.2, -0.1, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]
-    ds = simulate.map(TRIANGLE, GRID, d, 0.15, 3.0)
+    ds = simulate.compute_map(TRIANGLE, GRID, d, 0.15, 3.0)
     pl = Planner(TRIANGLE, load_maps(ds, 5.0, 2.0), {"A": 42.5, "B": 2.5, "C": 35.0}, 0.1, 0.9)
     plans = pl.search(2)
     return pl, plans

@@ -36,8 +36,8 @@ JUMP_PROBE = 0.05  # degrees of theta_i either side of a suspect point
 def _is_band_jump(part, theta_i, d, mu_c, model):
     """True when theta_f jumps near (theta_i, d): rollouts 0.05 deg either side
     (at the finer setting) end more than 0.5 deg apart, or in other statuses."""
-    probe = simulate.map(part, [theta_i - JUMP_PROBE, theta_i + JUMP_PROBE], [d], mu_c, R_PIN,
-                         model=model, ds_max=0.05, tol=1e-7 / 32)
+    probe = simulate.compute_map(part, [theta_i - JUMP_PROBE, theta_i + JUMP_PROBE], [d], mu_c, R_PIN,
+                                 model=model, ds_max=0.05, tol=1e-7 / 32)
     s = probe.status.values[0]
     t = probe.theta_f.values[0]
     return bool(s[0] != s[1] or abs(circular_diff(t[0], t[1])) > 0.5)
@@ -49,9 +49,9 @@ def _is_band_jump(part, theta_i, d, mu_c, model):
                                      pytest.param(QUAD, id="quad")])
 def test_theta_f_converges_under_step_halving(outline, mu_c, model):
     part = Part.from_vertices(outline)
-    base = simulate.map(part, CONV_THETA, CONV_D, mu_c, R_PIN, model=model, ds_max=0.1, tol=1e-7)
-    fine = simulate.map(part, CONV_THETA, CONV_D, mu_c, R_PIN, model=model, ds_max=0.05,
-                        tol=1e-7 / 32)
+    base = simulate.compute_map(part, CONV_THETA, CONV_D, mu_c, R_PIN, model=model, ds_max=0.1, tol=1e-7)
+    fine = simulate.compute_map(part, CONV_THETA, CONV_D, mu_c, R_PIN, model=model, ds_max=0.05,
+                                tol=1e-7 / 32)
     # The step settings must reach the integrator (else this test is empty).
     assert not np.array_equal(base.theta_f.values, fine.theta_f.values)
     ok = base.status.values == STATUS["ok"]
@@ -84,7 +84,7 @@ def test_far_pin_misses(outline):
     part = Part.from_vertices(outline)
     d_far = 1.01 * (1.0 + R_PIN / part.a)
     theta = np.arange(0.0, 360.0, 7.5)
-    m = simulate.map(part, theta, [-d_far, d_far, -2.0, 3.0], 0.2, R_PIN)
+    m = simulate.compute_map(part, theta, [-d_far, d_far, -2.0, 3.0], 0.2, R_PIN)
     assert np.all(m.status.values == STATUS["miss"])
     assert np.all(np.abs(circular_diff(m.theta_f.values, theta[None, :])) < 1e-9)
     assert np.all(m.dy.values == 0.0)
@@ -161,7 +161,7 @@ def test_convex_parts_never_jam_in_a_notch(outline):
     # A convex part has no notch: the pin on a vertex must not count as two
     # simultaneous contacts.
     part = Part.from_vertices(outline)
-    m = simulate.map(part, np.arange(0.0, 360.0, 3.0), [-0.6, -0.3, -0.1, 0.1, 0.3, 0.6], 0.3, R_PIN)
+    m = simulate.compute_map(part, np.arange(0.0, 360.0, 3.0), [-0.6, -0.3, -0.1, 0.1, 0.3, 0.6], 0.3, R_PIN)
     assert not np.any(m.jam_reason.values == _jam_code(m, "notch"))
     assert np.all(m.status.values != STATUS["jammed"])
 
@@ -189,7 +189,7 @@ def test_max_travel_truncates_at_the_same_state(triangle):
 
 
 def test_small_max_travel_truncates_in_a_map(triangle):
-    m = simulate.map(triangle, np.arange(0.0, 360.0, 30.0), [0.3, -0.3], 0.2, R_PIN, max_travel=0.5)
+    m = simulate.compute_map(triangle, np.arange(0.0, 360.0, 30.0), [0.3, -0.3], 0.2, R_PIN, max_travel=0.5)
     hit = m.status.values != STATUS["miss"]
     assert hit.any()
     assert np.all(m.status.values[hit] == STATUS["truncated"])
@@ -294,8 +294,8 @@ def test_rollout_is_deterministic(quad):
 def test_map_is_independent_of_thread_count(quad):
     theta = np.arange(0.0, 360.0, 10.0) + 0.5
     d = [-0.7, -0.3, 0.2, 0.6]
-    one = simulate.map(quad, theta, d, 0.25, R_PIN, threads=1)
-    two = simulate.map(quad, theta, d, 0.25, R_PIN, threads=2)
+    one = simulate.compute_map(quad, theta, d, 0.25, R_PIN, threads=1)
+    two = simulate.compute_map(quad, theta, d, 0.25, R_PIN, threads=2)
     xr.testing.assert_identical(one, two)
     for v in one.data_vars:
         assert np.array_equal(one[v].values, two[v].values), v
@@ -304,7 +304,7 @@ def test_map_is_independent_of_thread_count(quad):
 def test_map_entries_equal_single_rollouts(quad):
     theta = np.array([5.0, 95.0, 185.0, 275.0])
     d = np.array([-0.5, 0.35])
-    m = simulate.map(quad, theta, d, 0.25, R_PIN)
+    m = simulate.compute_map(quad, theta, d, 0.25, R_PIN)
     assert m.theta_f.dims == ("d", "theta_i")
     np.testing.assert_array_equal(m.theta_i.values, theta)
     np.testing.assert_array_equal(m.d.values, d)
@@ -320,7 +320,7 @@ def test_map_entries_equal_single_rollouts(quad):
 
 
 def test_theta_f_is_wrapped(quad):
-    m = simulate.map(quad, np.arange(-720.0, 720.0, 45.0), [0.3, -0.3], 0.1, R_PIN)
+    m = simulate.compute_map(quad, np.arange(-720.0, 720.0, 45.0), [0.3, -0.3], 0.1, R_PIN)
     assert np.all((m.theta_f.values >= 0.0) & (m.theta_f.values < 360.0))
     # theta_i and theta_i + 360 are the same orientation.
     a = simulate.rollout(quad, 20.0, 0.3, 0.1, R_PIN)
@@ -362,7 +362,7 @@ def test_bad_parameters_raise(triangle, kwargs):
         simulate.rollout(triangle, **args)
     margs = dict(args, theta_i=[args["theta_i"], 10.0], d=[args["d"]])
     with pytest.raises(PinfeedError):
-        simulate.map(triangle, **margs)
+        simulate.compute_map(triangle, **margs)
 
 
 def test_closest_feature_of_a_pin():

@@ -242,6 +242,11 @@ class Catalog:
                 for r in rows.values()]
 
     def entries_for(self, part: str) -> list[dict]:
+        """The index entries of one part, by id or name.
+
+        Raises :class:`PinfeedError` when the part is unknown, stored in
+        several families or its name matches several parts.
+        """
         found = [e for e in self.entries if part in (e["part_id"], e["part_name"])]
         if not found:
             known = sorted({e["part_name"] for e in self.entries})

@@ -62,18 +62,21 @@ def remove_stale_temps(folder) -> list[Path]:
 
 
 def write_atomic(ds: xr.Dataset, path, encoding=None) -> Path:
+    """Write ``ds`` to the HDF5 file ``path`` atomically (a temporary file, then renamed)."""
     with atomic_target(path) as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding, invalid_netcdf=True)
     return Path(path)
 
 
 def write_text_atomic(text: str, path) -> Path:
+    """Write ``text`` to ``path`` atomically (a temporary file, then renamed)."""
     with atomic_target(path) as tmp:
         Path(tmp).write_text(text)
     return Path(path)
 
 
 def write_json(obj, path) -> Path:
+    """Write ``obj`` as indented, key-sorted JSON to ``path`` atomically."""
     return write_text_atomic(json.dumps(obj, indent=1, sort_keys=True, default=float) + "\n", path)
 
 

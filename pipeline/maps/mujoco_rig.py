@@ -37,6 +37,7 @@ past 50 a. The peak force leaves out the first 10 ms of each contact episode
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -208,6 +209,88 @@ def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0
     on the pin, units of mu_s m g; s = belt travel since first contact, mm).
     """
     mujoco = _mujoco()
+    xy, a, izz, pts, load = _support(part, mass, mu_s)
+    r_pin = r_pin_mm / 1000.0
+    vb = belt_speed_mm_s / 1000.0
+    eps = V_REG_MM_S / 1000.0
+    th0 = math.radians(theta_i_deg)
+    direction, speed, start, touch = _pin_path(xy, th0, d, v_pin, a, r_pin)
+    if not math.isfinite(touch):
+        return 1, "none", th0 % (2 * math.pi), 0.0, 0.0, 0, 0.0, np.zeros((0, 4)), np.zeros((0, 3))
+    pin_start = start + max(touch - 0.02e-3, 0.0) * direction
+    model, data = _build(mujoco, xy, r_pin, mu_c, mass, izz, pin_start, direction, th0)
+    pin_dof = model.jnt_dofadr[model.joint("pin").id]
+    pin_geom = model.geom("pin").id
+    dt = model.opt.timestep
+    pin_speed = vb * speed
+    forces6 = np.zeros(6)
+    st = _Passage(theta_ref=th0)
+    max_steps = int((60.0 * a * speed + 10 * a) / (vb * dt)) + 200000
+    while True:
+        st.step += 1
+        if st.step > max_steps:
+            st.status, st.reason = 3, "step budget"
+            break
+        data.qvel[pin_dof] = pin_speed
+        ux, uy = _apply_belt_friction(data, pts, load, eps)
+        mujoco.mj_step(model, data)
+        st.s_belt += vb * dt
+        fpx, fpy, touching, where = _pin_contacts(mujoco, model, data, pin_geom, forces6)
+        if touching and _contact_step(st, model, data, xy, a, vb * dt, dt,
+                                      math.hypot(fpx, fpy) / (mu_s * mass * G), where):
+            break
+        st.was_touching = touching
+        if trajectory and st.step % record_every == 0:
+            st.traj.append((st.s_belt * 1000.0, data.qpos[0] * 1000.0, data.qpos[1] * 1000.0,
+                            data.qpos[2]))
+            st.frc.append((st.s_belt * 1000.0, fpx / (mu_s * mass * G), fpy / (mu_s * mass * G)))
+        if st.s_belt * 1000.0 >= max_travel:
+            st.status, st.reason = 3, "none"
+            break
+        if not touching and st.step % 20 == 0 and _passage_over(model, data, xy, ux, uy, vb,
+                                                                direction, a, r_pin):
+            break
+    if st.status == 0 and st.travel == 0.0:
+        st.status = 1
+    return (st.status, st.reason, float(data.qpos[2]) % (2 * math.pi), float(data.qpos[1]) * 1000.0,
+            st.travel * 1000.0, st.changes, st.peak, np.array(st.traj).reshape(-1, 4),
+            np.array(st.frc).reshape(-1, 3))
+
+
+def _build(mujoco, xy, r_pin, mu_c, mass, izz, pin_start, direction, th0):
+    """The MuJoCo model (a non-convex outline split into triangles) and its data
+    with the part at orientation ``th0`` (rad)."""
+    pieces = [xy[list(t)] for t in _triangulate(xy)] if not _convex(xy) else [xy]
+    model = mujoco.MjModel.from_xml_string(_model_xml(pieces, r_pin, mu_c, mass, izz, pin_start,
+                                                      direction))
+    data = mujoco.MjData(model)
+    data.qpos[2] = th0
+    return model, data
+
+
+@dataclass
+class _Passage:
+    """The running state of one MuJoCo passage (SI units; ``s_belt`` belt travel)."""
+    theta_ref: float
+    travel: float = 0.0
+    s_belt: float = 0.0
+    changes: int = 0
+    peak: float = 0.0
+    feature: tuple | None = None
+    episode_t: float = 0.0
+    was_touching: bool = False
+    travel_ref: float = 0.0
+    status: int = 0
+    reason: str = "none"
+    step: int = 0
+    traj: list = field(default_factory=list)
+    frc: list = field(default_factory=list)
+
+
+def _support(part, mass, mu_s):
+    """``(xy, a, izz, pts, load)``: the outline about its centroid (m), its
+    radius a (m), polar inertia (kg m^2), the support grid points inside it
+    (m, body frame) and the normal load on each (N)."""
     xy_mm = np.asarray(part.vertices, dtype=float)
     if _mass_properties(xy_mm)[0] < 0:
         xy_mm = xy_mm[::-1].copy()
@@ -216,8 +299,6 @@ def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0
     a_mm = float(np.max(np.hypot(xy_mm[:, 0], xy_mm[:, 1])))
     xy = xy_mm / 1000.0
     a = a_mm / 1000.0
-    r_pin = r_pin_mm / 1000.0
-    vb = belt_speed_mm_s / 1000.0
     izz = mass * jpol / area / 1e6
     # Support grid (body frame), centred on the centroid.
     s = GRID_MM / 1000.0
@@ -226,9 +307,14 @@ def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0
     pts = np.column_stack([gx.ravel(), gy.ravel()])
     pts = pts[_inside(xy, pts)]
     load = mu_s * mass * G / len(pts)
-    eps = V_REG_MM_S / 1000.0
-    # Pin path in the belt frame: P(tau) = (-tau, d a + v_pin tau) vb-scaled.
-    th0 = math.radians(theta_i_deg)
+    return xy, a, izz, pts, load
+
+
+def _pin_path(xy, th0, d, v_pin, a, r_pin):
+    """``(direction, speed, start, touch)`` of the pin's straight path in the
+    belt frame, ``P(tau) = (-tau, d a + v_pin tau)`` scaled by the belt speed:
+    unit direction, speed over belt speed, start point (m) and the distance
+    (m) along the path to first touch (``inf`` for a miss)."""
     rot = np.array([[math.cos(th0), -math.sin(th0)], [math.sin(th0), math.cos(th0)]])
     world = xy @ rot.T
     vel = np.array([-1.0, v_pin])
@@ -238,119 +324,95 @@ def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0
     start = np.array([-tau0, d * a + v_pin * tau0])
     reach = 2.0 * abs(tau0) * speed
     touch = _first_touch(world, start, direction, reach, r_pin)
-    if not math.isfinite(touch):
-        return 1, "none", th0 % (2 * math.pi), 0.0, 0.0, 0, 0.0, np.zeros((0, 4)), np.zeros((0, 3))
-    pin_start = start + max(touch - 0.02e-3, 0.0) * direction
-    pieces = [xy[list(t)] for t in _triangulate(xy)] if not _convex(xy) else [xy]
-    model = mujoco.MjModel.from_xml_string(_model_xml(pieces, r_pin, mu_c, mass, izz, pin_start,
-                                                      direction))
-    data = mujoco.MjData(model)
-    data.qpos[2] = th0
-    pin_dof = model.jnt_dofadr[model.joint("pin").id]
-    pin_geom = model.geom("pin").id
-    dt = model.opt.timestep
-    pin_speed = vb * speed
-    forces6 = np.zeros(6)
-    travel = 0.0
-    s_belt = 0.0
-    changes = 0
-    peak = 0.0
-    feature = None
-    episode_t = 0.0
-    was_touching = False
-    theta_ref, travel_ref = th0, 0.0
-    status, reason = 0, "none"
-    traj, frc = [], []
-    max_steps = int((60.0 * a * speed + 10 * a) / (vb * dt)) + 200000
-    step = 0
-    while True:
-        step += 1
-        if step > max_steps:
-            status, reason = 3, "step budget"
-            break
-        data.qvel[pin_dof] = pin_speed
+    return direction, speed, start, touch
+
+
+def _apply_belt_friction(data, pts, load, eps):
+    """Set the belt's regularised friction on the part as generalised forces;
+    returns the support points' velocities ``(ux, uy)`` (m/s)."""
+    th = data.qpos[2]
+    c, sn = math.cos(th), math.sin(th)
+    rx = c * pts[:, 0] - sn * pts[:, 1]
+    ry = sn * pts[:, 0] + c * pts[:, 1]
+    vx, vy, om = data.qvel[0], data.qvel[1], data.qvel[2]
+    ux = vx - om * ry
+    uy = vy + om * rx
+    k = load / np.sqrt(ux * ux + uy * uy + eps * eps)
+    fx = -k * ux
+    fy = -k * uy
+    data.qfrc_applied[0] = fx.sum()
+    data.qfrc_applied[1] = fy.sum()
+    data.qfrc_applied[2] = (rx * fy - ry * fx).sum()
+    return ux, uy
+
+
+def _pin_contacts(mujoco, model, data, pin_geom, forces6):
+    """``(fpx, fpy, touching, where)``: the force on the pin (N), whether it
+    pushes, and the contact points (m)."""
+    fpx = fpy = 0.0
+    touching = False
+    where = []
+    for i in range(data.ncon):
+        con = data.contact[i]
+        if pin_geom not in (con.geom1, con.geom2):
+            continue
+        mujoco.mj_contactForce(model, data, i, forces6)
+        if forces6[0] <= 0.0:
+            continue
+        touching = True
+        frame = np.array(con.frame).reshape(3, 3)
+        f_world = frame.T @ forces6[:3]
+        sign = 1.0 if con.geom2 == pin_geom else -1.0  # force on geom2 is +f
+        fpx += sign * f_world[0]
+        fpy += sign * f_world[1]
+        where.append(np.array(con.pos[:2]))
+    return fpx, fpy, touching, where
+
+
+def _contact_step(st, model, data, xy, a, ds, dt, f, where) -> bool:
+    """Book one step in contact (``ds`` pin travel, m; ``f`` force on the pin
+    in mu_s m g): peak force, feature changes, jams. True when jammed."""
+    if not st.was_touching:
+        st.episode_t = 0.0
+    st.episode_t += dt
+    st.travel += ds
+    if st.episode_t > _IMPACT_S:
+        st.peak = max(st.peak, f)
+    if len(where) > 1:
+        spread = max(np.linalg.norm(w - where[0]) for w in where)
+        if spread > 1e-3 * a:
+            st.status, st.reason = 2, "notch"
+            return True
+    if st.step % 20 == 0:
+        feat = _feature(xy, data.qpos[:3], data.xpos[model.body("pin").id][:2])
+        if st.feature is not None and feat != st.feature:
+            st.changes += 1
+        st.feature = feat
+    th = data.qpos[2]
+    if abs(th - st.theta_ref) >= 1e-4:
+        st.theta_ref, st.travel_ref = th, st.travel
+    elif st.travel - st.travel_ref > 3.0 * a:
+        st.status, st.reason = 2, "no rotation"
+        return True
+    if st.travel > 50.0 * a:
+        st.status, st.reason = 2, "travel limit"
+        return True
+    return False
+
+
+def _passage_over(model, data, xy, ux, uy, vb, direction, a, r_pin) -> bool:
+    """Whether the part (out of contact) is at rest on the belt and the pin's
+    remaining path misses it."""
+    vmax = float(np.sqrt((ux * ux + uy * uy).max()))
+    if vmax < _REST * vb:
         th = data.qpos[2]
-        c, sn = math.cos(th), math.sin(th)
-        rx = c * pts[:, 0] - sn * pts[:, 1]
-        ry = sn * pts[:, 0] + c * pts[:, 1]
-        vx, vy, om = data.qvel[0], data.qvel[1], data.qvel[2]
-        ux = vx - om * ry
-        uy = vy + om * rx
-        k = load / np.sqrt(ux * ux + uy * uy + eps * eps)
-        fx = -k * ux
-        fy = -k * uy
-        data.qfrc_applied[0] = fx.sum()
-        data.qfrc_applied[1] = fy.sum()
-        data.qfrc_applied[2] = (rx * fy - ry * fx).sum()
-        mujoco.mj_step(model, data)
-        s_belt += vb * dt
-        # Pin contacts.
-        fpx = fpy = 0.0
-        touching = False
-        where = []
-        for i in range(data.ncon):
-            con = data.contact[i]
-            if pin_geom not in (con.geom1, con.geom2):
-                continue
-            mujoco.mj_contactForce(model, data, i, forces6)
-            if forces6[0] <= 0.0:
-                continue
-            touching = True
-            frame = np.array(con.frame).reshape(3, 3)
-            f_world = frame.T @ forces6[:3]
-            sign = 1.0 if con.geom2 == pin_geom else -1.0  # force on geom2 is +f
-            fpx += sign * f_world[0]
-            fpy += sign * f_world[1]
-            where.append(np.array(con.pos[:2]))
-        if touching:
-            if not was_touching:
-                episode_t = 0.0
-            episode_t += dt
-            travel += vb * dt
-            f = math.hypot(fpx, fpy) / (mu_s * mass * G)
-            if episode_t > _IMPACT_S:
-                peak = max(peak, f)
-            if len(where) > 1:
-                spread = max(np.linalg.norm(w - where[0]) for w in where)
-                if spread > 1e-3 * a:
-                    status, reason = 2, "notch"
-                    break
-            if step % 20 == 0:
-                feat = _feature(xy, data.qpos[:3], data.xpos[model.body("pin").id][:2])
-                if feature is not None and feat != feature:
-                    changes += 1
-                feature = feat
-            th = data.qpos[2]
-            if abs(th - theta_ref) >= 1e-4:
-                theta_ref, travel_ref = th, travel
-            elif travel - travel_ref > 3.0 * a:
-                status, reason = 2, "no rotation"
-                break
-            if travel > 50.0 * a:
-                status, reason = 2, "travel limit"
-                break
-        was_touching = touching
-        if trajectory and step % record_every == 0:
-            traj.append((s_belt * 1000.0, data.qpos[0] * 1000.0, data.qpos[1] * 1000.0, data.qpos[2]))
-            frc.append((s_belt * 1000.0, fpx / (mu_s * mass * G), fpy / (mu_s * mass * G)))
-        if s_belt * 1000.0 >= max_travel:
-            status, reason = 3, "none"
-            break
-        if not touching and step % 20 == 0:
-            vmax = float(np.sqrt((ux * ux + uy * uy).max()))
-            if vmax < _REST * vb:
-                th = data.qpos[2]
-                rot = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
-                world = xy @ rot.T + data.qpos[:2]
-                pin_now = np.array(data.xpos[model.body("pin").id][:2])
-                if not _path_hits(world, pin_now + 1e-6 * direction, direction,
-                                  4.0 * a + 2.0 * r_pin, r_pin * 0.999):
-                    break
-    if status == 0 and travel == 0.0:
-        status = 1
-    return (status, reason, float(data.qpos[2]) % (2 * math.pi), float(data.qpos[1]) * 1000.0,
-            travel * 1000.0, changes, peak, np.array(traj).reshape(-1, 4),
-            np.array(frc).reshape(-1, 3))
+        rot = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+        world = xy @ rot.T + data.qpos[:2]
+        pin_now = np.array(data.xpos[model.body("pin").id][:2])
+        if not _path_hits(world, pin_now + 1e-6 * direction, direction,
+                          4.0 * a + 2.0 * r_pin, r_pin * 0.999):
+            return True
+    return False
 
 
 def _convex(xy):

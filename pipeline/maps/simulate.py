@@ -139,12 +139,23 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
                    math.radians(theta), dd, float(v_pin), cap, float(ds_max), float(tol),
                    bool(trajectory))
     status, reason, theta_f, dy, travel, changes, peak, traj, force = res
-    unit = length_unit
-    ds = xr.Dataset(
+    ds = _passage_dataset(STATUS_NAMES[status], JAM_REASONS[reason] or "none",
+                          "why jammed (or truncated by the step budget)",
+                          theta_f, dy, travel, changes, peak, theta, dd, length_unit,
+                          _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol,
+                                        length_unit))
+    if trajectory:
+        _add_trajectory(ds, traj, force, length_unit, "centroid displacement along the belt")
+    return ds
+
+
+def _passage_dataset(status_name, reason_name, reason_long_name, theta_f, dy, travel, changes,
+                     peak, theta, dd, unit, attrs) -> xr.Dataset:
+    """The scalar Dataset of one passage (``theta_f`` in radians, unwrapped)."""
+    return xr.Dataset(
         {
-            "status": ((), STATUS_NAMES[status], {"long_name": "rollout status"}),
-            "jam_reason": ((), JAM_REASONS[reason] or "none",
-                           {"long_name": "why jammed (or truncated by the step budget)"}),
+            "status": ((), status_name, {"long_name": "rollout status"}),
+            "jam_reason": ((), reason_name, {"long_name": reason_long_name}),
             "theta_f": ((), _wrap_deg(math.degrees(theta_f)),
                         {"units": "degree", "long_name": "final orientation"}),
             "dy": ((), dy, {"units": unit, "long_name": "centroid displacement across the belt"}),
@@ -154,17 +165,19 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
         },
         coords={"theta_i": ((), theta, {"units": "degree", "long_name": "initial orientation"}),
                 "d": ((), dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"})},
-        attrs=_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit),
+        attrs=attrs,
     )
-    if trajectory:
-        ds["traj_s"] = ("step", traj[:, 0], {"units": unit, "long_name": "belt travel since first contact"})
-        ds["traj_x"] = ("step", traj[:, 1], {"units": unit, "long_name": "centroid displacement along the belt"})
-        ds["traj_y"] = ("step", traj[:, 2], {"units": unit, "long_name": "centroid displacement across the belt"})
-        ds["traj_theta"] = ("step", np.degrees(traj[:, 3]), {"units": "degree", "long_name": "orientation (unwrapped)"})
-        ds["force_s"] = ("sample", force[:, 0], {"units": unit, "long_name": "belt travel since first contact"})
-        ds["force_x"] = ("sample", force[:, 1], {"units": "mu_s m g", "long_name": "force on the pin along the belt"})
-        ds["force_y"] = ("sample", force[:, 2], {"units": "mu_s m g", "long_name": "force on the pin across the belt"})
-    return ds
+
+
+def _add_trajectory(ds, traj, force, unit, x_long_name):
+    """Add the trajectory (dim ``step``) and the force on the pin (dim ``sample``) to ``ds``."""
+    ds["traj_s"] = ("step", traj[:, 0], {"units": unit, "long_name": "belt travel since first contact"})
+    ds["traj_x"] = ("step", traj[:, 1], {"units": unit, "long_name": x_long_name})
+    ds["traj_y"] = ("step", traj[:, 2], {"units": unit, "long_name": "centroid displacement across the belt"})
+    ds["traj_theta"] = ("step", np.degrees(traj[:, 3]), {"units": "degree", "long_name": "orientation (unwrapped)"})
+    ds["force_s"] = ("sample", force[:, 0], {"units": unit, "long_name": "belt travel since first contact"})
+    ds["force_x"] = ("sample", force[:, 1], {"units": "mu_s m g", "long_name": "force on the pin along the belt"})
+    ds["force_y"] = ("sample", force[:, 2], {"units": "mu_s m g", "long_name": "force on the pin across the belt"})
 
 
 def _wrap_deg(x):
@@ -198,11 +211,11 @@ def _cuda_installed() -> bool:
     return importlib.util.find_spec("numba_cuda") is not None
 
 
-def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "minpower",
-        v_pin: float = 0.0, max_travel: float | None = None, threads: int | None = None,
-        ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
-        length_unit: str = "mm", belt_speed: float | None = None,
-        mu_s: float = 0.5, backend: str = "cpu") -> xr.Dataset:
+def compute_map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "minpower",
+                v_pin: float = 0.0, max_travel: float | None = None, threads: int | None = None,
+                ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
+                length_unit: str = "mm", belt_speed: float | None = None,
+                mu_s: float = 0.5, backend: str = "cpu") -> xr.Dataset:
     """Configuration map set: rollouts over ``d x theta_i`` (paper eq. 2).
 
     ``model="dynamic"`` needs ``belt_speed`` (mm/s; the part in mm) and takes
@@ -216,6 +229,37 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
     ``contact_travel``, ``feature_changes`` and ``peak_force``.
     """
     dynamic = model == "dynamic"
+    fr = _check_map_inputs(part, mu_c, pin_radius, model, v_pin, max_travel, ds_max, tol,
+                           belt_speed, mu_s, backend)
+    th = _angles(theta_i, "theta_i")
+    dd = _angles(d, "d")
+    cap = np.inf if max_travel is None else float(max_travel)
+    if backend == "cuda":
+        prep = part.prepared()
+        out = cuda_grid()(
+            *prep, MODELS.index(model), float(mu_c), float(pin_radius), np.radians(th), dd,
+            float(v_pin), cap, float(ds_max), float(tol), max_steps_for(prep[0].shape[0]))
+    elif dynamic:
+        out = _dynamic_grid(part, mu_c, pin_radius, th, dd, v_pin, fr, belt_speed, cap, threads)
+    else:
+        with _threads(threads) as n:
+            out = _rollout_grid(
+                *part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
+                np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol),
+                blocks_for(n, th.size * dd.size))
+    attrs = _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, length_unit)
+    jam_attrs = dict(JAM_ATTRS)
+    if dynamic:
+        jam_attrs = _dynamic_jam_attrs()
+        attrs.update(belt_speed=float(belt_speed), mu_s=float(mu_s), froude=fr)
+    return _map_dataset(out, th, dd, length_unit, jam_attrs, dict(attrs, kernel_backend=backend))
+
+
+def _check_map_inputs(part, mu_c, pin_radius, model, v_pin, max_travel, ds_max, tol,
+                      belt_speed, mu_s, backend):
+    """Refuse bad map arguments; the Froude number for ``model="dynamic"`` (else ``None``)."""
+    dynamic = model == "dynamic"
+    fr = None
     if model == "mujoco":
         raise PinfeedError("the MuJoCo rig is for single passages (seconds each), not maps")
     if dynamic:
@@ -229,38 +273,31 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
         raise PinfeedError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
     if backend == "cuda" and dynamic:
         raise PinfeedError("the cuda backend runs the quasi-static models; use backend cpu for model dynamic")
-    th = _angles(theta_i, "theta_i")
-    dd = _angles(d, "d")
-    cap = np.inf if max_travel is None else float(max_travel)
-    prep = part.prepared()
-    if backend == "cuda":
-        status, reason, theta_f, dy, travel, changes, peak = cuda_grid()(
-            *prep, MODELS.index(model), float(mu_c), float(pin_radius), np.radians(th), dd,
-            float(v_pin), cap, float(ds_max), float(tol), max_steps_for(prep[0].shape[0]))
-    else:
-        with _threads(threads) as n:
-            if dynamic:
-                from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
-                                             _dyn_rollout_grid)
-                verts, area, a, quad, _, convex = prep
-                status, reason, theta_f, dy, travel, changes, peak = _dyn_rollout_grid(
-                    verts, area, a, quad, convex, float(mu_c), float(pin_radius), np.radians(th), dd,
-                    float(v_pin), fr, 0.0, DEFAULT_V_REG / float(belt_speed), DEFAULT_H, cap,
-                    DEFAULT_MAX_STEPS, n)
-            else:
-                status, reason, theta_f, dy, travel, changes, peak = _rollout_grid(
-                    *prep, MODELS.index(model), float(mu_c), float(pin_radius),
-                    np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol),
-                    blocks_for(n, th.size * dd.size))
-    unit = length_unit
-    jam_attrs = dict(JAM_ATTRS)
-    attrs = _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, unit)
-    if dynamic:
-        from kernels.dynamic import DYN_REASONS
-        jam_attrs = {"long_name": "why a rollout was declared jammed or truncated",
-                     "flag_values": np.arange(len(DYN_REASONS), dtype=np.int8),
-                     "flag_meanings": " ".join(["none"] + [r.replace(" ", "_") for r in DYN_REASONS[1:]])}
-        attrs.update(belt_speed=float(belt_speed), mu_s=float(mu_s), froude=fr)
+    return fr
+
+
+def _dynamic_grid(part, mu_c, pin_radius, th, dd, v_pin, fr, belt_speed, cap, threads):
+    """The dynamic model's grid kernel over ``d x theta_i`` (``th`` in degrees)."""
+    from kernels.dynamic import DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG, _dyn_rollout_grid
+    verts, area, a, quad, _, convex = part.prepared()
+    with _threads(threads) as n:
+        return _dyn_rollout_grid(
+            verts, area, a, quad, convex, float(mu_c), float(pin_radius), np.radians(th), dd,
+            float(v_pin), fr, 0.0, DEFAULT_V_REG / float(belt_speed), DEFAULT_H, cap,
+            DEFAULT_MAX_STEPS, n)
+
+
+def _dynamic_jam_attrs() -> dict:
+    """``jam_reason`` flag attributes of the dynamic model (its reasons add ``step_budget``)."""
+    from kernels.dynamic import DYN_REASONS
+    return {"long_name": "why a rollout was declared jammed or truncated",
+            "flag_values": np.arange(len(DYN_REASONS), dtype=np.int8),
+            "flag_meanings": " ".join(["none"] + [r.replace(" ", "_") for r in DYN_REASONS[1:]])}
+
+
+def _map_dataset(out, th, dd, unit, jam_attrs, attrs) -> xr.Dataset:
+    """Pack a grid kernel's arrays (dims ``d x theta_i``) into the map Dataset."""
+    status, reason, theta_f, dy, travel, changes, peak = out
     return xr.Dataset(
         {
             "theta_f": (("d", "theta_i"), _wrap_deg(np.degrees(theta_f)),
@@ -276,7 +313,7 @@ def map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: str = "mi
             "d": ("d", dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"}),
             "theta_i": ("theta_i", th, {"units": "degree", "long_name": "initial orientation"}),
         },
-        attrs=dict(attrs, kernel_backend=backend),
+        attrs=attrs,
     )
 
 
@@ -362,49 +399,36 @@ def dynamic_rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radiu
     theta = float(_angles(theta_i, "theta_i")[0])
     dd = float(_angles(d, "d")[0])
     cap = np.inf if max_travel is None else float(max_travel)
-    twist = None
     if model == "dynamic":
-        from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG, DYN_REASONS,
-                                     _dyn_rollout)
-        verts, area, a, quad, _, convex = part.prepared()
-        res = _dyn_rollout(verts, area, a, quad, convex, float(mu_c), float(pin_radius),
-                           math.radians(theta), dd, float(v_pin), fr, float(restitution),
-                           DEFAULT_V_REG / float(belt_speed), float(h or DEFAULT_H), cap,
-                           int(max_steps or DEFAULT_MAX_STEPS), bool(trajectory))
-        status, reason, theta_f, dy, travel, changes, peak, traj, force, twist = res
-        reason_name = DYN_REASONS[reason] or "none"
+        out = _dynamic_passage(part, theta, dd, mu_c, pin_radius, v_pin, fr, restitution,
+                               belt_speed, cap, h, max_steps, trajectory)
     else:
         from pipeline.maps.mujoco_rig import mujoco_rollout
         out = mujoco_rollout(part, theta, dd, float(mu_c), float(pin_radius), float(belt_speed),
                              float(mu_s), v_pin=float(v_pin), max_travel=cap,
-                             trajectory=bool(trajectory))
-        status, reason_name, theta_f, dy, travel, changes, peak, traj, force = out
-    ds = xr.Dataset(
-        {
-            "status": ((), STATUS_NAMES[status], {"long_name": "rollout status"}),
-            "jam_reason": ((), reason_name, {"long_name": "why jammed or truncated"}),
-            "theta_f": ((), _wrap_deg(math.degrees(theta_f)),
-                        {"units": "degree", "long_name": "final orientation"}),
-            "dy": ((), dy, {"units": "mm", "long_name": "centroid displacement across the belt"}),
-            "contact_travel": ((), travel, {"units": "mm", "long_name": "pin travel in contact"}),
-            "feature_changes": ((), int(changes), {"long_name": "contact feature changes"}),
-            "peak_force": ((), peak, {"units": "mu_s m g", "long_name": "peak force on the pin"}),
-        },
-        coords={"theta_i": ((), theta, {"units": "degree", "long_name": "initial orientation"}),
-                "d": ((), dd, {"units": "1", "long_name": "contact parameter (y_pin - y_com) / a"})},
-        attrs=dict(_common_attrs(part, model, mu_c, pin_radius, v_pin, 0.0, 0.0, "mm"),
-                   belt_speed=float(belt_speed), mu_s=float(mu_s), froude=fr,
-                   restitution=float(restitution)),
-    )
+                             trajectory=bool(trajectory)) + (None,)
+    status, reason_name, theta_f, dy, travel, changes, peak, traj, force, twist = out
+    ds = _passage_dataset(STATUS_NAMES[status], reason_name, "why jammed or truncated",
+                          theta_f, dy, travel, changes, peak, theta, dd, "mm",
+                          dict(_common_attrs(part, model, mu_c, pin_radius, v_pin, 0.0, 0.0, "mm"),
+                               belt_speed=float(belt_speed), mu_s=float(mu_s), froude=fr,
+                               restitution=float(restitution)))
     if trajectory:
-        ds["traj_s"] = ("step", traj[:, 0], {"units": "mm", "long_name": "belt travel since first contact"})
-        ds["traj_x"] = ("step", traj[:, 1], {"units": "mm", "long_name": "centroid displacement along the belt (belt frame)"})
-        ds["traj_y"] = ("step", traj[:, 2], {"units": "mm", "long_name": "centroid displacement across the belt"})
-        ds["traj_theta"] = ("step", np.degrees(traj[:, 3]), {"units": "degree", "long_name": "orientation (unwrapped)"})
-        ds["force_s"] = ("sample", force[:, 0], {"units": "mm", "long_name": "belt travel since first contact"})
-        ds["force_x"] = ("sample", force[:, 1], {"units": "mu_s m g", "long_name": "force on the pin along the belt"})
-        ds["force_y"] = ("sample", force[:, 2], {"units": "mu_s m g", "long_name": "force on the pin across the belt"})
+        _add_trajectory(ds, traj, force, "mm", "centroid displacement along the belt (belt frame)")
         if twist is not None:
             for j, name in enumerate(("s", "vx", "vy", "omega", "vn", "impulse_n")):
                 ds[f"twist_{name}"] = ("step", twist[:, j])
     return ds
+
+
+def _dynamic_passage(part, theta, dd, mu_c, pin_radius, v_pin, fr, restitution, belt_speed,
+                     cap, h, max_steps, trajectory):
+    """``kernels.dynamic``'s one passage, its jam reason decoded to a name (``theta`` in degrees)."""
+    from kernels.dynamic import DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG, DYN_REASONS, _dyn_rollout
+    verts, area, a, quad, _, convex = part.prepared()
+    res = _dyn_rollout(verts, area, a, quad, convex, float(mu_c), float(pin_radius),
+                       math.radians(theta), dd, float(v_pin), fr, float(restitution),
+                       DEFAULT_V_REG / float(belt_speed), float(h or DEFAULT_H), cap,
+                       int(max_steps or DEFAULT_MAX_STEPS), bool(trajectory))
+    status, reason, theta_f, dy, travel, changes, peak, traj, force, twist = res
+    return status, DYN_REASONS[reason] or "none", theta_f, dy, travel, changes, peak, traj, force, twist

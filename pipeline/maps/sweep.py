@@ -34,6 +34,7 @@ SCHEMA_VERSION = 1
 
 @dataclass(frozen=True)
 class ShardJob:
+    """One shard to compute: a part's map set at one model, mu_c, pin speed and belt (mm/s)."""
     family: str
     part: Part
     model: str
@@ -43,6 +44,7 @@ class ShardJob:
     mu_s: float = 0.5
 
     def path(self, catalog_dir) -> Path:
+        """The shard's file under ``catalog_dir``."""
         return shard_path(catalog_dir, self.family, self.part.id, self.model, self.mu_c, self.v_pin,
                           self.belt_speed, self.mu_s)
 
@@ -59,6 +61,7 @@ def shard_tag(mu_c, v_pin=0.0, belt_speed=0.0, mu_s=0.5) -> str:
 
 def shard_path(catalog_dir, family, part_id, model, mu_c, v_pin=0.0, belt_speed=0.0,
                mu_s=0.5) -> Path:
+    """The shard file ``catalog_dir/family/part_id/model/TAG.h5`` (see :func:`shard_tag`)."""
     return Path(catalog_dir) / family / part_id / model / f"{shard_tag(mu_c, v_pin, belt_speed, mu_s)}.h5"
 
 
@@ -100,11 +103,11 @@ def compute_shard(config, job: ShardJob, threads=None, backend=None):
     ``sweep.backend`` (default ``"cpu"``)."""
     sweep = config["sweep"]
     kernel = sweep.get("kernel", {})
-    ds = simulate.map(job.part, theta_grid(config), np.asarray(sweep["d"], float), job.mu_c,
-                      sweep["pin_radius"], model=job.model, v_pin=job.v_pin, threads=threads,
-                      **({"belt_speed": job.belt_speed, "mu_s": job.mu_s} if job.belt_speed > 0 else {}),
-                      ds_max=kernel.get("ds_max", 0.1), tol=kernel.get("tol", 1e-7),
-                      backend=backend or sweep.get("backend", "cpu"))
+    ds = simulate.compute_map(job.part, theta_grid(config), np.asarray(sweep["d"], float), job.mu_c,
+                              sweep["pin_radius"], model=job.model, v_pin=job.v_pin, threads=threads,
+                              **({"belt_speed": job.belt_speed, "mu_s": job.mu_s} if job.belt_speed > 0 else {}),
+                              ds_max=kernel.get("ds_max", 0.1), tol=kernel.get("tol", 1e-7),
+                              backend=backend or sweep.get("backend", "cpu"))
     ds.attrs.update(provenance_attrs())
     ds.attrs.update({
         "title": f"pinfeed configuration maps: {job.part.id}, {job.model}, mu_c={job.mu_c:g}, "

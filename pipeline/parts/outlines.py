@@ -43,9 +43,11 @@ class Outline:
 
     @property
     def n_vertices(self) -> int:
+        """Number of vertices after flattening."""
         return int(self.vertices.shape[0])
 
     def describe(self) -> str:
+        """One line saying where the outline came from and how it was flattened."""
         return (f"{self.source}: {self.name}, flattened to {self.n_vertices} vertices "
                 f"(chordal tolerance {self.flatten_tol:g} mm)")
 

@@ -136,10 +136,12 @@ class Part:
 
     @property
     def n_vertices(self) -> int:
+        """Number of vertices of the outline."""
         return self.vertices.shape[0]
 
     @property
     def is_convex(self) -> bool:
+        """Whether the outline is convex."""
         return bool(_geo._is_convex(self.vertices))
 
     def prepared(self):
@@ -151,6 +153,7 @@ class Part:
         return Part.from_vertices(self.vertices * np.array([1.0, -1.0]), self.name + "-mirror")
 
     def scaled(self, k: float) -> "Part":
+        """The same part scaled by ``k`` (about the origin of its vertices)."""
         return Part.from_vertices(self.vertices * float(k), self.name)
 
     def rotated(self, phi_deg: float) -> "Part":
@@ -185,5 +188,6 @@ class Part:
         return 1
 
     def to_dict(self) -> dict:
+        """Name, id, vertices, area and radius ``a`` (the part's length unit) as a JSON-ready dict."""
         return {"name": self.name, "id": self.id, "vertices": self.vertices.tolist(),
                 "area": self.area, "a": self.a}

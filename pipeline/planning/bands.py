@@ -1,7 +1,8 @@
 """Bands, kernels, COM intervals and adjusted bands of one configuration map (spec section 5).
 
 Everything is on the circle: theta_f values are grouped around 0/360, a band
-may wrap through 360 (or cover the whole circle), and a kernel may be several
+may wrap through 360 (or cover the whole circle), and a band kernel K_j
+(``Band.kernel_arcs``; "kernel" alone means a Numba kernel) may be several
 separate arcs of theta_i. Arcs are ``(start, width)`` in degrees: the set
 ``start + [0, width]`` taken modulo 360.
 
@@ -27,6 +28,11 @@ from pipeline.planning.arcs import format_arc, format_arcs, in_arc  # noqa: F401
 
 @dataclass
 class Band:
+    """One band B_j of a map: its arc of theta_f, adjusted band, COM interval and kernel K_j.
+
+    Angles in degrees (arcs ``start + [0, width]`` modulo 360), ``com_*`` in
+    the part's length unit; ``kernel_arcs`` is K_j, ``members`` its grid indices.
+    """
     start: float
     width: float
     mean: float
@@ -36,18 +42,21 @@ class Band:
     com_min: float
     com_max: float
     n: int
-    kernel: list = field(default_factory=list)  # [(start, width)] arcs of theta_i
+    kernel_arcs: list = field(default_factory=list)  # K_j: [(start, width)] arcs of theta_i
     members: list = field(default_factory=list)  # theta_i grid indices
 
     @property
     def wraps(self) -> bool:
+        """Whether the band runs through 360 degrees."""
         return self.start + self.width >= 360.0
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """The band as a JSON-ready dict; K_j is stored under the key ``"kernel"`` (file format)."""
+        return {("kernel" if k == "kernel_arcs" else k): v for k, v in asdict(self).items()}
 
 
 def circular_mean_std(deg) -> tuple[float, float]:
+    """Circular mean (degrees, [0, 360)) and circular standard deviation ``sqrt(-2 ln R)`` (degrees) of ``deg``."""
     rad = np.radians(np.asarray(deg, float))
     c, s = np.cos(rad).mean(), np.sin(rad).mean()
     r = math.hypot(c, s)
@@ -120,7 +129,7 @@ def extract_bands(theta_i, theta_f, dy, status, threshold_T: float, factor_c: fl
         bands.append(Band(start=start, width=width, mean=mean, sigma=sigma,
                           adj_start=(mean - half) % 360.0, adj_width=2.0 * half,
                           com_min=float(dy[idx].min()), com_max=float(dy[idx].max()),
-                          n=int(idx.size), kernel=_grid_arcs(theta_i, idx),
+                          n=int(idx.size), kernel_arcs=_grid_arcs(theta_i, idx),
                           members=[int(i) for i in idx]))
     bands.sort(key=lambda b: b.start)
     return bands

@@ -12,7 +12,7 @@ adjusted-band arcs hit, merged where they overlap); a ``miss`` leaves the
 state as it was; a ``jammed`` outcome forbids the pin. A child's centroid
 interval adds the range of dy over the grid points the state covers
 (``com="covered"``, default) or, literally as spec section 6 says, the COM
-interval of the whole kernel of each band hit (``com="kernel"``); the kernel
+interval of the whole band kernel K_j of each band hit (``com="kernel"``); K_j
 often spans 100+ degrees of theta_i whose dy spread tens of millimetres, so
 the literal rule makes nearly every second pin metastable.
 
@@ -46,6 +46,7 @@ from pipeline.planning.plan import nominal_friction, parse_friction
 
 
 class Step:
+    """One pin of a paper plan: its height (mm), d range, and the orientation arc and COM interval reached."""
     pin: str
     y_pin: float
     d_lo: float
@@ -60,12 +61,14 @@ class Step:
 
 
 class State:
+    """An orientation arc (degrees) and centroid interval (mm) a part may be in."""
     arc: tuple  # (start, width), degrees
     y_lo: float
     y_hi: float
     history: tuple = field(default=(), compare=False, hash=False)
 
     def key(self):
+        """Rounded ``(start, width, y_lo, y_hi)``: states equal up to rounding share a key."""
         return (round(self.arc[0], 6), round(self.arc[1], 6), round(self.y_lo, 6), round(self.y_hi, 6))
 
 
@@ -87,6 +90,7 @@ class MapData:
 
 
 class Plan:
+    """A paper-planner pin sequence with its final orientation sets and margin."""
     pins: tuple  # labels in order
     n_sets: int
     final_sets: list  # [(start, width)] merged final arcs
@@ -96,10 +100,12 @@ class Plan:
     n_dynamic: int = 0  # how many of the pins (the last ones) move
 
     def rank_key(self):
+        """Sort key, best first: fewer final sets, larger margin, fewer pins, narrower sets."""
         return (self.n_sets, -round(self.margin, 9), len(self.pins),
                 round(sum(w for _, w in self.final_sets), 6))
 
     def to_dict(self) -> dict:
+        """The plan as a JSON-ready dict (the stored plan format)."""
         return {
             "pins": list(self.pins), "n_final_sets": self.n_sets,
             "final_sets": [{"start": s, "width": w} for s, w in self.final_sets],
@@ -170,10 +176,12 @@ class Planner:
 
     @property
     def static_labels(self) -> list[str]:
+        """Labels of the static pins."""
         return [k for k, v in self.speeds.items() if v == 0.0]
 
     @property
     def dynamic_labels(self) -> list[str]:
+        """Labels of the moving pins."""
         return [k for k, v in self.speeds.items() if v != 0.0]
 
     def initial_states(self) -> dict:
@@ -350,6 +358,7 @@ def pins_from_config(values) -> dict:
 
 
 def catalog_part(cat: Catalog, name: str) -> Part:
+    """The :class:`Part` stored in the catalog under ``name`` (id or name)."""
     e = cat.entries_for(name)[0]
     return Part.from_vertices(e["part_vertices"], name=e["part_name"])
 

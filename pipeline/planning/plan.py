@@ -179,6 +179,7 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
 
 
 def planner_pin_heights(planner: TightPlanner) -> dict:
+    """Pin label -> pin height across the belt (mm) of ``planner``."""
     return {label: pin.y for label, pin in planner.pins.items()}
 
 

@@ -100,14 +100,17 @@ class StateSet:
 
     @property
     def arc(self) -> tuple[float, float]:
+        """``(start, width)`` of the orientation arc, degrees."""
         return (self.start, self.width)
 
     def to_dict(self) -> dict:
+        """The state set as a JSON-ready dict (arc, y_c and mu_c intervals)."""
         return {"arc": {"start": self.start, "width": self.width},
                 "y_c": [self.y_lo, self.y_hi], "mu_c": [self.mu_lo, self.mu_hi]}
 
     @classmethod
     def from_dict(cls, d: dict) -> "StateSet":
+        """The state set stored by :meth:`to_dict`."""
         return cls(float(d["arc"]["start"]), float(d["arc"]["width"]), float(d["y_c"][0]),
                    float(d["y_c"][1]), float(d["mu_c"][0]), float(d["mu_c"][1]))
 

@@ -54,6 +54,7 @@ class Step:
     after: StateSet
 
     def to_dict(self) -> dict:
+        """The step as a JSON-ready dict (the stored plan format)."""
         return {"pin": self.pin, "y_pin": self.y_pin, "v_pin": self.v_pin,
                 "d_range": [self.d_lo, self.d_hi],
                 "band": {"start": self.after.start, "width": self.after.width},
@@ -78,15 +79,18 @@ class TightPlan:
 
     @property
     def n_dynamic(self) -> int:
+        """How many of the plan's pins move."""
         return sum(1 for v in self.pin_speeds if v != 0.0)
 
     def success_fraction(self) -> float:
+        """Fraction of verification trials that ended in the predicted sets (0 if not verified)."""
         if not self.verification:
             return 0.0
         t = self.verification["trials"]
         return self.verification["successes"] / t if t else 0.0
 
     def rank_key(self):
+        """Sort key, best first: fewer final sets, more successes, fewer pins and jumps, larger margin."""
         return (self.n_sets, -round(self.success_fraction(), 6), len(self.pins), self.jumps,
                 -round(self.margin, 9), round(sum(w for _, w in self.final_sets), 6))
 
@@ -96,6 +100,7 @@ class TightPlan:
                            for br in self.branches[label]])
 
     def to_dict(self) -> dict:
+        """The plan as a JSON-ready dict (the stored plan format)."""
         return {
             "mode": "tight",
             "pins": list(self.pins), "pin_heights_mm": list(self.pin_heights_mm),
@@ -114,6 +119,7 @@ class TightPlan:
 
 @dataclass
 class SearchStats:
+    """Counters of one search: transitions, rollouts, nodes, time (s), pruning, per level."""
     transitions: int = 0
     rollouts: int = 0
     nodes: int = 0
@@ -187,13 +193,16 @@ class TightPlanner:
 
     @property
     def static_labels(self) -> list[str]:
+        """Labels of the static pins."""
         return [k for k, p in self.pins.items() if p.v_pin == 0.0]
 
     @property
     def moving_labels(self) -> list[str]:
+        """Labels of the moving pins."""
         return [k for k, p in self.pins.items() if p.v_pin != 0.0]
 
     def initial_states(self) -> dict[str, StateSet]:
+        """Initial state label -> the part's resting state set, with the planner's uncertainties."""
         return initial_state_sets(self.part, self.mu_c, self.unc)
 
     def transition(self, state: StateSet, label: str):

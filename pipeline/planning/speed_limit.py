@@ -147,6 +147,19 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
                                         mu_s, r_pin)
         return curve[v]
 
+    limit = _speed_limit(frac, grid, required, resolution)
+    return {"curve": [[v, curve[v]] for v in sorted(curve)], "speed_limit_mm_s": float(limit),
+            "trials_per_speed": int(sum(d[0].size for d in draws)),
+            "seconds": round(time.perf_counter() - start_time, 2)}
+
+
+def _speed_limit(frac, grid, required, resolution) -> float:
+    """The highest belt speed (mm/s) whose success ``frac(v)`` reaches ``required``.
+
+    Walks the sorted coarse ``grid`` up to the first failing speed, then
+    bisects between the last success and it on multiples of ``resolution``;
+    ``0.0`` if the slowest speed fails, the highest speed if none fails.
+    """
     lo = None
     hi = None
     for v in grid:
@@ -156,22 +169,18 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
             hi = v
             break
     if lo is None:
-        limit = 0.0
-    elif hi is None:
-        limit = lo
-    else:
-        while hi - lo > resolution:
-            mid = resolution * round(0.5 * (lo + hi) / resolution)
-            if mid <= lo or mid >= hi:
-                break
-            if frac(mid) >= required:
-                lo = mid
-            else:
-                hi = mid
-        limit = lo
-    return {"curve": [[v, curve[v]] for v in sorted(curve)], "speed_limit_mm_s": float(limit),
-            "trials_per_speed": int(sum(d[0].size for d in draws)),
-            "seconds": round(time.perf_counter() - start_time, 2)}
+        return 0.0
+    if hi is None:
+        return lo
+    while hi - lo > resolution:
+        mid = resolution * round(0.5 * (lo + hi) / resolution)
+        if mid <= lo or mid >= hi:
+            break
+        if frac(mid) >= required:
+            lo = mid
+        else:
+            hi = mid
+    return lo
 
 
 def stored_plan_speed(result: dict, config: dict, plan: int = 1, mu_text=None, mu_s: float = 0.5,

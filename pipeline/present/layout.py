@@ -329,31 +329,13 @@ def layout_plan(part: Part, labels, heights, states: dict, mu_c, pin_radius: flo
     if not states:
         raise PinfeedError("give at least one initial state")
     kw = dict(model=model, belt_speed=belt_speed, mu_s=mu_s, perturb=perturb)
-    trials = run_trials(part, heights, states, mu_c, pin_radius, trials=cfg["trials"],
-                        corners=cfg["corners"], seed=cfg["seed"], **kw)
-    good = [t for t in trials if not t.jam]
-    if not good:
-        raise PinfeedError(f"every layout trial jammed ({trials[0].jam}); this plan cannot be laid out")
-    nominal = run_trials(part, heights, states, mu_c, pin_radius, nominal=True, **kw)
+    trials, good, nominal = _layout_trials(part, heights, states, mu_c, pin_radius, cfg, kw)
     margin = cfg["station_margin_mm"]
     stations, bounds = place_stations(part, good, pin_radius, margin)
-    # Entry: every centroid starts far enough upstream that nothing touches yet.
-    first_touch = [float(pin_reach(_rotated(part.vertices, t.theta), t.heights[0] - t.y_c,
-                                   pin_radius)) for t in good + nominal]
-    entry = max([r for r in first_touch if math.isfinite(r)] + [part.a + pin_radius]) + margin
+    entry = _entry_distance(part, good + nominal, pin_radius, margin)
     lanes = trial_lanes(part, good, stations, pin_radius, entry)
     nominal_lanes = trial_lanes(part, nominal, stations, pin_radius, entry)
-    step = cfg["time_step_mm"]
-    course = max(float(lane.B[-1]) for lane in lanes) + entry + 4.0 * part.a
-    clock = step * np.arange(-int(math.ceil(course / step)), int(math.ceil(2 * course / step)) + 1)
-    y_lanes = np.concatenate([lane.y for lane in lanes])
-    spacing, y_min, y_max = touch_free_spacing(
-        part, lanes, clock, cfg["slab_mm"],
-        (float(y_lanes.min()) - part.a, float(y_lanes.max()) + part.a))
-    starts, ends = contact_windows(good, lanes, len(heights))
-    busy = [max(e) - min(s) if s else 0.0 for s, e in zip(starts, ends)]
-    pin_spacing = step * (math.floor(max(busy) / step) + 1)
-    pitch = max(spacing, pin_spacing) + cfg["pitch_margin_mm"]
+    spacing, y_min, y_max, busy, pitch = _pitch(part, good, lanes, len(heights), entry, cfg)
     belt_top = y_max + cfg["belt_margin_mm"]
     belt_bottom = min(0.0, y_min - cfg["belt_margin_mm"]) if y_min < 0 else 0.0
     fence_end = _fence_end(part, lanes, pin_radius)
@@ -372,27 +354,72 @@ def layout_plan(part: Part, labels, heights, states: dict, mu_c, pin_radius: flo
         "mu_s": float(mu_s) if dynamic else None,
         "throughput_per_min": throughput,
         "drawing": drawing,
-        "method": {
-            "model": "dynamic" if dynamic else model,
-            "trials": {"per_state": int(cfg["trials"]), "corners": bool(cfg["corners"]),
-                       "replayed": len(trials), "jammed_left_out": len(trials) - len(good),
-                       "jams": sorted({t.jam for t in trials if t.jam}), "seed": int(cfg["seed"]),
-                       "perturbation": perturb or {}},
-            "margins_mm": {k: float(cfg[k]) for k in MARGIN_KEYS},
-            "stations": "first pin at x = 0; each next pin where its disc misses every pose of "
-                        "every trial from first touch at any earlier pin until the part rests, "
-                        "plus the station margin",
-            "station_bounds": bounds,
-            "pitch": {"touch_free_spacing_mm": spacing, "pin_busy_mm": [float(b) for b in busy],
-                      "time_step_mm": step, "slab_mm": cfg["slab_mm"],
-                      "rule": "max(touch-free spacing of two consecutive parts over every pair "
-                              "of trials, the longest span of any pin's contacts) + pitch margin"},
-            "belt_width": "fence y = 0 (or the lowest swept point minus the margin) to the "
-                          "highest swept point plus the belt margin",
-            "swept_y_mm": [y_min, y_max],
-            "throughput": "60 x belt speed / pitch" if dynamic else
-                          "none: the quasi-static model has no belt speed",
-        },
+        "method": _layout_method(cfg, "dynamic" if dynamic else model, trials, good, perturb, bounds,
+                                 spacing, busy, y_min, y_max, dynamic),
+    }
+
+
+def _layout_trials(part, heights, states, mu_c, pin_radius, cfg, kw):
+    """``(trials, good, nominal)``: the perturbed trials, those that did not
+    jam (none left raises :class:`PinfeedError`) and the nominal replays."""
+    trials = run_trials(part, heights, states, mu_c, pin_radius, trials=cfg["trials"],
+                        corners=cfg["corners"], seed=cfg["seed"], **kw)
+    good = [t for t in trials if not t.jam]
+    if not good:
+        raise PinfeedError(f"every layout trial jammed ({trials[0].jam}); this plan cannot be laid out")
+    nominal = run_trials(part, heights, states, mu_c, pin_radius, nominal=True, **kw)
+    return trials, good, nominal
+
+
+def _entry_distance(part, trials, pin_radius, margin) -> float:
+    """Entry (mm upstream of the first pin): every centroid starts far enough
+    upstream that nothing touches yet, plus ``margin``."""
+    first_touch = [float(pin_reach(_rotated(part.vertices, t.theta), t.heights[0] - t.y_c,
+                                   pin_radius)) for t in trials]
+    return max([r for r in first_touch if math.isfinite(r)] + [part.a + pin_radius]) + margin
+
+
+def _pitch(part, good, lanes, n_pins, entry, cfg):
+    """``(spacing, y_min, y_max, busy, pitch)`` in mm: the touch-free spacing of
+    two consecutive parts, the swept y range, each pin's contact span and the
+    pitch (the larger of spacing and busy span on the time grid, plus margin)."""
+    step = cfg["time_step_mm"]
+    course = max(float(lane.B[-1]) for lane in lanes) + entry + 4.0 * part.a
+    clock = step * np.arange(-int(math.ceil(course / step)), int(math.ceil(2 * course / step)) + 1)
+    y_lanes = np.concatenate([lane.y for lane in lanes])
+    spacing, y_min, y_max = touch_free_spacing(
+        part, lanes, clock, cfg["slab_mm"],
+        (float(y_lanes.min()) - part.a, float(y_lanes.max()) + part.a))
+    starts, ends = contact_windows(good, lanes, n_pins)
+    busy = [max(e) - min(s) if s else 0.0 for s, e in zip(starts, ends)]
+    pin_spacing = step * (math.floor(max(busy) / step) + 1)
+    pitch = max(spacing, pin_spacing) + cfg["pitch_margin_mm"]
+    return spacing, y_min, y_max, busy, pitch
+
+
+def _layout_method(cfg, model, trials, good, perturb, bounds, spacing, busy, y_min, y_max,
+                   dynamic) -> dict:
+    """The ``method`` entry of a layout: how each number was obtained."""
+    return {
+        "model": model,
+        "trials": {"per_state": int(cfg["trials"]), "corners": bool(cfg["corners"]),
+                   "replayed": len(trials), "jammed_left_out": len(trials) - len(good),
+                   "jams": sorted({t.jam for t in trials if t.jam}), "seed": int(cfg["seed"]),
+                   "perturbation": perturb or {}},
+        "margins_mm": {k: float(cfg[k]) for k in MARGIN_KEYS},
+        "stations": "first pin at x = 0; each next pin where its disc misses every pose of "
+                    "every trial from first touch at any earlier pin until the part rests, "
+                    "plus the station margin",
+        "station_bounds": bounds,
+        "pitch": {"touch_free_spacing_mm": spacing, "pin_busy_mm": [float(b) for b in busy],
+                  "time_step_mm": cfg["time_step_mm"], "slab_mm": cfg["slab_mm"],
+                  "rule": "max(touch-free spacing of two consecutive parts over every pair "
+                          "of trials, the longest span of any pin's contacts) + pitch margin"},
+        "belt_width": "fence y = 0 (or the lowest swept point minus the margin) to the "
+                      "highest swept point plus the belt margin",
+        "swept_y_mm": [y_min, y_max],
+        "throughput": "60 x belt speed / pitch" if dynamic else
+                      "none: the quasi-static model has no belt speed",
     }
 
 
@@ -458,29 +485,14 @@ def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None
     mu_s = float(cfg["mu_s"] if mu_s is None else mu_s)
     heights = [float(h) for h in plan["pin_heights_mm"]]
     arcs = [(s["start"], s["width"]) for s in plan["final_sets"]]
-    if belt_speed is not None:
-        simulate.check_belt(part, belt_speed, mu_s)
-    else:
-        simulate.check_belt(part, min(DEFAULT_SPEEDS), mu_s)  # a bad mu_s before any work
+    # A bad belt speed or mu_s is refused before any work.
+    simulate.check_belt(part, min(DEFAULT_SPEEDS) if belt_speed is None else belt_speed, mu_s)
     curve = speed_curve(part, heights, [0.0] * len(heights), list(states.values()), arcs, mu_c,
                         mu_s=mu_s, perturb=perturbation_from_verify(config.get("verify", {})),
                         trials=cfg["speed_trials"], r_pin=pin_radius, seed=cfg["seed"])
     limit = curve["speed_limit_mm_s"]
-    warnings = []
-    if belt_speed is None and limit > 0:
-        belt_speed = cfg["speed_fraction"] * limit
-        source = f"{100 * cfg['speed_fraction']:g} % of the plan's speed limit {limit:g} mm/s"
-    elif belt_speed is None:
-        source = "none"
-        quasi_static = True
-        warnings.append(f"no belt speed of the grid ({', '.join(f'{v:g}' for v in DEFAULT_SPEEDS)} "
-                        f"mm/s) passes the plan's trials: laid out with the quasi-static model, no "
-                        f"throughput; give --belt-speed MM_S")
-    else:
-        source = "given"
-        if belt_speed > limit:
-            warnings.append(f"belt speed {belt_speed:g} mm/s is above the plan's speed limit "
-                            f"{limit:g} mm/s (fewer than 99 % of its trials end in the final set)")
+    belt_speed, source, quasi_static, warnings = _belt_speed_choice(belt_speed, limit, cfg,
+                                                                    quasi_static)
     out = layout_plan(part, plan["pins"], heights, states, mu_c, pin_radius, model=result["model"],
                       belt_speed=None if quasi_static else belt_speed, mu_s=mu_s, settings=cfg,
                       perturb=config.get("verify"))
@@ -501,6 +513,32 @@ def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None
         "curve": curve["curve"]}
     out.update(provenance_attrs())
     return out
+
+
+def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
+    """``(belt_speed, source, quasi_static, warnings)`` of a stored plan's layout.
+
+    Without ``belt_speed`` (mm/s): ``speed_fraction`` of the speed ``limit``
+    (mm/s), or none and the quasi-static model when no speed passes; a given
+    speed above the limit is kept with a warning.
+    """
+    from pipeline.planning.speed_limit import DEFAULT_SPEEDS
+    warnings = []
+    if belt_speed is None and limit > 0:
+        belt_speed = cfg["speed_fraction"] * limit
+        source = f"{100 * cfg['speed_fraction']:g} % of the plan's speed limit {limit:g} mm/s"
+    elif belt_speed is None:
+        source = "none"
+        quasi_static = True
+        warnings.append(f"no belt speed of the grid ({', '.join(f'{v:g}' for v in DEFAULT_SPEEDS)} "
+                        f"mm/s) passes the plan's trials: laid out with the quasi-static model, no "
+                        f"throughput; give --belt-speed MM_S")
+    else:
+        source = "given"
+        if belt_speed > limit:
+            warnings.append(f"belt speed {belt_speed:g} mm/s is above the plan's speed limit "
+                            f"{limit:g} mm/s (fewer than 99 % of its trials end in the final set)")
+    return belt_speed, source, quasi_static, warnings
 
 
 DRAWING_SUFFIXES = (".dxf", ".svg", ".png")

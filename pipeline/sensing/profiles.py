@@ -57,6 +57,12 @@ from pipeline.planning.verify import PERTURB_DEFAULTS  # one set of perturbation
 
 @dataclass
 class Sensor:
+    """A force/torque sensor on the first pin.
+
+    Rate in Hz, belt speed in mm/s, pin length (sensor to contact) in mm,
+    noise and biases in units of mu_s m g; ``window`` moving-average samples,
+    ``regions``, ``dead_zone`` and ``margin`` set the sign-matrix classifier.
+    """
     rate_hz: float = 200.0
     belt_speed: float = 20.0  # mm/s
     pin_length: float = 30.0  # mm, sensor to contact
@@ -70,9 +76,11 @@ class Sensor:
 
     @classmethod
     def from_config(cls, cfg: dict | None) -> "Sensor":
+        """The sensor of a config's ``sensor`` section (defaults where missing)."""
         return cls(**(cfg or {}))
 
     def to_dict(self):
+        """The sensor settings as a JSON-ready dict."""
         return asdict(self)
 
 
@@ -84,6 +92,7 @@ class Profile:
     fy: np.ndarray
 
     def moments(self, pin_length):
+        """Moments ``(M_x, M_y)`` at the sensor for a pin of length ``pin_length`` (mm)."""
         return pin_length * self.fy, -pin_length * self.fx
 
 
@@ -110,6 +119,7 @@ def measure(profile: Profile, sensor: Sensor, rng) -> Profile:
 
 
 def smooth(values, window: int) -> np.ndarray:
+    """Moving average of ``values`` over ``window`` samples (edges repeat the end values)."""
     values = np.asarray(values, float)
     if window <= 1 or values.size < 2:
         return values.copy()
@@ -207,6 +217,11 @@ def classify(measured: np.ndarray, references: dict, margin: int) -> dict:
 
 
 def first_pin_rollout(part: Part, theta, y_c, y_pin, mu_c, pin_radius, model):
+    """The rollout of one resting state past the first pin, with trajectory and force.
+
+    ``theta`` in degrees; ``y_c`` (centroid) and ``y_pin`` (pin) across the belt
+    in mm; ``pin_radius`` in mm.
+    """
     from pipeline.maps import simulate
     return simulate.rollout(part, theta, (y_pin - y_c) / part.a, mu_c, pin_radius, model=model,
                             trajectory=True)

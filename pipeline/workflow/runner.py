@@ -160,6 +160,7 @@ def run(args: list[str]) -> int:
 
 
 def main(argv=None) -> int:
+    """``python -m pipeline.workflow run|unlock [SNAKEMAKE ARGS...]``; returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv or argv[0] not in ("run", "unlock"):
         print("usage: python -m pipeline.workflow run|unlock [SNAKEMAKE ARGS...]", file=sys.stderr)

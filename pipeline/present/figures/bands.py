@@ -22,7 +22,7 @@ from kernels.rollout import JAMMED, MISS, OK, TRUNCATED
 from pipeline.planning.bands import extract_bands
 from pipeline.present.figures import circle_axes, save_figure
 
-MIN_THICKNESS = 3.0  # degrees: the thinnest band or kernel drawn
+MIN_THICKNESS = 3.0  # degrees: the thinnest band B_j or kernel K_j drawn
 BAND_STYLE = dict(facecolor="tab:blue", edgecolor="tab:blue", alpha=0.25, lw=0.6)
 ADJ_STYLE = dict(facecolor="none", edgecolor="tab:orange", hatch="////", lw=1.0)
 POINTS = {
@@ -47,10 +47,10 @@ def arc_segments(start: float, width: float, min_width: float = 0.0) -> list[tup
     return [(lo, 360.0), (0.0, hi - 360.0)]
 
 
-def kernel_segments(kernel, step: float) -> list[tuple[float, float]]:
-    """K_j's arcs of grid points, each point standing for ``+- step/2``."""
+def kernel_arc_segments(kernel_arcs, step: float) -> list[tuple[float, float]]:
+    """K_j's arcs of grid points (degrees), each point standing for ``+- step/2``."""
     out = []
-    for start, width in kernel:
+    for start, width in kernel_arcs:
         out += arc_segments(start - 0.5 * step, min(width + step, 360.0), MIN_THICKNESS)
     return out
 
@@ -59,7 +59,7 @@ def band_rectangles(band, step: float, adjusted: bool = False) -> list[tuple[flo
     """``(x, y, width, height)`` of the rectangles B_j x K_j (or the adjusted band x K_j)."""
     ys = (arc_segments(band.adj_start, band.adj_width, MIN_THICKNESS) if adjusted
           else arc_segments(band.start, band.width, MIN_THICKNESS))
-    return [(x0, y0, x1 - x0, y1 - y0) for x0, x1 in kernel_segments(band.kernel, step) for y0, y1 in ys]
+    return [(x0, y0, x1 - x0, y1 - y0) for x0, x1 in kernel_arc_segments(band.kernel_arcs, step) for y0, y1 in ys]
 
 
 def draw_map_panel(ax, theta_i, theta_f, dy, status, threshold_T, factor_c) -> list:

@@ -46,4 +46,5 @@ def outline_figure(part, source: str | None = None):
 
 
 def plot_outline(part, out, source: str | None = None) -> Path:
+    """Draw the part's outline (and its source, if given) to the image file ``out``."""
     return save_figure(outline_figure(part, source), out)

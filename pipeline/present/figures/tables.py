@@ -25,6 +25,7 @@ HEADER = ["part", "plan", "pins", "initial state", "trials", "successes", "failu
 
 
 def markdown_table(rows, header=HEADER) -> str:
+    """A Markdown table of ``rows`` (lists of strings) under ``header``."""
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
     return "\n".join(lines) + "\n"
