@@ -25,18 +25,21 @@ method on the step fraction, so the step never straddles one.
 The kernel runs in named stages (``_rollout_core`` loops over them):
 ``_first_contact``; per step the slope ``_derivative``, ``_recontact``
 after a separation, ``_adaptive_step`` (Cash-Karp steps ``_step`` under
-error control), ``_end_step`` (end slope, events ``_events`` and their
-location ``_locate``) and ``_handle_event`` (jams and feature changes).
-The stages share two records, tuples that Numba passes by value:
+error control), the end slope and events ``_events``, an event's location
+``_locate`` and ``_handle_event`` (jams and feature changes).
+The stages take the part's arrays ``verts`` and ``quad`` (from ``_prepare``)
+as they are, and the rollout's scalar parameters as one record, a tuple
+that Numba passes by value::
 
-- ``part = (verts, quad, area, m_max, convex)``, from ``_prepare``;
-- ``pin = (model, mu, rp, vpwx, vpwy)``: the contact model and friction,
-  the pin radius in units of a and the pin's velocity in the belt frame,
+    prm = (model, mu, rp, vpwx, vpwy, area, m_max, convex)
 
-and rows of the scratch array ``work`` grouped by use: ``rk = (ks, tmp,
-warm)`` for a Runge-Kutta step, ``trial = (y, k1, y_new, k_end, g_end)``
-for the step just taken and ``loc = (y_located, g, mask, yi, y_try)`` for
-the event location.
+(the contact model and friction, the pin radius in units of a, the pin's
+velocity in the belt frame, and the part's area, largest support moment and
+convexity). ``_locate`` takes the arrays of the step it shortens and its
+scratch as two tuples. Tuples of arrays are kept off the per-step path:
+taking an array out of a tuple costs a reference-count update that a plain
+array argument does not (measured: grouping the part and the Runge-Kutta
+scratch that way cost about 10 % of the ellipsoid model's speed).
 
 Lengths are ``sqrt(x*x + y*y)`` rather than ``math.hypot`` (twice as slow),
 safe in units of a.
@@ -45,7 +48,7 @@ import math
 
 import numpy as np
 
-from ._numba import jit
+from ._numba import jit, jit_inline
 from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
                        _ray_first_contact)
 from .models import SEPARATE, SLIDE_NEG, SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide
@@ -154,13 +157,14 @@ def _contact_geometry(verts, kind, idx, qx, qy):
 
 
 @jit
-def _derivative(part, pin, kind, idx, y, sp, warm, out):
+def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
     """Right-hand side at state ``y`` (belt travel ``sp``) into ``out``;
     updates the warm-start history ``warm``.
 
     Parameters
     ----------
-    part, pin : the part and pin records (see the module's Notes).
+    verts, quad, prm : the part's arrays and the scalar parameters (see the
+        module's Notes).
     kind, idx : the contact feature (``geometry.EDGE`` or ``VERTEX``, index).
     y : state ``(theta, q_x, q_y, X_x, X_y)``.
     sp : belt travel at ``y`` (units of a).
@@ -195,8 +199,7 @@ def _derivative(part, pin, kind, idx, y, sp, warm, out):
     right-hand side; the rollout ends the contact at the located crossing
     and never integrates past it.
     """
-    verts, quad, area, m_max, _ = part
-    model, mu, _, vpwx, vpwy = pin
+    model, mu, _, vpwx, vpwy, area, m_max, _ = prm
     cx, cy, nx, ny, _, _ = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     vpx = cs * vpwx + sn * vpwy
@@ -278,20 +281,21 @@ _CK_B4 = np.array([2825.0 / 27648.0, 0.0, 18575.0 / 48384.0, 13525.0 / 55296.0,
 
 
 @jit
-def _step(part, pin, kind, idx, y0, s0, k1, h, y1, rk):
+def _step(verts, quad, prm, kind, idx, y0, s0, k1, h, y1, ks, tmp, warm):
     """One Cash-Karp step of size ``h`` from ``y0`` at travel ``s0`` (slope
     ``k1`` given) into ``y1`` (5th-order solution, projected back onto the
     contact).
 
     Parameters
     ----------
-    part, pin : the part and pin records (see the module's Notes).
+    verts, quad, prm : the part's arrays and the scalar parameters (see the
+        module's Notes).
     kind, idx : the contact feature.
     y0, s0, k1 : start state, its belt travel and its slope.
     h : step size (units of belt travel, a).
     y1 : the end state (written).
-    rk : ``(ks, tmp, warm)``: the six stage slopes and a stage state
-        (scratch), and the warm-start history of ``_derivative``.
+    ks, tmp, warm : the six stage slopes and a stage state (scratch), and
+        the warm-start history of ``_derivative``.
 
     Returns
     -------
@@ -305,7 +309,6 @@ def _step(part, pin, kind, idx, y0, s0, k1, h, y1, rk):
     tableau ``_CK_*``): ``y1 = y0 + h sum_j b5_j k_j`` and the error
     estimate ``h max_i |sum_j (b5_j - b4_j) k_j,i|``.
     """
-    ks, tmp, warm = rk
     for i in range(5):
         ks[0, i] = k1[i]
     ok = True
@@ -315,7 +318,7 @@ def _step(part, pin, kind, idx, y0, s0, k1, h, y1, rk):
             for j in range(st):
                 acc += _CK_A[st, j] * ks[j, i]
             tmp[i] = y0[i] + h * acc
-        res = _derivative(part, pin, kind, idx, tmp, s0 + _CK_C[st] * h, warm, ks[st])
+        res = _derivative(verts, quad, prm, kind, idx, tmp, s0 + _CK_C[st] * h, warm, ks[st])
         ok = ok and res[0] == TWIST_OK
     err = 0.0
     for i in range(5):
@@ -326,16 +329,15 @@ def _step(part, pin, kind, idx, y0, s0, k1, h, y1, rk):
             acc4 += _CK_B4[j] * ks[j, i]
         y1[i] = y0[i] + h * acc5
         err = max(err, abs(h * (acc5 - acc4)))
-    _project(part[0], kind, idx, pin[2], y1)
+    _project(verts, kind, idx, prm[2], y1)
     return ok, err
 
 
 @jit
-def _events(part, pin, kind, idx, y, g):
+def _events(verts, prm, kind, idx, y, g):
     """Event values at ``y`` into ``g``: leave the feature at its start/end,
     separation (``n . v_p``) and a second contact; all negative when crossed."""
-    verts, _, _, _, convex = part
-    _, _, rp, vpwx, vpwy = pin
+    _, _, rp, vpwx, vpwy, _, _, convex = prm
     cx, cy, nx, ny, g[0], g[1] = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     g[2] = nx * (cs * vpwx + sn * vpwy) + ny * (-sn * vpwx + cs * vpwy)
@@ -380,21 +382,22 @@ def _hermite(y0, k0, y1, k1, h, alpha, out):
 
 
 @jit
-def _locate(part, pin, kind, idx, s0, h, trial, rk, loc):
+def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
     """Shrink the step from ``y0`` to end on the first event crossed by the
     full step of size ``h`` to ``y1`` (slope ``k_end``, event values ``g1``).
 
     Parameters
     ----------
-    part, pin : the part and pin records (see the module's Notes).
+    verts, quad, prm : the part's arrays and the scalar parameters (see the
+        module's Notes).
     kind, idx : the contact feature.
     s0, h : belt travel at the step's start, and the full step's size.
     trial : ``(y0, k1, y1, k_end, g1)``: the full step's start state and
         slope, end state and slope, and event values at its end.
-    rk : ``(ks, tmp, warm)`` as for ``_step``.
-    loc : ``(y_out, g, mask, yi, y_try)``: the state just before the
-        crossing (written), and scratch (event values, the events that
-        count, an interpolated and a trial state).
+    scratch : ``(y_out, ks, tmp, warm, g, mask, yi, y_try)``: the state
+        just before the crossing (written); ``ks, tmp, warm`` as for
+        ``_step``; event values, the events that count, an interpolated and
+        a trial state.
 
     Returns
     -------
@@ -412,10 +415,10 @@ def _locate(part, pin, kind, idx, s0, h, trial, rk, loc):
     over the four), so an earlier event found while refining takes over.
     """
     y0, k1, y1, k_end, g1 = trial
-    y_out, g, mask, yi, y_try = loc
+    y_out, ks, tmp, warm, g, mask, yi, y_try = scratch
     for j in range(4):
         mask[j] = 1.0 if g1[j] < -_EVENT_TOL else 0.0
-    _events(part, pin, kind, idx, y0, g)
+    _events(verts, prm, kind, idx, y0, g)
     f0 = _min_over(g, mask)
     f1 = _min_over(g1, mask)
     # 1. Root of the event function along the interpolant (Illinois).
@@ -428,7 +431,7 @@ def _locate(part, pin, kind, idx, s0, h, trial, rk, loc):
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
         _hermite(y0, k1, y1, k_end, h, alpha, yi)
-        _events(part, pin, kind, idx, yi, g)
+        _events(verts, prm, kind, idx, yi, g)
         f = _min_over(g, mask)
         if f < 0.0:
             hi, f_hi = alpha, f
@@ -454,8 +457,8 @@ def _locate(part, pin, kind, idx, s0, h, trial, rk, loc):
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
         n_steps += 1
-        _step(part, pin, kind, idx, y0, s0, k1, alpha * h, y_try, rk)
-        _events(part, pin, kind, idx, y_try, g)
+        _step(verts, quad, prm, kind, idx, y0, s0, k1, alpha * h, y_try, ks, tmp, warm)
+        _events(verts, prm, kind, idx, y_try, g)
         for j in range(4):
             if mask[j] == 0.0 and g[j] < -_EVENT_TOL:
                 mask[j] = 1.0  # an earlier event than the ones seen so far
@@ -483,16 +486,16 @@ def _locate(part, pin, kind, idx, s0, h, trial, rk, loc):
             slope = 0.0
             if it < 8:
                 _hermite(y0, k1, y1, k_end, h, alpha + 1e-7, yi)
-                _events(part, pin, kind, idx, yi, g)
+                _events(verts, prm, kind, idx, yi, g)
                 f_up = _min_over(g, mask)
                 _hermite(y0, k1, y1, k_end, h, alpha, yi)
-                _events(part, pin, kind, idx, yi, g)
+                _events(verts, prm, kind, idx, yi, g)
                 slope = (f_up - _min_over(g, mask)) / 1e-7
             nxt = alpha - f / slope if slope < 0.0 else 0.5 * (lo + hi)
         prev_alpha, prev_f = alpha, f
         # Aim slightly early so the kept state lies before the crossing.
         alpha = nxt - 1e-13 / h
-    _events(part, pin, kind, idx, y_out, g)
+    _events(verts, prm, kind, idx, y_out, g)
     ev = 0
     best = np.inf
     for j in range(4):
@@ -562,12 +565,13 @@ def _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, the
 
 
 @jit
-def _first_contact(part, pin, theta_i, d, y, warm, mask):
+def _first_contact(verts, prm, theta_i, d, y, warm, mask):
     """Stage 1: the pin's first touch of the part, and the initial state.
 
     Parameters
     ----------
-    part, pin : the part and pin records (see the module's Notes).
+    verts, prm : the part's vertices and the scalar parameters (see the
+        module's Notes).
     theta_i : initial orientation (radians).
     d : contact parameter (units of a).
     y, warm, mask : state, warm-start history and event mask (written when
@@ -587,8 +591,7 @@ def _first_contact(part, pin, theta_i, d, y, warm, mask):
     frame (``geometry._ray_first_contact``). The warm start is a translation
     along the pin's path.
     """
-    verts = part[0]
-    _, _, rp, vpwx, vpwy = pin
+    _, _, rp, vpwx, vpwy, _, _, _ = prm
     v_pin = vpwy
     s0 = -(2.0 + rp + abs(d)) * (1.0 + abs(v_pin))
     px, py = -s0 * 1.0, s0 * v_pin
@@ -606,8 +609,8 @@ def _first_contact(part, pin, theta_i, d, y, warm, mask):
     return sigma, kind, idx
 
 
-@jit
-def _recontact(part, pin, y):
+@jit_inline
+def _recontact(verts, prm, y):
     """After a separation: the part rests while the pin travels on; a
     non-convex part may be caught again further along the pin's path.
 
@@ -615,14 +618,14 @@ def _recontact(part, pin, y):
     touch (``inf`` if none), the feature touched and the pin's direction in
     the body frame. The caller moves the pin.
     """
-    _, _, rp, vpwx, vpwy = pin
+    _, _, rp, vpwx, vpwy, _, _, _ = prm
     cs, sn = math.cos(y[0]), math.sin(y[0])
     wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
-    sigma, kind, idx = _ray_first_contact(part[0], y[1], y[2], wx, wy, rp, 1e-9)
+    sigma, kind, idx = _ray_first_contact(verts, y[1], y[2], wx, wy, rp, 1e-9)
     return sigma, kind, idx, wx, wy
 
 
-@jit
+@jit_inline
 def _first_step_size(k1, h_max, kind, rp):
     """Step size to try: ``h_max`` capped so that the contact normal turns
     by at most ``_DTHETA_CAP`` (with the part on an edge; around the vertex
@@ -638,8 +641,8 @@ def _first_step_size(k1, h_max, kind, rp):
     return h
 
 
-@jit
-def _adaptive_step(part, pin, kind, idx, y, s, k1, h, tol, y_new, rk):
+@jit_inline
+def _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h, tol, y_new, ks, tmp, warm):
     """Stage 2: one accepted step from ``y`` (travel ``s``, slope ``k1``)
     into ``y_new``, shrinking ``h`` until the error is within ``tol``.
 
@@ -662,7 +665,7 @@ def _adaptive_step(part, pin, kind, idx, y, s, k1, h, tol, y_new, rk):
     attempts = 0
     while True:
         attempts += 1
-        ok, err = _step(part, pin, kind, idx, y, s, k1, h, y_new, rk)
+        ok, err = _step(verts, quad, prm, kind, idx, y, s, k1, h, y_new, ks, tmp, warm)
         if h < 1e-12:
             break
         if not ok:
@@ -675,7 +678,7 @@ def _adaptive_step(part, pin, kind, idx, y, s, k1, h, tol, y_new, rk):
     return ok, err, h, rejected, attempts
 
 
-@jit
+@jit_inline
 def _next_step_size(err, tol, h, rejected, ds_max):
     """Size of the next step: grow gently (at most ``_GROW_MAX``), and not
     at all right after a rejection (rejected steps cost five contact solves
@@ -686,43 +689,7 @@ def _next_step_size(err, tol, h, rejected, ds_max):
     return min(ds_max, h * grow)
 
 
-@jit
-def _end_step(part, pin, kind, idx, s, h, trial, rk, loc):
-    """Stage 3: the slope and event values at the end of the step just
-    taken, and, if an event was crossed, its location (``_locate``).
-
-    ``trial`` is ``(y, k1, y_new, k_end, g_end)`` and ``loc`` as for
-    ``_locate``: ``y_new`` ends up holding the state to continue from (the
-    located one if an event was crossed), ``k1`` the slope there when known.
-
-    Returns
-    -------
-    (fraction, event, steps, have_k1, status, mode, fx, fy)
-        The fraction of the step kept, the event crossed (-1: none), the
-        real steps ``_locate`` took, and whether ``k1`` (and the contact
-        solve's ``status, mode, fx, fy``) hold the slope at ``y_new``.
-
-    Notes
-    -----
-    Without an event the end slope is the next step's first stage (FSAL);
-    with one it is only the end slope of the dense output ``_locate`` uses.
-    """
-    y, k1, y_new, k_end, g_end = trial
-    st, mode, fx, fy = _derivative(part, pin, kind, idx, y_new, s + h, rk[2], k_end)
-    _events(part, pin, kind, idx, y_new, g_end)
-    ev = _first_event(g_end, _EVENT_TOL)
-    if ev >= 0:
-        frac, ev, n_loc = _locate(part, pin, kind, idx, s, h, trial, rk, loc)
-        y_located = loc[0]
-        for i in range(5):
-            y_new[i] = y_located[i]
-        return frac, ev, n_loc, False, st, mode, fx, fy
-    for i in range(5):
-        k1[i] = k_end[i]
-    return 1.0, ev, 0, True, st, mode, fx, fy
-
-
-@jit
+@jit_inline
 def _handle_event(verts, rp, ev, y, travel, kind, idx, changes, theta_ref, travel_ref):
     """Stage 4: after a step, the jam tests and the event crossed.
 
@@ -787,7 +754,8 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     The loop runs the stages ``_first_contact``, then per step: the slope
     (``_derivative``, unless the last step's end slope is known), a
     re-contact after a separation (``_recontact``), ``_adaptive_step``,
-    ``_end_step`` (events and their location) and ``_handle_event``.
+    the end slope and events (``_events``), an event's location
+    (``_locate``) and ``_handle_event``.
 
     Every integration attempt counts against ``max_steps``: accepted and
     rejected steps, the real steps of an event location and each re-contact
@@ -799,18 +767,18 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     n_traj = 0
     n_force = 0
     two_pi = 2.0 * math.pi
-    part = (verts, quad, area, m_max, convex)
-    pin = (model, mu_c, rp, -1.0, v_pin)
+    prm = (model, mu_c, rp, -1.0, v_pin, area, m_max, convex)
     y = work[_W_Y]
     y_new = work[_W_YNEW]
     k1 = work[_W_K1]
     k_end = work[_W_KEND]
-    warm = work[_W_WARM]
+    y_located = work[_W_YLOC]
+    tmp = work[_W_TMP]
+    ks = work[_W_KS:_W_KS + 6]
+    g_end = work[_W_GEND]
     mask = work[_W_MASK]
-    rk = (work[_W_KS:_W_KS + 6], work[_W_TMP], warm)
-    trial = (y, k1, y_new, k_end, work[_W_GEND])
-    loc = (work[_W_YLOC], work[_W_GWORK], mask, work[_W_YI], work[_W_YTRY])
-    sigma, kind, idx = _first_contact(part, pin, theta_i, d, y, warm, mask)
+    warm = work[_W_WARM]
+    sigma, kind, idx = _first_contact(verts, prm, theta_i, d, y, warm, mask)
     if not math.isfinite(sigma):
         return MISS, JAM_NONE, theta_i % two_pi, 0.0, 0.0, 0, 0.0, 0, 0, 0
     s = 0.0
@@ -832,7 +800,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             status, reason = TRUNCATED, TRUNC_STEP_BUDGET
             break
         if not have_k1:
-            st, mode, fx, fy = _derivative(part, pin, kind, idx, y, s, warm, k1)
+            st, mode, fx, fy = _derivative(verts, quad, prm, kind, idx, y, s, warm, k1)
         if separated:
             # A located separation ends just before n . v_p crosses zero.
             st, mode, separated = TWIST_OK, SEPARATE, False
@@ -850,7 +818,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             n_force += 1
         if mode == SEPARATE:
             steps += 1
-            sigma, kind, idx, wx, wy = _recontact(part, pin, y)
+            sigma, kind, idx, wx, wy = _recontact(verts, prm, y)
             if not math.isfinite(sigma):
                 break
             if s + sigma >= s_cap:
@@ -866,18 +834,34 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             status = TRUNCATED
             break
         h = _first_step_size(k1, min(h_next, s_cap - s), kind, rp)
-        ok, err, h, rejected, attempts = _adaptive_step(part, pin, kind, idx, y, s, k1, h, tol,
-                                                        y_new, rk)
+        ok, err, h, rejected, attempts = _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h,
+                                                        tol, y_new, ks, tmp, warm)
         steps += attempts
         if not ok:
             status, reason = JAMMED, JAM_NO_PUSH
             break
         h_next = _next_step_size(err, tol, h, rejected, ds_max)
-        frac, ev, n_loc, have_k1, st_e, mode_e, fx_e, fy_e = _end_step(part, pin, kind, idx, s,
-                                                                       h, trial, rk, loc)
-        steps += n_loc
-        if have_k1:
+        # Slope at the step's end: the next step's first stage when no event
+        # intervenes (FSAL), and the end slope of the dense output otherwise.
+        st_e, mode_e, fx_e, fy_e = _derivative(verts, quad, prm, kind, idx, y_new, s + h, warm,
+                                               k_end)
+        _events(verts, prm, kind, idx, y_new, g_end)
+        ev = _first_event(g_end, _EVENT_TOL)
+        frac = 1.0
+        if ev >= 0:
+            trial = (y, k1, y_new, k_end, g_end)
+            scratch = (y_located, ks, tmp, warm, work[_W_GWORK], mask, work[_W_YI],
+                       work[_W_YTRY])
+            frac, ev, n_loc = _locate(verts, quad, prm, kind, idx, s, h, trial, scratch)
+            steps += n_loc
+            for i in range(5):
+                y_new[i] = y_located[i]
+            have_k1 = False
+        else:
+            for i in range(5):
+                k1[i] = k_end[i]
             st, mode, fx, fy = st_e, mode_e, fx_e, fy_e
+            have_k1 = True
         for i in range(5):
             y[i] = y_new[i]
         s += frac * h
