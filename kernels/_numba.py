@@ -36,6 +36,14 @@ def jit(fn):
     return njit(**JIT_OPTIONS)(fn)
 
 
+def jit_inline(fn):
+    """``jit`` plus ``inline="always"``: Numba inlines ``fn`` into its callers
+    (in its own IR, before LLVM), for a stage of a kernel that is called once
+    per step from one place and takes many arrays: a call that LLVM does not
+    inline passes every array's fields one by one."""
+    return njit(inline="always", **JIT_OPTIONS)(fn)
+
+
 def jit_parallel(fn):
     """Compile ``fn`` with the project's defaults plus ``parallel=True``."""
     return njit(**PARALLEL_OPTIONS)(fn)

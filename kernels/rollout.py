@@ -22,6 +22,25 @@ drift. Feature
 changes, separation and second contacts are events located by the Illinois
 method on the step fraction, so the step never straddles one.
 
+The kernel runs in named stages (``_rollout_core`` loops over them):
+``_first_contact``; per step the slope ``_derivative``, ``_recontact``
+after a separation, ``_adaptive_step`` (Cash-Karp steps ``_step`` under
+error control), the end slope and events ``_events``, an event's location
+``_locate`` and ``_handle_event`` (jams and feature changes).
+The stages take the part's arrays ``verts`` and ``quad`` (from ``_prepare``)
+as they are, and the rollout's scalar parameters as one record, a tuple
+that Numba passes by value::
+
+    prm = (model, mu, rp, vpwx, vpwy, area, m_max, convex)
+
+(the contact model and friction, the pin radius in units of a, the pin's
+velocity in the belt frame, and the part's area, largest support moment and
+convexity). ``_locate`` takes the arrays of the step it shortens and its
+scratch as two tuples. Tuples of arrays are kept off the per-step path:
+taking an array out of a tuple costs a reference-count update that a plain
+array argument does not (measured: grouping the part and the Runge-Kutta
+scratch that way cost about 10 % of the ellipsoid model's speed).
+
 Lengths are ``sqrt(x*x + y*y)`` rather than ``math.hypot`` (twice as slow),
 safe in units of a.
 """
@@ -29,7 +48,7 @@ import math
 
 import numpy as np
 
-from ._numba import jit
+from ._numba import jit, jit_inline
 from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
                        _ray_first_contact)
 from .models import SEPARATE, SLIDE_NEG, SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide
@@ -138,12 +157,25 @@ def _contact_geometry(verts, kind, idx, qx, qy):
 
 
 @jit
-def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, sp, warm, out):
+def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
     """Right-hand side at state ``y`` (belt travel ``sp``) into ``out``;
     updates the warm-start history ``warm``.
 
-    Returns ``(status, mode, fx, fy)`` with the pin force on the part in the
-    body frame.
+    Parameters
+    ----------
+    verts, quad, prm : the part's arrays and the scalar parameters (see the
+        module's Notes).
+    kind, idx : the contact feature (``geometry.EDGE`` or ``VERTEX``, index).
+    y : state ``(theta, q_x, q_y, X_x, X_y)``.
+    sp : belt travel at ``y`` (units of a).
+    warm : warm-start history of the contact solve (updated).
+    out : the five slopes ``d y / ds`` (written).
+
+    Returns
+    -------
+    (status, mode, fx, fy)
+        The contact solve's status and mode, and the pin force on the part in
+        the body frame.
 
     Notes
     -----
@@ -167,6 +199,7 @@ def _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, y, s
     right-hand side; the rollout ends the contact at the located crossing
     and never integrates past it.
     """
+    model, mu, _, vpwx, vpwy, area, m_max, _ = prm
     cx, cy, nx, ny, _, _ = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     vpx = cs * vpwx + sn * vpwy
@@ -248,14 +281,33 @@ _CK_B4 = np.array([2825.0 / 27648.0, 0.0, 18575.0 / 48384.0, 13525.0 / 55296.0,
 
 
 @jit
-def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, s0, k1, h, y1,
-          ks, tmp, warm):
+def _step(verts, quad, prm, kind, idx, y0, s0, k1, h, y1, ks, tmp, warm):
     """One Cash-Karp step of size ``h`` from ``y0`` at travel ``s0`` (slope
     ``k1`` given) into ``y1`` (5th-order solution, projected back onto the
     contact).
 
-    Returns ``(ok, err)``: ``ok`` is False if a stage found no pushing
-    solution; ``err`` is the max-norm of the embedded error estimate.
+    Parameters
+    ----------
+    verts, quad, prm : the part's arrays and the scalar parameters (see the
+        module's Notes).
+    kind, idx : the contact feature.
+    y0, s0, k1 : start state, its belt travel and its slope.
+    h : step size (units of belt travel, a).
+    y1 : the end state (written).
+    ks, tmp, warm : the six stage slopes and a stage state (scratch), and
+        the warm-start history of ``_derivative``.
+
+    Returns
+    -------
+    (ok, err)
+        ``ok`` is False if a stage found no pushing solution; ``err`` is the
+        max-norm of the embedded error estimate.
+
+    Notes
+    -----
+    Cash-Karp embedded 5(4) pair (Cash and Karp 1990, ACM TOMS 16, 201;
+    tableau ``_CK_*``): ``y1 = y0 + h sum_j b5_j k_j`` and the error
+    estimate ``h max_i |sum_j (b5_j - b4_j) k_j,i|``.
     """
     for i in range(5):
         ks[0, i] = k1[i]
@@ -266,8 +318,7 @@ def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, s0
             for j in range(st):
                 acc += _CK_A[st, j] * ks[j, i]
             tmp[i] = y0[i] + h * acc
-        res = _derivative(model, verts, quad, area, m_max, mu, kind, idx, vpwx, vpwy, tmp,
-                          s0 + _CK_C[st] * h, warm, ks[st])
+        res = _derivative(verts, quad, prm, kind, idx, tmp, s0 + _CK_C[st] * h, warm, ks[st])
         ok = ok and res[0] == TWIST_OK
     err = 0.0
     for i in range(5):
@@ -278,14 +329,15 @@ def _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, s0
             acc4 += _CK_B4[j] * ks[j, i]
         y1[i] = y0[i] + h * acc5
         err = max(err, abs(h * (acc5 - acc4)))
-    _project(verts, kind, idx, rp, y1)
+    _project(verts, kind, idx, prm[2], y1)
     return ok, err
 
 
 @jit
-def _events(verts, convex, kind, idx, rp, vpwx, vpwy, y, g):
+def _events(verts, prm, kind, idx, y, g):
     """Event values at ``y`` into ``g``: leave the feature at its start/end,
     separation (``n . v_p``) and a second contact; all negative when crossed."""
+    _, _, rp, vpwx, vpwy, _, _, convex = prm
     cx, cy, nx, ny, g[0], g[1] = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     g[2] = nx * (cs * vpwx + sn * vpwy) + ny * (-sn * vpwx + cs * vpwy)
@@ -330,20 +382,43 @@ def _hermite(y0, k0, y1, k1, h, alpha, out):
 
 
 @jit
-def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vpwy, y0, s0, k1,
-            h, y1, k_end, g1, y_out, ks, tmp, warm, g, mask, yi, y_try):
+def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
     """Shrink the step from ``y0`` to end on the first event crossed by the
     full step of size ``h`` to ``y1`` (slope ``k_end``, event values ``g1``).
 
-    The crossing is first found on the step's Hermite interpolant (no contact
-    solves), then refined with real steps by safeguarded secant iterations.
-    The state just before the crossing goes to ``y_out``; ``yi`` and
-    ``y_try`` are scratch. Returns ``(fraction, event, steps)`` with the
-    number of real steps taken.
+    Parameters
+    ----------
+    verts, quad, prm : the part's arrays and the scalar parameters (see the
+        module's Notes).
+    kind, idx : the contact feature.
+    s0, h : belt travel at the step's start, and the full step's size.
+    trial : ``(y0, k1, y1, k_end, g1)``: the full step's start state and
+        slope, end state and slope, and event values at its end.
+    scratch : ``(y_out, ks, tmp, warm, g, mask, yi, y_try)``: the state
+        just before the crossing (written); ``ks, tmp, warm`` as for
+        ``_step``; event values, the events that count, an interpolated and
+        a trial state.
+
+    Returns
+    -------
+    (fraction, event, steps)
+        The step fraction kept, the event crossed (index into the event
+        values of ``_events``) and the number of real steps taken.
+
+    Notes
+    -----
+    The crossing is first found on the step's cubic Hermite interpolant (no
+    contact solves) by the Illinois variant of regula falsi (Dowell and
+    Jarratt 1971, BIT 11, 168), then refined with real steps by safeguarded
+    secant iterations kept inside the bracket of real evaluations. The
+    event function is the least of the event values crossed so far (a mask
+    over the four), so an earlier event found while refining takes over.
     """
+    y0, k1, y1, k_end, g1 = trial
+    y_out, ks, tmp, warm, g, mask, yi, y_try = scratch
     for j in range(4):
         mask[j] = 1.0 if g1[j] < -_EVENT_TOL else 0.0
-    _events(verts, convex, kind, idx, rp, vpwx, vpwy, y0, g)
+    _events(verts, prm, kind, idx, y0, g)
     f0 = _min_over(g, mask)
     f1 = _min_over(g1, mask)
     # 1. Root of the event function along the interpolant (Illinois).
@@ -356,7 +431,7 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
         _hermite(y0, k1, y1, k_end, h, alpha, yi)
-        _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
+        _events(verts, prm, kind, idx, yi, g)
         f = _min_over(g, mask)
         if f < 0.0:
             hi, f_hi = alpha, f
@@ -382,9 +457,8 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
         n_steps += 1
-        _step(model, verts, quad, area, m_max, mu, kind, idx, rp, vpwx, vpwy, y0, s0, k1,
-              alpha * h, y_try, ks, tmp, warm)
-        _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_try, g)
+        _step(verts, quad, prm, kind, idx, y0, s0, k1, alpha * h, y_try, ks, tmp, warm)
+        _events(verts, prm, kind, idx, y_try, g)
         for j in range(4):
             if mask[j] == 0.0 and g[j] < -_EVENT_TOL:
                 mask[j] = 1.0  # an earlier event than the ones seen so far
@@ -412,16 +486,16 @@ def _locate(model, verts, quad, area, m_max, mu, convex, kind, idx, rp, vpwx, vp
             slope = 0.0
             if it < 8:
                 _hermite(y0, k1, y1, k_end, h, alpha + 1e-7, yi)
-                _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
+                _events(verts, prm, kind, idx, yi, g)
                 f_up = _min_over(g, mask)
                 _hermite(y0, k1, y1, k_end, h, alpha, yi)
-                _events(verts, convex, kind, idx, rp, vpwx, vpwy, yi, g)
+                _events(verts, prm, kind, idx, yi, g)
                 slope = (f_up - _min_over(g, mask)) / 1e-7
             nxt = alpha - f / slope if slope < 0.0 else 0.5 * (lo + hi)
         prev_alpha, prev_f = alpha, f
         # Aim slightly early so the kept state lies before the crossing.
         alpha = nxt - 1e-13 / h
-    _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_out, g)
+    _events(verts, prm, kind, idx, y_out, g)
     ev = 0
     best = np.inf
     for j in range(4):
@@ -491,6 +565,180 @@ def _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, the
 
 
 @jit
+def _first_contact(verts, prm, theta_i, d, y, warm, mask):
+    """Stage 1: the pin's first touch of the part, and the initial state.
+
+    Parameters
+    ----------
+    verts, prm : the part's vertices and the scalar parameters (see the
+        module's Notes).
+    theta_i : initial orientation (radians).
+    d : contact parameter (units of a).
+    y, warm, mask : state, warm-start history and event mask (written when
+        the pin touches the part).
+
+    Returns
+    -------
+    (sigma, kind, idx)
+        Belt travel from the start station to the touch (``inf`` for a
+        miss) and the feature touched.
+
+    Notes
+    -----
+    The pin path passes ``y = 0`` at the centroid's starting station
+    ``x = 0``; it starts far enough back to clear the part, and the first
+    contact is found by casting the pin disc along its path in the body
+    frame (``geometry._ray_first_contact``). The warm start is a translation
+    along the pin's path.
+    """
+    _, _, rp, vpwx, vpwy, _, _, _ = prm
+    v_pin = vpwy
+    s0 = -(2.0 + rp + abs(d)) * (1.0 + abs(v_pin))
+    px, py = -s0 * 1.0, s0 * v_pin
+    cs, sn = math.cos(theta_i), math.sin(theta_i)
+    dx, dy0 = px - 0.0, py + d
+    qx, qy = cs * dx + sn * dy0, -sn * dx + cs * dy0
+    wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
+    sigma, kind, idx = _ray_first_contact(verts, qx, qy, wx, wy, rp, 0.0)
+    if math.isfinite(sigma):
+        y[0], y[1], y[2], y[3], y[4] = theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d
+        warm[0], warm[1], warm[2], warm[3], warm[4] = wx, wy, 0.0, 0.0, 0.0
+        warm[9] = 0.0
+        for j in range(4):
+            mask[j] = 0.0
+    return sigma, kind, idx
+
+
+@jit_inline
+def _recontact(verts, prm, y):
+    """After a separation: the part rests while the pin travels on; a
+    non-convex part may be caught again further along the pin's path.
+
+    Returns ``(sigma, kind, idx, wx, wy)``: the pin travel to the next
+    touch (``inf`` if none), the feature touched and the pin's direction in
+    the body frame. The caller moves the pin.
+    """
+    _, _, rp, vpwx, vpwy, _, _, _ = prm
+    cs, sn = math.cos(y[0]), math.sin(y[0])
+    wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
+    sigma, kind, idx = _ray_first_contact(verts, y[1], y[2], wx, wy, rp, 1e-9)
+    return sigma, kind, idx, wx, wy
+
+
+@jit_inline
+def _first_step_size(k1, h_max, kind, rp):
+    """Step size to try: ``h_max`` capped so that the contact normal turns
+    by at most ``_DTHETA_CAP`` (with the part on an edge; around the vertex
+    on a vertex), so no event function can cross zero twice within one
+    step."""
+    h = h_max
+    if abs(k1[0]) * h > _DTHETA_CAP:
+        h = _DTHETA_CAP / abs(k1[0])
+    if kind == VERTEX:
+        turn = math.sqrt(k1[1] * k1[1] + k1[2] * k1[2]) / rp
+        if turn * h > _DTHETA_CAP:
+            h = _DTHETA_CAP / turn
+    return h
+
+
+@jit_inline
+def _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h, tol, y_new, ks, tmp, warm):
+    """Stage 2: one accepted step from ``y`` (travel ``s``, slope ``k1``)
+    into ``y_new``, shrinking ``h`` until the error is within ``tol``.
+
+    Returns
+    -------
+    (ok, err, h, rejected, attempts)
+        ``ok`` False if no pushing solution exists at a stage of the last
+        attempt; the error estimate and size of the step taken; whether an
+        attempt was rejected; the number of attempts (each counts against
+        the step budget).
+
+    Notes
+    -----
+    Standard step-size control of an embedded pair of orders 5 and 4
+    (Hairer, Norsett and Wanner, *Solving ODEs I*, II.4):
+    ``h <- h max(0.2, 0.8 (tol / err)^(1/5))`` after a rejection, halving
+    when a stage has no pushing solution, and giving up below ``1e-12``.
+    """
+    rejected = False
+    attempts = 0
+    while True:
+        attempts += 1
+        ok, err = _step(verts, quad, prm, kind, idx, y, s, k1, h, y_new, ks, tmp, warm)
+        if h < 1e-12:
+            break
+        if not ok:
+            h *= 0.5
+        elif err > tol:
+            h *= max(0.2, 0.8 * (tol / err) ** 0.2)
+        else:
+            break
+        rejected = True
+    return ok, err, h, rejected, attempts
+
+
+@jit_inline
+def _next_step_size(err, tol, h, rejected, ds_max):
+    """Size of the next step: grow gently (at most ``_GROW_MAX``), and not
+    at all right after a rejection (rejected steps cost five contact solves
+    each); never above ``ds_max``."""
+    grow = _GROW_MAX if err <= 0.0 else min(_GROW_MAX, 0.8 * (tol / err) ** 0.2)
+    if rejected:
+        grow = min(grow, 1.0)
+    return min(ds_max, h * grow)
+
+
+@jit_inline
+def _handle_event(verts, rp, ev, y, travel, kind, idx, changes, theta_ref, travel_ref):
+    """Stage 4: after a step, the jam tests and the event crossed.
+
+    Parameters
+    ----------
+    verts, rp : the part's vertices and the pin radius (units of a).
+    ev : the event the step ended on (-1: none; see ``_events``).
+    y, travel : the state (the pin is projected onto a new feature) and the
+        pin travel in contact so far.
+    kind, idx : the contact feature.
+    changes : feature changes so far.
+    theta_ref, travel_ref : orientation and travel at the last rotation of
+        at least ``_JAM_ANGLE``.
+
+    Returns
+    -------
+    (reason, kind, idx, changes, theta_ref, travel_ref)
+        ``reason`` is ``JAM_NONE`` unless the rollout jams.
+
+    Notes
+    -----
+    Tests in this order: no rotation of ``_JAM_ANGLE`` over ``_JAM_TRAVEL``
+    of pin travel, travel past ``_MAX_TRAVEL``, a second contact (notch),
+    then a feature change (an edge to its end vertex or a vertex to the
+    adjacent edge, events 0 and 1), which fails past ``_MAX_CHANGES``.
+    Separation (event 2) is handled by the caller.
+    """
+    if abs(y[0] - theta_ref) >= _JAM_ANGLE:
+        theta_ref, travel_ref = y[0], travel
+    elif travel - travel_ref > _JAM_TRAVEL:
+        return JAM_NO_ROTATION, kind, idx, changes, theta_ref, travel_ref
+    if travel > _MAX_TRAVEL:
+        return JAM_TRAVEL, kind, idx, changes, theta_ref, travel_ref
+    if ev == 3:
+        return JAM_NOTCH, kind, idx, changes, theta_ref, travel_ref
+    if ev == 0 or ev == 1:
+        changes += 1
+        if changes > _MAX_CHANGES:
+            return JAM_CHATTER, kind, idx, changes, theta_ref, travel_ref
+        n = verts.shape[0]
+        if kind == EDGE:
+            kind, idx = VERTEX, (idx if ev == 0 else (idx + 1) % n)
+        else:
+            kind, idx = EDGE, ((idx - 1 + n) % n if ev == 0 else idx)
+        _project(verts, kind, idx, rp, y)
+    return JAM_NONE, kind, idx, changes, theta_ref, travel_ref
+
+
+@jit
 def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
                   max_travel, ds_max, tol, record, max_steps, work, traj, force):
     """The rollout itself, without allocating: the scalar code path shared by
@@ -503,6 +751,12 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
 
     Notes
     -----
+    The loop runs the stages ``_first_contact``, then per step: the slope
+    (``_derivative``, unless the last step's end slope is known), a
+    re-contact after a separation (``_recontact``), ``_adaptive_step``,
+    the end slope and events (``_events``), an event's location
+    (``_locate``) and ``_handle_event``.
+
     Every integration attempt counts against ``max_steps``: accepted and
     rejected steps, the real steps of an event location and each re-contact
     after a separation. The budget is checked before each step, so at most
@@ -513,18 +767,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     n_traj = 0
     n_force = 0
     two_pi = 2.0 * math.pi
-    vpwx, vpwy = -1.0, v_pin
-    # The pin path passes y = 0 at the centroid's starting station x = 0.
-    s0 = -(2.0 + rp + abs(d)) * (1.0 + abs(v_pin))
-    px, py = -s0 * 1.0, s0 * v_pin
-    cs, sn = math.cos(theta_i), math.sin(theta_i)
-    dx, dy0 = px - 0.0, py + d
-    qx, qy = cs * dx + sn * dy0, -sn * dx + cs * dy0
-    wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
-    sigma, kind, idx = _ray_first_contact(verts, qx, qy, wx, wy, rp, 0.0)
-    theta_wrapped = theta_i % two_pi
-    if not math.isfinite(sigma):
-        return MISS, JAM_NONE, theta_wrapped, 0.0, 0.0, 0, 0.0, 0, 0, 0
+    prm = (model, mu_c, rp, -1.0, v_pin, area, m_max, convex)
     y = work[_W_Y]
     y_new = work[_W_YNEW]
     k1 = work[_W_K1]
@@ -533,15 +776,11 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     tmp = work[_W_TMP]
     ks = work[_W_KS:_W_KS + 6]
     g_end = work[_W_GEND]
-    g_work = work[_W_GWORK]
     mask = work[_W_MASK]
     warm = work[_W_WARM]
-    y[0], y[1], y[2], y[3], y[4] = theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d
-    # Warm-start history (see _derivative): a translation along the pin's path.
-    warm[0], warm[1], warm[2], warm[3], warm[4] = wx, wy, 0.0, 0.0, 0.0
-    warm[9] = 0.0
-    for j in range(4):
-        mask[j] = 0.0
+    sigma, kind, idx = _first_contact(verts, prm, theta_i, d, y, warm, mask)
+    if not math.isfinite(sigma):
+        return MISS, JAM_NONE, theta_i % two_pi, 0.0, 0.0, 0, 0.0, 0, 0, 0
     s = 0.0
     h_next = ds_max
     travel = 0.0
@@ -561,15 +800,14 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             status, reason = TRUNCATED, TRUNC_STEP_BUDGET
             break
         if not have_k1:
-            st, mode, fx, fy = _derivative(model, verts, quad, area, m_max, mu_c, kind, idx,
-                                           vpwx, vpwy, y, s, warm, k1)
-        have_k1 = False
+            st, mode, fx, fy = _derivative(verts, quad, prm, kind, idx, y, s, warm, k1)
         if separated:
             # A located separation ends just before n . v_p crosses zero.
             st, mode, separated = TWIST_OK, SEPARATE, False
         if st != TWIST_OK:
             status, reason = JAMMED, JAM_NO_PUSH
             break
+        # The force on the pin, in the belt frame.
         cs, sn = math.cos(y[0]), math.sin(y[0])
         fwx, fwy = cs * fx - sn * fy, sn * fx + cs * fy
         if mode == SEPARATE:
@@ -579,11 +817,8 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             force[n_force, 0], force[n_force, 1], force[n_force, 2] = s * a, -fwx, -fwy
             n_force += 1
         if mode == SEPARATE:
-            # The pin moves away: the part rests while the pin travels on; a
-            # non-convex part may be caught again further along the path.
             steps += 1
-            wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
-            sigma, kind, idx = _ray_first_contact(verts, y[1], y[2], wx, wy, rp, 1e-9)
+            sigma, kind, idx, wx, wy = _recontact(verts, prm, y)
             if not math.isfinite(sigma):
                 break
             if s + sigma >= s_cap:
@@ -593,57 +828,35 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             y[2] += sigma * wy
             s += sigma
             changes += 1
+            have_k1 = False
             continue
         if s >= s_cap:
             status = TRUNCATED
             break
-        # Adaptive step: error control, plus caps on the turn of the contact
-        # normal (with the part on an edge, around the vertex on a vertex) so
-        # no event function can cross zero twice within one step.
-        h = min(h_next, s_cap - s)
-        if abs(k1[0]) * h > _DTHETA_CAP:
-            h = _DTHETA_CAP / abs(k1[0])
-        if kind == VERTEX:
-            turn = math.sqrt(k1[1] * k1[1] + k1[2] * k1[2]) / rp
-            if turn * h > _DTHETA_CAP:
-                h = _DTHETA_CAP / turn
-        rejected = False
-        while True:
-            steps += 1
-            ok, err = _step(model, verts, quad, area, m_max, mu_c, kind, idx, rp, vpwx, vpwy,
-                            y, s, k1, h, y_new, ks, tmp, warm)
-            if h < 1e-12:
-                break
-            if not ok:
-                h *= 0.5
-            elif err > tol:
-                h *= max(0.2, 0.8 * (tol / err) ** 0.2)
-            else:
-                break
-            rejected = True
+        h = _first_step_size(k1, min(h_next, s_cap - s), kind, rp)
+        ok, err, h, rejected, attempts = _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h,
+                                                        tol, y_new, ks, tmp, warm)
+        steps += attempts
         if not ok:
             status, reason = JAMMED, JAM_NO_PUSH
             break
-        # Grow gently, and not at all right after a rejection: rejected
-        # steps cost five contact solves each.
-        grow = _GROW_MAX if err <= 0.0 else min(_GROW_MAX, 0.8 * (tol / err) ** 0.2)
-        if rejected:
-            grow = min(grow, 1.0)
-        h_next = min(ds_max, h * grow)
+        h_next = _next_step_size(err, tol, h, rejected, ds_max)
         # Slope at the step's end: the next step's first stage when no event
-        # intervenes, and the end slope of the dense output otherwise.
-        st_e, mode_e, fx_e, fy_e = _derivative(model, verts, quad, area, m_max, mu_c, kind,
-                                               idx, vpwx, vpwy, y_new, s + h, warm, k_end)
-        _events(verts, convex, kind, idx, rp, vpwx, vpwy, y_new, g_end)
+        # intervenes (FSAL), and the end slope of the dense output otherwise.
+        st_e, mode_e, fx_e, fy_e = _derivative(verts, quad, prm, kind, idx, y_new, s + h, warm,
+                                               k_end)
+        _events(verts, prm, kind, idx, y_new, g_end)
         ev = _first_event(g_end, _EVENT_TOL)
         frac = 1.0
         if ev >= 0:
-            frac, ev, n_loc = _locate(model, verts, quad, area, m_max, mu_c, convex, kind, idx,
-                                      rp, vpwx, vpwy, y, s, k1, h, y_new, k_end, g_end, y_located,
-                                      ks, tmp, warm, g_work, mask, work[_W_YI], work[_W_YTRY])
+            trial = (y, k1, y_new, k_end, g_end)
+            scratch = (y_located, ks, tmp, warm, work[_W_GWORK], mask, work[_W_YI],
+                       work[_W_YTRY])
+            frac, ev, n_loc = _locate(verts, quad, prm, kind, idx, s, h, trial, scratch)
             steps += n_loc
             for i in range(5):
                 y_new[i] = y_located[i]
+            have_k1 = False
         else:
             for i in range(5):
                 k1[i] = k_end[i]
@@ -657,28 +870,11 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             traj[n_traj, 0], traj[n_traj, 1] = s * a, y[3] * a
             traj[n_traj, 2], traj[n_traj, 3] = (y[4] + d) * a, y[0]
             n_traj += 1
-        if abs(y[0] - theta_ref) >= _JAM_ANGLE:
-            theta_ref, travel_ref = y[0], travel
-        elif travel - travel_ref > _JAM_TRAVEL:
-            status, reason = JAMMED, JAM_NO_ROTATION
+        reason, kind, idx, changes, theta_ref, travel_ref = _handle_event(
+            verts, rp, ev, y, travel, kind, idx, changes, theta_ref, travel_ref)
+        if reason != JAM_NONE:
+            status = JAMMED
             break
-        if travel > _MAX_TRAVEL:
-            status, reason = JAMMED, JAM_TRAVEL
-            break
-        if ev == 3:
-            status, reason = JAMMED, JAM_NOTCH
-            break
-        if ev == 0 or ev == 1:
-            changes += 1
-            if changes > _MAX_CHANGES:
-                status, reason = JAMMED, JAM_CHATTER
-                break
-            n = verts.shape[0]
-            if kind == EDGE:
-                kind, idx = VERTEX, (idx if ev == 0 else (idx + 1) % n)
-            else:
-                kind, idx = EDGE, ((idx - 1 + n) % n if ev == 0 else idx)
-            _project(verts, kind, idx, rp, y)
         separated = ev == 2
     if record:
         force[n_force, 0], force[n_force, 1], force[n_force, 2] = s * a, 0.0, 0.0
