@@ -80,7 +80,8 @@ MUTATIONS = [
              "pipeline/planning/verify.py",
              'for branch in plan["initial_states"][label] if branch]',
              'for branch in plan["initial_states"][label][:1] if branch]',
-             ("tests/test_planning.py", "-k", "verification or triangle_plan")),
+             ("tests/test_planning.py", "tests/test_mutation_kills.py", "-k",
+              "verification or triangle_plan or predicted")),
 ]
 
 

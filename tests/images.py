@@ -39,8 +39,9 @@ def _longest_run(mask_1d) -> int:
 def assert_png_figure(path, min_width=300, min_height=150, min_ink=0.01, axes=True):
     """``path`` is a PNG of at least ``min_width`` x ``min_height`` pixels with at
     least ``min_ink`` of its pixels off the background; with ``axes``, a
-    horizontal and a vertical dark line at least a fifth of the image long
-    (a plot's spines) are drawn. Returns the image (rows, columns, channels)."""
+    horizontal and a vertical dark line at least a tenth of the image long
+    (a plot's spines; a tenth, so that one panel of a 4 x 4 grid counts) are
+    drawn. Returns the image (rows, columns, channels)."""
     import matplotlib.image as mpimg
     path = Path(path)
     assert path.read_bytes()[:8] == PNG_SIGNATURE, f"{path} is not a PNG"
@@ -58,7 +59,7 @@ def assert_png_figure(path, min_width=300, min_height=150, min_ink=0.01, axes=Tr
         dark = _dark(rgb)
         rows = max(_longest_run(r) for r in dark)
         cols = max(_longest_run(c) for c in dark.T)
-        assert rows >= w / 5 and cols >= h / 5, (
+        assert rows >= w / 10 and cols >= h / 10, (
             f"{path}: no axes (longest dark line {rows} px across, {cols} px down)")
     return img
 

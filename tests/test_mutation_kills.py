@@ -74,3 +74,24 @@ def test_stored_lattice_tells_tiny_tolerances_apart(tmp_path):
     lattice.add(np.array([[0, 50, 20]]), np.zeros(1, np.int8), np.array([10.0]), np.zeros(1))
     save_lattice(tmp_path, lattice)
     assert not load_lattice(tmp_path, PART, "minpower", 0.0, R_PIN, {"ds_max": 0.05, "tol": 2e-9}).known
+
+
+# ---------------------------------------- a stored plan's predicted sets: every branch
+
+def test_predicted_sets_take_every_branch_of_a_state():
+    """A state that splits at a pin has one branch per piece; the plan predicts
+    the union of every branch's last set (a state with no branch predicts
+    nothing). Arcs by hand: [10, 15] and [12, 22] overlap into [10, 22]
+    (start 10, width 12); [200, 204] and [350, 365] stay apart."""
+    from pipeline.planning.verify import predicted_sets
+
+    def step(start, width):
+        return {"band": {"start": start, "width": width}}
+    plan = {"initial_states": {
+        "split": [[step(90.0, 1.0), step(10.0, 5.0)], [step(90.0, 1.0), step(200.0, 4.0)],
+                  [step(12.0, 10.0)], [step(350.0, 15.0)]],
+        "none": [[]],
+    }}
+    got = sorted((round(s, 9), round(w, 9)) for s, w in predicted_sets(plan, "split"))
+    assert got == [(10.0, 12.0), (200.0, 4.0), (350.0, 15.0)]
+    assert predicted_sets(plan, "none") == []
