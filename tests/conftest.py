@@ -2,10 +2,18 @@
 
 Hypothesis profiles
 -------------------
-``ci`` (default): few examples, no deadline (the first call of a Numba kernel
+Registered here once, selected with ``HYPOTHESIS_PROFILE`` (no test sets
+deadline, seeds or health checks of its own):
+
+``ci`` (default): 100 examples, no deadline (the first call of a Numba kernel
 compiles, which would trip any per-example deadline), derandomized so that a
-CI run is reproducible. ``dev``: more examples, random seeds, for local
-bug hunting. Select with ``HYPOTHESIS_PROFILE=dev``.
+CI run is reproducible. ``dev``: 300 examples, random seeds, for local bug
+hunting. ``thorough``: 2000 examples, random seeds, for a long run before a
+release.
+
+A test whose every example runs full rollouts (seconds each) asks for a
+share of the profile's count with :func:`fewer_examples` and says why; the
+share keeps the same proportion in every profile.
 
 Nothing here reads ``/work/shared``: reference data the tests need is copied
 under ``tests/data``.
@@ -20,22 +28,20 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
-settings.register_profile(
-    "ci",
-    deadline=None,
-    max_examples=15,
-    derandomize=True,
-    print_blob=True,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
-)
-settings.register_profile(
-    "dev",
-    deadline=None,
-    max_examples=100,
-    print_blob=True,
-    suppress_health_check=[HealthCheck.too_slow],
-)
+_COMMON = dict(deadline=None, print_blob=True,
+               suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+settings.register_profile("ci", max_examples=100, derandomize=True, **_COMMON)
+settings.register_profile("dev", max_examples=300, **_COMMON)
+settings.register_profile("thorough", max_examples=2000, **_COMMON)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
+def fewer_examples(share: float) -> settings:
+    """Settings for a slow property: ``share`` of the loaded profile's
+    ``max_examples`` (at least 2), everything else from the profile. Use it
+    only where one example costs full rollouts, and say so at the test."""
+    return settings(max_examples=max(2, round(settings.default.max_examples * share)))
+
 
 DATA_DIR = Path(__file__).parent / "data"
 

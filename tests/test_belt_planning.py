@@ -10,6 +10,7 @@ import pytest
 import xarray as xr
 import yaml
 
+from images import assert_png_figure
 from pipeline.cli import main
 from pipeline.config import load_config
 from pipeline.errors import PinfeedError
@@ -144,7 +145,7 @@ def test_speed_stage_json_and_figure(planned, tmp_path):
     above = [f for v, f in result["curve"] if v > limit]
     assert not above or above[0] < 0.99  # and fails at the next speed tried
     out = speed_figure(result, tmp_path / "speed.png")
-    assert out.is_file() and out.stat().st_size > 1000
+    assert_png_figure(out)  # decoded: a plot with axes and a curve, not just bytes
 
 
 def test_speed_figure_has_labelled_axes_legend_and_marked_limit():

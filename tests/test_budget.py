@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from conftest import TRIANGLE
+from conftest import TRIANGLE, fewer_examples
 from kernels.models import ELLIPSOID, MINPOWER, TIP
 from kernels.rollout import (JAM_REASONS, JAMMED, MAX_STEPS, MIN_STEPS, OK, TRUNC_STEP_BUDGET,
                              TRUNCATED, _prepare, _rollout, _rollout_budget, max_steps_for)
@@ -124,6 +124,8 @@ def _log_uniform(lo, hi):
 BUDGET = 150
 
 
+# Each example runs a full rollout to its step budget: 15 in CI.
+@fewer_examples(0.15)
 @given(poly=st.one_of(triangles(), convex_polygons(), star_polygons()),
        scale=_log_uniform(1e-9, 1e6), rp_ratio=_log_uniform(1e-3, 1e6),
        mu=st.one_of(st.just(0.0), st.floats(0.0, 2.0)), model=st.sampled_from([0, 1, 2]),

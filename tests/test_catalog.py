@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
+from images import assert_png_figure
 from pipeline.config import load_config, validate_config
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
@@ -314,4 +315,4 @@ def test_cli_catalog_commands(swept, capsys):
     png = Path(root).parent / "m.png"
     assert main(["catalog", "plot", "--catalog", root, "--part", "tri", "--mu-c", "0.2",
                  "--out", str(png)]) == 0
-    assert png.stat().st_size > 10_000
+    assert_png_figure(png, min_width=500)

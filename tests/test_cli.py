@@ -18,6 +18,7 @@ import pytest
 import xarray as xr
 
 from conftest import TRIANGLE, circular_diff
+from images import assert_png_figure
 from pipeline.cli import main
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
@@ -233,8 +234,7 @@ def test_map_and_plot_round_trip(tmp_path, capsys):
     png = tmp_path / "map.png"
     code, stdout, err = run(capsys, ["plot-map", str(out), "--out", str(png)])
     assert code == 0, err
-    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert png.stat().st_size > 1000
+    assert_png_figure(png)
 
 
 def test_map_range_syntax(tmp_path, capsys):

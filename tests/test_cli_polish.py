@@ -64,9 +64,22 @@ def test_rollout_trajectory_table(capsys):
     out = capsys.readouterr().out
     assert "[[" not in out and "trajectory of theta_i = 30 deg" in out
     table = out.split("theta (deg)")[1].strip().splitlines()
-    assert 2 <= len(table) <= 11
+    # The same rollout through the Python API: the table shows 11 evenly spaced
+    # samples of its trajectory (all of them if fewer), both ends included.
+    import numpy as np
+
+    from pipeline.maps import simulate
+    from pipeline.parts.part import Part
+    ds = simulate.rollout(Part.from_vertices([[0, 0], [60, 0], [15, 35]]), 30.0, 0.3, 0.2, 3.0,
+                          trajectory=True)
+    n = ds.traj_s.size
+    assert f"({n} samples;" in out and len(table) == min(11, n)
     first = [float(v) for v in table[0].split()]
     assert first[:3] == [0.0, 0.0, 0.0] and first[3] == pytest.approx(30.0)
+    last = [float(v) for v in table[-1].split()]
+    assert last[0] == pytest.approx(float(ds.traj_s[-1]), abs=0.006)
+    assert abs((last[3] - float(ds.theta_f) + 180.0) % 360.0 - 180.0) <= 0.006
+    assert np.all(np.diff([float(r.split()[0]) for r in table]) > 0)  # s grows down the table
 
 
 def test_sense_hint_names_pinfeed_plan_for_an_ad_hoc_part(tmp_path):

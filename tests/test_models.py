@@ -13,7 +13,7 @@ from collections import namedtuple
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, event, given, settings
+from hypothesis import assume, event, given
 from hypothesis import strategies as st
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -38,10 +38,7 @@ from kernels.support import _fan_quadrature
 MODELS = {"minpower": MINPOWER, "tip": TIP, "ellipsoid": ELLIPSOID}
 SLIDES = (SLIDE_POS, SLIDE_NEG)
 
-# derandomize: the same (random-looking) cases on every run, so CI is stable.
-SETTINGS = {"deadline": None, "derandomize": True,
-            "suppress_health_check": [HealthCheck.too_slow, HealthCheck.filter_too_much]}
-
+# Hypothesis settings (examples, derandomized in CI) come from the profile in conftest.py.
 Part = namedtuple("Part", "verts area a quad m_max convex")
 
 
@@ -134,7 +131,6 @@ def check_kkt_against_reference(part, c, xi, f, rtol=1e-8, mtol=1e-6):
 # --------------------------------------------------------------------------- (a) minimum power
 
 
-@settings(max_examples=120, **SETTINGS)
 @given(contact_cases())
 def test_minpower_twist_minimises_power(case):
     part, c, n, vp, mu = case
@@ -266,7 +262,6 @@ def test_minpower_stick_independent_of_warm_start():
 
 
 @pytest.mark.parametrize("model", list(MODELS))
-@settings(max_examples=30, **SETTINGS)
 @given(case=contact_cases(mu=0.0), k=st.integers(1, 10), sign=st.sampled_from([-1.0, 1.0]))
 def test_frictionless_twist_depends_only_on_normal_pin_speed(model, case, k, sign):
     """mu = 0: the force is along n and the twist is one fixed sliding twist
@@ -317,7 +312,6 @@ def test_minpower_frictionless_grazing_pin_regression():
 
 
 @pytest.mark.parametrize("model", list(MODELS))
-@settings(max_examples=40, **SETTINGS)
 @given(case=contact_cases(mu=1e4))
 def test_stick_slide_switch_at_friction_cone_edge(model, case):
     part, c, n, vp, mu_big = case
@@ -344,7 +338,6 @@ def test_stick_slide_switch_at_friction_cone_edge(model, case):
         assert np.linalg.norm(f_dir(f_lo) - f_dir(f_s)) <= 0.6 * eps
 
 
-@settings(max_examples=40, **SETTINGS)
 @given(contact_cases(mu=0.0, max_angle=1.5, min_angle=0.9), st.floats(0.05, 50.0))
 def test_sliding_side_follows_sticking_force_when_it_pulls(case, mu):
     """Spec: the sliding side is the sign of the sticking force's f.t, also
@@ -366,7 +359,6 @@ def test_sliding_side_follows_sticking_force_when_it_pulls(case, mu):
 
 
 @pytest.mark.parametrize("model", list(MODELS))
-@settings(max_examples=80, **SETTINGS)
 @given(case=contact_cases(mu=st.floats(0.05, 1.0), min_angle=0.3))
 def test_slip_opposes_tangential_friction(model, case):
     part, c, n, vp, mu = case
@@ -384,7 +376,6 @@ def test_slip_opposes_tangential_friction(model, case):
 # --------------------------------------------------------------------------- (d) hint shortcut
 
 
-@settings(max_examples=250, **SETTINGS)
 @given(contact_cases(), st.tuples(st.floats(-3, 3), st.floats(-3, 3), st.floats(-3, 3)))
 def test_hint_shortcut_matches_full_rule(case, warm_rand):
     part, c, n, vp, mu = case
@@ -418,7 +409,6 @@ def _central_edge_contact(verts):
 
 
 @pytest.mark.parametrize("model", list(MODELS))
-@settings(max_examples=30, **SETTINGS)
 @given(xy=st.one_of(sts.convex_polygons(), sts.star_polygons()), k=st.integers(0, 20),
        alpha=st.floats(-1.4, 1.4), mu=st.floats(0.05, 2.0), speed=st.floats(0.5, 2.0))
 def test_force_line_through_centroid_gives_translation(model, xy, k, alpha, mu, speed):
@@ -447,7 +437,6 @@ def test_force_line_through_centroid_gives_translation(model, xy, k, alpha, mu, 
 # --------------------------------------------------------------------------- (f) tip
 
 
-@settings(max_examples=150, **SETTINGS)
 @given(contact_cases())
 def test_tip_cor_is_tip_of_cor_locus(case):
     part, c, n, vp, mu = case
@@ -474,7 +463,6 @@ def test_tip_cor_is_tip_of_cor_locus(case):
 # --------------------------------------------------------------------------- (g) ellipsoid
 
 
-@settings(max_examples=150, **SETTINGS)
 @given(contact_cases())
 def test_ellipsoid_twist_along_limit_surface_normal(case):
     part, c, n, vp, mu = case
@@ -500,7 +488,6 @@ def _rotate(xy, phi):
 
 
 @pytest.mark.parametrize("model", list(MODELS))
-@settings(max_examples=40, **SETTINGS)
 @given(case=contact_cases(), phi=st.floats(0.1, 6.2), k=st.floats(0.2, 5.0))
 def test_model_equivariance(model, case, phi, k):
     """Rotating the whole scene rotates the answer; mirroring it (y -> -y)

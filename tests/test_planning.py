@@ -7,6 +7,7 @@ import pytest
 import xarray as xr
 
 from kernels.rollout import JAMMED, MISS, OK
+from oracle import n_clusters, replay_sequence, trial_inputs
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
@@ -190,7 +191,15 @@ def triangle_plan():
 def test_triangle_plan_is_confirmed_by_full_rollouts(triangle_plan):
     pl, plans = triangle_plan
     best = plans[0]
-    assert best.n_sets <= 2
+    # The number of final sets the plan claims is the number an independent
+    # replay sees: every initial state, perturbed (random draws plus the
+    # corners of the box), pushed by plain rollouts through the plan's pins;
+    # the final orientations of all states fall into that many clusters.
+    trials = trial_inputs(TRIANGLE, len(best.pins), 4, seed=21, mu=(0.15, 0.15))
+    finals = replay_sequence(TRIANGLE, [pl.pins[p] for p in best.pins], trials)
+    assert finals is not None, "a trial jams or a pin passes a state's centroid on both sides"
+    thetas = [t for rows in finals for t, _ in rows]
+    assert best.n_sets == n_clusters(thetas, TRIANGLE.symmetry_order()), (best.final_sets, sorted(thetas))
     res = verify_plan(TRIANGLE, best.to_dict(), pl.pins, pl.initial_states(), 0.15, 3.0,
                       settings={"trials": 30, "seed": 3, "corners": False})
     for row in res["rows"]:

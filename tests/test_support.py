@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import assume, given
 from hypothesis import strategies as st
 from scipy import integrate
 
@@ -22,9 +22,6 @@ import strategies as sts
 
 from kernels.rollout import _prepare
 from kernels.support import _R_FAR, _max_moment, _power, _support
-
-SETTINGS = {"deadline": None,
-            "suppress_health_check": [HealthCheck.too_slow, HealthCheck.filter_too_much]}
 
 
 def kernel_support(verts, r):
@@ -168,7 +165,6 @@ def polygon_and_point(draw):
     return (xy + shift) * scale, (r + shift) * scale, kind
 
 
-@settings(max_examples=250, **SETTINGS)
 @given(polygon_and_point())
 def test_support_matches_reference(case):
     verts, r, _ = case
@@ -197,7 +193,6 @@ def test_support_exactly_on_edges_and_vertices(poly):
         assert_support_close(verts, p, kernel_support(verts, p), ref.support_ref(verts, p))
 
 
-@settings(max_examples=60, **SETTINGS)
 @given(sts.polygons(), st.data())
 def test_g_is_minus_grad_e_and_n_is_grad_g(xy, data):
     kind = data.draw(st.sampled_from(["inside", "outside"]))
@@ -252,7 +247,6 @@ def test_max_moment_tends_to_disc():
     assert abs(m_max - 2.0 / 3.0) <= 2.0 / 3.0 * (1 - math.cos(math.pi / 1024))
 
 
-@settings(max_examples=40, **SETTINGS)
 @given(sts.polygons())
 def test_max_moment_matches_reference(xy):
     verts, area, _ = ref.ccw_centred(xy)
@@ -263,7 +257,6 @@ def test_max_moment_matches_reference(xy):
 # --------------------------------------------------------------------------- quadrature
 
 
-@settings(max_examples=30, **SETTINGS)
 @given(sts.polygons())
 def test_fan_quadrature_exact_for_low_degree_polynomials(xy):
     verts, _, _, quad, _, _ = _prepare(xy)
@@ -346,31 +339,26 @@ def _check_power_derivatives_fd(verts, area, quad, xi):
     np.testing.assert_allclose(h, h_fd, rtol=0, atol=1e-6 * np.abs(h).max())
 
 
-@settings(max_examples=60, **SETTINGS)
 @given(prepared_and_twist("near"))
 def test_power_closed_form_regime_matches_reference(case):
     _check_power_against_reference(*case)
 
 
-@settings(max_examples=60, **SETTINGS)
 @given(prepared_and_twist("far"))
 def test_power_quadrature_regime_matches_reference(case):
     _check_power_against_reference(*case)
 
 
-@settings(max_examples=60, **SETTINGS)
 @given(prepared_and_twist("near"))
 def test_power_derivatives_finite_differences_near(case):
     _check_power_derivatives_fd(*case)
 
 
-@settings(max_examples=60, **SETTINGS)
 @given(prepared_and_twist("far"))
 def test_power_derivatives_finite_differences_far(case):
     _check_power_derivatives_fd(*case)
 
 
-@settings(max_examples=40, **SETTINGS)
 @given(sts.polygons(), st.floats(0.0, 2 * math.pi), st.floats(0.3, 3.0))
 def test_power_continuous_across_regime_switch(xy, ang, om):
     """P, grad P and Hess P agree on both sides of the switch at |COR| =

@@ -8,9 +8,10 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
+from conftest import fewer_examples
 from oracle import n_clusters, one_set_sequences, replay_sequence, trial_inputs
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
@@ -85,7 +86,8 @@ def triangles(draw):
     return Part.from_vertices([[0, 0], [60, 0], [x, y]], name="tri")
 
 
-@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# Each example builds an outcome lattice and runs ~60 rollouts per state: 4 in CI.
+@fewer_examples(0.04)
 @given(part=triangles(), y_pin=st.floats(-5.0, 45.0), mu=st.sampled_from([0.0, 0.2]))
 def test_propagation_is_sound_on_random_triangles(part, y_pin, mu):
     rng = np.random.default_rng(1)
@@ -132,7 +134,8 @@ def test_oracle_completeness_and_soundness_on_the_default_triangle():
                 assert any(in_arc(theta, s, w, 1e-6) for s, w in sets), (plan.pins, label, theta, sets)
 
 
-@settings(max_examples=2, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# Each example replays every 2-pin sequence of the oracle (hundreds of rollouts): 2 in CI.
+@fewer_examples(0.02)
 @given(part=triangles())
 def test_oracle_completeness_on_random_triangles(part):
     ys = [p[1] for p in part.stable_states()]
