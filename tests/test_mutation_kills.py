@@ -28,7 +28,7 @@ def test_theta_f_is_in_0_360_for_angles_at_the_seam(theta_i):
     assert one.status.item() == "miss"
     assert 0.0 <= float(one.theta_f) < 360.0
     assert abs(circular_diff(float(one.theta_f), theta_i)) < 1e-9
-    grid = simulate.map(PART, [theta_i, 10.0], [d_far], 0.2, R_PIN)
+    grid = simulate.compute_map(PART, [theta_i, 10.0], [d_far], 0.2, R_PIN)
     assert np.all((grid.theta_f.values >= 0.0) & (grid.theta_f.values < 360.0))
 
 
@@ -65,11 +65,9 @@ def test_stored_lattice_is_not_reused_under_other_settings(tmp_path, changed):
     assert not moved.known, f"lattice reused with another {changed}"
 
 
-@pytest.mark.xfail(strict=True, reason="load_lattice compares settings with np.isclose's default "
-                   "atol=1e-8, so kernel tolerances below ~1e-8 (1e-9 vs 2e-9) look equal and a "
-                   "lattice made with another tolerance is reused (found by this test; a relative "
-                   "comparison would fix it)")
 def test_stored_lattice_tells_tiny_tolerances_apart(tmp_path):
+    """Kernel tolerances below 1e-8 (1e-9 vs 2e-9) are different settings: a lattice
+    made with one is not reused for the other (an absolute tolerance once hid this)."""
     lattice = OutcomeLattice(PART, "minpower", R_PIN, 0.0, 0.05, 1e-9)
     lattice.add(np.array([[0, 50, 20]]), np.zeros(1, np.int8), np.array([10.0]), np.zeros(1))
     save_lattice(tmp_path, lattice)

@@ -76,7 +76,9 @@ def load_lattice(root, part: Part, model: str, v_pin: float, pin_radius: float,
         return lattice
     want = _settings(lattice)
     if ds.attrs.get("part_id") != part.id or ds.attrs.get("model") != lattice.model or any(
-            not np.isclose(float(ds.attrs.get(k, 0.0 if k in ("belt_speed", "mu_s") else np.nan)), v)
+            # relative only: tolerances of 1e-9 and 2e-9 must differ (a default atol of 1e-8 hid them)
+            not np.isclose(float(ds.attrs.get(k, 0.0 if k in ("belt_speed", "mu_s") else np.nan)), v,
+                           rtol=1e-9, atol=0.0)
             for k, v in want.items()):
         return lattice
     keys = np.stack([ds["key_theta_i"].values, ds["key_d"].values, ds["key_mu_c"].values], axis=1)
