@@ -12,12 +12,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from pipeline.maps.catalog import Catalog
-from pipeline.maps.io import read_json, read_map, write_json
+from pipeline.maps.io import read_map, write_json
 from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
 from pipeline.planning.bands import map_bands
 from pipeline.planning.paper import build_planner, paper_depth
 from pipeline.planning.plan import nominal_friction, parse_friction, plan_tight_all
+from pipeline.planning.types import validate_plan_file
 from pipeline.planning.verify import verify_plan
 from pipeline.provenance import provenance_attrs
 
@@ -160,6 +161,6 @@ def plan(config: dict, name: str, out) -> dict:
 def verify(plan_path, config: dict, out) -> dict:
     """Rule ``verify``: :func:`verify_part` of the stored plans at ``plan_path``,
     written to ``out``."""
-    result = verify_part(read_json(plan_path), config)
+    result = verify_part(validate_plan_file(plan_path), config)
     write_json(result, out)
     return result

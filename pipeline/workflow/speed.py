@@ -3,8 +3,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pipeline.maps.io import read_json, write_json
+from pipeline.maps.io import write_json
 from pipeline.planning.speed_limit import stored_plan_speed
+from pipeline.planning.types import validate_plan_file
 from pipeline.present.figures import placeholder
 from pipeline.present.figures.speed import plot_speed_curve
 from pipeline.provenance import provenance_attrs
@@ -42,7 +43,7 @@ def speed_figure(result: dict, out) -> Path:
 def speed(plan_path, config: dict, out, figure) -> dict:
     """Rule ``speed``: :func:`speed_part` of the stored plans at ``plan_path``,
     written to ``out``, and its figure (:func:`speed_figure`) to ``figure``."""
-    result = speed_part(read_json(plan_path), config)
+    result = speed_part(validate_plan_file(plan_path), config)
     write_json(result, out)
     speed_figure(result, figure)
     return result
