@@ -37,6 +37,7 @@ def _extra(d: dict, known) -> dict:
 
 
 def _pair(values) -> tuple:
+    """A stored ``[lo, hi]`` as a tuple."""
     return (values[0], values[1])
 
 
@@ -46,6 +47,7 @@ def _friction_in(value):
 
 
 def _friction_out(value):
+    """A friction as stored: a number or ``[lo, hi]``."""
     return list(value) if isinstance(value, tuple) else value
 
 
@@ -58,9 +60,11 @@ class Arc:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Arc":
+        """The record of a stored dict (as read from the plan file)."""
         return cls(d["start"], d["width"])
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         return {"start": self.start, "width": self.width}
 
     @property
@@ -84,9 +88,11 @@ class State:
 
     @classmethod
     def from_dict(cls, d: dict) -> "State":
+        """The record of a stored dict (as read from the plan file)."""
         return cls(Arc.from_dict(d["arc"]), _pair(d["y_c"]), _pair(d["mu_c"]), _extra(d, cls.KEYS))
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         return {"arc": self.arc.to_dict(), "y_c": list(self.y_c), "mu_c": list(self.mu_c), **self.extra}
 
 
@@ -99,9 +105,11 @@ class RestingState:
 
     @classmethod
     def from_dict(cls, d: dict) -> "RestingState":
+        """The record of a stored dict (as read from the plan file)."""
         return cls(d["theta"], d["y_c"])
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         return {"theta": self.theta, "y_c": self.y_c}
 
 
@@ -128,12 +136,14 @@ class Step:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Step":
+        """The record of a stored dict (as read from the plan file)."""
         carried = d.get("carried")
         return cls(d["pin"], d["y_pin"], d.get("v_pin"), _pair(d["d_range"]), Arc.from_dict(d["band"]),
                    _pair(d["com_interval"]), State.from_dict(carried) if carried is not None else None,
                    _extra(d, cls.KEYS))
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         out = {"pin": self.pin, "y_pin": self.y_pin}
         if self.v_pin is not None:
             out["v_pin"] = self.v_pin
@@ -159,10 +169,12 @@ class VerificationRow:
 
     @classmethod
     def from_dict(cls, d: dict) -> "VerificationRow":
+        """The record of a stored dict (as read from the plan file)."""
         return cls(d["state"], d["trials"], d["successes"], d["failures"], dict(d["reasons"]),
                    _extra(d, cls.KEYS))
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         return {"state": self.state, "trials": self.trials, "successes": self.successes,
                 "failures": self.failures, "reasons": dict(self.reasons), **self.extra}
 
@@ -187,11 +199,13 @@ class Verification:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Verification":
+        """The record of a stored dict (as read from the plan file)."""
         return cls(d["trials"], d["successes"], d["failures"],
                    tuple(VerificationRow.from_dict(r) for r in d["rows"]), d["model"],
                    d.get("belt_speed"), d.get("mu_s"), _extra(d, cls.KEYS))
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         out = {"trials": self.trials, "successes": self.successes, "failures": self.failures,
                "rows": [r.to_dict() for r in self.rows], "model": self.model}
         if self.belt_speed is not None:
@@ -207,10 +221,12 @@ class Verification:
 
 
 def _branches_in(d: dict) -> dict:
+    """Stored branches (label -> lists of step dicts) as tuples of :class:`Step`."""
     return {label: tuple(tuple(Step.from_dict(s) for s in br) for br in brs) for label, brs in d.items()}
 
 
 def _branches_out(branches: dict) -> dict:
+    """Branches of :class:`Step` as stored."""
     return {label: [[s.to_dict() for s in br] for br in brs] for label, brs in branches.items()}
 
 
@@ -252,6 +268,7 @@ class Plan:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Plan":
+        """The record of a stored dict (as read from the plan file)."""
         opt = lambda k: tuple(d[k]) if d.get(k) is not None else None  # noqa: E731
         ver = d.get("verification")
         sets = d.get("initial_sets")
@@ -263,6 +280,7 @@ class Plan:
                    Verification.from_dict(ver) if ver is not None else None, _extra(d, cls.KEYS))
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         out = {} if self.mode is None else {"mode": self.mode}
         out["pins"] = list(self.pins)
         for key in ("pin_heights_mm", "pin_speeds"):
@@ -296,6 +314,7 @@ class Plan:
 
 
 def _plan_or_none(d):
+    """A stored plan (or null) as a :class:`Plan` (or ``None``)."""
     return Plan.from_dict(d) if d is not None else None
 
 
@@ -336,6 +355,7 @@ class TightEntry:
 
     @classmethod
     def from_dict(cls, d: dict) -> "TightEntry":
+        """The record of a stored dict (as read from the plan file)."""
         rejected = d.get("rejected")
         return cls(_friction_in(d["mu_c"]), d["friction"], tuple(Plan.from_dict(p) for p in d["plans"]),
                    {k: RestingState.from_dict(v) for k, v in d["initial_states"].items()},
@@ -346,6 +366,7 @@ class TightEntry:
                    d.get("stats"), _extra(d, cls.KEYS))
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         values = {"mu_c": _friction_out(self.mu_c), "friction": self.friction,
                   "belt_speed": self.belt_speed, "mu_s": self.mu_s, "mechanics": self.mechanics,
                   "symmetry_order": self.symmetry_order, "depth": self.depth,
@@ -389,6 +410,7 @@ class PlanFile:
 
     @classmethod
     def from_dict(cls, d: dict) -> "PlanFile":
+        """The record of a stored dict (as read from the plan file)."""
         tight, plans, states = d.get("tight"), d.get("plans"), d.get("initial_states")
         return cls(d["part"], d.get("model"),
                    tuple(TightEntry.from_dict(t) for t in tight) if tight is not None else None,
@@ -399,6 +421,7 @@ class PlanFile:
                    _extra(d, cls.KEYS))
 
     def to_dict(self) -> dict:
+        """The stored dict: the keys and values this record was read from."""
         out = {"part": self.part}
         if self.model is not None:
             out["model"] = self.model

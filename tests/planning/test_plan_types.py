@@ -195,3 +195,28 @@ def test_consumers_refuse_a_broken_file_with_the_same_line(tight_file, tmp_path,
     assert main(["speed", "--part", "tri", "--results", str(tmp_path / "res"), "--trials", "2"]) == 2
     err = capsys.readouterr().err
     assert "is not a pinfeed plan file" in err and str(path) in err
+
+
+def test_the_verify_stage_replays_the_recommended_tight_plan_as_stored(tight_file):
+    # verify_part reads the tight entries as typed records: its check must be
+    # the replay of the stored dict with the stored heights, speeds and friction.
+    from pipeline.config import load_config
+    from pipeline.planning.verify import verify_plan
+    from pipeline.workflow.plan import verify_part
+    data = json.loads(tight_file.read_text())
+    entry = data["tight"][0]
+    data.update(initial_states=entry["initial_states"], plans=[], pins={}, mu_c=entry["mu_c"])
+    config = load_config(None)
+    config["verify"] = dict(config.get("verify", {}), trials=4)
+    out = verify_part(data, config)
+    assert [c["kind"] for c in out["checks"]] == [f"tight, mu_c {entry['friction']}"]
+    rec = entry["recommended"]
+    want = verify_plan(Part.from_vertices(data["part"]["vertices"], name="tri"), rec,
+                       dict(zip(rec["pins"], rec["pin_heights_mm"])),
+                       {k: (v["theta"], v["y_c"]) for k, v in entry["initial_states"].items()},
+                       entry["mu_c"], config["sweep"]["pin_radius"], data["model"], config["verify"],
+                       kernel=config["sweep"].get("kernel"))
+    want.pop("trials_detail")
+    got = dict(out["checks"][0])
+    got.pop("kind")
+    assert got == want and got["plan"] == rec["pins"] and got["trials"] > 0
