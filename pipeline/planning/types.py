@@ -246,14 +246,16 @@ class Plan:
     ``pin_speeds`` (v_pin / v_belt), ``jump_steps`` (steps whose box straddled
     a jump), ``initial_sets`` (label -> starting :class:`State`) and
     ``verification``; a paper-mode plan has none of these keys (``None``
-    here), its heights are the file's ``pins`` table."""
+    here), its heights are the file's ``pins`` table. Only ``pins`` and
+    ``final_sets`` are required: an older or hand-made plan may lack the rest
+    (``None``; then not written back)."""
     pins: tuple
-    n_final_sets: int
     final_sets: tuple
-    margin: float | None
-    sets_after_each_pin: tuple
-    n_dynamic_pins: int | None
-    branches: dict
+    n_final_sets: int | None = None
+    margin: float | None = None
+    sets_after_each_pin: tuple | None = None
+    n_dynamic_pins: int | None = None
+    branches: dict | None = None
     mode: str | None = None
     pin_heights_mm: tuple | None = None
     pin_speeds: tuple | None = None
@@ -272,9 +274,10 @@ class Plan:
         opt = lambda k: tuple(d[k]) if d.get(k) is not None else None  # noqa: E731
         ver = d.get("verification")
         sets = d.get("initial_sets")
-        return cls(tuple(d["pins"]), d["n_final_sets"], tuple(Arc.from_dict(s) for s in d["final_sets"]),
-                   d.get("margin"), tuple(d.get("sets_after_each_pin", ())), d.get("n_dynamic_pins"),
-                   _branches_in(d["initial_states"]), d.get("mode"), opt("pin_heights_mm"),
+        branches = d.get("initial_states")
+        return cls(tuple(d["pins"]), tuple(Arc.from_dict(s) for s in d["final_sets"]), d.get("n_final_sets"),
+                   d.get("margin"), opt("sets_after_each_pin"), d.get("n_dynamic_pins"),
+                   _branches_in(branches) if branches is not None else None, d.get("mode"), opt("pin_heights_mm"),
                    opt("pin_speeds"), d.get("jump_steps"),
                    {k: State.from_dict(v) for k, v in sets.items()} if sets is not None else None,
                    Verification.from_dict(ver) if ver is not None else None, _extra(d, cls.KEYS))
@@ -286,16 +289,21 @@ class Plan:
         for key in ("pin_heights_mm", "pin_speeds"):
             if getattr(self, key) is not None:
                 out[key] = list(getattr(self, key))
-        out.update({"n_final_sets": self.n_final_sets, "final_sets": [s.to_dict() for s in self.final_sets],
-                    "margin": self.margin})
+        if self.n_final_sets is not None:
+            out["n_final_sets"] = self.n_final_sets
+        out["final_sets"] = [s.to_dict() for s in self.final_sets]
+        if self.n_final_sets is not None or self.margin is not None:  # the planners always write it
+            out["margin"] = self.margin
         if self.jump_steps is not None:
             out["jump_steps"] = self.jump_steps
-        out["sets_after_each_pin"] = list(self.sets_after_each_pin)
+        if self.sets_after_each_pin is not None:
+            out["sets_after_each_pin"] = list(self.sets_after_each_pin)
         if self.n_dynamic_pins is not None:
             out["n_dynamic_pins"] = self.n_dynamic_pins
         if self.initial_sets is not None:
             out["initial_sets"] = {k: v.to_dict() for k, v in self.initial_sets.items()}
-        out["initial_states"] = _branches_out(self.branches)
+        if self.branches is not None:
+            out["initial_states"] = _branches_out(self.branches)
         if self.mode is not None or self.verification is not None:  # a tight plan always has the key
             out["verification"] = self.verification.to_dict() if self.verification else None
         return {**out, **self.extra}
@@ -334,7 +342,7 @@ class TightEntry:
     mu_c: object
     friction: str
     plans: tuple
-    initial_states: dict
+    initial_states: dict | None = None
     recommended: Plan | None = None
     warning: str | None = None
     belt_speed: float | None = None
@@ -356,9 +364,9 @@ class TightEntry:
     @classmethod
     def from_dict(cls, d: dict) -> "TightEntry":
         """The record of a stored dict (as read from the plan file)."""
-        rejected = d.get("rejected")
+        rejected, states = d.get("rejected"), d.get("initial_states")
         return cls(_friction_in(d["mu_c"]), d["friction"], tuple(Plan.from_dict(p) for p in d["plans"]),
-                   {k: RestingState.from_dict(v) for k, v in d["initial_states"].items()},
+                   {k: RestingState.from_dict(v) for k, v in states.items()} if states is not None else None,
                    _plan_or_none(d.get("recommended")), d.get("warning"), d.get("belt_speed"),
                    d.get("mu_s"), d.get("mechanics"), d.get("symmetry_order"), d.get("depth"),
                    d.get("complete_depth"), d.get("beam"),
@@ -375,7 +383,8 @@ class TightEntry:
                   "rejected": [p.to_dict() for p in self.rejected] if self.rejected is not None else None,
                   "recommended": self.recommended.to_dict() if self.recommended else None,
                   "warning": self.warning, "stats": self.stats,
-                  "initial_states": {k: v.to_dict() for k, v in self.initial_states.items()}}
+                  "initial_states": ({k: v.to_dict() for k, v in self.initial_states.items()}
+                                     if self.initial_states is not None else None)}
         out = {k: v for k, v in values.items() if v is not None or k in self.NULLABLE}
         return {**out, **self.extra}
 

@@ -220,3 +220,16 @@ def test_the_verify_stage_replays_the_recommended_tight_plan_as_stored(tight_fil
     got = dict(out["checks"][0])
     got.pop("kind")
     assert got == want and got["plan"] == rec["pins"] and got["trials"] > 0
+
+
+def test_a_minimal_plan_file_still_reads():
+    # Only what every reader needs is required: pins and final sets of each
+    # plan, the friction of each tight entry (older and hand-made files).
+    plan = {"pins": ["P1"], "final_sets": [{"start": 10.0, "width": 2.0}]}
+    data = {"part": RECT.to_dict(), "tight": [{"mu_c": [0.1, 0.3], "friction": "0.1:0.3", "plans": [plan]}]}
+    typed = PlanFile.from_dict(validate_plan_dict(data))
+    assert typed.tight[0].mu_c == (0.1, 0.3) and typed.tight[0].plans[0].final_arcs == [(10.0, 2.0)]
+    assert typed.tight[0].plans[0].to_dict() == plan
+    assert PlanFile.from_dict(typed.to_dict()) == typed
+    with pytest.raises(PinfeedError, match="'plans' is a required property"):
+        validate_plan_dict({"part": RECT.to_dict(), "tight": [{"mu_c": 0.1, "friction": "0.1"}]})
