@@ -11,7 +11,7 @@ from pipeline.maps.catalog import Catalog
 from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_source
 from pipeline.parts.part import Part
-from pipeline.planning.types import validate_plan_file
+from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.present.animate import animate_stored, recommended_index
 from pipeline.present.figures import placeholder, placeholder_gif
 from pipeline.present.figures.bands import plot_band_maps
@@ -104,20 +104,20 @@ def _sequence_figure(config, res, plan, what, path):
 
 def _carried_figure(config, res, path):
     """The tight planner's recommended plan (first friction): carried sets against replays."""
-    name = res["part"]["name"]
-    tight = (res.get("tight") or [None])[0]
-    if not tight or not tight["recommended"]:
-        placeholder(path, f"{name}: no recommended tight plan" + (f" ({tight['warning']})" if tight else ""))
+    stored = PlanFile.from_dict(res)
+    name = stored.name
+    tight = (stored.tight or [None])[0]
+    if not tight or not tight.recommended:
+        placeholder(path, f"{name}: no recommended tight plan" + (f" ({tight.warning})" if tight else ""))
         return
-    plan = tight["recommended"]
+    plan = tight.recommended.to_dict()
     part = Part.from_vertices(res["part"]["vertices"], name=name)
-    mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
     starts = {k: (v["theta"], v["y_c"]) for k, v in res["initial_states"].items()}
-    replays = replayed_paths(part, plan, starts, mu, config["sweep"]["pin_radius"], res["model"],
+    replays = replayed_paths(part, plan, starts, tight.mu_c, config["sweep"]["pin_radius"], res["model"],
                              config.get("verify", {}), kernel=config["sweep"].get("kernel"),
-                             belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
+                             belt_speed=tight.belt_speed, mu_s=tight.mu_s or 0.5)
     plot_carried(plan, replays, f"{name}: carried sets of plan {' '.join(plan['pins'])} (mu_c "
-                 f"{tight['friction']}) against {len(next(iter(replays.values()))[0])} replayed "
+                 f"{tight.friction}) against {len(next(iter(replays.values()))[0])} replayed "
                  f"rollouts per state", path)
 
 
