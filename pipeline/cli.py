@@ -512,8 +512,8 @@ def _results_arg(args, config) -> Path:
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from pipeline.config import load_config
-    from pipeline.maps.io import read_json
     from pipeline.planning.speed_limit import stored_plan_speed
+    from pipeline.planning.types import validate_plan_file
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
@@ -523,7 +523,7 @@ def cmd_speed(args):
         raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
     if args.trials < 1:
         raise PinfeedError(f"--trials must be at least 1, got {args.trials}")
-    out = stored_plan_speed(read_json(path), config, plan=args.plan, mu_text=args.mu_c,
+    out = stored_plan_speed(validate_plan_file(path), config, plan=args.plan, mu_text=args.mu_c,
                             mu_s=args.mu_s, trials=args.trials)
     if args.json:
         _print_json(out, default=float)
@@ -544,8 +544,8 @@ def _pick_tight_plan(result: dict, n: int, mu_text):
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.config import load_config
-    from pipeline.maps.io import read_json
     from pipeline.planning.plan import plan_hint
+    from pipeline.planning.types import validate_plan_file
     from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
     config = load_config(args.config)
     if args.out:
@@ -561,7 +561,7 @@ def cmd_layout(args):
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; "
                            f"{plan_hint(config, args.part, path.parent.parent)} first")
-    out = layout_stored(read_json(path), config, args.plan, args.mu_c, belt_speed=args.belt_speed,
+    out = layout_stored(validate_plan_file(path), config, args.plan, args.mu_c, belt_speed=args.belt_speed,
                         mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
     for warning in out["warnings"]:
         print(f"pinfeed: warning: {warning}", file=sys.stderr)
@@ -594,13 +594,14 @@ def cmd_animate(args):
     from pipeline.config import load_config
     from pipeline.maps.io import read_json
     from pipeline.planning.plan import plan_hint
+    from pipeline.planning.types import validate_plan_file
     from pipeline.present.animate import animate_stored, layout_inputs, plan_inputs
     config = load_config(args.config)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; "
                            f"{plan_hint(config, args.part, path.parent.parent)} first")
-    result = read_json(path)
+    result = validate_plan_file(path)
     stored_layout = path.parent.parent / f"layout_{args.part}.json"
     if args.layout is not None:
         if args.plan is not None:

@@ -19,9 +19,9 @@ from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_id
 from pipeline.parts.part import Part
 from pipeline.planning.plan import best_fixed_plan, parse_friction, plan_hint, tight_entry
+from pipeline.planning.types import validate_plan_file
 from pipeline.sensing.profiles import Sensor, classify, read_profile_csv, reference_profiles, resample, sign_matrix
-from pipeline.sensing.sensor_plan import (PLAN_SCHEMA, count_sets, final_for_verdict, read_checked_json,
-                                          sensing_frictions, stored_sensor_plan)
+from pipeline.sensing.sensor_plan import count_sets, final_for_verdict, sensing_frictions, stored_sensor_plan
 
 
 def classify_measured(config: dict, part_name: str, profile, root, catalog=None, y_pin=None) -> tuple[dict, dict]:
@@ -40,7 +40,7 @@ def classify_measured(config: dict, part_name: str, profile, root, catalog=None,
     if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
         stored = None  # no sensor plan, or one for another outline of that name
     plan_path = root / "plans" / f"{name}.json"
-    plan = read_checked_json(plan_path, PLAN_SCHEMA, "pinfeed plan result") if plan_path.is_file() else None
+    plan = validate_plan_file(plan_path) if plan_path.is_file() else None
     if plan is not None and plan["part"].get("id", part.id) != part.id:
         plan = None
     y_pin, first_pin, source, entry = _pin(y_pin, stored, plan, root, name)

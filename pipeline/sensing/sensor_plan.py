@@ -282,12 +282,12 @@ def sense_part(plan_path, config: dict, log=print, friction=None) -> dict:
     stored tight plans at ``friction`` (default the first planned), the score
     table at its first pin, the per-verdict final sets and their end-to-end
     check, with provenance."""
-    from pipeline.maps.io import read_json
     from pipeline.parts.part import Part
     from pipeline.planning.plan import tight_entry
+    from pipeline.planning.types import validate_plan_file
     from pipeline.provenance import provenance_attrs
     sc, sweep = config["sensing"], config["sweep"]
-    stored = read_json(plan_path)
+    stored = validate_plan_file(plan_path)
     entry = tight_entry(stored, friction)
     part = Part.from_vertices(stored["part"]["vertices"], name=stored["part"]["name"])
     model = stored.get("model", config["planner"]["model"])
@@ -327,16 +327,8 @@ SENSING_SCHEMA = {
                             "states": {"type": "object", "additionalProperties": {
                                 "type": "object", "required": ["final_sets"]}}}},
 }
-# A stored plan result: paper mode (``pins``, ``plans``), tight plans
-# (``tight``, a list of friction entries), or both.
-PLAN_SCHEMA = {
-    "type": "object", "required": ["part"],
-    "properties": {"part": _OBJ, "pins": _OBJ, "plans": {"type": "array", "items": _OBJ},
-                   "tight": {"type": "array", "items": {
-                       "type": "object", "required": ["mu_c", "friction", "plans", "initial_states"],
-                       "properties": {"mu_c": _FRICTION, "plans": {"type": "array", "items": _OBJ}}}}},
-    "anyOf": [{"required": ["pins", "plans"]}, {"required": ["tight"]}],
-}
+# A stored plan result is checked against ``pipeline/planning/plan.schema.json``
+# (``pipeline.planning.types.validate_plan_file``).
 
 
 def read_checked_json(path, schema: dict, what: str) -> dict:

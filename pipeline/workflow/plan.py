@@ -12,12 +12,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from pipeline.maps.catalog import Catalog
-from pipeline.maps.io import read_json, read_map, write_json
+from pipeline.maps.io import read_map, write_json
 from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
 from pipeline.planning.bands import map_bands
 from pipeline.planning.paper import build_planner, paper_depth
 from pipeline.planning.plan import nominal_friction, parse_friction, plan_tight_all
+from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.planning.verify import verify_plan
 from pipeline.provenance import provenance_attrs
 
@@ -122,17 +123,16 @@ def verify_part(plan_result: dict, config: dict) -> dict:
                           speeds=plan_result.get("pin_speeds", {}), kernel=kernel)
         res.pop("trials_detail")
         out["checks"].append({"kind": f"paper mode, {kind}", **res})
-    for tight in plan_result.get("tight", []):
-        plan = tight["recommended"]
+    for tight in PlanFile.from_dict(plan_result).tight or ():
+        plan = tight.recommended
         if plan is None:
             continue
-        mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
-        res = verify_plan(part, plan, dict(zip(plan["pins"], plan["pin_heights_mm"])), states, mu,
-                          radius, plan_result["model"], config.get("verify", {}), kernel=kernel,
-                          speeds=dict(zip(plan["pins"], plan["pin_speeds"])),
-                          belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
+        res = verify_plan(part, plan.to_dict(), dict(zip(plan.pins, plan.pin_heights_mm)), states,
+                          tight.mu_c, radius, plan_result["model"], config.get("verify", {}), kernel=kernel,
+                          speeds=dict(zip(plan.pins, plan.pin_speeds)),
+                          belt_speed=tight.belt_speed, mu_s=tight.mu_s or 0.5)
         res.pop("trials_detail")
-        out["checks"].append({"kind": f"tight, mu_c {tight['friction']}", **res})
+        out["checks"].append({"kind": f"tight, mu_c {tight.friction}", **res})
     if not out["checks"]:
         out["note"] = "no allowed plan within the depth"
     return out
@@ -160,6 +160,6 @@ def plan(config: dict, name: str, out) -> dict:
 def verify(plan_path, config: dict, out) -> dict:
     """Rule ``verify``: :func:`verify_part` of the stored plans at ``plan_path``,
     written to ``out``."""
-    result = verify_part(read_json(plan_path), config)
+    result = verify_part(validate_plan_file(plan_path), config)
     write_json(result, out)
     return result

@@ -11,6 +11,7 @@ from pipeline.maps.catalog import Catalog
 from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_source
 from pipeline.parts.part import Part
+from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.present.animate import animate_stored, recommended_index
 from pipeline.present.figures import placeholder, placeholder_gif
 from pipeline.present.figures.bands import plot_band_maps
@@ -51,7 +52,7 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
     bc, fc = config["bands"], config["figures"]
     verifications = {}
     for k, (plan_path, verify_path) in enumerate(zip(plan_paths, verify_paths)):
-        res = read_json(plan_path)
+        res = validate_plan_file(plan_path)
         name, part_id = res["part"]["name"], res["part"]["id"]
         maps = {model: cat.query(part_id, model=model, mu_c=res["mu_c"]).isel(mu_c=0).load()
                 for model in config["sweep"]["models"]}
@@ -103,20 +104,20 @@ def _sequence_figure(config, res, plan, what, path):
 
 def _carried_figure(config, res, path):
     """The tight planner's recommended plan (first friction): carried sets against replays."""
-    name = res["part"]["name"]
-    tight = (res.get("tight") or [None])[0]
-    if not tight or not tight["recommended"]:
-        placeholder(path, f"{name}: no recommended tight plan" + (f" ({tight['warning']})" if tight else ""))
+    stored = PlanFile.from_dict(res)
+    name = stored.name
+    tight = (stored.tight or [None])[0]
+    if not tight or not tight.recommended:
+        placeholder(path, f"{name}: no recommended tight plan" + (f" ({tight.warning})" if tight else ""))
         return
-    plan = tight["recommended"]
+    plan = tight.recommended.to_dict()
     part = Part.from_vertices(res["part"]["vertices"], name=name)
-    mu = tuple(tight["mu_c"]) if isinstance(tight["mu_c"], list) else tight["mu_c"]
     starts = {k: (v["theta"], v["y_c"]) for k, v in res["initial_states"].items()}
-    replays = replayed_paths(part, plan, starts, mu, config["sweep"]["pin_radius"], res["model"],
+    replays = replayed_paths(part, plan, starts, tight.mu_c, config["sweep"]["pin_radius"], res["model"],
                              config.get("verify", {}), kernel=config["sweep"].get("kernel"),
-                             belt_speed=tight.get("belt_speed"), mu_s=tight.get("mu_s") or 0.5)
+                             belt_speed=tight.belt_speed, mu_s=tight.mu_s or 0.5)
     plot_carried(plan, replays, f"{name}: carried sets of plan {' '.join(plan['pins'])} (mu_c "
-                 f"{tight['friction']}) against {len(next(iter(replays.values()))[0])} replayed "
+                 f"{tight.friction}) against {len(next(iter(replays.values()))[0])} replayed "
                  f"rollouts per state", path)
 
 
@@ -167,7 +168,7 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_p
     cat = Catalog.open(config["catalog_dir"])
     parts = {}
     for plan_path, verify_path in zip(plan_paths, verify_paths):
-        plan = read_json(plan_path)
+        plan = validate_plan_file(plan_path)
         name = plan["part"]["name"]
         files = {k: p for k, p in part_files(results, name).items() if Path(p).is_file()}
         files.update(plan=Path(plan_path), verify=Path(verify_path))
@@ -195,11 +196,11 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_p
 
 def outline(plan_path, config: dict, out) -> Path:
     """Rule ``outline``: :func:`outline_figure` of the stored plans at ``plan_path``."""
-    return outline_figure(read_json(plan_path), config, out)
+    return outline_figure(validate_plan_file(plan_path), config, out)
 
 
 def animate(plan_path, config: dict, out, frames: int, fps: int, layout_path=None) -> dict:
     """Rule ``animate``: :func:`animate_part` of the stored plans at ``plan_path``,
     on the feeder of the layout stage's JSON at ``layout_path`` when given."""
     layout = read_json(layout_path) if layout_path else None
-    return animate_part(read_json(plan_path), config, out, frames, fps, layout=layout)
+    return animate_part(validate_plan_file(plan_path), config, out, frames, fps, layout=layout)

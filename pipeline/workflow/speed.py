@@ -3,8 +3,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pipeline.maps.io import read_json, write_json
+from pipeline.maps.io import write_json
 from pipeline.planning.speed_limit import stored_plan_speed
+from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.present.figures import placeholder
 from pipeline.present.figures.speed import plot_speed_curve
 from pipeline.provenance import provenance_attrs
@@ -17,10 +18,11 @@ def speed_part(plan_result: dict, config: dict) -> dict:
     ``speed_limit.stored_plan_speed`` plus provenance. A part without a
     recommended plan gets ``speed_limit_mm_s: None`` and a ``note``."""
     sc = config.get("speed", {})
-    name = plan_result["part"]["name"]
-    tight = (plan_result.get("tight") or [None])[0]
-    if not tight or not tight.get("plans"):
-        why = tight["warning"] if tight else "no tight plan"
+    stored = PlanFile.from_dict(plan_result)
+    name = stored.name
+    tight = (stored.tight or [None])[0]
+    if not tight or not tight.plans:
+        why = tight.warning if tight else "no tight plan"
         return {"part": name, "speed_limit_mm_s": None, "curve": [], "note": why,
                 **provenance_attrs()}
     res = stored_plan_speed(plan_result, config, plan=1, mu_s=float(sc.get("mu_s", 0.5)),
@@ -42,7 +44,7 @@ def speed_figure(result: dict, out) -> Path:
 def speed(plan_path, config: dict, out, figure) -> dict:
     """Rule ``speed``: :func:`speed_part` of the stored plans at ``plan_path``,
     written to ``out``, and its figure (:func:`speed_figure`) to ``figure``."""
-    result = speed_part(read_json(plan_path), config)
+    result = speed_part(validate_plan_file(plan_path), config)
     write_json(result, out)
     speed_figure(result, figure)
     return result
