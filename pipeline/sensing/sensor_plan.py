@@ -61,7 +61,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
-from pipeline.planning.arcs import in_arc, merge_arcs, merge_modulo
+from pipeline.parts.contact import contact_parameter
+from pipeline.planning.arcs import arc_within, merge_arcs, merge_modulo
 from pipeline.planning.verify import predicted_sets
 from pipeline.sensing.profiles import PERTURB_DEFAULTS, Sensor, score_table
 
@@ -92,8 +93,7 @@ def _arcs_dict(arcs):
 def _within(inner, sets) -> bool:
     """Every arc of ``inner`` lies inside one of ``sets`` (all circular, degrees)."""
     for s, w in inner:
-        if not any(W >= 360.0 or (in_arc(s, S, W, 1e-6) and (s - S) % 360.0 + w <= W + 1e-6)
-                   for S, W in sets):
+        if not any(arc_within((s, w), outer) for outer in sets):
             return False
     return True
 
@@ -253,7 +253,7 @@ def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor
             row["trials"] += 1
             claimed, jammed = None, False
             for k, (y_pin, v_pin, off) in enumerate(zip(heights, speeds, offsets)):
-                r = rollout(part, theta, (y_pin + off - y_c) / part.a, mu, pin_radius, model=model,
+                r = rollout(part, theta, contact_parameter(y_pin + off, y_c, part.a), mu, pin_radius, model=model,
                             v_pin=float(v_pin), trajectory=k == 0, **kernel)
                 if str(r.status.item()) == "jammed":
                     jammed = True
