@@ -326,47 +326,17 @@ def cmd_sweep(args):
 
 
 def cmd_plan(args):
+    """Plan a part (see :func:`pipeline.workflow.commands.plan_command`)."""
     from pipeline.config import load_config
-    from pipeline.planning.plan import parse_friction
-    config = load_config(args.config)
-    if args.catalog:
-        config["catalog_dir"] = args.catalog
-    pc = config["planner"]
-    if args.mu_c is not None:
-        pc["mu_c"] = args.mu_c
-        pc["frictions"] = []
-    parse_friction(pc["mu_c"])  # a clear error before any work
-    if args.depth is not None and args.depth < 1:
-        raise PinfeedError(f"--depth must be at least 1 (the largest number of pins), got {args.depth}")
-    for key in ("model", "depth", "coverage"):
-        if getattr(args, key) is not None:
-            pc[key] = getattr(args, key)
-    _plan_dynamic_args(args, pc["dynamic"])
-    if args.pins:
-        pc["pins"] = [float(x) for x in parse_values(args.pins, "--pins")]
-    if args.belt_speed is not None:
-        pc["belt_speed"] = args.belt_speed
-    if args.mu_s is not None:
-        if pc.get("belt_speed") is None:
-            raise PinfeedError("--mu-s is the belt friction of the dynamic model: give --belt-speed too")
-        pc["mu_s"] = args.mu_s
+    from pipeline.workflow.commands import plan_command, planner_settings
+    speeds = None if args.speeds is None else (parse_values(args.speeds, "--speeds") if args.speeds else [])
+    pins = parse_values(args.pins, "--pins") if args.pins else None
+    config = planner_settings(load_config(args.config), catalog=args.catalog, mu_c=args.mu_c,
+                              depth=args.depth, model=args.model, coverage=args.coverage, speeds=speeds,
+                              dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
+                              mu_s=args.mu_s)
     part = _plan_part_arg(args, config)
-    from pipeline.planning.plan import planner_belt
-    belt_speed, _ = planner_belt(config, part)  # a bad belt: a one-line error before any work
-    if belt_speed is not None and args.mode != "tight":
-        raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
-                           "the paper-mode planner uses the quasi-static map shards: use --mode tight")
-    if args.mode == "tight":
-        result = _plan_tight_only(part, config, progress=None if args.json else _progress)
-    else:
-        from pipeline.workflow.plan import ensure_maps, plan_part
-        cat = ensure_maps(config, part)
-        if args.mode == "paper":
-            config = dict(config, planner=dict(pc, mu_c=pc["mu_c"], frictions=[]))
-        result = plan_part(cat, part.id, config, progress=None if args.json else _progress,
-                           tight=args.mode == "both")
-        if args.mode == "paper":
-            result.pop("tight")
+    result = plan_command(part, config, args.mode, progress=None if args.json else _progress)
     if args.out:
         from pipeline.maps.io import write_json
         write_json(result, args.out)
@@ -380,45 +350,11 @@ def _progress(message):
     print(f"  ... {message}", flush=True)
 
 
-def _plan_dynamic_args(args, dynamic):
-    if args.speeds is not None:
-        dynamic["speeds"] = [float(v) for v in parse_values(args.speeds, "--speeds")] if args.speeds else []
-        if any(v == 0.0 for v in dynamic["speeds"]):
-            raise PinfeedError("--speeds lists moving pins: drop 0 (static pins are always candidates)")
-    if args.dynamic_depth is not None:
-        if args.dynamic_depth < 0:
-            raise PinfeedError("--dynamic-depth must be 0 (fixed pins only) or more")
-        dynamic["depth"] = args.dynamic_depth
-    if dynamic["depth"] == 0:
-        dynamic["speeds"] = []
-
-
 def _plan_part_arg(args, config):
-    from pipeline.parts.families import family_parts
-    from pipeline.parts.part import Part
+    from pipeline.workflow.commands import named_part
     if args.vertices or args.outline:
         return _part_from_args(args)
-    if not args.part:
-        raise PinfeedError("give --part NAME, --vertices \"x0,y0 x1,y1 ...\" or --outline FILE")
-    found = [p for fam, spec in config["families"].items() for p in family_parts(fam, spec)
-             if args.part in (p.name, p.id)]
-    if found:
-        return found[0]
-    from pipeline.maps.catalog import Catalog
-    cat = Catalog.open(config["catalog_dir"])
-    e = cat.entries_for(args.part)[0]  # raises 'unknown part' with the known names
-    return Part.from_vertices(e["part_vertices"], name=e["part_name"])
-
-
-def _plan_tight_only(part, config, progress=None) -> dict:
-    from pipeline.planning.plan import plan_tight_all
-    from pipeline.planning.plan import planner_belt
-    from pipeline.provenance import provenance_attrs
-    belt_speed, mu_s = planner_belt(config, part)
-    belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
-    return {"part": part.to_dict(), "model": config["planner"]["model"], **belt,
-            "tight": plan_tight_all(part, config, config["catalog_dir"], progress=progress),
-            **provenance_attrs()}
+    return named_part(config, args.part)
 
 
 def _verification_counts(plan) -> dict | None:
@@ -477,7 +413,7 @@ def _print_plan_result(result, part, config, mode):
             v = plan["verification"]
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
             print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
-                  f"{format_arcs([(s['start'], s['width']) for s in plan['final_sets']])}; "
+                  f"{format_arcs(plan['final_sets'])}; "
                   f"verified {v['successes']}/{v['trials']} trials; margin in d " + (f"{plan['margin']:+.3f}" if plan['margin'] is not None else "n/a (touches nothing)"))
     if mode == "tight" or "plans" not in result:
         return
@@ -489,7 +425,7 @@ def _print_plan_result(result, part, config, mode):
         heights = ", ".join(f"{q} at {result['pins'][q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
                             for q in plan["pins"])
         print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
-              f"{format_arcs([(s['start'], s['width']) for s in plan['final_sets']])}; "
+              f"{format_arcs(plan['final_sets'])}; "
               f"margin in d {plan['margin']:.3f}")
 
 
@@ -537,16 +473,11 @@ def cmd_layout(args):
     from pipeline.maps.io import read_json
     from pipeline.planning.plan import plan_hint
     from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
+    from pipeline.workflow.commands import layout_settings
     config = load_config(args.config)
     if args.out:
         check_drawing_path(args.out)  # before minutes of trials
-    settings = {}
-    if args.margin is not None:
-        if not (math.isfinite(args.margin) and args.margin >= 0):
-            raise PinfeedError(f"--margin must be a length >= 0 mm, got {args.margin:g}")
-        settings["station_margin_mm"] = args.margin
-    if args.trials is not None:
-        settings["trials"] = args.trials
+    settings = layout_settings(args.margin, args.trials)
     path = _results_arg(args, config) / "plans" / f"{args.part}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {args.part} at {path}; "
@@ -644,7 +575,7 @@ def cmd_sense_classify(args):
     """Classify a measured profile (see :func:`pipeline.sensing.measured.classify_measured`)."""
     from pipeline.config import load_config
     from pipeline.sensing.measured import classify_measured
-    from pipeline.sensing.sensor_plan import describe_sets
+    from pipeline.planning.arcs import format_arcs
     config = load_config(args.config)
     result, context = classify_measured(config, args.part, args.profile, _results_arg(args, config),
                                         catalog=args.catalog, y_pin=args.y_pin)
@@ -676,9 +607,9 @@ def cmd_sense_classify(args):
         print(f"final orientation: unknown (the stored sensor plan reads pin {stored['first_pin']} "
               f"at y = {stored['y_pin']:g} mm, not this one)")
     elif result["final_known"]:
-        print(f"final orientation: {describe_sets(final)} (sensor plan {' -> '.join(stored['plan']['pins'])})")
+        print(f"final orientation: {format_arcs(final)} (sensor plan {' -> '.join(stored['plan']['pins'])})")
     else:
-        print(f"final orientation: one of {describe_sets(final)} (the verdict does not decide it)")
+        print(f"final orientation: one of {format_arcs(final)} (the verdict does not decide it)")
 
 
 class _Parser(argparse.ArgumentParser):

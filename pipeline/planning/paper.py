@@ -118,7 +118,10 @@ class Plan:
 
 
 def load_maps(ds, threshold_T: float, factor_c: float) -> list[MapData]:
-    """MapData for every d of a map set (dims ``(d, theta_i)``), sorted by d."""
+    """MapData for every d of a map set (dims ``(d, theta_i)``), sorted by d: the
+    bands (:func:`~pipeline.planning.bands.extract_bands`) of each map with its
+    arrays and band lookup. The one reader of a map set's bands: the planner
+    and the bands stage (``workflow.plan.shard_bands``) both call it."""
     out = []
     theta_i = np.asarray(ds["theta_i"].values, float)
     for d in sorted(float(x) for x in ds["d"].values):
