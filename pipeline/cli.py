@@ -99,32 +99,13 @@ def _add_physics(p, d_required=True, belt=False):
 
 
 def cmd_rollout(args):
-    from pipeline.maps import simulate
+    """Roll a part past one pin (see :func:`pipeline.workflow.commands.rollout_rows`)."""
+    from pipeline.workflow.commands import rollout_belt, rollout_rows
     part = _part_from_args(args)
-    belt = {}
-    if args.model in simulate.BELT_MODELS:
-        if args.belt_speed is None:
-            raise PinfeedError(f"--model {args.model} needs --belt-speed MM_S")
-        simulate.check_belt(part, args.belt_speed, args.mu_s)
-        belt = dict(belt_speed=args.belt_speed, mu_s=args.mu_s)
-    elif args.belt_speed is not None:
-        raise PinfeedError(f"--belt-speed is for --model dynamic or mujoco, not {args.model} "
-                           f"(quasi-static: no belt speed)")
-    rows = []
-    for theta in parse_values(args.theta_i, "--theta-i"):
-        ds = simulate.rollout(part, theta, args.d, args.mu_c, args.pin_radius, model=args.model,
-                              v_pin=args.v_pin, max_travel=args.max_travel,
-                              trajectory=args.trajectory, **belt)
-        row = {"theta_i": float(theta), "status": str(ds.status.item()),
-               "theta_f": float(ds.theta_f), "dy": float(ds.dy),
-               "contact_travel": float(ds.contact_travel),
-               "feature_changes": int(ds.feature_changes), "peak_force": float(ds.peak_force),
-               "jam_reason": str(ds.jam_reason.item())}
-        if args.trajectory:
-            row["trajectory"] = np.column_stack([ds.traj_s, ds.traj_x, ds.traj_y,
-                                                 ds.traj_theta]).tolist()
-            row["force"] = np.column_stack([ds.force_s, ds.force_x, ds.force_y]).tolist()
-        rows.append(row)
+    belt = rollout_belt(part, args.model, args.belt_speed, args.mu_s)
+    rows = rollout_rows(part, parse_values(args.theta_i, "--theta-i"), args.d, args.mu_c, args.pin_radius,
+                        args.model, v_pin=args.v_pin, max_travel=args.max_travel,
+                        trajectory=args.trajectory, belt=belt)
     if args.json:
         _print_json(rows)
         return
@@ -470,19 +451,14 @@ def _pick_tight_plan(result: dict, n: int, mu_text):
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.config import load_config
-    from pipeline.maps.io import read_json
-    from pipeline.planning.plan import plan_hint
     from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
-    from pipeline.workflow.commands import layout_settings
+    from pipeline.workflow.commands import layout_settings, stored_plan
     config = load_config(args.config)
     if args.out:
         check_drawing_path(args.out)  # before minutes of trials
     settings = layout_settings(args.margin, args.trials)
-    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
-    if not path.is_file():
-        raise PinfeedError(f"no stored plan for {args.part} at {path}; "
-                           f"{plan_hint(config, args.part, path.parent.parent)} first")
-    out = layout_stored(read_json(path), config, args.plan, args.mu_c, belt_speed=args.belt_speed,
+    result, _ = stored_plan(config, _results_arg(args, config), args.part)
+    out = layout_stored(result, config, args.plan, args.mu_c, belt_speed=args.belt_speed,
                         mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
     for warning in out["warnings"]:
         print(f"pinfeed: warning: {warning}", file=sys.stderr)
@@ -491,6 +467,13 @@ def cmd_layout(args):
     if args.json:
         _print_json(out, default=float)
         return
+    _print_layout(out)
+    if args.out:
+        print(f"wrote {args.out}")
+
+
+def _print_layout(out: dict):
+    """The stations, belt, pitch and throughput of a layout, for people."""
     m = out["method"]
     print(f"{out['part']}, plan {out['plan']['number']}: {' '.join(out['plan']['pins'])} "
           f"(mu_c {out['plan']['friction']}); model {m['model']}, {m['trials']['replayed']} trials "
@@ -506,38 +489,22 @@ def cmd_layout(args):
           f"x = {out['fence_end_x_mm']:.1f} mm")
     tp = out["throughput_per_min"]
     print(f"throughput {'n/a' if tp is None else f'{tp:.1f} parts/min'}")
-    if args.out:
-        print(f"wrote {args.out}")
 
 
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
     from pipeline.config import load_config
-    from pipeline.maps.io import read_json
-    from pipeline.planning.plan import plan_hint
-    from pipeline.present.animate import animate_stored, layout_inputs, plan_inputs
+    from pipeline.present.animate import animate_stored
+    from pipeline.workflow.commands import animation_inputs, stored_plan
     config = load_config(args.config)
-    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
-    if not path.is_file():
-        raise PinfeedError(f"no stored plan for {args.part} at {path}; "
-                           f"{plan_hint(config, args.part, path.parent.parent)} first")
-    result = read_json(path)
+    result, path = stored_plan(config, _results_arg(args, config), args.part)
     stored_layout = path.parent.parent / f"layout_{args.part}.json"
-    if args.layout is not None:
-        if args.plan is not None:
-            raise PinfeedError("--layout animates the layout's own plan; leave out --plan")
-        layout_path = stored_layout if args.layout == "auto" else Path(args.layout)
-        if not layout_path.is_file():
-            raise PinfeedError(f"no layout at {layout_path}; run 'pinfeed layout --part {args.part}' "
-                               f"or the workflow first")
-        layout = read_json(layout_path)
-        inputs = layout_inputs(result, layout)  # fails early on a layout of another part or plan
+    inputs, layout = animation_inputs(result, config, args.part, args.plan, args.layout, stored_layout)
+    if layout is not None:
         pins = " -> ".join(f"{r['label']} at x {r['x_mm']:.1f}, y {r['y_mm']:g} mm" for r in layout["stations"])
         print(f"animating the laid-out {inputs['what']} of {args.part}: {pins}; pitch "
               f"{layout['pitch_mm']:.1f} mm; {len(inputs['states'])} initial states", flush=True)
     else:
-        layout = None
-        inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
         pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
                            for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
         print(f"animating the {inputs['what']} of {args.part}: {pins}; {len(inputs['states'])} initial "
@@ -575,20 +542,25 @@ def cmd_sense_classify(args):
     """Classify a measured profile (see :func:`pipeline.sensing.measured.classify_measured`)."""
     from pipeline.config import load_config
     from pipeline.sensing.measured import classify_measured
-    from pipeline.planning.arcs import format_arcs
     config = load_config(args.config)
     result, context = classify_measured(config, args.part, args.profile, _results_arg(args, config),
                                         catalog=args.catalog, y_pin=args.y_pin)
     if args.json:
         _print_json(result)
         return
+    _print_classification(result, context, args.profile)
+
+
+def _print_classification(result: dict, context: dict, profile):
+    """A measured profile's verdict and final orientation, for people."""
+    from pipeline.planning.arcs import format_arcs
     stored, final = context["stored"], result["final_sets"]
     mu_planned, margin = result["mu_c"], result["margin"]
     planned = f"{mu_planned[0]:g}:{mu_planned[1]:g}" if isinstance(mu_planned, list) else f"{mu_planned:g}"
     print(f"part {result['part_id']}: sensor pin at y = {result['y_pin']:g} mm ({result['y_pin_source']}); "
           f"model {result['model']}, mu_c {planned} (profiles simulated at {result['mu_c_profiles']:g}), "
           f"pin radius {result['pin_radius']:g} mm")
-    print(f"profile {args.profile}: {result['samples']} samples over {result['duration']:.3f} s at "
+    print(f"profile {profile}: {result['samples']} samples over {result['duration']:.3f} s at "
           f"{result['sensor']['rate_hz']:g} Hz")
     if context["note"]:
         print(f"verdict: undecided ({context['note']})")

@@ -125,3 +125,84 @@ def layout_settings(margin=None, trials=None) -> dict:
     if trials is not None:
         settings["trials"] = trials
     return settings
+
+
+def rollout_belt(part: Part, model: str, belt_speed: float | None, mu_s: float) -> dict:
+    """The belt settings of ``pinfeed rollout``: a belt model (``dynamic``,
+    ``mujoco``) needs ``belt_speed`` (mm/s; checked with ``mu_s`` for this
+    part), a quasi-static one takes none. Returns ``{"belt_speed", "mu_s"}``
+    or ``{}`` (quasi-static)."""
+    from pipeline.maps import simulate
+    if model in simulate.BELT_MODELS:
+        if belt_speed is None:
+            raise PinfeedError(f"--model {model} needs --belt-speed MM_S")
+        simulate.check_belt(part, belt_speed, mu_s)
+        return dict(belt_speed=belt_speed, mu_s=mu_s)
+    if belt_speed is not None:
+        raise PinfeedError(f"--belt-speed is for --model dynamic or mujoco, not {model} "
+                           f"(quasi-static: no belt speed)")
+    return {}
+
+
+def rollout_rows(part: Part, thetas, d: float, mu_c: float, pin_radius: float, model: str, *,
+                 v_pin: float = 0.0, max_travel=None, trajectory: bool = False,
+                 belt: dict | None = None) -> list[dict]:
+    """``pinfeed rollout``: one rollout of ``part`` per initial orientation in
+    ``thetas`` (degrees) at contact parameter ``d``, with the belt settings
+    ``belt`` of :func:`rollout_belt`. Returns a dict per rollout (the keys of
+    ``--json``; with ``trajectory`` also the samples ``[s, x, y, theta]`` and
+    the forces ``[s, F_x, F_y]``)."""
+    import numpy as np
+
+    from pipeline.maps import simulate
+    belt = belt or {}
+    rows = []
+    for theta in thetas:
+        ds = simulate.rollout(part, theta, d, mu_c, pin_radius, model=model, v_pin=v_pin,
+                              max_travel=max_travel, trajectory=trajectory, **belt)
+        row = {"theta_i": float(theta), "status": str(ds.status.item()),
+               "theta_f": float(ds.theta_f), "dy": float(ds.dy),
+               "contact_travel": float(ds.contact_travel),
+               "feature_changes": int(ds.feature_changes), "peak_force": float(ds.peak_force),
+               "jam_reason": str(ds.jam_reason.item())}
+        if trajectory:
+            row["trajectory"] = np.column_stack([ds.traj_s, ds.traj_x, ds.traj_y,
+                                                 ds.traj_theta]).tolist()
+            row["force"] = np.column_stack([ds.force_s, ds.force_x, ds.force_y]).tolist()
+        rows.append(row)
+    return rows
+
+
+def stored_plan(config: dict, root, part_name: str) -> tuple:
+    """``(plan result, path)`` of the plan file stored for ``part_name`` under the
+    results folder ``root``; a missing file is a one-line error saying how to make it."""
+    from pathlib import Path
+
+    from pipeline.maps.io import read_json
+    from pipeline.planning.plan import plan_hint
+    path = Path(root) / "plans" / f"{part_name}.json"
+    if not path.is_file():
+        raise PinfeedError(f"no stored plan for {part_name} at {path}; "
+                           f"{plan_hint(config, part_name, path.parent.parent)} first")
+    return read_json(path), path
+
+
+def animation_inputs(result: dict, config: dict, part_name: str, plan, layout, stored_layout) -> tuple:
+    """``(inputs, layout)`` for ``pinfeed animate``: with ``layout`` (a path, or
+    ``"auto"`` for ``stored_layout``) the laid-out plan and that layout (a dict);
+    else plan ``plan`` of the stored ``result`` and ``None``. Fails early on a
+    bad ``--plan``, a missing layout or a layout of another part or plan."""
+    from pathlib import Path
+
+    from pipeline.maps.io import read_json
+    from pipeline.present.animate import layout_inputs, plan_inputs
+    if layout is None:
+        return plan_inputs(result, plan, config), None
+    if plan is not None:
+        raise PinfeedError("--layout animates the layout's own plan; leave out --plan")
+    layout_path = stored_layout if layout == "auto" else Path(layout)
+    if not layout_path.is_file():
+        raise PinfeedError(f"no layout at {layout_path}; run 'pinfeed layout --part {part_name}' "
+                           f"or the workflow first")
+    stored = read_json(layout_path)
+    return layout_inputs(result, stored), stored
