@@ -99,33 +99,13 @@ def _add_physics(p, d_required=True, belt=False):
 
 
 def cmd_rollout(args):
-    """``pinfeed rollout``: roll a part past one pin and print one row (or JSON) per orientation."""
-    from pipeline.maps import simulate
+    """Roll a part past one pin (see :func:`pipeline.workflow.commands.rollout_rows`)."""
+    from pipeline.workflow.commands import rollout_belt, rollout_rows
     part = _part_from_args(args)
-    belt = {}
-    if args.model in simulate.BELT_MODELS:
-        if args.belt_speed is None:
-            raise PinfeedError(f"--model {args.model} needs --belt-speed MM_S")
-        simulate.check_belt(part, args.belt_speed, args.mu_s)
-        belt = dict(belt_speed=args.belt_speed, mu_s=args.mu_s)
-    elif args.belt_speed is not None:
-        raise PinfeedError(f"--belt-speed is for --model dynamic or mujoco, not {args.model} "
-                           f"(quasi-static: no belt speed)")
-    rows = []
-    for theta in parse_values(args.theta_i, "--theta-i"):
-        ds = simulate.rollout(part, theta, args.d, args.mu_c, args.pin_radius, model=args.model,
-                              v_pin=args.v_pin, max_travel=args.max_travel,
-                              trajectory=args.trajectory, **belt)
-        row = {"theta_i": float(theta), "status": str(ds.status.item()),
-               "theta_f": float(ds.theta_f), "dy": float(ds.dy),
-               "contact_travel": float(ds.contact_travel),
-               "feature_changes": int(ds.feature_changes), "peak_force": float(ds.peak_force),
-               "jam_reason": str(ds.jam_reason.item())}
-        if args.trajectory:
-            row["trajectory"] = np.column_stack([ds.traj_s, ds.traj_x, ds.traj_y,
-                                                 ds.traj_theta]).tolist()
-            row["force"] = np.column_stack([ds.force_s, ds.force_x, ds.force_y]).tolist()
-        rows.append(row)
+    belt = rollout_belt(part, args.model, args.belt_speed, args.mu_s)
+    rows = rollout_rows(part, parse_values(args.theta_i, "--theta-i"), args.d, args.mu_c, args.pin_radius,
+                        args.model, v_pin=args.v_pin, max_travel=args.max_travel,
+                        trajectory=args.trajectory, belt=belt)
     if args.json:
         _print_json(rows)
         return
@@ -335,48 +315,17 @@ def cmd_sweep(args):
 
 
 def cmd_plan(args):
-    """``pinfeed plan``: plan (and verify) pin sequences for the config's parts."""
+    """Plan a part (see :func:`pipeline.workflow.commands.plan_command`)."""
     from pipeline.config import load_config
-    from pipeline.planning.plan import parse_friction
-    config = load_config(args.config)
-    if args.catalog:
-        config["catalog_dir"] = args.catalog
-    pc = config["planner"]
-    if args.mu_c is not None:
-        pc["mu_c"] = args.mu_c
-        pc["frictions"] = []
-    parse_friction(pc["mu_c"])  # a clear error before any work
-    if args.depth is not None and args.depth < 1:
-        raise PinfeedError(f"--depth must be at least 1 (the largest number of pins), got {args.depth}")
-    for key in ("model", "depth", "coverage"):
-        if getattr(args, key) is not None:
-            pc[key] = getattr(args, key)
-    _plan_dynamic_args(args, pc["dynamic"])
-    if args.pins:
-        pc["pins"] = [float(x) for x in parse_values(args.pins, "--pins")]
-    if args.belt_speed is not None:
-        pc["belt_speed"] = args.belt_speed
-    if args.mu_s is not None:
-        if pc.get("belt_speed") is None:
-            raise PinfeedError("--mu-s is the belt friction of the dynamic model: give --belt-speed too")
-        pc["mu_s"] = args.mu_s
+    from pipeline.workflow.commands import plan_command, planner_settings
+    speeds = None if args.speeds is None else (parse_values(args.speeds, "--speeds") if args.speeds else [])
+    pins = parse_values(args.pins, "--pins") if args.pins else None
+    config = planner_settings(load_config(args.config), catalog=args.catalog, mu_c=args.mu_c,
+                              depth=args.depth, model=args.model, coverage=args.coverage, speeds=speeds,
+                              dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
+                              mu_s=args.mu_s)
     part = _plan_part_arg(args, config)
-    from pipeline.planning.plan import planner_belt
-    belt_speed, _ = planner_belt(config, part)  # a bad belt: a one-line error before any work
-    if belt_speed is not None and args.mode != "tight":
-        raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
-                           "the paper-mode planner uses the quasi-static map shards: use --mode tight")
-    if args.mode == "tight":
-        result = _plan_tight_only(part, config, progress=None if args.json else _progress)
-    else:
-        from pipeline.workflow.plan import ensure_maps, plan_part
-        cat = ensure_maps(config, part)
-        if args.mode == "paper":
-            config = dict(config, planner=dict(pc, mu_c=pc["mu_c"], frictions=[]))
-        result = plan_part(cat, part.id, config, progress=None if args.json else _progress,
-                           tight=args.mode == "both")
-        if args.mode == "paper":
-            result.pop("tight")
+    result = plan_command(part, config, args.mode, progress=None if args.json else _progress)
     if args.out:
         from pipeline.maps.io import write_json
         write_json(result, args.out)
@@ -390,45 +339,11 @@ def _progress(message):
     print(f"  ... {message}", flush=True)
 
 
-def _plan_dynamic_args(args, dynamic):
-    if args.speeds is not None:
-        dynamic["speeds"] = [float(v) for v in parse_values(args.speeds, "--speeds")] if args.speeds else []
-        if any(v == 0.0 for v in dynamic["speeds"]):
-            raise PinfeedError("--speeds lists moving pins: drop 0 (static pins are always candidates)")
-    if args.dynamic_depth is not None:
-        if args.dynamic_depth < 0:
-            raise PinfeedError("--dynamic-depth must be 0 (fixed pins only) or more")
-        dynamic["depth"] = args.dynamic_depth
-    if dynamic["depth"] == 0:
-        dynamic["speeds"] = []
-
-
 def _plan_part_arg(args, config):
-    from pipeline.parts.families import family_parts
-    from pipeline.parts.part import Part
+    from pipeline.workflow.commands import named_part
     if args.vertices or args.outline:
         return _part_from_args(args)
-    if not args.part:
-        raise PinfeedError("give --part NAME, --vertices \"x0,y0 x1,y1 ...\" or --outline FILE")
-    found = [p for fam, spec in config["families"].items() for p in family_parts(fam, spec)
-             if args.part in (p.name, p.id)]
-    if found:
-        return found[0]
-    from pipeline.maps.catalog import Catalog
-    cat = Catalog.open(config["catalog_dir"])
-    e = cat.entries_for(args.part)[0]  # raises 'unknown part' with the known names
-    return Part.from_vertices(e["part_vertices"], name=e["part_name"])
-
-
-def _plan_tight_only(part, config, progress=None) -> dict:
-    from pipeline.planning.plan import plan_tight_all
-    from pipeline.planning.plan import planner_belt
-    from pipeline.provenance import provenance_attrs
-    belt_speed, mu_s = planner_belt(config, part)
-    belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
-    return {"part": part.to_dict(), "model": config["planner"]["model"], **belt,
-            "tight": plan_tight_all(part, config, config["catalog_dir"], progress=progress),
-            **provenance_attrs()}
+    return named_part(config, args.part)
 
 
 def _verification_counts(plan) -> dict | None:
@@ -487,7 +402,7 @@ def _print_plan_result(result, part, config, mode):
             v = plan["verification"]
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
             print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
-                  f"{format_arcs([(s['start'], s['width']) for s in plan['final_sets']])}; "
+                  f"{format_arcs(plan['final_sets'])}; "
                   f"verified {v['successes']}/{v['trials']} trials; margin in d " + (f"{plan['margin']:+.3f}" if plan['margin'] is not None else "n/a (touches nothing)"))
     if mode == "tight" or "plans" not in result:
         return
@@ -499,7 +414,7 @@ def _print_plan_result(result, part, config, mode):
         heights = ", ".join(f"{q} at {result['pins'][q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
                             for q in plan["pins"])
         print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
-              f"{format_arcs([(s['start'], s['width']) for s in plan['final_sets']])}; "
+              f"{format_arcs(plan['final_sets'])}; "
               f"margin in d {plan['margin']:.3f}")
 
 
@@ -544,24 +459,14 @@ def _pick_tight_plan(result: dict, n: int, mu_text):
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.config import load_config
-    from pipeline.planning.plan import plan_hint
-    from pipeline.planning.types import validate_plan_file
     from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
+    from pipeline.workflow.commands import layout_settings, stored_plan
     config = load_config(args.config)
     if args.out:
         check_drawing_path(args.out)  # before minutes of trials
-    settings = {}
-    if args.margin is not None:
-        if not (math.isfinite(args.margin) and args.margin >= 0):
-            raise PinfeedError(f"--margin must be a length >= 0 mm, got {args.margin:g}")
-        settings["station_margin_mm"] = args.margin
-    if args.trials is not None:
-        settings["trials"] = args.trials
-    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
-    if not path.is_file():
-        raise PinfeedError(f"no stored plan for {args.part} at {path}; "
-                           f"{plan_hint(config, args.part, path.parent.parent)} first")
-    out = layout_stored(validate_plan_file(path), config, args.plan, args.mu_c, belt_speed=args.belt_speed,
+    settings = layout_settings(args.margin, args.trials)
+    result, _ = stored_plan(config, _results_arg(args, config), args.part)
+    out = layout_stored(result, config, args.plan, args.mu_c, belt_speed=args.belt_speed,
                         mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
     for warning in out["warnings"]:
         print(f"pinfeed: warning: {warning}", file=sys.stderr)
@@ -570,6 +475,13 @@ def cmd_layout(args):
     if args.json:
         _print_json(out, default=float)
         return
+    _print_layout(out)
+    if args.out:
+        print(f"wrote {args.out}")
+
+
+def _print_layout(out: dict):
+    """The stations, belt, pitch and throughput of a layout, for people."""
     m = out["method"]
     print(f"{out['part']}, plan {out['plan']['number']}: {' '.join(out['plan']['pins'])} "
           f"(mu_c {out['plan']['friction']}); model {m['model']}, {m['trials']['replayed']} trials "
@@ -585,39 +497,22 @@ def cmd_layout(args):
           f"x = {out['fence_end_x_mm']:.1f} mm")
     tp = out["throughput_per_min"]
     print(f"throughput {'n/a' if tp is None else f'{tp:.1f} parts/min'}")
-    if args.out:
-        print(f"wrote {args.out}")
 
 
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
     from pipeline.config import load_config
-    from pipeline.maps.io import read_json
-    from pipeline.planning.plan import plan_hint
-    from pipeline.planning.types import validate_plan_file
-    from pipeline.present.animate import animate_stored, layout_inputs, plan_inputs
+    from pipeline.present.animate import animate_stored
+    from pipeline.workflow.commands import animation_inputs, stored_plan
     config = load_config(args.config)
-    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
-    if not path.is_file():
-        raise PinfeedError(f"no stored plan for {args.part} at {path}; "
-                           f"{plan_hint(config, args.part, path.parent.parent)} first")
-    result = validate_plan_file(path)
+    result, path = stored_plan(config, _results_arg(args, config), args.part)
     stored_layout = path.parent.parent / f"layout_{args.part}.json"
-    if args.layout is not None:
-        if args.plan is not None:
-            raise PinfeedError("--layout animates the layout's own plan; leave out --plan")
-        layout_path = stored_layout if args.layout == "auto" else Path(args.layout)
-        if not layout_path.is_file():
-            raise PinfeedError(f"no layout at {layout_path}; run 'pinfeed layout --part {args.part}' "
-                               f"or the workflow first")
-        layout = read_json(layout_path)
-        inputs = layout_inputs(result, layout)  # fails early on a layout of another part or plan
+    inputs, layout = animation_inputs(result, config, args.part, args.plan, args.layout, stored_layout)
+    if layout is not None:
         pins = " -> ".join(f"{r['label']} at x {r['x_mm']:.1f}, y {r['y_mm']:g} mm" for r in layout["stations"])
         print(f"animating the laid-out {inputs['what']} of {args.part}: {pins}; pitch "
               f"{layout['pitch_mm']:.1f} mm; {len(inputs['states'])} initial states", flush=True)
     else:
-        layout = None
-        inputs = plan_inputs(result, args.plan, config)  # fails early on a bad --plan
         pins = " -> ".join(f"{lbl} at {h:g} mm" + (f" moving {v:+g} v_b" if v else "")
                            for lbl, h, v in zip(inputs["labels"], inputs["heights"], inputs["speeds"]))
         print(f"animating the {inputs['what']} of {args.part}: {pins}; {len(inputs['states'])} initial "
@@ -655,20 +550,25 @@ def cmd_sense_classify(args):
     """Classify a measured profile (see :func:`pipeline.sensing.measured.classify_measured`)."""
     from pipeline.config import load_config
     from pipeline.sensing.measured import classify_measured
-    from pipeline.sensing.sensor_plan import describe_sets
     config = load_config(args.config)
     result, context = classify_measured(config, args.part, args.profile, _results_arg(args, config),
                                         catalog=args.catalog, y_pin=args.y_pin)
     if args.json:
         _print_json(result)
         return
+    _print_classification(result, context, args.profile)
+
+
+def _print_classification(result: dict, context: dict, profile):
+    """A measured profile's verdict and final orientation, for people."""
+    from pipeline.planning.arcs import format_arcs
     stored, final = context["stored"], result["final_sets"]
     mu_planned, margin = result["mu_c"], result["margin"]
     planned = f"{mu_planned[0]:g}:{mu_planned[1]:g}" if isinstance(mu_planned, list) else f"{mu_planned:g}"
     print(f"part {result['part_id']}: sensor pin at y = {result['y_pin']:g} mm ({result['y_pin_source']}); "
           f"model {result['model']}, mu_c {planned} (profiles simulated at {result['mu_c_profiles']:g}), "
           f"pin radius {result['pin_radius']:g} mm")
-    print(f"profile {args.profile}: {result['samples']} samples over {result['duration']:.3f} s at "
+    print(f"profile {profile}: {result['samples']} samples over {result['duration']:.3f} s at "
           f"{result['sensor']['rate_hz']:g} Hz")
     if context["note"]:
         print(f"verdict: undecided ({context['note']})")
@@ -687,9 +587,9 @@ def cmd_sense_classify(args):
         print(f"final orientation: unknown (the stored sensor plan reads pin {stored['first_pin']} "
               f"at y = {stored['y_pin']:g} mm, not this one)")
     elif result["final_known"]:
-        print(f"final orientation: {describe_sets(final)} (sensor plan {' -> '.join(stored['plan']['pins'])})")
+        print(f"final orientation: {format_arcs(final)} (sensor plan {' -> '.join(stored['plan']['pins'])})")
     else:
-        print(f"final orientation: one of {describe_sets(final)} (the verdict does not decide it)")
+        print(f"final orientation: one of {format_arcs(final)} (the verdict does not decide it)")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -16,7 +16,11 @@ def in_arc(x, start, width, tol=1e-9):
 
 
 def arc_within(inner, outer, tol=1e-6) -> bool:
-    """True if arc ``inner`` lies inside arc ``outer``."""
+    """True if arc ``inner`` lies inside arc ``outer`` (both ``(start, width)``,
+    degrees), up to ``tol`` degrees: ``inner``'s start, taken from ``outer``'s
+    start going counter-clockwise (through 360 if need be), plus its width
+    does not pass ``outer``'s end. An ``outer`` of width 360 holds every arc.
+    The one containment test of the house (planner, paper mode, sensing)."""
     if outer[1] >= 360.0:
         return True
     return (inner[0] - outer[0]) % 360.0 + inner[1] <= outer[1] + tol
@@ -73,7 +77,17 @@ def format_arc(start: float, width: float, digits: int = 1) -> str:
     return f"{lo:.{digits}f} deg" if lo == hi else f"{lo:.{digits}f}-{hi:.{digits}f} deg"
 
 
-def format_arcs(sets, digits: int = 1) -> str:
-    """Several arcs (``(start, width)`` pairs or ``{"start", "width"}`` dicts), comma-separated."""
+def format_arcs(sets, digits: int = 1, style: str = "range") -> str:
+    """Orientation sets for people: the one formatter every report, figure and
+    CLI line uses. ``sets`` are ``(start, width)`` pairs or ``{"start",
+    "width"}`` dicts (as stored plans hold them); comma-separated.
+
+    ``style="range"`` (default): each as :func:`format_arc` (``355.0-5.0 deg``),
+    ``"none"`` for no sets. ``style="interval"``: ``[start, start + width]``
+    unwrapped, ``digits`` decimals (``[355, 365]``), empty for no sets."""
     pairs = [(s["start"], s["width"]) if isinstance(s, dict) else tuple(s) for s in sets]
+    if style == "interval":
+        return ", ".join(f"[{s:.{digits}f}, {s + w:.{digits}f}]" for s, w in pairs)
+    if style != "range":
+        raise ValueError(f"style must be 'range' or 'interval', got {style!r}")
     return ", ".join(format_arc(s, w, digits) for s, w in pairs) or "none"

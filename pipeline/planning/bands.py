@@ -142,13 +142,3 @@ def band_lookup(bands: list[Band], n_theta: int) -> np.ndarray:
         out[b.members] = j
     return out
 
-
-def map_bands(ds, threshold_T: float, factor_c: float) -> dict:
-    """Bands of every d of a map set (Dataset with dims ``(d, theta_i)``), keyed by d."""
-    out = {}
-    for d in ds["d"].values:
-        sub = ds.sel(d=d)
-        out[float(d)] = extract_bands(ds["theta_i"].values, sub["theta_f"].values,
-                                      sub["dy"].values, sub["status"].values,
-                                      threshold_T, factor_c)
-    return out

@@ -36,8 +36,9 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 from pipeline.errors import PinfeedError
 from pipeline.maps.catalog import Catalog
 from pipeline.parts.families import config_part_id
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
+from pipeline.planning.arcs import arc_within, in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
 from pipeline.planning.bands import band_lookup, extract_bands
 from pipeline.planning.plan import nominal_friction, parse_friction
 
@@ -123,7 +124,10 @@ class Plan:
 
 
 def load_maps(ds, threshold_T: float, factor_c: float) -> list[MapData]:
-    """MapData for every d of a map set (dims ``(d, theta_i)``), sorted by d."""
+    """MapData for every d of a map set (dims ``(d, theta_i)``), sorted by d: the
+    bands (:func:`~pipeline.planning.bands.extract_bands`) of each map with its
+    arrays and band lookup. The one reader of a map set's bands: the planner
+    and the bands stage (``workflow.plan.shard_bands``) both call it."""
     out = []
     theta_i = np.asarray(ds["theta_i"].values, float)
     for d in sorted(float(x) for x in ds["d"].values):
@@ -221,7 +225,7 @@ class Planner:
     def _transition(self, state: State, label: str):
         a = self.part.a
         y_pin, v_pin = self.pins[label], self.speeds[label]
-        d_lo, d_hi = (y_pin - state.y_hi) / a, (y_pin - state.y_lo) / a
+        d_lo, d_hi = contact_parameter(y_pin, state.y_hi, a), contact_parameter(y_pin, state.y_lo, a)
         # The limits apply to the offset of the pin's path from the centroid,
         # perpendicular to the pin's motion relative to the belt (-1, v): for a
         # moving pin that is d / sqrt(1 + v^2) (see tests/test_dynamic.py).
@@ -253,7 +257,7 @@ class Planner:
                     hits.append(((b.adj_start, b.adj_width), m.dy[i], m.dy[i]))
         children = []
         for arc in merge_arcs([h[0] for h in hits]):
-            inside = [h for h in hits if _arc_within(h[0], arc)]
+            inside = [h for h in hits if arc_within(h[0], arc)]
             children.append((arc, state.y_lo + min(h[1] for h in inside),
                              state.y_hi + max(h[2] for h in inside)))
         return children, margin, d_lo, d_hi
@@ -331,13 +335,6 @@ class Planner:
         branches = {label: [list(st.history) for st in states] for label, states in zip(labels, joint)}
         n_dynamic = sum(1 for p in seq if self.speeds[p] != 0.0)
         return Plan(seq, len(finals), finals, float(margin), branches, sets_after, n_dynamic)
-
-
-def _arc_within(inner, outer) -> bool:
-    s, w = inner
-    if outer[1] >= 360.0:
-        return True
-    return bool(in_arc(s, outer[0], outer[1], 1e-6)) and (s - outer[0]) % 360.0 + w <= outer[1] + 1e-6
 
 
 def _dedupe(states):

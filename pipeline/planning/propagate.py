@@ -47,8 +47,9 @@ import numpy as np
 
 from kernels.rollout import JAMMED, MISS, TRUNCATED
 
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import merge_arcs
+from pipeline.planning.arcs import arc_within, merge_arcs
 
 # Lattice units: theta in 1/64 deg, d in 1/3200, mu in 1/1600.
 UNITS = (1.0 / 64.0, 1.0 / 3200.0, 1.0 / 1600.0)
@@ -266,8 +267,8 @@ def propagate(state: StateSet, y_pin: float, part: Part, lattice: OutcomeLattice
     resolving them would take more than ``MAX_POINTS`` lattice points (the
     search then forbids the pin). The d range is not checked here."""
     a = part.a
-    d_lo = (y_pin - pin_halfwidth - state.y_hi) / a
-    d_hi = (y_pin + pin_halfwidth - state.y_lo) / a
+    d_lo = contact_parameter(y_pin - pin_halfwidth, state.y_hi, a)
+    d_hi = contact_parameter(y_pin + pin_halfwidth, state.y_lo, a)
     lo = (state.start / UNITS[0], d_lo / UNITS[1], state.mu_lo / UNITS[2])
     hi = ((state.start + state.width) / UNITS[0], d_hi / UNITS[1], state.mu_hi / UNITS[2])
     cells = _cells_covering(lo, hi)
@@ -393,7 +394,7 @@ def _children(pieces, state, y_pin, h, a, d_lo, d_hi):
     for arc in arcs:
         y_lo, y_hi = math.inf, -math.inf
         for p in pieces:
-            if not _arc_within((p[0] % 360.0, p[1]), arc):
+            if not arc_within((p[0] % 360.0, p[1]), arc):
                 continue
             # Two sound bounds on the new y_c, intersected: y_c + dy with y_c
             # consistent with this piece's d range, and y_pin + offset + g.
@@ -405,9 +406,3 @@ def _children(pieces, state, y_pin, h, a, d_lo, d_hi):
         children.append(snapped_state(arc[0], arc[1], y_lo, y_hi, state.mu_lo, state.mu_hi))
     return children
 
-
-def _arc_within(inner, outer) -> bool:
-    if outer[1] >= 360.0:
-        return True
-    off = (inner[0] - outer[0]) % 360.0
-    return off + inner[1] <= outer[1] + 1e-6

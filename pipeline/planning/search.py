@@ -29,6 +29,7 @@ import time
 from dataclasses import dataclass, field
 
 from pipeline.errors import PinfeedError
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import merge_arcs, merge_modulo
 from pipeline.planning.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
@@ -215,7 +216,7 @@ class TightPlanner:
 
     def _transition(self, state: StateSet, pin: Pin):
         a, h = self.part.a, self.unc.pin_halfwidth
-        d_lo, d_hi = (pin.y - h - state.y_hi) / a, (pin.y + h - state.y_lo) / a
+        d_lo, d_hi = contact_parameter(pin.y - h, state.y_hi, a), contact_parameter(pin.y + h, state.y_lo, a)
         shrink = 1.0 / math.sqrt(1.0 + pin.v_pin * pin.v_pin)
         near, far = shrink * min(abs(d_lo), abs(d_hi)), shrink * max(abs(d_lo), abs(d_hi))
         if d_lo < 0.0 < d_hi:

@@ -26,6 +26,7 @@ import numpy as np
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, JAMMED, MISS, TRUNCATED
 
 from pipeline.maps import simulate
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import in_arc, merge_arcs
 
@@ -124,7 +125,7 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
         idx = np.flatnonzero(alive)
         if idx.size == 0:
             break
-        d = (y_pin + offsets[idx, k] - y_c[idx]) / part.a
+        d = contact_parameter(y_pin + offsets[idx, k], y_c[idx], part.a)
         if belt_speed is None:
             res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, model,
                                           v_pin=float(v), ds_max=ds_max, tol=tol)

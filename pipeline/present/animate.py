@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.errors import PinfeedError
+from pipeline.parts.contact import contact_parameter
 
 
 @dataclass
@@ -154,7 +155,7 @@ def roll_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, spac
     for label, (theta, y_c) in states.items():  # the kernel results do not depend on stations
         steps = []
         for h, v in zip(heights, speeds):
-            r = simulate.rollout(part, theta, (h - y_c) / a, mu_c, pin_radius, model=model,
+            r = simulate.rollout(part, theta, contact_parameter(h, y_c, a), mu_c, pin_radius, model=model,
                                  v_pin=float(v), trajectory=True)
             steps.append((theta, y_c, r))
             if str(r.status.item()) == "jammed":

@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pipeline.errors import PinfeedError
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.present.animate import Lane, _lane, _rotated, pin_reach
 
@@ -153,7 +154,7 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
             trial = Trial(label, float(th[j]) % 360.0, float(yc[j]), float(mu[j]), heights + offs[j])
             theta, y = trial.theta, trial.y_c
             for k, h in enumerate(trial.heights):
-                ds = simulate.rollout(part, theta, (h - y) / part.a, trial.mu_c, pin_radius,
+                ds = simulate.rollout(part, theta, contact_parameter(h, y, part.a), trial.mu_c, pin_radius,
                                       trajectory=True, **belt)
                 trial.steps.append((theta, y, ds))
                 status = str(ds.status.item())

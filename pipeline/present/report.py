@@ -14,6 +14,7 @@ from pathlib import Path
 from pipeline import __version__
 from pipeline.config import config_hash
 from pipeline.maps.io import write_text_atomic
+from pipeline.planning.arcs import format_arcs
 from pipeline.present.figures.tables import HEADER, verification_rows
 from pipeline.provenance import creation_time, git_commit
 
@@ -148,7 +149,6 @@ def _layout_section(lay: dict, files: dict, base) -> list[str]:
 
 def _paper_plans(res: dict) -> list[str]:
     """Paper mode's ranked plans (adjusted bands), best first."""
-    from pipeline.planning.arcs import format_arcs
     if not res["plans"]:
         return ["<p>Paper mode: no allowed plan within the depth.</p>"]
     p = ["<h4>Paper-mode plans (adjusted bands), best first</h4><table><tr><th>rank</th><th>pins</th>"
@@ -156,7 +156,7 @@ def _paper_plans(res: dict) -> list[str]:
          "<th>final sets</th><th>orientation sets</th><th>margin in d</th></tr>"]
     speeds = res.get("pin_speeds", {})
     for k, plan in enumerate(res["plans"], start=1):
-        sets = format_arcs([(s["start"], s["width"]) for s in plan["final_sets"]])
+        sets = format_arcs(plan["final_sets"])
         heights = ", ".join(f"{res['pins'][q]:g}" + (f" @ {speeds[q]:+g}" if q in speeds else "")
                             for q in plan["pins"])
         after = " → ".join(str(n) for n in plan.get("sets_after_each_pin", []))
@@ -233,7 +233,6 @@ def _speed_cell(speed: dict | None, friction: str, pins) -> str:
 def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> list[str]:
     """The paper-mode plan beside the tight planner's, with verification counts
     and the speed limit (mm/s, dynamic model) of the plan the speed stage replayed."""
-    from pipeline.planning.arcs import format_arcs
     checks = {c["kind"]: c for c in (ver or {}).get("checks", [])}
     p = ['<h4>Paper mode beside the tight planner</h4><table class="side-by-side"><tr><th>planner</th>'
          "<th>friction mu_c</th><th>pins (height, mm)</th><th>final sets</th>"
@@ -242,7 +241,7 @@ def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> lis
     static = res.get("best_static")
     if static:
         pins = ", ".join(f"{q} ({res['pins'][q]:g})" for q in static["pins"])
-        sets = format_arcs([(s["start"], s["width"]) for s in static["final_sets"]])
+        sets = format_arcs(static["final_sets"])
         p.append(f"<tr><td>paper mode, fixed pins</td><td>{res['mu_c']:g} (stored maps)</td>"
                  f"<td>{html.escape(pins)}</td><td>{static['n_final_sets']}</td><td>{sets}</td>"
                  f"<td>{_counts(checks.get('paper mode, fixed pins'))}</td><td>n/a</td></tr>")
@@ -253,7 +252,7 @@ def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> lis
                      f"{html.escape(t['warning'] or 'no plan')}</td></tr>")
             continue
         pins = ", ".join(f"{q} ({y:g})" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
-        sets = format_arcs([(s["start"], s["width"]) for s in plan["final_sets"]])
+        sets = format_arcs(plan["final_sets"])
         planner = "tight" + (f" at {t['belt_speed']:g} mm/s" if t.get("belt_speed") else "")
         p.append(f"<tr><td>{planner}</td><td>{t['friction']}</td><td>{html.escape(pins)}</td>"
                  f"<td>{plan['n_final_sets']}</td><td>{sets}</td>"
@@ -261,10 +260,6 @@ def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> lis
                  f"{_speed_cell(speed, t['friction'], plan['pins'])}</tr>")
     p.append("</table>")
     return p
-
-
-def _sets(sets) -> str:
-    return ", ".join(f"[{s['start']:.0f}, {s['start'] + s['width']:.0f}]" for s in sets)
 
 
 def _sensing_section(res: dict, figs: dict, base) -> list[str]:
@@ -286,7 +281,8 @@ def _sensing_section(res: dict, figs: dict, base) -> list[str]:
     p.append("<table><tr><th>sensor verdict (states it cannot tell apart)</th>"
              "<th>final orientation set(s) (deg)</th><th>known</th></tr>")
     for g in res["groups"]:
-        p.append(f"<tr><td>{html.escape(', '.join(g['states']))}</td><td>{_sets(g['final_sets'])}</td>"
+        sets = format_arcs(g["final_sets"], digits=0, style="interval")
+        p.append(f"<tr><td>{html.escape(', '.join(g['states']))}</td><td>{sets}</td>"
                  f"<td>{'yes' if g['known'] else 'no'}</td></tr>")
     p.append("</table>")
     if "verification" in res:

@@ -36,44 +36,15 @@ def classify_measured(config: dict, part_name: str, profile, root, catalog=None,
     root = Path(root)  # stored plans and sensor plans
     part, catalog_radius = _part(config, part_name, root, catalog)
     name = part.name
-    stored = stored_sensor_plan(root, name)
-    if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
-        stored = None  # no sensor plan, or one for another outline of that name
-    plan_path = root / "plans" / f"{name}.json"
-    plan = validate_plan_file(plan_path) if plan_path.is_file() else None
-    if plan is not None and plan["part"].get("id", part.id) != part.id:
-        plan = None
+    stored, plan = _stored_plans(root, part)
     y_pin, first_pin, source, entry = _pin(y_pin, stored, plan, root, name)
     if y_pin is None:
         raise PinfeedError(f"no sensor pin for {name}: no stored sensor plan and no recommended plan under "
                            f"{root}; {plan_hint(config, name, root)} or give the sensor pin's height with "
                            f"--y-pin MM")
-    # The friction, resolved once (sensor_plan.sensing_frictions): as planned, and
-    # the one value of the simulated profiles (a range's middle).
-    if stored is not None:
-        sensor = Sensor.from_config(stored["sensor"])
-        mu_planned, model = stored["mu_c"], stored["model"]
-        mu_profiles = float(stored["mu_c_profiles"])
-    else:
-        sensor = Sensor.from_config(config["sensing"]["sensor"])
-        if entry is not None:
-            friction = entry
-        elif plan is not None and "mu_c" in plan:
-            friction = {"mu_c": plan["mu_c"]}
-        else:
-            friction = {"mu_c": parse_friction(config["planner"]["mu_c"])}
-        mu_planned, mu_profiles = sensing_frictions(friction)
-        mu_planned = list(mu_planned) if isinstance(mu_planned, tuple) else mu_planned
-        model = plan.get("model", config["planner"]["model"]) if plan else config["planner"]["model"]
-    if stored is not None:
-        pin_radius = float(stored["pin_radius"])
-    else:
-        pin_radius = catalog_radius if catalog_radius is not None else float(config["sweep"]["pin_radius"])
-    raw = read_profile_csv(profile)
-    measured = resample(raw, sensor.rate_hz)
-    if measured.t.size < sensor.regions:
-        raise PinfeedError(f"{profile}: the profile spans {raw.t[-1] - raw.t[0]:.3g} s, fewer than "
-                           f"{sensor.regions} samples at {sensor.rate_hz:g} Hz; give the whole contact")
+    sensor, mu_planned, mu_profiles, model, pin_radius = _sensing_inputs(config, stored, plan, entry,
+                                                                         catalog_radius)
+    measured = _measured_profile(profile, sensor)
     states = {f"state {k}": {"theta": float(th), "y_c": float(y)}
               for k, (th, y) in enumerate(part.stable_states(), start=1)}
     refs = {k: sign_matrix(p, sensor) for k, p in
@@ -95,6 +66,52 @@ def classify_measured(config: dict, part_name: str, profile, root, catalog=None,
               "sensor_plan": stored["plan"]["pins"] if on_plan else None,
               "final_sets": final, "final_known": known}
     return result, {"note": verdict.get("note"), "stored": stored}
+
+
+def _stored_plans(root: Path, part: Part):
+    """``(sensor plan, plan result)`` stored under ``root`` for ``part``; each None
+    when absent, not found, or stored for another outline of that name."""
+    stored = stored_sensor_plan(root, part.name)
+    if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
+        stored = None  # no sensor plan, or one for another outline of that name
+    plan_path = root / "plans" / f"{part.name}.json"
+    plan = validate_plan_file(plan_path) if plan_path.is_file() else None
+    if plan is not None and plan["part"].get("id", part.id) != part.id:
+        plan = None
+    return stored, plan
+
+
+def _sensing_inputs(config, stored, plan, entry, catalog_radius):
+    """``(sensor, mu_planned, mu_profiles, model, pin_radius)``: the stored sensor
+    plan's, else the plan's and the config's. The friction is resolved once
+    (``sensor_plan.sensing_frictions``): as planned, and the one value of the
+    simulated profiles (a range's middle)."""
+    if stored is not None:
+        return (Sensor.from_config(stored["sensor"]), stored["mu_c"], float(stored["mu_c_profiles"]),
+                stored["model"], float(stored["pin_radius"]))
+    sensor = Sensor.from_config(config["sensing"]["sensor"])
+    if entry is not None:
+        friction = entry
+    elif plan is not None and "mu_c" in plan:
+        friction = {"mu_c": plan["mu_c"]}
+    else:
+        friction = {"mu_c": parse_friction(config["planner"]["mu_c"])}
+    mu_planned, mu_profiles = sensing_frictions(friction)
+    mu_planned = list(mu_planned) if isinstance(mu_planned, tuple) else mu_planned
+    model = plan.get("model", config["planner"]["model"]) if plan else config["planner"]["model"]
+    pin_radius = catalog_radius if catalog_radius is not None else float(config["sweep"]["pin_radius"])
+    return sensor, mu_planned, mu_profiles, model, pin_radius
+
+
+def _measured_profile(profile, sensor: Sensor):
+    """The measured profile (CSV at ``profile``) resampled at the sensor rate; a
+    profile too short for the sensor's regions is a one-line error."""
+    raw = read_profile_csv(profile)
+    measured = resample(raw, sensor.rate_hz)
+    if measured.t.size < sensor.regions:
+        raise PinfeedError(f"{profile}: the profile spans {raw.t[-1] - raw.t[0]:.3g} s, fewer than "
+                           f"{sensor.regions} samples at {sensor.rate_hz:g} Hz; give the whole contact")
+    return measured
 
 
 def _part(config, part_name, root, catalog=None):

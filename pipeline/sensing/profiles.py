@@ -51,8 +51,9 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 
 from pipeline.errors import PinfeedError
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.verify import PERTURB_DEFAULTS  # one set of perturbation sizes for every check
+from pipeline.planning.verify import PERTURB_DEFAULTS, perturbed_inputs  # one set of perturbation sizes for every check
 
 
 @dataclass
@@ -223,7 +224,7 @@ def first_pin_rollout(part: Part, theta, y_c, y_pin, mu_c, pin_radius, model):
     in mm; ``pin_radius`` in mm.
     """
     from pipeline.maps import simulate
-    return simulate.rollout(part, theta, (y_pin - y_c) / part.a, mu_c, pin_radius, model=model,
+    return simulate.rollout(part, theta, contact_parameter(y_pin, y_c, part.a), mu_c, pin_radius, model=model,
                             trajectory=True)
 
 
@@ -238,19 +239,14 @@ def reference_profiles(part, states: dict, y_pin, mu_c, pin_radius, model, senso
 
 def synthetic_measurement(part, state: dict, y_pin, mu_c, pin_radius, model, sensor: Sensor,
                           perturb: dict, rng) -> Profile:
-    """One synthetic reading of ``state`` at the pin: perturbed inputs (theta_i
-    normal, y_c and pin position uniform; ``mu_c`` a value: normal around it,
-    clipped at 0; a range ``(lo, hi)``: uniform over it, as the verify stage
-    draws it) rolled out again, sampled at the sensor rate, then sensor bias
-    and noise."""
-    theta = state["theta"] + rng.normal(0, perturb["theta_sigma"])
-    y_c = state["y_c"] + rng.uniform(-perturb["y_halfwidth"], perturb["y_halfwidth"])
-    y_at = y_pin + rng.uniform(-perturb["pin_halfwidth"], perturb["pin_halfwidth"])
-    if isinstance(mu_c, (tuple, list)):
-        mu = rng.uniform(float(mu_c[0]), float(mu_c[1]))
-    else:
-        mu = max(0.0, mu_c + rng.normal(0, perturb["mu_sigma"]))
-    r = first_pin_rollout(part, theta, y_c, y_at, mu, pin_radius, model)
+    """One synthetic reading of ``state`` at the pin: inputs drawn from the
+    verify stage's perturbation box (:func:`pipeline.planning.verify.perturbed_inputs`:
+    theta_i and a friction value normal, truncated at 2 sigma, friction
+    clipped at 0, a friction range ``(lo, hi)`` uniform; y_c and the pin
+    position uniform; sizes from ``perturb``) rolled out again, sampled at the
+    sensor rate, then sensor bias and noise."""
+    theta, y_c, mu, offsets = perturbed_inputs(state["theta"], state["y_c"], mu_c, 1, perturb, rng)
+    r = first_pin_rollout(part, theta, y_c, y_pin + float(offsets[0]), mu, pin_radius, model)
     prof = profile_from_rollout(r.force_s.values, r.force_x.values, r.force_y.values, sensor)
     return measure(prof, sensor, rng)
 

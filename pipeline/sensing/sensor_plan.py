@@ -61,7 +61,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
-from pipeline.planning.arcs import in_arc, merge_arcs, merge_modulo
+from pipeline.parts.contact import contact_parameter
+from pipeline.planning.arcs import arc_within, merge_arcs, merge_modulo
 from pipeline.planning.verify import predicted_sets
 from pipeline.sensing.profiles import PERTURB_DEFAULTS, Sensor, score_table
 
@@ -92,8 +93,7 @@ def _arcs_dict(arcs):
 def _within(inner, sets) -> bool:
     """Every arc of ``inner`` lies inside one of ``sets`` (all circular, degrees)."""
     for s, w in inner:
-        if not any(W >= 360.0 or (in_arc(s, S, W, 1e-6) and (s - S) % 360.0 + w <= W + 1e-6)
-                   for S, W in sets):
+        if not any(arc_within((s, w), outer) for outer in sets):
             return False
     return True
 
@@ -130,32 +130,18 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
     """The best sensor plan among the stored tight plans of one friction entry
     (``entry``: an element of a stored plan result's ``tight`` list); see the
     module docstring."""
-    planned, mu_profiles = sensing_frictions(entry)
-    order = int(entry.get("symmetry_order", 1))
-    states = {k: {"theta": float(s["theta"]), "y_c": float(s["y_c"])}
-              for k, s in entry["initial_states"].items()}
-    labels = list(states)
-    stored = entry["plans"]
-    candidates = [(rank, p) for rank, p in enumerate(stored) if not p["pin_speeds"][0]]
-    out = {"friction": entry["friction"], "mu_c": list(planned) if isinstance(planned, tuple) else planned,
-           "mu_c_profiles": mu_profiles, "symmetry_order": order, "initial_states": states,
-           "depth": entry["depth"], "n_candidates": len(candidates), "found": bool(candidates)}
+    out, candidates = _entry_header(entry)
     if not candidates:
         why = entry.get("warning") or "no verified plan starts with a fixed pin"
         return dict(out, note=f"no stored verified plan to put the sensor on: {why}")
-    recommended = stored[0]
+    order, states = out["symmetry_order"], out["initial_states"]
+    stored = entry["plans"]
     fixed = [(rank, p) for rank, p in candidates if not moving_pins(p)]
-    one_set = [(rank, p) for rank, p in fixed if p["n_final_sets"] == 1]
-    if one_set:
-        candidates = one_set[:1]  # fixed pins end in one set: nothing ranks above it
-    order_of_pins = []  # first pins by the stored rank of their best plan
-    for _, p in candidates:
-        if (p["pins"][0], p["pin_heights_mm"][0]) not in order_of_pins:
-            order_of_pins.append((p["pins"][0], p["pin_heights_mm"][0]))
-    evaluated = order_of_pins if max_first_pins is None else order_of_pins[:max(1, int(max_first_pins))]
+    candidates, evaluated = _first_pins(candidates, fixed, max_first_pins)
+    planned, _ = sensing_frictions(entry)
     tables = {}
     for pin, y_pin in evaluated:
-        tables[pin] = score_table(part, states, y_pin, mu_profiles, pin_radius, model, sensor,
+        tables[pin] = score_table(part, states, y_pin, out["mu_c_profiles"], pin_radius, model, sensor,
                                   trials=trials, perturb=perturb, seed=seed,
                                   apart_fraction=apart_fraction, measured_mu=planned)
         log(f"first pin {pin} ({y_pin:g} mm): groups {tables[pin]['groups']}, "
@@ -163,9 +149,57 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
     ranked = sorted((sensor_rank_key(p, rank, tables[p["pins"][0]]["groups"], order), rank, p)
                     for rank, p in candidates if p["pins"][0] in tables)
     best_key, best_rank, best = ranked[0]
+    per_pin = {}
+    for key, _, p in ranked:
+        per_pin.setdefault(p["pins"][0], key)
+    return dict(
+        out,
+        **_best_plan_fields(best, best_key, best_rank, tables[best["pins"][0]], list(states), order, trials),
+        first_pins=[{"pin": q, "y_pin": y, "groups": tables[q]["groups"],
+                     "accuracy": tables[q]["accuracy"], "wrong": tables[q]["wrong"],
+                     "worst_sets": per_pin[q][0] if q in per_pin else None,
+                     "best_stored_rank": per_pin[q][2] + 1 if q in per_pin else None}
+                    for q, y in evaluated],
+        without_sensor=_summary(stored[0]),
+        best_fixed_pins=_summary(fixed[0][1]) if fixed else None,
+    )
+
+
+def _entry_header(entry: dict):
+    """``(out, candidates)``: the fields every sensor plan result starts with, and
+    the stored plans (``(rank, plan)``) whose first pin is fixed (a sensor can sit there)."""
+    planned, mu_profiles = sensing_frictions(entry)
+    order = int(entry.get("symmetry_order", 1))
+    states = {k: {"theta": float(s["theta"]), "y_c": float(s["y_c"])}
+              for k, s in entry["initial_states"].items()}
+    candidates = [(rank, p) for rank, p in enumerate(entry["plans"]) if not p["pin_speeds"][0]]
+    out = {"friction": entry["friction"], "mu_c": list(planned) if isinstance(planned, tuple) else planned,
+           "mu_c_profiles": mu_profiles, "symmetry_order": order, "initial_states": states,
+           "depth": entry["depth"], "n_candidates": len(candidates), "found": bool(candidates)}
+    return out, candidates
+
+
+def _first_pins(candidates, fixed, max_first_pins):
+    """``(candidates, evaluated)``: the plans still in the running (only the best
+    fixed-pin plan if one ends in one set: nothing ranks above it) and the first
+    pins ``(label, height)`` to score, by the stored rank of their best plan,
+    at most ``max_first_pins`` of them."""
+    one_set = [(rank, p) for rank, p in fixed if p["n_final_sets"] == 1]
+    if one_set:
+        candidates = one_set[:1]
+    order_of_pins = []
+    for _, p in candidates:
+        if (p["pins"][0], p["pin_heights_mm"][0]) not in order_of_pins:
+            order_of_pins.append((p["pins"][0], p["pin_heights_mm"][0]))
+    evaluated = order_of_pins if max_first_pins is None else order_of_pins[:max(1, int(max_first_pins))]
+    return candidates, evaluated
+
+
+def _best_plan_fields(best, best_key, best_rank, table, labels, order, trials) -> dict:
+    """The result's fields about the chosen plan ``best`` and its first pin's score ``table``:
+    the verdict groups and their final sets, each state's, and how often a verdict
+    leaves the final orientation known, wrong or ambiguous."""
     sensor_needed = best["n_final_sets"] > 1
-    pin = best["pins"][0]
-    table = tables[pin]
     finals = {lab: predicted_sets(best, lab) for lab in labels}
     groups = []
     for g in table["groups"]:
@@ -178,9 +212,6 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
     summary = {k: table[k] for k in ("labels", "mean_scores", "elements", "accuracy", "wrong",
                                      "told_apart", "groups", "trials", "perturb", "seed",
                                      "apart_fraction", "reference_signs")}
-    per_pin = {}
-    for key, _, p in ranked:
-        per_pin.setdefault(p["pins"][0], key)
     if sensor_needed:
         note = (f"the plan alone ends in {best['n_final_sets']} sets; the sensor's verdict says which "
                 f"results (worst {best_key[0]} per verdict)")
@@ -188,9 +219,8 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
         note = ("the plan ends in one set: the sensor is not needed for the final orientation "
                 "(its verdict still tells which resting state arrived)")
     return dict(
-        out,
         sensor_needed=sensor_needed, note=note,
-        first_pin=pin, y_pin=float(best["pin_heights_mm"][0]),
+        first_pin=best["pins"][0], y_pin=float(best["pin_heights_mm"][0]),
         plan=best, plan_rank=best_rank + 1,
         worst_sets=best_key[0],
         known_for_every_state=best_key[0] == 1,
@@ -199,13 +229,6 @@ def plan_with_sensor(part, entry: dict, pin_radius: float, model: str, sensor: S
                       "final_sets": _arcs_dict(finals[lab])} for lab in labels},
         score_table=summary,
         final_outcomes={lab: {k: c / n for k, c in cnt.items()} for lab, cnt in counts.items()},
-        first_pins=[{"pin": q, "y_pin": y, "groups": tables[q]["groups"],
-                     "accuracy": tables[q]["accuracy"], "wrong": tables[q]["wrong"],
-                     "worst_sets": per_pin[q][0] if q in per_pin else None,
-                     "best_stored_rank": per_pin[q][2] + 1 if q in per_pin else None}
-                    for q, y in evaluated],
-        without_sensor=_summary(recommended),
-        best_fixed_pins=_summary(fixed[0][1]) if fixed else None,
     )
 
 
@@ -253,7 +276,7 @@ def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor
             row["trials"] += 1
             claimed, jammed = None, False
             for k, (y_pin, v_pin, off) in enumerate(zip(heights, speeds, offsets)):
-                r = rollout(part, theta, (y_pin + off - y_c) / part.a, mu, pin_radius, model=model,
+                r = rollout(part, theta, contact_parameter(y_pin + off, y_c, part.a), mu, pin_radius, model=model,
                             v_pin=float(v_pin), trajectory=k == 0, **kernel)
                 if str(r.status.item()) == "jammed":
                     jammed = True
@@ -358,7 +381,3 @@ def final_for_verdict(sensing: dict, candidates) -> list[dict]:
     return _arcs_dict(merge_arcs(arcs))
 
 
-def describe_sets(sets) -> str:
-    """Final sets for people: ``223.1-232.2 deg, ...`` (see ``arcs.format_arcs``)."""
-    from pipeline.planning.arcs import format_arcs
-    return format_arcs(sets)

@@ -15,8 +15,7 @@ from pipeline.maps.catalog import Catalog
 from pipeline.maps.io import read_map, write_json
 from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
-from pipeline.planning.bands import map_bands
-from pipeline.planning.paper import build_planner, paper_depth
+from pipeline.planning.paper import build_planner, load_maps, paper_depth
 from pipeline.planning.plan import nominal_friction, parse_friction, plan_tight_all
 from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.planning.verify import verify_plan
@@ -28,11 +27,11 @@ def shard_bands(shard, threshold_T, factor_c) -> dict:
     kernels K_j as all their arcs, COM intervals and the bands adjusted by
     ``factor_c`` standard deviations (threshold ``threshold_T``)."""
     ds = read_map(shard)
-    bands = map_bands(ds, threshold_T, factor_c)
+    maps = load_maps(ds, threshold_T, factor_c)
     return {"part_id": ds.attrs["part_id"], "model": ds.attrs["model"], "mu_c": ds.attrs["mu_c"],
             "v_pin": float(ds.attrs.get("v_pin", 0.0)),
             "threshold_T": threshold_T, "factor_c": factor_c, "shard": str(shard),
-            "maps": {f"{d:g}": [b.to_dict() for b in bs] for d, bs in bands.items()},
+            "maps": {f"{m.d:g}": [b.to_dict() for b in m.bands] for m in maps},
             **provenance_attrs()}
 
 

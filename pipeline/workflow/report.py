@@ -10,6 +10,7 @@ from pipeline.maps import simulate
 from pipeline.maps.catalog import Catalog
 from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_source
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.present.animate import animate_stored, recommended_index
@@ -33,7 +34,7 @@ def nominal_paths(plan_result: dict, config: dict, plan: dict | None = None) -> 
         theta, y = s["theta"], s["y_c"]
         path = [(theta, y)]
         for pin in best["pins"]:
-            r = simulate.rollout(part, theta, (plan_result["pins"][pin] - y) / part.a,
+            r = simulate.rollout(part, theta, contact_parameter(plan_result["pins"][pin], y, part.a),
                                  plan_result["mu_c"], config["sweep"]["pin_radius"],
                                  model=plan_result["model"], v_pin=speeds.get(pin, 0.0))
             theta, y = float(r.theta_f), y + float(r.dy)

@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle, Polygon
 
-from pipeline.planning.bands import format_arcs
+from pipeline.planning.arcs import format_arcs
 from pipeline.present.figures import save_figure
 
 
