@@ -117,8 +117,19 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     """Search, verify and rank plans for ``part`` at friction ``mu_c`` (a value
     or a range); returns a JSON-ready dict (``plans`` best first, each with
     its ``verification``; ``recommended``; ``warning``; search statistics)."""
+    depth = int(depth if depth is not None else config["planner"]["depth"])
+    planner, candidates = _search_candidates(part, config, mu_c, lattices, depth, progress)
+    states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
+    _verify_candidates(part, config, mu_c, planner, candidates, states, progress)
+    candidates.sort(key=lambda p: p.rank_key())
+    good = [p for p in candidates if p.verification["failures"] <= MAX_FAILURE * p.verification["trials"]]
+    return _tight_result(config, mu_c, depth, keep, planner, candidates, good, states)
+
+
+def _search_candidates(part: Part, config: dict, mu_c, lattices, depth: int, progress):
+    """``(planner, candidate plans)``: fixed pins first; moving pins follow them
+    when fixed pins leave more than one set and the config allows moving pins."""
     pc = config["planner"]
-    depth = int(depth if depth is not None else pc["depth"])
     planner = planner_for(part, config, mu_c, lattices)
     search = dict(keep=int(pc.get("candidates", 12)), complete_depth=int(pc.get("complete_depth", 2)),
                   static_beam=int(pc.get("beam", 30)), progress=progress)
@@ -131,8 +142,14 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
         planner = planner_for(part, config, mu_c, planner.lattices, moving=True)
         candidates = planner.search(depth, dynamic_depth=int(dyn["depth"]),
                                     beam=int(dyn.get("beam", 30)), **search)
+    return planner, candidates
+
+
+def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, states, progress) -> None:
+    """Replay each candidate by perturbed full rollouts (``verify_plan``) and
+    attach the summary as ``plan.verification``."""
+    pc = config["planner"]
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
-    states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
     for plan in candidates:
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
@@ -145,16 +162,23 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
                                 if "belt_speed" in res else {})}
         if progress:
             progress(f"verified {' '.join(plan.pins)}: {res['successes']}/{res['trials']} trials")
-    candidates.sort(key=lambda p: p.rank_key())
-    good = [p for p in candidates if p.verification["failures"] <= MAX_FAILURE * p.verification["trials"]]
-    warning = None
+
+
+def _no_plan_warning(depth: int, candidates, good):
+    """Why nothing is recommended (None when a verified plan exists)."""
     if not candidates:
-        warning = f"no allowed pin sequence within depth {depth}"
-    elif not good:
+        return f"no allowed pin sequence within depth {depth}"
+    if not good:
         best = candidates[0]
-        warning = (f"no plan passed verification: the best prediction, {' '.join(best.pins)} "
-                   f"({format_arcs(best.final_sets)}), failed {best.verification['failures']} of "
-                   f"{best.verification['trials']} trials")
+        return (f"no plan passed verification: the best prediction, {' '.join(best.pins)} "
+                f"({format_arcs(best.final_sets)}), failed {best.verification['failures']} of "
+                f"{best.verification['trials']} trials")
+    return None
+
+
+def _tight_result(config: dict, mu_c, depth: int, keep: int, planner, candidates, good, states) -> dict:
+    """The JSON-ready tight-planner entry at one friction (the stored format)."""
+    pc = config["planner"]
     recommended = good[0] if good else None
     return {
         "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c,
@@ -167,7 +191,7 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
         "plans": [p.to_dict() for p in good[:keep]],
         "rejected": [p.to_dict() for p in candidates if p not in good][:keep],
         "recommended": recommended.to_dict() if recommended else None,
-        "warning": warning,
+        "warning": _no_plan_warning(depth, candidates, good),
         "stats": {"transitions": planner.stats.transitions, "rollouts": planner.stats.rollouts,
                   "joint_states": planner.stats.nodes, "seconds": round(planner.stats.seconds, 2),
                   "pruned_branching": planner.stats.pruned_branching,
