@@ -16,7 +16,7 @@ import time
 
 from pipeline.config import load_config
 from pipeline.parts.families import family_parts
-from pipeline.planning.plan import parse_friction
+from pipeline.planning.settings import parse_friction
 from pipeline.planning.plan import plan_tight_all
 
 

@@ -6,7 +6,8 @@ import pytest
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
-from pipeline.present.animate import _gap, _rotated, animate_plan, plan_inputs, roll_plan
+from pipeline.present.animate import animate_plan, plan_inputs, roll_plan
+from pipeline.present.lanes import gap as point_gap, rotated
 
 PART = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 STATES = {f"state {k}": (float(th), float(y)) for k, (th, y) in enumerate(PART.stable_states(), 1)}
@@ -28,10 +29,10 @@ def test_lanes_follow_the_kernel_and_touch_the_pins():
         for k, b0 in lane.contacts:
             # At first contact the pin touches the outline; a little earlier it is clear of it.
             x, yy, th = lane.pose(b0)
-            poly = _rotated(PART.vertices, th) + [x, yy]
-            assert _gap(np.array([stations[k], HEIGHTS[k]]), poly) == pytest.approx(3.0, abs=1e-3)
+            poly = rotated(PART.vertices, th) + [x, yy]
+            assert point_gap(np.array([stations[k], HEIGHTS[k]]), poly) == pytest.approx(3.0, abs=1e-3)
             x, yy, th = lane.pose(b0 - 0.5)
-            assert _gap(np.array([stations[k], HEIGHTS[k]]), _rotated(PART.vertices, th) + [x, yy]) > 3.0
+            assert point_gap(np.array([stations[k], HEIGHTS[k]]), rotated(PART.vertices, th) + [x, yy]) > 3.0
 
 
 def test_gif_has_the_frames_asked_for(tmp_path):
@@ -113,7 +114,7 @@ def test_cli_animate(tmp_path, capsys):
 
 
 def test_moving_pin_touches_at_its_height_on_the_clock():
-    from pipeline.present.animate import pin_height
+    from pipeline.present.lanes import pin_height
     speeds = [0.0, 1.0]
     lanes, stations, _ = roll_plan(PART, HEIGHTS, speeds, STATES, 0.15, "minpower", 3.0)
     touched = 0
@@ -121,6 +122,6 @@ def test_moving_pin_touches_at_its_height_on_the_clock():
         for k, b0 in lane.contacts:
             x, y, th = lane.pose(b0)
             pin = np.array([stations[k], pin_height(lane, k, b0, HEIGHTS[k], speeds[k], stations[k])])
-            assert _gap(pin, _rotated(PART.vertices, th) + [x, y]) == pytest.approx(3.0, abs=1e-3)
+            assert point_gap(pin, rotated(PART.vertices, th) + [x, y]) == pytest.approx(3.0, abs=1e-3)
             touched += k == 1
     assert touched  # the moving pin met some state

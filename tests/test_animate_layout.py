@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from pipeline.maps import simulate
-from pipeline.present.animate import _gap, _rotated, animate_layout, station_figure, station_scene
+from pipeline.present.animate import animate_layout, station_figure, station_scene
+from pipeline.present.lanes import gap as point_gap, rotated
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 
@@ -79,9 +80,9 @@ def test_each_part_replays_its_passage_past_the_stations(scene):
     touched = set()
     for b in np.linspace(0.0, scene.b_end, 1500):
         for k, label, x, y, th in scene.part_poses(b):
-            poly = _rotated(PART.vertices, th) + [x, y]
+            poly = rotated(PART.vertices, th) + [x, y]
             for j, row in enumerate(stations):
-                gap = _gap(np.array([row["x_mm"], row["y_mm"]]), poly)
+                gap = point_gap(np.array([row["x_mm"], row["y_mm"]]), poly)
                 assert gap > row["radius_mm"] - 0.3, (k, j, b, gap)
                 if gap < row["radius_mm"] + 0.05:
                     touched.add((k, j))
@@ -109,7 +110,7 @@ def test_gif_frames_title_and_model(tmp_path, monkeypatch):
         seen.update(kw, heights=list(heights), model=model)
         raise RuntimeError("stop")
 
-    monkeypatch.setattr("pipeline.present.layout.run_trials", spy)
+    monkeypatch.setattr("pipeline.present.lanes.run_trials", spy)
     with pytest.raises(RuntimeError, match="stop"):
         station_scene(PART, _layout(model="dynamic", speed=150.0), STATES, MU)
     assert seen["belt_speed"] == 150.0 and seen["mu_s"] == 0.5 and seen["nominal"]

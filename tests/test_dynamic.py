@@ -30,7 +30,8 @@ from images import assert_animation, assert_png_figure
 from conftest import fewer_examples
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.planning.paper import Planner, load_maps, pins_from_config
+from pipeline.planning.paper import Planner, load_maps
+from pipeline.planning.settings import pins_from_config
 from pipeline.planning.paper import dynamic_label
 from pipeline.planning.verify import verify_plan
 from test_invariants import (R_PIN, _contact_fraction, assert_maps_agree, d_values, models,

@@ -40,13 +40,7 @@ KERNEL_WRAPPERS = {
 
 # Private names used across modules of the same package, each with its reason
 # and the way out. Keep this empty where possible.
-SAME_PACKAGE_EXCEPTIONS = {
-    ("pipeline.present.layout", "pipeline.present.animate._lane"):
-        "the feeder layout runs each part along animate's lane (same course, same pin reach); "
-        "animate.py is being changed on another branch, so the lane geometry moves to its own "
-        "public module once that lands (issue 14, phase 2)",
-    ("pipeline.present.layout", "pipeline.present.animate._rotated"): "as above",
-}
+SAME_PACKAGE_EXCEPTIONS: dict = {}
 
 
 def module_name(path: Path) -> str:

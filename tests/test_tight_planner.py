@@ -18,7 +18,7 @@ from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import format_arc, in_arc, merge_modulo
 from pipeline.planning.lattice_store import lattice_path, load_lattice, save_lattice
-from pipeline.planning.plan import parse_friction
+from pipeline.planning.settings import parse_friction
 from pipeline.planning.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Uncertainty, initial_state_sets,
                                 propagate)
 from pipeline.planning.search import TightPlanner

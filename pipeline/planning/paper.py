@@ -40,7 +40,7 @@ from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import arc_within, in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
 from pipeline.planning.bands import band_lookup, extract_bands
-from pipeline.planning.plan import nominal_friction, parse_friction
+from pipeline.planning.settings import nominal_friction, parse_friction, pins_from_config
 
 
 @dataclass(frozen=True)
@@ -344,11 +344,6 @@ def _dedupe(states):
             keys.add(st.key())
             out.append(st)
     return out
-
-
-def pins_from_config(values) -> dict:
-    """Global pin labels ``P1, P2, ...`` for the configured heights (mm above the fence)."""
-    return {f"P{k}": float(y) for k, y in enumerate(values, start=1)}
 
 
 # ---------------------------------------------------------------------- a catalog part's planner

@@ -20,7 +20,6 @@ replays with the dynamic model at the same speed.
 """
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
@@ -29,45 +28,12 @@ from pipeline.planning.arcs import format_arcs
 from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.propagate import Tolerances, Uncertainty
 from pipeline.planning.search import TightPlanner
+from pipeline.planning.settings import friction_label, parse_friction, pins_from_config
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import verify_plan
 
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
-
-
-def parse_friction(value):
-    """``0.15`` -> 0.15; ``"0.1:0.3"`` or ``[0.1, 0.3]`` -> ``(0.1, 0.3)``. Raises
-    :class:`PinfeedError` for negative, non-finite or reversed values."""
-    if isinstance(value, str):
-        parts = value.split(":")
-        try:
-            nums = [float(p) for p in parts]
-        except ValueError:
-            raise PinfeedError(f"friction {value!r} is not a number or a range LO:HI") from None
-    elif isinstance(value, (list, tuple)):
-        nums = [float(v) for v in value]
-    else:
-        nums = [float(value)]
-    if len(nums) not in (1, 2) or not all(math.isfinite(x) and x >= 0 for x in nums):
-        raise PinfeedError(f"friction (--mu-c, planner.mu_c) {value!r} must be a finite number >= 0 or a range LO:HI of such numbers")
-    if len(nums) == 2:
-        if nums[1] < nums[0]:
-            raise PinfeedError(f"friction range {value!r} has LO > HI; write it as LO:HI")
-        return (nums[0], nums[1]) if nums[1] > nums[0] else nums[0]
-    return nums[0]
-
-
-def friction_label(mu_c) -> str:
-    """``0.15`` -> ``'0.15'``; ``(0.1, 0.3)`` -> ``'0.1:0.3'``."""
-    if isinstance(mu_c, tuple):
-        return f"{mu_c[0]:g}:{mu_c[1]:g}"
-    return f"{mu_c:g}"
-
-
-def nominal_friction(mu_c) -> float:
-    """One friction value to draw nominal paths with: the value or the range's middle."""
-    return 0.5 * (mu_c[0] + mu_c[1]) if isinstance(mu_c, tuple) else float(mu_c)
 
 
 def planner_belt(config: dict, part: Part | None = None):
@@ -97,7 +63,6 @@ def planner_for(part: Part, config: dict, mu_c, lattices=None, moving: bool = Fa
     (and, with ``moving``, every candidate height at every ``planner.dynamic``
     speed as a moving pin, labelled like ``P23v-2``); at ``planner.belt_speed``
     when it is set (:func:`planner_belt`)."""
-    from pipeline.planning.paper import pins_from_config
     pc, sweep = config["planner"], config["sweep"]
     belt_speed, mu_s = planner_belt(config, part)
     static = pins_from_config(pc["pins"])

@@ -198,7 +198,8 @@ def stored_plan_speed(result: dict, config: dict, plan: int = 1, mu_text=None, m
     quasi-static), ``trials``, ``trials_per_speed``, ``seconds`` and ``method``.
     """
     from pipeline.parts.part import Part
-    from pipeline.planning.plan import friction_label, pick_tight_plan
+    from pipeline.planning.plan import pick_tight_plan
+    from pipeline.planning.settings import friction_label
     if not (isinstance(trials, int) and trials >= 1):
         raise PinfeedError(f"trials must be a whole number >= 1, got {trials!r}")
     chosen, mu_c, entry = pick_tight_plan(result, plan, mu_text)

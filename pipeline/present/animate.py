@@ -18,127 +18,14 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
-
-
-@dataclass
-class Lane:
-    """One initial state's motion: centroid and orientation against belt travel B."""
-
-    label: str
-    B: np.ndarray  # belt travel (mm), non-decreasing
-    x: np.ndarray  # centroid, world (mm)
-    y: np.ndarray
-    theta: np.ndarray  # degrees, unwrapped
-    outcome: str = "ok"  # ok, or "jammed at P3 (reason)"
-    contacts: list = field(default_factory=list)  # (pin index, B at first contact)
-    lead: list = field(default_factory=list)  # per pin: x_world - B before that pin's contact
-
-    def poses(self, b):
-        """Centroid x, y and theta (deg) at the belt travels ``b`` (an array):
-        before the first sample and after the last the part rides the belt
-        (a jammed part stays at its pin)."""
-        b = np.asarray(b, float)
-        x = np.interp(b, self.B, self.x)
-        before, after = b < self.B[0], b > self.B[-1]
-        x = np.where(before, self.x[0] + (b - self.B[0]), x)
-        if self.outcome == "ok":
-            x = np.where(after, self.x[-1] + (b - self.B[-1]), x)
-        return x, np.interp(b, self.B, self.y), np.interp(b, self.B, self.theta)
-
-    def pose(self, b: float):
-        """Centroid (x, y) and theta (deg) at belt travel ``b``."""
-        if b >= self.B[-1] and self.outcome != "ok":
-            return self.x[-1], self.y[-1], self.theta[-1]  # jammed: held at the pin
-        if b >= self.B[-1]:  # past the last pin: rides the belt
-            return self.x[-1] + (b - self.B[-1]), self.y[-1], self.theta[-1]
-        return (float(np.interp(b, self.B, self.x)), float(np.interp(b, self.B, self.y)),
-                float(np.interp(b, self.B, self.theta)))
-
-
-def _rotated(vertices, theta_deg):
-    c, s = math.cos(math.radians(theta_deg)), math.sin(math.radians(theta_deg))
-    return vertices @ np.array([[c, s], [-s, c]])
-
-
-def _gap(point, poly) -> float:
-    """Distance from ``point`` to polygon ``poly`` (0 inside)."""
-    a, b = poly, np.roll(poly, -1, axis=0)
-    ab = b - a
-    t = np.clip(np.einsum("ij,ij->i", point - a, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
-    d = np.hypot(*(a + t[:, None] * ab - point).T).min()
-    x, y = point
-    cross = ((a[:, 1] > y) != (b[:, 1] > y)) & (
-        x < (b[:, 0] - a[:, 0]) * (y - a[:, 1]) / np.where(b[:, 1] == a[:, 1], 1e-300, b[:, 1] - a[:, 1]) + a[:, 0])
-    return 0.0 if np.count_nonzero(cross) % 2 else float(d)
-
-
-def pin_reach(polygons, height, r_pin) -> np.ndarray:
-    """How far downstream a pin of radius ``r_pin`` on the line ``y = height`` can
-    stand and still touch each polygon: the largest pin-centre x with the disc
-    meeting the polygon (exact: the rightmost point of the polygon grown by the
-    disc on that line), ``-inf`` where the line passes by.
-
-    Parameters
-    ----------
-    polygons : array ``(..., n, 2)`` of outlines (world frame, mm).
-    height : the pin's y, mm.
-    r_pin : the pin radius, mm.
-
-    Returns
-    -------
-    array of shape ``polygons.shape[:-2]``.
-    """
-    a = np.asarray(polygons, float)
-    b = np.roll(a, -1, axis=-2)
-    # The polygon grown by the disc is the union of the polygon and a capsule
-    # per edge; on a horizontal line its rightmost point lies on an end circle
-    # or on a side of a capsule.
-    dy = height - a[..., 1]
-    best = np.where(np.abs(dy) <= r_pin, a[..., 0] + np.sqrt(np.clip(r_pin ** 2 - dy ** 2, 0.0, None)),
-                    -np.inf).max(axis=-1)
-    edge = b - a
-    length = np.hypot(edge[..., 0], edge[..., 1])
-    normal = np.stack([-edge[..., 1], edge[..., 0]], axis=-1) / np.where(length > 0, length, 1.0)[..., None]
-    for side in (1.0, -1.0):
-        p, q = a + side * r_pin * normal, b + side * r_pin * normal
-        flat = p[..., 1] == q[..., 1]
-        t = (height - p[..., 1]) / np.where(flat, 1.0, q[..., 1] - p[..., 1])
-        x = p[..., 0] + t * (q[..., 0] - p[..., 0])
-        crossing = ~flat & (t >= 0.0) & (t <= 1.0)
-        best = np.maximum(best, np.where(crossing, x, -np.inf).max(axis=-1))
-    return best
-
-
-def contact_offset(vertices, theta_deg, dh, v_pin, r_pin, a) -> float:
-    """The centroid's station relative to the pin, u = x_free - X_k, at first touch:
-    the pin sits at (-u, dh + v_pin u) from the centroid (``dh`` = pin height at the
-    station minus y_c). A fixed pin: exact (:func:`pin_reach`); a moving one:
-    scanned upstream to downstream, then bisected."""
-    poly = _rotated(vertices, theta_deg)
-    if v_pin == 0.0:
-        reach = float(pin_reach(poly, dh, r_pin))
-        return -reach if math.isfinite(reach) else math.nan
-    reach = (2.0 * a + r_pin + abs(dh)) * (1.0 + abs(v_pin))
-    us = np.linspace(-reach, reach, 4001)
-    touching = [_gap(np.array([-u, dh + v_pin * u]), poly) <= r_pin for u in us]
-    if not any(touching):
-        return math.nan
-    k = touching.index(True)
-    lo, hi = (us[k - 1], us[k]) if k else (us[0], us[0])
-    for _ in range(40):
-        mid = 0.5 * (lo + hi)
-        if _gap(np.array([-mid, dh + v_pin * mid]), poly) <= r_pin:
-            hi = mid
-        else:
-            lo = mid
-    return hi
+from pipeline.present.lanes import build_lane, pin_height, pin_reach, rotated
 
 
 def roll_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, spacing=None):
@@ -166,49 +53,9 @@ def roll_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, spac
                   + [0.0])
     spacing = spacing or max(4.0 * a, longest + 3.0 * a)
     stations = [(k + 1) * spacing for k in range(len(heights))]
-    lanes = [_lane(part, label, steps, stations, heights, speeds, pin_radius)
+    lanes = [build_lane(part, label, steps, stations, heights, speeds, pin_radius)
              for label, steps in runs.items()]
     return lanes, stations, stations[-1] + spacing if stations else spacing
-
-
-def _lane(part, label, steps, stations, heights, speeds, pin_radius) -> Lane:
-    """Place one state's kernel trajectories on the world clock."""
-    B, X, Y, T = [0.0], [0.0], [steps[0][1]], [steps[0][0]]
-    shift = 0.0  # centroid's lead over the belt from earlier contacts (x_world = B + shift)
-    lane = Lane(label, *(np.zeros(0),) * 4)
-    for k, (theta, y_c, r) in enumerate(steps):
-        lane.lead.append(shift)
-        status = str(r.status.item())
-        if status == "miss":
-            continue
-        u = contact_offset(part.vertices, theta, heights[k] - y_c, speeds[k], pin_radius, part.a)
-        if not math.isfinite(u):
-            continue
-        b0 = stations[k] + u - shift  # belt travel when x_free reaches X_k + u
-        s = np.asarray(r.traj_s, float)
-        # The kernel records the absolute orientation, starting from theta.
-        t_unwrapped = T[-1] + (np.asarray(r.traj_theta, float) - theta)
-        B += list(b0 + s)
-        X += list(stations[k] + u + s + np.asarray(r.traj_x, float))
-        Y += list(y_c + np.asarray(r.traj_y, float))
-        T += list(t_unwrapped)
-        lane.contacts.append((k, b0))
-        shift = X[-1] - B[-1]
-        if status == "jammed":
-            lane.outcome = f"jammed at pin {k + 1} ({r.jam_reason.item()})"
-            break
-    lane.lead += [shift] * (len(stations) - len(lane.lead))
-    lane.B, lane.x, lane.y, lane.theta = (np.array(v, float) for v in (B, X, Y, T))
-    # Stations are spaced beyond the longest contact, so a contact starts after the ride before it.
-    lane.B = np.maximum.accumulate(lane.B)
-    return lane
-
-
-def pin_height(lane: Lane, k: int, b: float, h: float, v: float, station: float) -> float:
-    """Pin k's height at belt travel ``b`` as seen in ``lane``: it passes ``h`` when the
-    centroid's belt-carried station (with the lead from earlier contacts, not pin
-    k's own) reaches the pin's station."""
-    return h + v * (b + lane.lead[k] - station)
 
 
 DPI = 80
@@ -329,7 +176,7 @@ def _moving_figure(part, still, panes, stations, heights, speeds, pin_radius):
         clock.set_text(f"belt travel {b:6.1f} mm")
         for lane, to_px, body, pins, marks, note, lo, x_lo, x_hi in movers:
             x, y, th = lane.pose(b)
-            body.set_xy(to_px.transform(_rotated(part.vertices, th) + np.array([x, y])))
+            body.set_xy(to_px.transform(rotated(part.vertices, th) + np.array([x, y])))
             for k, pin in pins.items():
                 pin.center = tuple(to_px.transform((stations[k], pin_height(
                     lane, k, b, heights[k], speeds[k], stations[k]))))
@@ -364,7 +211,7 @@ def recommended_index(result: dict):
 def _chosen_plan(result: dict, plan_index):
     """(plan dict, friction, description) of ``plan_index``: None (the recommended
     plan), ``"tight"``, or a 1-based paper-mode index."""
-    from pipeline.planning.plan import nominal_friction, parse_friction
+    from pipeline.planning.settings import nominal_friction, parse_friction
     name = result["part"]["name"]
     if plan_index is None:
         plan_index = recommended_index(result)
@@ -506,15 +353,15 @@ class StationScene:
 def station_scene(part, layout: dict, states: dict, mu_c, n_parts: int | None = None) -> StationScene:
     """Replay one nominal passage per initial state with the layout's model (the
     dynamic model at its belt speed and ``mu_s`` when the layout used it, else
-    its quasi-static model: ``layout.run_trials(nominal=True)``, the kernels'
+    its quasi-static model: ``lanes.run_trials(nominal=True)``, the kernels'
     trajectories) past the layout's stations, and set up the stream of parts.
 
     ``layout``: the JSON of ``pinfeed layout`` (``stations``, ``pitch_mm``,
     ``fence_y_mm``, ``fence_end_x_mm``, ``belt_y_mm``, ``belt_speed_mm_s``,
     ``mu_s``, ``method.model``, ``method.margins_mm``). ``states``: label ->
     ``(theta_deg, y_c_mm)``. ``n_parts``: default one per state, at least 3."""
-    from pipeline.present.layout import run_trials, trial_lanes
-    from pipeline.planning.plan import nominal_friction
+    from pipeline.present.lanes import run_trials, trial_lanes
+    from pipeline.planning.settings import nominal_friction
     rows = layout.get("stations") or []
     if not rows:
         raise PinfeedError(f"the layout of {layout.get('part', 'the part')} has no pin stations "
@@ -538,7 +385,7 @@ def station_scene(part, layout: dict, states: dict, mu_c, n_parts: int | None = 
                         mu_s=float(layout.get("mu_s") or 0.5), nominal=True)
     margin = float((method.get("margins_mm") or {}).get("station_margin_mm", 5.0))
     # As the layout: every centroid starts far enough upstream of the first pin that nothing touches.
-    reach = [float(pin_reach(_rotated(part.vertices, t.theta), heights[0] - t.y_c, pin_radius))
+    reach = [float(pin_reach(rotated(part.vertices, t.theta), heights[0] - t.y_c, pin_radius))
              for t in trials]
     entry = max([r for r in reach if math.isfinite(r)] + [part.a + pin_radius]) + margin
     lanes = trial_lanes(part, trials, [x - xs[0] for x in xs], pin_radius, entry)
@@ -600,7 +447,7 @@ def station_figure(scene: StationScene, title: str) -> dict:
 
     def draw(b):
         for (k, _, x, y, th), body in zip(scene.part_poses(b), parts):
-            body.set_xy(_rotated(part.vertices, th) + np.array([x, y]))
+            body.set_xy(rotated(part.vertices, th) + np.array([x, y]))
         ticks = np.arange(x_lo + b % (0.5 * a), x_hi, 0.5 * a)  # the belt's texture moves with it
         marks.set_data(ticks, np.full_like(ticks, scene.belt_y[0] + 0.1 * a))
         clock.set_text(f"belt travel {b:6.1f} mm")

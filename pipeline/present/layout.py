@@ -17,12 +17,12 @@ states, the friction) and replayed trials with trajectories:
   model integrates the slide after separation; the quasi-static part rests at
   once) is known relative to that pin's station. Pin j stands so far
   downstream of pin k that its disc, at the trial's perturbed height, misses
-  every one of those poses (:func:`pipeline.present.animate.pin_reach`, exact for
+  every one of those poses (:func:`pipeline.present.lanes.pin_reach`, exact for
   polygons), plus ``station_margin_mm``: the part has left pin k and come to
   rest before pin j touches it. Every earlier pin k bounds pin j (a part that
   misses a pin rides on from the pin before).
 - **Pitch.** Every trial becomes a lane on one clock, the belt travel B
-  (``animate._lane``). The next part runs the same course ``p`` later. For
+  (``lanes.build_lane``). The next part runs the same course ``p`` later. For
   every B and every horizontal slab of the belt (``slab_mm`` high) the
   x-range that any trial's outline covers in that slab is known exactly
   (edges clipped to the slab); two parts cannot touch if in every slab the
@@ -45,14 +45,12 @@ arrival, which a fixed drawing cannot show.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from pipeline.errors import PinfeedError
-from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.present.animate import Lane, _lane, _rotated, pin_reach
+from pipeline.present.lanes import Lane, Trial, outlines, passage_poses, pin_reach, rotated, run_trials, trial_lanes
 
 LAYOUT_DEFAULTS = {
     "trials": 20,
@@ -95,100 +93,6 @@ def check_layout_settings(settings: dict | None) -> dict:
     return cfg
 
 
-@dataclass
-class Trial:
-    """One replayed part: its perturbed start, friction and pins, and every passage."""
-
-    state: str
-    theta: float  # initial orientation, degrees
-    y_c: float  # initial centroid height, mm
-    mu_c: float
-    heights: np.ndarray  # the pins' perturbed heights, mm
-    steps: list = field(default_factory=list)  # (theta_deg, y_c, rollout Dataset) per pin
-    jam: str = ""  # why the part stopped, or ""
-
-
-def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model: str,
-               belt_speed: float | None = None, mu_s: float = 0.5, perturb: dict | None = None,
-               trials: int = 20, corners: bool = False, seed: int = 1,
-               nominal: bool = False) -> list[Trial]:
-    """Replay ``trials`` perturbed parts per initial state past the pins.
-
-    Parameters
-    ----------
-    heights : pin heights in passage order, mm.
-    states : label -> ``(theta_deg, y_c_mm)``.
-    mu_c : a value, or a range ``(lo, hi)`` drawn uniformly.
-    model : the quasi-static model (``belt_speed`` None) or ignored: with a
-        ``belt_speed`` (mm/s) the dynamic model runs with belt friction ``mu_s``.
-    perturb : ``verify``-style sizes (``theta_sigma``, ``y_halfwidth``,
-        ``mu_sigma``, ``pin_halfwidth``).
-    corners : also replay every corner of the perturbation box.
-    nominal : one unperturbed trial per state instead (nominal friction).
-
-    Returns
-    -------
-    list of :class:`Trial`, state by state.
-    """
-    from pipeline.maps import simulate
-    from pipeline.planning.plan import nominal_friction
-    from pipeline.planning.verify import PERTURB_DEFAULTS, corner_inputs, perturbed_batch
-    cfg = dict(PERTURB_DEFAULTS, **(perturb or {}))
-    rng = np.random.default_rng(seed)
-    heights = np.asarray(heights, float)
-    n_pins = heights.size
-    belt = {"model": "dynamic", "belt_speed": float(belt_speed), "mu_s": float(mu_s)} \
-        if belt_speed is not None else {"model": model}
-    out = []
-    for label, (theta0, yc0) in states.items():
-        if nominal:
-            th, yc = np.array([theta0], float), np.array([yc0], float)
-            mu, offs = np.array([nominal_friction(mu_c)]), np.zeros((1, n_pins))
-        else:
-            th, yc, mu, offs = perturbed_batch(theta0, yc0, mu_c, n_pins, cfg, rng, int(trials))
-            if corners:
-                extra = corner_inputs(theta0, yc0, mu_c, n_pins, cfg)
-                th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), extra[:3]))
-                offs = np.concatenate([offs, extra[3]])
-        for j in range(th.size):
-            trial = Trial(label, float(th[j]) % 360.0, float(yc[j]), float(mu[j]), heights + offs[j])
-            theta, y = trial.theta, trial.y_c
-            for k, h in enumerate(trial.heights):
-                ds = simulate.rollout(part, theta, contact_parameter(h, y, part.a), trial.mu_c, pin_radius,
-                                      trajectory=True, **belt)
-                trial.steps.append((theta, y, ds))
-                status = str(ds.status.item())
-                if status in ("jammed", "truncated"):
-                    trial.jam = f"{status} at pin {k + 1} ({ds.jam_reason.item()})"
-                    break
-                theta, y = float(ds.theta_f), y + float(ds.dy)
-            out.append(trial)
-    return out
-
-
-def outlines(vertices, x, y, theta_deg) -> np.ndarray:
-    """The part's outline at each pose: array ``(n_poses, n_vertices, 2)``, mm."""
-    t = np.radians(np.asarray(theta_deg, float))
-    c, s = np.cos(t)[:, None], np.sin(t)[:, None]
-    vx, vy = vertices[:, 0][None, :], vertices[:, 1][None, :]
-    return np.stack([np.asarray(x, float)[:, None] + c * vx - s * vy,
-                     np.asarray(y, float)[:, None] + s * vx + c * vy], axis=-1)
-
-
-def passage_poses(part: Part, theta: float, y_c: float, ds, height: float, pin_radius: float):
-    """The part's poses over one passage, centroid x relative to the pin's station:
-    the pose at first touch, then every recorded pose until the part rests
-    (``None`` for a miss). Returns ``(x, y, theta_deg)`` arrays."""
-    if str(ds.status.item()) == "miss" or ds.traj_s.size == 0:
-        return None
-    reach = float(pin_reach(_rotated(part.vertices, theta), height - y_c, pin_radius))
-    u = -reach  # the centroid's x at first touch, the pin at x = 0
-    s = np.asarray(ds.traj_s, float)
-    return (np.concatenate([[u], u + s + np.asarray(ds.traj_x, float)]),
-            np.concatenate([[y_c], y_c + np.asarray(ds.traj_y, float)]),
-            np.concatenate([[theta], np.asarray(ds.traj_theta, float)]))
-
-
 def place_stations(part: Part, trials: list[Trial], pin_radius: float, margin: float):
     """Stations of the pins along the belt (the first at x = 0; see the module notes).
 
@@ -213,20 +117,6 @@ def place_stations(part: Part, trials: list[Trial], pin_radius: float, margin: f
         stations.append(need)
         bounds.append(bound)
     return stations, bounds
-
-
-def trial_lanes(part: Part, trials: list[Trial], stations, pin_radius: float, entry: float):
-    """Each trial on the common clock (belt travel B, mm): at B = 0 its centroid
-    is at x = -``entry``; returns a :class:`~pipeline.present.animate.Lane` per trial in
-    world coordinates (first pin at x = 0)."""
-    shifted = [x + entry for x in stations]
-    lanes = []
-    for t in trials:
-        lane = _lane(part, t.state, t.steps, shifted, list(t.heights), [0.0] * len(shifted),
-                     pin_radius)
-        lane.x = lane.x - entry
-        lanes.append(lane)
-    return lanes
 
 
 def contact_windows(trials: list[Trial], lanes: list[Lane], n_pins: int):
@@ -375,7 +265,7 @@ def _layout_trials(part, heights, states, mu_c, pin_radius, cfg, kw):
 def _entry_distance(part, trials, pin_radius, margin) -> float:
     """Entry (mm upstream of the first pin): every centroid starts far enough
     upstream that nothing touches yet, plus ``margin``."""
-    first_touch = [float(pin_reach(_rotated(part.vertices, t.theta), t.heights[0] - t.y_c,
+    first_touch = [float(pin_reach(rotated(part.vertices, t.theta), t.heights[0] - t.y_c,
                                    pin_radius)) for t in trials]
     return max([r for r in first_touch if math.isfinite(r)] + [part.a + pin_radius]) + margin
 
@@ -443,7 +333,7 @@ def _drawing(part, states, nominal_lanes, stations, pitch, entry, pin_radius, ma
         entry_parts.append({"state": label, "x_mm": x, "y_mm": float(y_c), "theta_deg": float(theta) % 360,
                             "outline": outlines(part.vertices, [x], [y_c], [theta])[0].tolist()})
         x_end, y_end, th_end = (float(v) for v in (lane.x[-1], lane.y[-1], lane.theta[-1]))
-        poly = _rotated(part.vertices, th_end)
+        poly = rotated(part.vertices, th_end)
         clear_x = stations[-1] + pin_radius + margin - float(poly[:, 0].min())
         x_exit = max(x_end, clear_x) + k * pitch
         exit_parts.append({"state": label, "x_mm": x_exit, "y_mm": y_end, "theta_deg": th_end % 360,
@@ -470,7 +360,8 @@ def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None
     throughput, and ``warnings`` says so).
     """
     from pipeline.maps import simulate
-    from pipeline.planning.plan import friction_label, pick_tight_plan
+    from pipeline.planning.plan import pick_tight_plan
+    from pipeline.planning.settings import friction_label
     from pipeline.planning.speed_limit import DEFAULT_SPEEDS, perturbation_from_verify, speed_curve
     from pipeline.provenance import provenance_attrs
     cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})

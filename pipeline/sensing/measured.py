@@ -18,7 +18,8 @@ from pipeline.maps.catalog import Catalog
 from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_id
 from pipeline.parts.part import Part
-from pipeline.planning.plan import best_fixed_plan, parse_friction, plan_hint, tight_entry
+from pipeline.planning.plan import best_fixed_plan, plan_hint, tight_entry
+from pipeline.planning.settings import parse_friction
 from pipeline.planning.types import validate_plan_file
 from pipeline.sensing.profiles import Sensor, classify, read_profile_csv, reference_profiles, resample, sign_matrix
 from pipeline.sensing.sensor_plan import count_sets, final_for_verdict, sensing_frictions, stored_sensor_plan

@@ -70,7 +70,7 @@ from pipeline.sensing.profiles import PERTURB_DEFAULTS, Sensor, score_table
 def sensing_frictions(entry: dict):
     """``(planned, profiles)``: the entry's friction as planned (a value or a
     tuple ``(lo, hi)``) and the one value the simulated profiles use."""
-    from pipeline.planning.plan import nominal_friction
+    from pipeline.planning.settings import nominal_friction
     mu = entry["mu_c"]
     planned = (float(mu[0]), float(mu[1])) if isinstance(mu, (list, tuple)) else float(mu)
     return planned, nominal_friction(planned)

@@ -13,7 +13,8 @@ from pipeline.errors import PinfeedError
 from pipeline.maps.catalog import Catalog
 from pipeline.parts.families import family_parts
 from pipeline.parts.part import Part
-from pipeline.planning.plan import parse_friction, plan_tight_all, planner_belt
+from pipeline.planning.plan import plan_tight_all, planner_belt
+from pipeline.planning.settings import parse_friction
 from pipeline.provenance import provenance_attrs
 
 PLAN_MODES = ("tight", "paper", "both")

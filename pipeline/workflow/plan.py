@@ -16,7 +16,8 @@ from pipeline.maps.io import read_map, write_json
 from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
 from pipeline.planning.paper import build_planner, load_maps, paper_depth
-from pipeline.planning.plan import nominal_friction, parse_friction, plan_tight_all
+from pipeline.planning.plan import plan_tight_all
+from pipeline.planning.settings import nominal_friction, parse_friction
 from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.planning.verify import verify_plan
 from pipeline.provenance import provenance_attrs
