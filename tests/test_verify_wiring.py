@@ -26,6 +26,14 @@ CONFIG_MU = 0.37  # an unusual value: no default or fallback equals it
 TIGHT_MU = [0.25, 0.35]
 
 
+def _tight_entry(friction, mu_c, pins, height):
+    """A stored tight-planner entry (the keys the plan schema requires) recommending ``pins``."""
+    plan = {"pins": pins, "pin_heights_mm": [height], "pin_speeds": [0.0], "final_sets": [],
+            "initial_states": {}}
+    return {"friction": friction, "mu_c": mu_c, "belt_speed": None, "mu_s": None,
+            "plans": [plan], "recommended": plan, "warning": None}
+
+
 def _plan_result():
     plan = {"pins": ["A", "B"], "n_final_sets": 1, "n_dynamic_pins": 0, "final_sets": [],
             "initial_states": {}}
@@ -34,12 +42,7 @@ def _plan_result():
         "model": "minpower", "mu_c": CONFIG_MU, "pins": {"A": 5.0, "B": 20.0}, "pin_speeds": {},
         "initial_states": {"state 1": {"theta": 0.0, "y_c": 10.0}},
         "plans": [plan], "best_static": plan,
-        "tight": [{"friction": "0.25:0.35", "mu_c": TIGHT_MU, "belt_speed": None, "mu_s": None,
-                   "recommended": {"pins": ["A"], "pin_heights_mm": [7.5], "pin_speeds": [0.0],
-                                   "initial_states": {}}},
-                  {"friction": "0.1", "mu_c": 0.1, "recommended": {
-                      "pins": ["B"], "pin_heights_mm": [12.5], "pin_speeds": [0.0],
-                      "initial_states": {}}}],
+        "tight": [_tight_entry("0.25:0.35", TIGHT_MU, ["A"], 7.5), _tight_entry("0.1", 0.1, ["B"], 12.5)],
     }
 
 
