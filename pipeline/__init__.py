@@ -1,6 +1,6 @@
 """pinfeed: design part feeders that orient flat parts with overhead pins.
 
-Layers, lowest first (README "Layout"; ``tests/test_layers.py`` keeps them):
+Layers, lowest first (README "Layout"; ``tests/house/test_layers.py`` keeps them):
 utilities (errors, logs, progress, provenance, checks), ``parts``, ``config``,
 ``maps``, ``planning``, ``sensing``, ``present``, ``workflow``, ``cli``.
 

@@ -1,4 +1,4 @@
-"""Run under NUMBA_ENABLE_CUDASIM=1 by tests/test_cuda.py: the CUDA grid
+"""Run under NUMBA_ENABLE_CUDASIM=1 by tests/kernels/test_cuda.py: the CUDA grid
 kernel on a tiny grid against the CPU grid; prints one JSON line."""
 import json
 import sys

@@ -3,5 +3,5 @@ normalised outline), part families and generators (``families``), and
 outline readers for DXF and SVG (``outlines``).
 
 Layer 1 of the pipeline: imports only ``kernels`` (geometry) and the
-top-level utilities (``errors``, ...). See ``tests/test_layers.py``.
+top-level utilities (``errors``, ...). See ``tests/house/test_layers.py``.
 """

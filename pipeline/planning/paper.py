@@ -228,7 +228,7 @@ class Planner:
         d_lo, d_hi = contact_parameter(y_pin, state.y_hi, a), contact_parameter(y_pin, state.y_lo, a)
         # The limits apply to the offset of the pin's path from the centroid,
         # perpendicular to the pin's motion relative to the belt (-1, v): for a
-        # moving pin that is d / sqrt(1 + v^2) (see tests/test_dynamic.py).
+        # moving pin that is d / sqrt(1 + v^2) (see tests/kernels/test_dynamic.py).
         shrink = 1.0 / math.sqrt(1.0 + v_pin * v_pin)
         near, far = shrink * min(abs(d_lo), abs(d_hi)), shrink * max(abs(d_lo), abs(d_hi))
         if d_lo < 0.0 < d_hi or near < self.d_min - 1e-12 or far > self.d_max + 1e-12:

@@ -37,7 +37,7 @@ from pipeline.planning.verify import verify_plan
 from test_invariants import (R_PIN, _contact_fraction, assert_maps_agree, d_values, models,
                              mu_values, parts, theta_grid)
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 speeds = st.floats(0.3, 2.5).flatmap(lambda v: st.sampled_from([v, -v]))
 
 
@@ -227,7 +227,7 @@ def test_workflow_plans_verifies_and_draws_moving_pins(tmp_path):
     """The whole downstream chain on a small sweep with one moving-pin speed:
     plan, verify (both plans), sensing, figures (maps by speed, both sequence
     diagrams) and the report."""
-    from test_catalog import _snakemake
+    from workflow_runs import run_snakemake as _snakemake
     cfg = {
         "catalog_dir": "cat", "results_dir": "res",
         "families": {"fam": {"parts": [{"name": "tri", "vertices": [[0, 0], [60, 0], [15, 35]]}]}},

@@ -25,7 +25,7 @@ from pipeline.maps.io import read_map
 from pipeline.maps.sweep import run_sweep, shard_jobs
 from pipeline.parts.part import MAX_VERTICES, Part, PolygonError
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 VENV_BIN = Path(sys.executable).parent
 TRI = [[0, 0], [60, 0], [15, 35]]
 TINY = {

@@ -543,7 +543,7 @@ def test_cli_module_entry_point():
     import subprocess
     import sys
     from pathlib import Path
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     run = subprocess.run([sys.executable, "-m", "pipeline.cli", "sense", "classify", "--help"], cwd=root,
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and "time (s), F_x, F_y" in run.stdout

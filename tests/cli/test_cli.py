@@ -55,7 +55,7 @@ def run_script(args, cwd):
     # PYTHONPATH: the script runs this checkout's package even where the
     # editable install points at another checkout (a git worktree).
     env = {k: v for k, v in os.environ.items() if k != "PYTHONWARNINGS"}
-    env["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parent.parent),
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parents[2]),
                                          *filter(None, [env.get("PYTHONPATH")])])
     return subprocess.run([str(PINFEED), *args], capture_output=True, text=True, cwd=cwd,
                           timeout=300, env=env)

@@ -1,9 +1,6 @@
 """The map database: sweep, shards, index, queries, workflow (issue: map database)."""
 import hashlib
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import h5py
@@ -18,9 +15,9 @@ from pipeline.maps import simulate
 from pipeline.maps.catalog import Catalog
 from pipeline.maps.sweep import run_sweep, shard_jobs, write_shard
 from pipeline.parts.part import Part
+from workflow_runs import run_snakemake as _snakemake
 
-ROOT = Path(__file__).resolve().parent.parent
-VENV_BIN = Path(sys.executable).parent
+ROOT = Path(__file__).resolve().parents[2]
 
 TINY = {
     "families": {"fam": {"parts": [{"name": "tri", "vertices": [[0, 0], [60, 0], [15, 35]]}],
@@ -262,13 +259,6 @@ def test_dask_distributed_sweep_matches_local(tiny, tmp_path):
         qa = a.query("tri", model=model).load()
         qb = b.query("tri", model=model).load()
         np.testing.assert_array_equal(qa["theta_f"].values, qb["theta_f"].values)
-
-
-def _snakemake(workdir, *extra):
-    env = dict(os.environ, PATH=f"{VENV_BIN}{os.pathsep}{os.environ.get('PATH', '')}")
-    return subprocess.run([str(VENV_BIN / "snakemake"), "-s", str(ROOT / "Snakefile"),
-                           "--cores", "2", "--directory", str(workdir), *extra],
-                          capture_output=True, text=True, env=env, timeout=600)
 
 
 def test_workflow_end_to_end_and_rerun_is_a_no_op(tmp_path):

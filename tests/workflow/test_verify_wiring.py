@@ -21,7 +21,7 @@ import pytest
 from conftest import TRIANGLE
 from pipeline.planning.verify import verify_plan
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 CONFIG_MU = 0.37  # an unusual value: no default or fallback equals it
 TIGHT_MU = [0.25, 0.35]
 

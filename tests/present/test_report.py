@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from test_catalog import _snakemake
+from workflow_runs import run_snakemake as _snakemake
 
 from pipeline.config import config_name, load_config, results_folder, validate_config
 

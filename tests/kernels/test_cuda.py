@@ -30,7 +30,7 @@ from pipeline.maps import simulate
 HAVE_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
 needs_cuda_extra = pytest.mark.skipif(not HAVE_NUMBA_CUDA,
                                       reason="the cuda extra (numba-cuda) is not installed")
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 OK, MISS, JAMMED = 0, 1, 2
 
 
