@@ -184,13 +184,14 @@ class Verification:
     """Perturbed full rollouts of a plan (``verify.verify_plan``): total
     ``trials``, ``successes`` and ``failures`` (counts), one
     :class:`VerificationRow` per initial state, the ``model`` replayed with
-    (``"dynamic"`` at a belt speed) and, for the dynamic model only, the belt
-    speed (mm/s) and belt friction ``mu_s``."""
+    (``"dynamic"`` at a belt speed; None in files verified before the model was
+    recorded) and, for the dynamic model only, the belt speed (mm/s) and belt
+    friction ``mu_s``."""
     trials: int
     successes: int
     failures: int
     rows: tuple
-    model: str
+    model: str | None = None
     belt_speed: float | None = None
     mu_s: float | None = None
     extra: dict = field(default_factory=dict)
@@ -201,13 +202,15 @@ class Verification:
     def from_dict(cls, d: dict) -> "Verification":
         """The record of a stored dict (as read from the plan file)."""
         return cls(d["trials"], d["successes"], d["failures"],
-                   tuple(VerificationRow.from_dict(r) for r in d["rows"]), d["model"],
+                   tuple(VerificationRow.from_dict(r) for r in d["rows"]), d.get("model"),
                    d.get("belt_speed"), d.get("mu_s"), _extra(d, cls.KEYS))
 
     def to_dict(self) -> dict:
         """The stored dict: the keys and values this record was read from."""
         out = {"trials": self.trials, "successes": self.successes, "failures": self.failures,
-               "rows": [r.to_dict() for r in self.rows], "model": self.model}
+               "rows": [r.to_dict() for r in self.rows]}
+        if self.model is not None:  # older files have no model
+            out["model"] = self.model
         if self.belt_speed is not None:
             out["belt_speed"] = self.belt_speed
         if self.mu_s is not None:

@@ -233,3 +233,15 @@ def test_a_minimal_plan_file_still_reads():
     assert PlanFile.from_dict(typed.to_dict()) == typed
     with pytest.raises(PinfeedError, match="'plans' is a required property"):
         validate_plan_dict({"part": RECT.to_dict(), "tight": [{"mu_c": 0.1, "friction": "0.1"}]})
+
+
+def test_a_verification_without_its_model_still_reads():
+    # Plans verified before the replay model was recorded have no
+    # verification.model; they read, and are written back as they were.
+    verification = {"trials": 4, "successes": 4, "failures": 0,
+                    "rows": [{"state": "state 1", "trials": 4, "successes": 4, "failures": 0, "reasons": {}}]}
+    plan = {"pins": ["P1"], "final_sets": [{"start": 10.0, "width": 2.0}], "verification": verification}
+    data = {"part": RECT.to_dict(), "tight": [{"mu_c": 0.2, "friction": "0.2", "plans": [plan]}]}
+    typed = PlanFile.from_dict(validate_plan_dict(data))
+    assert typed.tight[0].plans[0].verification.model is None
+    assert typed.to_dict()["tight"][0]["plans"][0]["verification"] == verification
