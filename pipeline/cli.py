@@ -386,36 +386,39 @@ def _plan_json(result, mode) -> dict:
 
 
 def _print_plan_result(result, part, config, mode):
+    """A plan result (the dict ``plan_command`` returns), for people."""
     from pipeline.planning.arcs import format_arcs
     from pipeline.planning.plan import mechanics_label, planner_belt
+    from pipeline.planning.types import as_plan_file
+    result = as_plan_file(result)
     pc = config["planner"]
     print(f"part {part.id}: model {mechanics_label(pc['model'], *planner_belt(config))}, depth {pc['depth']}")
     for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
         print(f"  state {k}: resting on the fence at theta = {theta:.1f} deg, y_c = {y_c:.2f} mm")
-    for t in result.get("tight", []):
-        st = t["stats"]
-        print(f"tight planner, friction {t['friction']}: {st['rollouts']} new rollouts in "
+    for t in result.tight or ():
+        st = t.stats
+        print(f"tight planner, friction {t.friction}: {st['rollouts']} new rollouts in "
               f"{st['seconds']:.0f} s, stored under {config['catalog_dir']}/refine/{part.id}/")
-        if t["warning"]:
-            print(f"  WARNING: {t['warning']}")
-        for k, plan in enumerate(t["plans"], start=1):
-            v = plan["verification"]
-            heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
-            print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
-                  f"{format_arcs(plan['final_sets'])}; "
-                  f"verified {v['successes']}/{v['trials']} trials; margin in d " + (f"{plan['margin']:+.3f}" if plan['margin'] is not None else "n/a (touches nothing)"))
-    if mode == "tight" or "plans" not in result:
+        if t.warning:
+            print(f"  WARNING: {t.warning}")
+        for k, plan in enumerate(t.plans, start=1):
+            v = plan.verification
+            heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))
+            print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
+                  f"{format_arcs(plan.final_arcs)}; "
+                  f"verified {v.successes}/{v.trials} trials; margin in d " + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
+    if mode == "tight" or result.plans is None:
         return
-    print(f"paper-mode planner (adjusted bands), {result['selection']}:")
-    if not result["plans"]:
+    print(f"paper-mode planner (adjusted bands), {result.extra['selection']}:")
+    if not result.plans:
         print("  no allowed pin sequence within the depth")
-    speeds = result["pin_speeds"]
-    for k, plan in enumerate(result["plans"], start=1):
-        heights = ", ".join(f"{q} at {result['pins'][q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
-                            for q in plan["pins"])
-        print(f"  #{k}: {heights} -> {plan['n_final_sets']} final set(s): "
-              f"{format_arcs(plan['final_sets'])}; "
-              f"margin in d {plan['margin']:.3f}")
+    speeds = result.pin_speeds
+    for k, plan in enumerate(result.plans, start=1):
+        heights = ", ".join(f"{q} at {result.pins[q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
+                            for q in plan.pins)
+        print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
+              f"{format_arcs(plan.final_arcs)}; "
+              f"margin in d {plan.margin:.3f}")
 
 
 def _results_arg(args, config) -> Path:

@@ -29,6 +29,7 @@ from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.propagate import Tolerances, Uncertainty
 from pipeline.planning.search import TightPlanner
 from pipeline.planning.settings import friction_label, parse_friction, pins_from_config
+from pipeline.planning.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import verify_plan
 
@@ -172,39 +173,44 @@ def planner_pin_heights(planner: TightPlanner) -> dict:
     return {label: pin.y for label, pin in planner.pins.items()}
 
 
-def tight_entry(plan_result: dict, friction=None) -> dict:
+def tight_entry(plan_result, friction=None) -> TightEntry:
     """The stored tight-planner entry at ``friction`` (a value, a range or its
-    text ``LO:HI``; default the first planned friction, ``planner.mu_c``)."""
-    tight = plan_result.get("tight") or []
+    text ``LO:HI``; default the first planned friction, ``planner.mu_c``) of a
+    stored plan (a :class:`PlanFile` or its dict), as a :class:`TightEntry`."""
+    tight = as_plan_file(plan_result).tight or ()
     if not tight:
         raise PinfeedError("the stored plan has no tight-planner plans; re-plan with 'pinfeed plan' "
                            "(--mode tight or both) or re-run the workflow")
     if friction is None:
         return tight[0]
     want = friction_label(parse_friction(friction))
-    found = [t for t in tight if t["friction"] == want]
+    found = [t for t in tight if t.friction == want]
     if not found:
-        raise PinfeedError(f"no stored plan at mu_c {want}; stored: {', '.join(t['friction'] for t in tight)}")
+        raise PinfeedError(f"no stored plan at mu_c {want}; stored: {', '.join(t.friction for t in tight)}")
     return found[0]
 
 
-def pick_tight_plan(result: dict, n: int, mu_text):
-    """Plan ``n`` (1 = recommended) of the stored tight plans at friction ``mu_text``
-    (default: the first planned friction), that friction and its stored entry."""
+def pick_tight_plan(result, n: int, mu_text) -> tuple:
+    """``(plan, mu_c, entry)``: plan ``n`` (1 = recommended, a :class:`Plan`) of
+    the stored tight plans at friction ``mu_text`` (default: the first planned
+    friction) of a stored plan (a :class:`PlanFile` or its dict), that
+    friction (a value or ``(lo, hi)``) and its :class:`TightEntry`."""
     entry = tight_entry(result, mu_text)
-    if not entry["plans"]:
-        raise PinfeedError(f"no verified plan at mu_c {entry['friction']}: {entry['warning']}")
-    if not 1 <= n <= len(entry["plans"]):
-        raise PinfeedError(f"--plan must be 1 to {len(entry['plans'])}, got {n}")
-    mu = entry["mu_c"]
-    return entry["plans"][n - 1], (tuple(mu) if isinstance(mu, list) else mu), entry
+    if not entry.plans:
+        raise PinfeedError(f"no verified plan at mu_c {entry.friction}: {entry.warning}")
+    if not 1 <= n <= len(entry.plans):
+        raise PinfeedError(f"--plan must be 1 to {len(entry.plans)}, got {n}")
+    return entry.plans[n - 1], entry.mu_c, entry
 
 
-def best_fixed_plan(plan_result: dict):
-    """The best plan of fixed pins only in a stored plan result (None if none)."""
-    if plan_result.get("best_static"):
-        return plan_result["best_static"]
-    return next((p for p in plan_result["plans"] if not p.get("n_dynamic_pins", 0)), None)
+def best_fixed_plan(plan_result) -> Plan | None:
+    """The best plan of fixed pins only in a stored plan (a :class:`PlanFile` or
+    its dict; paper mode's ``best_static``, else its first plan without moving
+    pins), as a :class:`Plan` (None if none)."""
+    result = as_plan_file(plan_result)
+    if result.best_static:
+        return result.best_static
+    return next((p for p in result.plans or () if not p.n_dynamic_pins), None)
 
 
 def plan_hint(config: dict, name: str, root) -> str:

@@ -22,7 +22,9 @@ import numpy as np
 
 from pipeline.checks import FROUDE_MAX, G_MM_S2, check_belt
 from pipeline.errors import PinfeedError
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
+from pipeline.planning.arcs import in_arc
 
 DEFAULT_SPEEDS = (10.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
 
@@ -37,11 +39,12 @@ def perturbation_from_verify(verify: dict) -> dict:
 
 
 def _in_arcs(theta_deg, arcs) -> np.ndarray:
-    """Whether each orientation (degrees) lies in one of the arcs ``(start, width)``."""
+    """Whether each orientation (degrees) lies in one of the arcs ``(start, width)``
+    (:func:`~pipeline.planning.arcs.in_arc`, ends included, no tolerance)."""
     theta_deg = np.asarray(theta_deg, float)
     inside = np.zeros(theta_deg.shape, bool)
     for start, width in arcs:
-        inside |= (theta_deg - start) % 360.0 <= width
+        inside |= in_arc(theta_deg, start, width, tol=0.0)
     return inside
 
 
@@ -90,9 +93,9 @@ def success_fraction(part: Part, pin_heights, pin_speed_ratios, draws, final_arc
         idx = np.flatnonzero(alive)
         if idx.size == 0:
             break
-        res = rollout_points(part, theta[idx], (pins[idx, k] - y_c[idx]) / part.a, mu[idx], r_pin,
-                             "dynamic", v_pin=float(v_pin), threads=threads,
-                             belt_speed=float(belt_speed), mu_s=float(mu_s))
+        d_k = contact_parameter(pins[idx, k], y_c[idx], part.a)
+        res = rollout_points(part, theta[idx], d_k, mu[idx], r_pin, "dynamic", v_pin=float(v_pin),
+                             threads=threads, belt_speed=float(belt_speed), mu_s=float(mu_s))
         stuck = (res["status"] == JAMMED) | (res["status"] == TRUNCATED)
         alive[idx[stuck]] = False
         theta[idx] = res["theta_f"]
@@ -183,11 +186,12 @@ def _speed_limit(frac, grid, required, resolution) -> float:
     return lo
 
 
-def stored_plan_speed(result: dict, config: dict, plan: int = 1, mu_text=None, mu_s: float = 0.5,
+def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: float = 0.5,
                       trials: int = 300, speeds=DEFAULT_SPEEDS, resolution: float = 5.0,
                       required: float = 0.99, seed: int = 0) -> dict:
     """The speed curve and speed limit of a stored tight plan (a plan file's
-    ``tight`` entry, see :func:`pick_tight_plan`), with the verify stage's
+    ``tight`` entry, see :func:`pick_tight_plan`; ``result`` a
+    :class:`~pipeline.planning.types.PlanFile` or its dict), with the verify stage's
     perturbation sizes (``config["verify"]``) and the sweep's pin radius.
 
     Returns the JSON of ``pinfeed speed`` and the workflow's speed stage:
@@ -197,30 +201,31 @@ def stored_plan_speed(result: dict, config: dict, plan: int = 1, mu_text=None, m
     success fraction), ``planned_belt_speed`` (``None``: planned
     quasi-static), ``trials``, ``trials_per_speed``, ``seconds`` and ``method``.
     """
-    from pipeline.parts.part import Part
     from pipeline.planning.plan import pick_tight_plan
     from pipeline.planning.settings import friction_label
+    from pipeline.planning.types import as_plan_file
     if not (isinstance(trials, int) and trials >= 1):
         raise PinfeedError(f"trials must be a whole number >= 1, got {trials!r}")
+    result = as_plan_file(result)
     chosen, mu_c, entry = pick_tight_plan(result, plan, mu_text)
-    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    part = Part.from_vertices(result.part["vertices"], name=result.name)
     perturb = perturbation_from_verify(config.get("verify", {}))
     # A tight-only plan file keeps the resting states per friction entry.
-    stored_states = entry.get("initial_states") or result.get("initial_states") or {}
-    states = [(s["theta"], s["y_c"]) for s in stored_states.values()]
-    arcs = [(s["start"], s["width"]) for s in chosen["final_sets"]]
-    res = speed_curve(part, chosen["pin_heights_mm"], chosen["pin_speeds"], states, arcs, mu_c,
+    stored_states = entry.initial_states or result.initial_states or {}
+    states = [(s.theta, s.y_c) for s in stored_states.values()]
+    arcs = chosen.final_arcs
+    res = speed_curve(part, chosen.pin_heights_mm, chosen.pin_speeds, states, arcs, mu_c,
                       mu_s=mu_s, perturb=perturb, trials=trials, speeds=speeds,
                       resolution=resolution, required=required,
                       r_pin=config["sweep"]["pin_radius"], seed=seed)
-    return {"part": part.name, "pin_labels": list(chosen["pins"]),
-            "pin_heights_mm": list(chosen["pin_heights_mm"]),
-            "pin_speeds": list(chosen["pin_speeds"]),
+    return {"part": part.name, "pin_labels": list(chosen.pins),
+            "pin_heights_mm": list(chosen.pin_heights_mm),
+            "pin_speeds": list(chosen.pin_speeds),
             "final_set": [{"start": s, "width": w} for s, w in arcs],
             "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c, "friction": friction_label(mu_c),
             "mu_s": float(mu_s), "required": float(required),
             "speed_limit_mm_s": res["speed_limit_mm_s"], "curve": res["curve"],
-            "planned_belt_speed": entry.get("belt_speed"), "trials": int(trials),
+            "planned_belt_speed": entry.belt_speed, "trials": int(trials),
             "trials_per_speed": res["trials_per_speed"], "seconds": res["seconds"],
             "method": f"dynamic model, {trials} perturbed trials per initial state plus corners "
                       f"at each speed; limit = highest speed with >= {100 * required:g} % in the "

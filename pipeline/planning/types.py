@@ -457,6 +457,13 @@ class PlanFile:
         return self.part["name"]
 
 
+def as_plan_file(result) -> PlanFile:
+    """``result`` as a :class:`PlanFile`: a record is returned as it is, a stored
+    plan dict (as read from the file) is read with :meth:`PlanFile.from_dict`.
+    The one place where a consumer turns a plan dict into records."""
+    return result if isinstance(result, PlanFile) else PlanFile.from_dict(result)
+
+
 # ---------------------------------------------------------------------- schema
 
 

@@ -198,55 +198,69 @@ def _moving_figure(part, still, panes, stations, heights, speeds, pin_radius):
 _LABEL = re.compile(r"^P(\d+)(?:v([+-]?[\d.]+))?$")
 
 
-def recommended_index(result: dict):
-    """Which plan of a stored result is the recommended one: ``"tight"`` (the
-    tight planner's recommended plan at the first friction), else ``1`` (paper
-    mode's best), else None (no plan)."""
-    tight = (result.get("tight") or [None])[0]
-    if tight and tight.get("recommended"):
+def recommended_index(result):
+    """Which plan of a stored result (a :class:`~pipeline.planning.types.PlanFile`
+    or its dict) is the recommended one: ``"tight"`` (the tight planner's
+    recommended plan at the first friction), else ``1`` (paper mode's best),
+    else None (no plan)."""
+    from pipeline.planning.types import as_plan_file
+    result = as_plan_file(result)
+    if result.tight and result.tight[0].recommended:
         return "tight"
-    return 1 if result.get("plans") else None
+    return 1 if result.plans else None
 
 
-def _chosen_plan(result: dict, plan_index):
-    """(plan dict, friction, description) of ``plan_index``: None (the recommended
-    plan), ``"tight"``, or a 1-based paper-mode index."""
+def _chosen_plan(result, plan_index):
+    """(:class:`Plan`, friction, description) of ``plan_index`` in the
+    :class:`PlanFile` ``result``: None (the recommended plan), ``"tight"``, or
+    a 1-based paper-mode index."""
     from pipeline.planning.settings import nominal_friction, parse_friction
-    name = result["part"]["name"]
+    name = result.name
     if plan_index is None:
         plan_index = recommended_index(result)
         if plan_index is None:
             raise PinfeedError(f"{name}: the stored result has no plan to animate")
     if plan_index == "tight":
-        tight = (result.get("tight") or [None])[0]
-        if not tight or not tight.get("recommended"):
+        tight = result.tight[0] if result.tight else None
+        if not tight or not tight.recommended:
             raise PinfeedError(f"{name}: the stored result has no recommended tight plan")
-        mu = nominal_friction(parse_friction(tight["mu_c"]))
-        return tight["recommended"], mu, f"tight plan at mu_c {tight['friction']}"
-    plans = result.get("plans") or []
+        mu = nominal_friction(parse_friction(tight.mu_c))
+        return tight.recommended, mu, f"tight plan at mu_c {tight.friction}"
+    plans = result.plans or ()
     if not plans:
         raise PinfeedError(f"{name}: the stored result has no paper-mode plan to animate")
     if not 1 <= plan_index <= len(plans):
         raise PinfeedError(f"--plan {plan_index}: {name} has plans 1 to {len(plans)}")
-    return plans[plan_index - 1], float(result["mu_c"]), f"plan {plan_index}"
+    return plans[plan_index - 1], float(result.mu_c), f"plan {plan_index}"
 
 
-def plan_inputs(result: dict, plan_index, config: dict) -> dict:
-    """Plain inputs of a plan of a stored plan result (``RESULTS/plans/NAME.json``):
-    pin labels, heights, speeds, states, physics, and ``what`` (which plan).
+def _resting_states(*stored) -> dict:
+    """label -> ``(theta_deg, y_c_mm)`` of the first non-empty of ``stored``
+    (label -> :class:`~pipeline.planning.types.RestingState` maps or None):
+    ``pinfeed plan --mode tight`` files keep them per friction entry only."""
+    found = next((s for s in stored if s), {})
+    return {k: (float(s.theta), float(s.y_c)) for k, s in found.items()}
+
+
+def plan_inputs(result, plan_index, config: dict) -> dict:
+    """Plain inputs of a plan of a stored plan result (``RESULTS/plans/NAME.json``;
+    a :class:`~pipeline.planning.types.PlanFile` or its dict): pin labels,
+    heights, speeds, states, physics, and ``what`` (which plan).
     ``plan_index``: None for the recommended plan (the tight planner's, else
     paper mode's best), ``"tight"``, or a 1-based paper-mode plan. Heights: the
     plan's ``pin_heights_mm`` if present, else the result's label -> height
     table, else the config's ``planner.pins`` by label P1..."""
+    from pipeline.planning.types import as_plan_file
+    result = as_plan_file(result)
     plan, mu_c, what = _chosen_plan(result, plan_index)
-    labels = list(plan["pins"])
-    table = result.get("pins") if isinstance(result.get("pins"), dict) else {}
-    speeds_table = result.get("pin_speeds") or {}
+    labels = list(plan.pins)
+    table = result.pins if isinstance(result.pins, dict) else {}
+    speeds_table = result.pin_speeds or {}
     heights, speeds = [], []
     for k, label in enumerate(labels):
         m = _LABEL.match(str(label))
-        if plan.get("pin_heights_mm") is not None:
-            h = float(plan["pin_heights_mm"][k])
+        if plan.pin_heights_mm is not None:
+            h = float(plan.pin_heights_mm[k])
         elif label in table:
             h = float(table[label])
         elif m and int(m.group(1)) <= len(config["planner"]["pins"]):
@@ -254,25 +268,26 @@ def plan_inputs(result: dict, plan_index, config: dict) -> dict:
         else:
             raise PinfeedError(f"pin {label!r} of the {what} has no height in the plan or the config")
         heights.append(h)
-        if plan.get("pin_speeds") is not None:
-            speeds.append(float(plan["pin_speeds"][k]))
+        if plan.pin_speeds is not None:
+            speeds.append(float(plan.pin_speeds[k]))
         else:
             speeds.append(float(speeds_table.get(label, float(m.group(2)) if m and m.group(2) else 0.0)))
-    # 'pinfeed plan --mode tight' files keep the resting states per friction entry.
-    stored = result.get("initial_states") or ((result.get("tight") or [{}])[0].get("initial_states") or {})
-    states = {k: (float(s["theta"]), float(s["y_c"])) for k, s in stored.items()}
+    states = _resting_states(result.initial_states, result.tight[0].initial_states if result.tight else None)
     return {"labels": labels, "heights": heights, "speeds": speeds, "states": states,
-            "mu_c": mu_c, "model": result["model"], "what": what,
-            "pin_radius": float(result.get("pin_radius", config["sweep"]["pin_radius"]))}
+            "mu_c": mu_c, "model": result.model, "what": what,
+            "pin_radius": float(result.extra.get("pin_radius", config["sweep"]["pin_radius"]))}
 
 
-def layout_inputs(result: dict, layout: dict) -> dict:
+def layout_inputs(result, layout: dict) -> dict:
     """The plan a layout (``pinfeed layout``'s JSON) was made from, in a stored plan
-    result: ``{"labels", "heights", "states", "mu_c", "what"}``. A one-line
+    result (a :class:`~pipeline.planning.types.PlanFile` or its dict):
+    ``{"labels", "heights", "states", "mu_c", "what"}``. A one-line
     :class:`PinfeedError` when the layout is of another part, has no plan, or
     its pins are not the stored plan's."""
     from pipeline.planning.plan import pick_tight_plan
-    name = result["part"]["name"]
+    from pipeline.planning.types import as_plan_file
+    result = as_plan_file(result)
+    name = result.name
     if layout.get("part") != name:
         raise PinfeedError(f"the layout is of {layout.get('part')!r}, not {name!r}")
     if not layout.get("plan") or not layout.get("stations"):
@@ -280,17 +295,16 @@ def layout_inputs(result: dict, layout: dict) -> dict:
     number, friction = int(layout["plan"]["number"]), layout["plan"].get("friction")
     plan, mu_c, entry = pick_tight_plan(result, number, friction)
     labels = [str(r["label"]) for r in layout["stations"]]
-    if list(plan["pins"]) != labels:
+    if list(plan.pins) != labels:
         raise PinfeedError(f"the layout's pins {' '.join(labels)} are not tight plan {number}'s "
-                           f"({' '.join(plan['pins'])}) in the stored plan; re-run 'pinfeed layout'")
-    stored = entry.get("initial_states") or result.get("initial_states") or {}
+                           f"({' '.join(plan.pins)}) in the stored plan; re-run 'pinfeed layout'")
     return {"labels": labels, "heights": [float(r["y_mm"]) for r in layout["stations"]],
-            "states": {k: (float(s["theta"]), float(s["y_c"])) for k, s in stored.items()},
+            "states": _resting_states(entry.initial_states, result.initial_states),
             "mu_c": layout.get("mu_c", list(mu_c) if isinstance(mu_c, tuple) else mu_c),
-            "what": f"tight plan {number} at mu_c {entry['friction']}"}
+            "what": f"tight plan {number} at mu_c {entry.friction}"}
 
 
-def animate_stored(result: dict, config: dict, out, plan_index=None, frames: int = 120,
+def animate_stored(result, config: dict, out, plan_index=None, frames: int = 120,
                    fps: int = 20, layout: dict | None = None) -> dict:
     """Animate a plan of a stored plan result (``plan_index`` as in :func:`plan_inputs`;
     what ``pinfeed animate`` and the workflow's animate rule call). Returns
@@ -301,14 +315,16 @@ def animate_stored(result: dict, config: dict, out, plan_index=None, frames: int
     stations, parts arriving at the layout's pitch; ``plan_index`` is then
     not used."""
     from pipeline.parts.part import Part
+    from pipeline.planning.types import as_plan_file
+    result = as_plan_file(result)
     if layout is not None:
         inputs = layout_inputs(result, layout)
-        part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+        part = Part.from_vertices(result.part["vertices"], name=result.name)
         done = animate_layout(part, layout, inputs["states"], inputs["mu_c"], out, frames=frames, fps=fps,
                               what=f"{inputs['what']}, pins {' → '.join(inputs['labels'])}")
         return {**done, **inputs}
     inputs = plan_inputs(result, plan_index, config)
-    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    part = Part.from_vertices(result.part["vertices"], name=result.name)
     done = animate_plan(part, inputs["heights"], inputs["speeds"], inputs["states"], inputs["mu_c"],
                         inputs["model"], inputs["pin_radius"], out, labels=inputs["labels"],
                         frames=frames, fps=fps,

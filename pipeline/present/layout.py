@@ -345,11 +345,12 @@ def _drawing(part, states, nominal_lanes, stations, pitch, entry, pin_radius, ma
 # ------------------------------------------------------------- stored plans
 
 
-def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None,
+def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
                   belt_speed: float | None = None, mu_s: float | None = None,
                   quasi_static: bool = False, settings: dict | None = None) -> dict:
     """The layout of tight plan ``plan_number`` of a stored plan result
-    (``RESULTS/plans/NAME.json``), as ``pinfeed layout`` and the workflow make it.
+    (``RESULTS/plans/NAME.json``; a :class:`~pipeline.planning.types.PlanFile`
+    or its dict), as ``pinfeed layout`` and the workflow make it.
 
     The plan's speed limit is computed (``speed_limit.speed_curve`` with
     ``speed_trials`` trials per state); without ``belt_speed`` the belt runs at
@@ -360,23 +361,18 @@ def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None
     throughput, and ``warnings`` says so).
     """
     from pipeline.maps import simulate
-    from pipeline.planning.plan import pick_tight_plan
     from pipeline.planning.settings import friction_label
     from pipeline.planning.speed_limit import DEFAULT_SPEEDS, perturbation_from_verify, speed_curve
+    from pipeline.planning.types import as_plan_file
     from pipeline.provenance import provenance_attrs
     cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})
-    plan, mu_c, entry = pick_tight_plan(result, int(plan_number), mu_text)
-    speeds = [float(v) for v in plan.get("pin_speeds") or []]
-    if any(speeds):
-        raise PinfeedError(f"plan {plan_number} ({' '.join(plan['pins'])}) has moving pins; a layout "
-                           f"places fixed pins only: choose a plan of fixed pins with --plan N")
-    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
-    stored_states = entry.get("initial_states") or result.get("initial_states") or {}
-    states = {k: (float(s["theta"]), float(s["y_c"])) for k, s in stored_states.items()}
-    pin_radius = float(result.get("pin_radius", config["sweep"]["pin_radius"]))
+    result = as_plan_file(result)
+    plan, mu_c, states = _fixed_pin_plan(result, plan_number, mu_text)
+    part = Part.from_vertices(result.part["vertices"], name=result.name)
+    pin_radius = float(result.extra.get("pin_radius", config["sweep"]["pin_radius"]))
     mu_s = float(cfg["mu_s"] if mu_s is None else mu_s)
-    heights = [float(h) for h in plan["pin_heights_mm"]]
-    arcs = [(s["start"], s["width"]) for s in plan["final_sets"]]
+    heights = [float(h) for h in plan.pin_heights_mm]
+    arcs = plan.final_arcs
     # A bad belt speed or mu_s is refused before any work.
     simulate.check_belt(part, min(DEFAULT_SPEEDS) if belt_speed is None else belt_speed, mu_s)
     curve = speed_curve(part, heights, [0.0] * len(heights), list(states.values()), arcs, mu_c,
@@ -385,7 +381,7 @@ def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None
     limit = curve["speed_limit_mm_s"]
     belt_speed, source, quasi_static, warnings = _belt_speed_choice(belt_speed, limit, cfg,
                                                                     quasi_static)
-    out = layout_plan(part, plan["pins"], heights, states, mu_c, pin_radius, model=result["model"],
+    out = layout_plan(part, list(plan.pins), heights, states, mu_c, pin_radius, model=result.model,
                       belt_speed=None if quasi_static else belt_speed, mu_s=mu_s, settings=cfg,
                       perturb=config.get("verify"))
     out["belt_speed_mm_s"] = None if belt_speed is None else float(belt_speed)
@@ -394,8 +390,8 @@ def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None
     out["speed_limit_mm_s"] = float(limit)
     out["mu_c"] = list(mu_c) if isinstance(mu_c, tuple) else mu_c
     out["plan"] = {"number": int(plan_number), "friction": friction_label(mu_c),
-                   "pins": list(plan["pins"]), "pin_heights_mm": heights,
-                   "final_sets": plan["final_sets"]}
+                   "pins": list(plan.pins), "pin_heights_mm": heights,
+                   "final_sets": [s.to_dict() for s in plan.final_sets]}
     out["warnings"] = warnings
     out["method"]["belt_speed"] = source
     out["method"]["throughput"] = "60 x belt speed / pitch" if belt_speed else "none: no belt speed"
@@ -405,6 +401,21 @@ def layout_stored(result: dict, config: dict, plan_number: int = 1, mu_text=None
         "curve": curve["curve"]}
     out.update(provenance_attrs())
     return out
+
+
+def _fixed_pin_plan(result, plan_number, mu_text):
+    """``(plan, mu_c, states)``: tight plan ``plan_number`` at friction ``mu_text``
+    of the :class:`~pipeline.planning.types.PlanFile` ``result``
+    (:func:`~pipeline.planning.plan.pick_tight_plan`), refused with a one-line
+    :class:`PinfeedError` if it has moving pins; ``states``: label ->
+    ``(theta_deg, y_c_mm)``, the entry's resting states, else the file's."""
+    from pipeline.planning.plan import pick_tight_plan
+    plan, mu_c, entry = pick_tight_plan(result, int(plan_number), mu_text)
+    if any(float(v) for v in plan.pin_speeds or ()):
+        raise PinfeedError(f"plan {plan_number} ({' '.join(plan.pins)}) has moving pins; a layout "
+                           f"places fixed pins only: choose a plan of fixed pins with --plan N")
+    stored_states = entry.initial_states or result.initial_states or {}
+    return plan, mu_c, {k: (float(s.theta), float(s.y_c)) for k, s in stored_states.items()}
 
 
 def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
@@ -459,7 +470,7 @@ def write_drawing(layout: dict, path):
     return draw_feeder(layout, path)
 
 
-def layout_part(plan_result: dict, config: dict, outputs: dict) -> str:
+def layout_part(plan_result, config: dict, outputs: dict) -> str:
     """The workflow's layout stage: the first tight plan of fixed pins at the
     first planned friction, laid out and drawn; ``outputs`` maps ``json``,
     ``dxf``, ``svg`` and ``png`` to paths. A part with no such plan gets a JSON
@@ -467,11 +478,12 @@ def layout_part(plan_result: dict, config: dict, outputs: dict) -> str:
     import time
 
     from pipeline.maps.io import write_json
+    from pipeline.planning.types import as_plan_file
     start = time.perf_counter()
-    tight = (plan_result.get("tight") or [{}])[0]
-    number = next((k for k, p in enumerate(tight.get("plans") or [], start=1)
-                   if not any(p.get("pin_speeds") or [])), None)
-    name = plan_result["part"]["name"]
+    plan_result = as_plan_file(plan_result)
+    first_plans = plan_result.tight[0].plans if plan_result.tight else ()
+    number = next((k for k, p in enumerate(first_plans, start=1) if not any(p.pin_speeds or [])), None)
+    name = plan_result.name
     if number is None:
         note = f"{name}: no tight plan of fixed pins to lay out"
         write_json({"part": name, "plan": None, "note": note}, outputs["json"])

@@ -20,7 +20,7 @@ from pipeline.parts.families import config_part_id
 from pipeline.parts.part import Part
 from pipeline.planning.plan import best_fixed_plan, plan_hint, tight_entry
 from pipeline.planning.settings import parse_friction
-from pipeline.planning.types import validate_plan_file
+from pipeline.planning.types import load_plan
 from pipeline.sensing.profiles import Sensor, classify, read_profile_csv, reference_profiles, resample, sign_matrix
 from pipeline.sensing.sensor_plan import count_sets, final_for_verdict, sensing_frictions, stored_sensor_plan
 
@@ -70,14 +70,15 @@ def classify_measured(config: dict, part_name: str, profile, root, catalog=None,
 
 
 def _stored_plans(root: Path, part: Part):
-    """``(sensor plan, plan result)`` stored under ``root`` for ``part``; each None
-    when absent, not found, or stored for another outline of that name."""
+    """``(sensor plan, plan result)`` stored under ``root`` for ``part`` (the plan
+    result a :class:`~pipeline.planning.types.PlanFile`); each None when
+    absent, not found, or stored for another outline of that name."""
     stored = stored_sensor_plan(root, part.name)
     if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
         stored = None  # no sensor plan, or one for another outline of that name
     plan_path = root / "plans" / f"{part.name}.json"
-    plan = validate_plan_file(plan_path) if plan_path.is_file() else None
-    if plan is not None and plan["part"].get("id", part.id) != part.id:
+    plan = load_plan(plan_path) if plan_path.is_file() else None
+    if plan is not None and plan.part.get("id", part.id) != part.id:
         plan = None
     return stored, plan
 
@@ -92,14 +93,14 @@ def _sensing_inputs(config, stored, plan, entry, catalog_radius):
                 stored["model"], float(stored["pin_radius"]))
     sensor = Sensor.from_config(config["sensing"]["sensor"])
     if entry is not None:
-        friction = entry
-    elif plan is not None and "mu_c" in plan:
-        friction = {"mu_c": plan["mu_c"]}
+        friction = {"mu_c": entry.mu_c}
+    elif plan is not None and plan.mu_c is not None:
+        friction = {"mu_c": plan.mu_c}
     else:
         friction = {"mu_c": parse_friction(config["planner"]["mu_c"])}
     mu_planned, mu_profiles = sensing_frictions(friction)
     mu_planned = list(mu_planned) if isinstance(mu_planned, tuple) else mu_planned
-    model = plan.get("model", config["planner"]["model"]) if plan else config["planner"]["model"]
+    model = plan.model if plan is not None and plan.model is not None else config["planner"]["model"]
     pin_radius = catalog_radius if catalog_radius is not None else float(config["sweep"]["pin_radius"])
     return sensor, mu_planned, mu_profiles, model, pin_radius
 
@@ -141,7 +142,7 @@ def _pin(y_pin, stored, plan, root, name):
     stored sensor plan's first pin, else the first pin of the stored recommended
     tight plan (first planned friction), else that of paper mode's best
     fixed-pin plan, else ``y_pin`` (--y-pin, which always wins)."""
-    entry = tight_entry(plan) if plan is not None and plan.get("tight") else None
+    entry = tight_entry(plan) if plan is not None and plan.tight else None
     plan_path = root / "plans" / f"{name}.json"
     if y_pin is not None:
         if not math.isfinite(y_pin):
@@ -149,12 +150,12 @@ def _pin(y_pin, stored, plan, root, name):
         return float(y_pin), None, "--y-pin", entry
     if stored is not None:
         return float(stored["y_pin"]), stored["first_pin"], f"sensor plan {root / 'sensing' / (name + '.json')}", entry
-    if entry is not None and entry.get("recommended"):
-        rec = entry["recommended"]
-        return (float(rec["pin_heights_mm"][0]), rec["pins"][0],
-                f"first pin of the recommended tight plan at mu_c {entry['friction']} {plan_path}", entry)
-    if plan is not None and plan.get("pins") and best_fixed_plan(plan):
-        first_pin = best_fixed_plan(plan)["pins"][0]  # the sensor sits on a fixed pin
-        return (float(plan["pins"][first_pin]), first_pin,
+    if entry is not None and entry.recommended:
+        rec = entry.recommended
+        return (float(rec.pin_heights_mm[0]), rec.pins[0],
+                f"first pin of the recommended tight plan at mu_c {entry.friction} {plan_path}", entry)
+    if plan is not None and plan.pins and best_fixed_plan(plan):
+        first_pin = best_fixed_plan(plan).pins[0]  # the sensor sits on a fixed pin
+        return (float(plan.pins[first_pin]), first_pin,
                 f"first pin of the best fixed-pin plan {plan_path}", entry)
     return None, None, None, entry

@@ -307,20 +307,20 @@ def sense_part(plan_path, config: dict, log=print, friction=None) -> dict:
     check, with provenance."""
     from pipeline.parts.part import Part
     from pipeline.planning.plan import tight_entry
-    from pipeline.planning.types import validate_plan_file
+    from pipeline.planning.types import load_plan
     from pipeline.provenance import provenance_attrs
     sc, sweep = config["sensing"], config["sweep"]
-    stored = validate_plan_file(plan_path)
+    stored = load_plan(plan_path)
     entry = tight_entry(stored, friction)
-    part = Part.from_vertices(stored["part"]["vertices"], name=stored["part"]["name"])
-    model = stored.get("model", config["planner"]["model"])
+    part = Part.from_vertices(stored.part["vertices"], name=stored.name)
+    model = stored.model if stored.model is not None else config["planner"]["model"]
     sensor = Sensor.from_config(sc["sensor"])
-    res = plan_with_sensor(part, entry, sweep["pin_radius"], model, sensor, trials=sc["trials"],
+    res = plan_with_sensor(part, entry.to_dict(), sweep["pin_radius"], model, sensor, trials=sc["trials"],
                            perturb=dict(PERTURB_DEFAULTS, **sc["perturb"]), seed=sc["seed"],
                            apart_fraction=sc["apart_fraction"], max_first_pins=sc["max_first_pins"],
                            log=log)
     out = {"part": part.to_dict(), "model": model, "pin_radius": sweep["pin_radius"],
-           "plan_file": str(plan_path), "plan_created": stored.get("created"),
+           "plan_file": str(plan_path), "plan_created": stored.extra.get("created"),
            "sensor": sensor.to_dict(), **res}
     if res["found"]:
         out["verification"] = verify_sensor_plan(part, out, sweep["pin_radius"], model, sensor,

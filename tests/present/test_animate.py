@@ -79,16 +79,16 @@ def test_plan_inputs_prefers_the_tight_recommended_plan():
     from pipeline.present.animate import recommended_index
     config = {"planner": {"pins": [0.0, 5.0, 10.0, 15.0, 20.0]}, "sweep": {"pin_radius": 3.0}}
     stored = _stored()
-    stored["tight"] = [{"friction": "0.1:0.3", "mu_c": [0.1, 0.3],
+    stored["tight"] = [{"friction": "0.1:0.3", "mu_c": [0.1, 0.3], "plans": [],
                         "recommended": {"pins": ["P7", "P9"], "pin_heights_mm": [12.5, 30.0],
-                                        "pin_speeds": [0.0, -1.0]}}]
+                                        "pin_speeds": [0.0, -1.0], "final_sets": []}}]
     assert recommended_index(stored) == "tight"
     got = plan_inputs(stored, None, config)
     assert got["labels"] == ["P7", "P9"] and got["heights"] == [12.5, 30.0] and got["speeds"] == [0.0, -1.0]
     assert got["mu_c"] == pytest.approx(0.2) and got["what"] == "tight plan at mu_c 0.1:0.3"
     assert plan_inputs(stored, 1, config)["labels"] == ["P2", "P5v+2"]  # paper mode on request
     stored["tight"][0]["recommended"] = None
-    assert recommended_index(stored) == 1 and recommended_index({"plans": []}) is None
+    assert recommended_index(stored) == 1 and recommended_index({"part": PART.to_dict(), "plans": []}) is None
 
 
 def test_cli_animate(tmp_path, capsys):
