@@ -453,12 +453,6 @@ def cmd_speed(args):
         print(f"  {speed:7.1f} mm/s: {100 * frac:5.1f} % of trials in the final set")
 
 
-def _pick_tight_plan(result: dict, n: int, mu_text):
-    """See :func:`pipeline.planning.pick_tight_plan` (shared with ``pinfeed layout``)."""
-    from pipeline.planning.plan import pick_tight_plan
-    return pick_tight_plan(result, n, mu_text)
-
-
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.config import load_config

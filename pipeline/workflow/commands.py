@@ -17,8 +17,6 @@ from pipeline.planning.plan import plan_tight_all, planner_belt
 from pipeline.planning.settings import parse_friction
 from pipeline.provenance import provenance_attrs
 
-PLAN_MODES = ("tight", "paper", "both")
-
 
 def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model=None, coverage=None,
                      speeds=None, dynamic_depth=None, pins=None, belt_speed=None, mu_s=None) -> dict:
