@@ -61,18 +61,10 @@ def roll_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, spac
 DPI = 80
 
 
-def animate_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, out,
-                 labels=None, frames: int = 120, fps: int = 20, title: str | None = None) -> dict:
-    """Write the animation to ``out`` (.gif through Pillow; .mp4 needs ffmpeg).
-    Returns ``{"out", "frames", "belt_travel", "outcomes"}``.
-
-    The still parts (axes, fence, fixed pins, labels) are drawn once into an
-    image; each frame draws only the moving ones over it, in pixel coordinates
-    taken from the still figure's transforms, so long animations stay quick."""
-    import matplotlib.pyplot as plt
+def _check_animation_out(out, frames: int, fps: int) -> Path:
+    """``out`` as a Path, checked before any work: a .gif, or an .mp4 where ffmpeg
+    is installed, and at least 2 frames at 1 fps or more."""
     from matplotlib import animation
-
-    from pipeline.present.figures import save_figure  # noqa: F401 (selects the Agg backend)
     out = Path(out)
     suffix = out.suffix.lower()
     if suffix not in (".gif", ".mp4"):
@@ -82,19 +74,44 @@ def animate_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, o
                            "instead (--out plan.gif) or install ffmpeg")
     if frames < 2 or fps < 1:
         raise PinfeedError(f"--frames must be at least 2 and --fps at least 1, got {frames} and {fps}")
+    return out
+
+
+def _write_animation(fig, draw, b_end: float, out: Path, frames: int, fps: int) -> int:
+    """Draw ``frames`` evenly spaced belt travels 0..``b_end`` with ``draw(B)``,
+    write them to ``out`` (Pillow for .gif, ffmpeg for .mp4), close ``fig`` and
+    return the number of frames written."""
+    import matplotlib.pyplot as plt
+    from matplotlib import animation
+    B = np.linspace(0.0, b_end, int(frames))
+    anim = animation.FuncAnimation(fig, lambda i: draw(B[i]), frames=len(B), blit=False)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    writer = animation.PillowWriter(fps=fps) if out.suffix.lower() == ".gif" else animation.FFMpegWriter(fps=fps)
+    anim.save(str(out), writer=writer, dpi=DPI)
+    plt.close(fig)
+    return int(len(B))
+
+
+def animate_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, out,
+                 labels=None, frames: int = 120, fps: int = 20, title: str | None = None) -> dict:
+    """Write the animation to ``out`` (.gif through Pillow; .mp4 needs ffmpeg).
+    Returns ``{"out", "frames", "belt_travel", "outcomes"}``.
+
+    The still parts (axes, fence, fixed pins, labels) are drawn once into an
+    image; each frame draws only the moving ones over it, in pixel coordinates
+    taken from the still figure's transforms, so long animations stay quick."""
+    import matplotlib.pyplot as plt
+
+    from pipeline.present.figures import save_figure  # noqa: F401 (selects the Agg backend)
+    out = _check_animation_out(out, frames, fps)
     labels = labels or [f"P{k + 1}" for k in range(len(heights))]
     lanes, stations, b_end = roll_plan(part, heights, speeds, states, mu_c, model, pin_radius)
     still, panes = _still_figure(part, lanes, stations, heights, speeds, labels, pin_radius, b_end,
                                  title or f"{part.name}: pins {' → '.join(labels)}")
     fig, draw = _moving_figure(part, still, panes, stations, heights, speeds, pin_radius)
     plt.close(still)
-    B = np.linspace(0.0, b_end, int(frames))
-    anim = animation.FuncAnimation(fig, lambda i: draw(B[i]), frames=len(B), blit=False)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    writer = animation.PillowWriter(fps=fps) if suffix == ".gif" else animation.FFMpegWriter(fps=fps)
-    anim.save(str(out), writer=writer, dpi=DPI)
-    plt.close(fig)
-    return {"out": str(out), "frames": int(len(B)), "belt_travel": float(b_end),
+    n_frames = _write_animation(fig, draw, b_end, out, frames, fps)
+    return {"out": str(out), "frames": n_frames, "belt_travel": float(b_end),
             "outcomes": {ln.label: ln.outcome for ln in lanes}}
 
 
@@ -488,25 +505,10 @@ def animate_layout(part, layout: dict, states: dict, mu_c, out, frames: int = 12
     """Write the animation of a laid-out feeder (:func:`station_scene`,
     :func:`station_figure`) to ``out`` (.gif; .mp4 needs ffmpeg). Returns
     ``{"out", "frames", "belt_travel", "outcomes", "pitch_mm", "model"}``."""
-    import matplotlib.pyplot as plt
-    from matplotlib import animation
-    out = Path(out)
-    suffix = out.suffix.lower()
-    if suffix not in (".gif", ".mp4"):
-        raise PinfeedError(f"--out {out}: write a .gif or an .mp4 file")
-    if suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
-        raise PinfeedError("writing MP4 needs ffmpeg, which is not installed here; write a .gif "
-                           "instead (--out plan.gif) or install ffmpeg")
-    if frames < 2 or fps < 1:
-        raise PinfeedError(f"--frames must be at least 2 and --fps at least 1, got {frames} and {fps}")
+    out = _check_animation_out(out, frames, fps)
     scene = station_scene(part, layout, states, mu_c, n_parts)
     fig = station_figure(scene, title or station_title(part.name, scene, what))
-    B = np.linspace(0.0, scene.b_end, int(frames))
-    anim = animation.FuncAnimation(fig["fig"], lambda i: fig["draw"](B[i]), frames=len(B), blit=False)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    writer = animation.PillowWriter(fps=fps) if suffix == ".gif" else animation.FFMpegWriter(fps=fps)
-    anim.save(str(out), writer=writer, dpi=DPI)
-    plt.close(fig["fig"])
-    return {"out": str(out), "frames": int(len(B)), "belt_travel": float(scene.b_end),
+    n_frames = _write_animation(fig["fig"], fig["draw"], scene.b_end, out, frames, fps)
+    return {"out": str(out), "frames": n_frames, "belt_travel": float(scene.b_end),
             "outcomes": {ln.label: ln.outcome for ln in scene.lanes}, "pitch_mm": scene.pitch,
             "model": scene.model}
