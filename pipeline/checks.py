@@ -140,3 +140,17 @@ def check_belt(part, belt_speed, mu_s) -> float:
             f"after the impact) rather than pushing it; slow the belt below "
             f"{math.sqrt(FROUDE_MAX * mu_s * G_MM_S2 * part.a):.0f} mm/s")
     return fr
+
+
+def schema_problem(data, schema: dict, limit: int = 120) -> str | None:
+    """Where ``data`` first breaks the JSON ``schema`` (draft 2020-12), as
+    ``"at PATH: MESSAGE"`` on one line (the message cut at ``limit``
+    characters; jsonschema's best match), or None when it fits. Callers wrap
+    it in their own :class:`PinfeedError` saying what the file is and how to
+    make it again."""
+    import jsonschema
+    err = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(schema).iter_errors(data))
+    if err is None:
+        return None
+    where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
+    return f"at {where}: {' '.join(err.message.split())[:limit]}"

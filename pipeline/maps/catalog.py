@@ -31,10 +31,10 @@ import hashlib
 import json
 from pathlib import Path
 
-import jsonschema
 import numpy as np
 import xarray as xr
 
+from pipeline.checks import schema_problem
 from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_json
 
@@ -133,11 +133,9 @@ def read_index(index: Path, root: Path) -> dict:
         raise PinfeedError(f"{index} is corrupt; {hint}") from None
     except OSError as exc:
         raise PinfeedError(f"cannot read {index}: {exc.strerror}; check its permissions") from None
-    err = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(INDEX_SCHEMA).iter_errors(data))
-    if err is not None:
-        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
-        raise PinfeedError(f"{index} is not a pinfeed catalog index (at {where}: "
-                           f"{err.message[:120]}); {hint}")
+    problem = schema_problem(data, INDEX_SCHEMA)
+    if problem is not None:
+        raise PinfeedError(f"{index} is not a pinfeed catalog index ({problem}); {hint}")
     return data
 
 

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
+from pipeline.checks import schema_problem
 from pipeline.errors import PinfeedError
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "plan.schema.json"
@@ -485,13 +486,9 @@ def validate_plan_dict(data, source="the plan") -> dict:
     """``data`` if it has the shape of a stored plan file, else a one-line
     :class:`PinfeedError` naming ``source`` (the file), where it is wrong and
     how to make it again."""
-    import jsonschema
-    validator = jsonschema.Draft202012Validator(plan_schema())
-    err = jsonschema.exceptions.best_match(validator.iter_errors(data))
-    if err is not None:
-        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
-        message = " ".join(err.message.split())[:120]
-        raise PinfeedError(f"{source} is not a pinfeed plan file (at {where}: {message}); "
+    problem = schema_problem(data, plan_schema())
+    if problem is not None:
+        raise PinfeedError(f"{source} is not a pinfeed plan file ({problem}); "
                            f"delete it and make it again: {regenerate_hint(data, source)}")
     return data
 

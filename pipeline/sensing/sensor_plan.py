@@ -357,14 +357,12 @@ SENSING_SCHEMA = {
 def read_checked_json(path, schema: dict, what: str) -> dict:
     """A stored result file, checked against ``schema``; a file of the wrong shape
     is a :class:`PinfeedError` that says to delete it and re-run the workflow."""
-    import jsonschema
-
+    from pipeline.checks import schema_problem
     from pipeline.maps.io import read_json
     data = read_json(path)
-    err = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(schema).iter_errors(data))
-    if err is not None:
-        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
-        raise PinfeedError(f"{path} is not a {what} (at {where}: {err.message[:100]}); delete it and "
+    problem = schema_problem(data, schema, limit=100)
+    if problem is not None:
+        raise PinfeedError(f"{path} is not a {what} ({problem}); delete it and "
                            f"re-run the workflow ('make run')")
     return data
 
