@@ -111,7 +111,7 @@ def speed(kits, repeat, mus):
                   + f" | {ratios} |", flush=True)
 
 
-def accuracy(kits):
+def accuracy(kits, models=tuple(MODELS)):
     """Both kernels at the default settings, and a fine reference (the
     worktree kernel at ds_max 0.05, tol 1e-7 / 32, the settings of the
     step-halving test): max |delta theta_f| between the two, and of each
@@ -123,7 +123,8 @@ def accuracy(kits):
           f"{k1} vs fine | status changes |")
     print("|---|---|---|---|---|---|---|")
     for pname, outline in PARTS.items():
-        for mname, model in MODELS.items():
+        for mname in models:
+            model = MODELS[mname]
             for mu_c in (0.0, 0.2, 0.5):
                 a = grid(b0, r0, outline, model, mu_c, theta, PAPER_D)
                 b = grid(b1, r1, outline, model, mu_c, theta, PAPER_D)
@@ -148,6 +149,8 @@ def main():
     ap.add_argument("--speed", action="store_true")
     ap.add_argument("--accuracy", action="store_true")
     ap.add_argument("--mu", type=float, nargs="+", default=[0.2, 0.0], help="speed: mu_c values")
+    ap.add_argument("--models", nargs="+", choices=tuple(MODELS), default=list(MODELS),
+                    help="accuracy: the models to compare")
     args = ap.parse_args()
     numba.set_num_threads(1)
     _, rb, rr = load_ref(args.ref)
@@ -156,7 +159,7 @@ def main():
         speed(kits, args.repeat, args.mu)
         print()
     if args.accuracy:
-        accuracy(kits)
+        accuracy(kits, args.models)
 
 
 if __name__ == "__main__":

@@ -107,8 +107,8 @@ MIN_STEPS = 1000
 # CUDA thread with a fixed-size local array.
 _W_Y, _W_YNEW, _W_K1, _W_KEND, _W_YLOC, _W_TMP, _W_YI, _W_YTRY = 0, 1, 2, 3, 4, 5, 6, 7
 _W_KS = 8  # six rows: the Runge-Kutta stages
-_W_GEND, _W_GWORK, _W_MASK, _W_WARM = 14, 15, 16, 17
-_W_ROWS = 18
+_W_GEND, _W_GWORK, _W_MASK, _W_WARM, _W_WSAVE = 14, 15, 16, 17, 18
+_W_ROWS = 19
 _W_COLS = 14
 
 
@@ -233,7 +233,12 @@ def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
         vx, vy, om = _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx,
                                       vpy, mu, wvx, wvy, wom, int(warm[3]))
     elif st == TWIST_OK and mode != SEPARATE:
-        if sp != warm[4] or warm[9] < 1.0:
+        if warm[9] >= 2.0 and sp == warm[8] and sp != warm[4]:
+            # The travel of the one before last (a step's end slope after
+            # its last stage, at the same travel as the stage before):
+            # replace that one, so the three travels stay distinct.
+            warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
+        elif sp != warm[4] or warm[9] < 1.0:
             warm[10], warm[11], warm[12], warm[13] = warm[5], warm[6], warm[7], warm[8]
             warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
             warm[9] = min(warm[9] + 1.0, 3.0)
@@ -642,7 +647,8 @@ def _first_step_size(k1, h_max, kind, rp):
 
 
 @jit_inline
-def _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h, tol, y_new, ks, tmp, warm):
+def _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h, tol, y_new, ks, tmp, warm,
+                   warm_saved):
     """Stage 2: one accepted step from ``y`` (travel ``s``, slope ``k1``)
     into ``y_new``, shrinking ``h`` until the error is within ``tol``.
 
@@ -663,8 +669,15 @@ def _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h, tol, y_new, ks, tmp
     """
     rejected = False
     attempts = 0
+    for i in range(warm.shape[0]):
+        warm_saved[i] = warm[i]
     while True:
         attempts += 1
+        if rejected:
+            # Warm-start a retry from the solves before the rejected attempt
+            # (near s), not from the rejected attempt's far stages.
+            for i in range(warm.shape[0]):
+                warm[i] = warm_saved[i]
         ok, err = _step(verts, quad, prm, kind, idx, y, s, k1, h, y_new, ks, tmp, warm)
         if h < 1e-12:
             break
@@ -835,7 +848,8 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             break
         h = _first_step_size(k1, min(h_next, s_cap - s), kind, rp)
         ok, err, h, rejected, attempts = _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h,
-                                                        tol, y_new, ks, tmp, warm)
+                                                        tol, y_new, ks, tmp, warm,
+                                                        work[_W_WSAVE])
         steps += attempts
         if not ok:
             status, reason = JAMMED, JAM_NO_PUSH
