@@ -32,7 +32,7 @@ slow): all quantities are in units of a, far from overflow and underflow.
 """
 import math
 
-from ._numba import jit
+from ._numba import jit, jit_inline
 from .support import _power
 
 MINPOWER = 0
@@ -54,8 +54,79 @@ _NEWTON_MAX_IT = 60
 _DEC_TAKE = 1e-12
 
 
+# No local model of P for ``_minimise`` (see ``_model_step``).
+NO_MODEL = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+# A model step longer than this fraction of ``1 + |y|`` is not taken.
+_MODEL_STEP_MAX = 0.1
+
+
+@jit_inline
+def _newton_direction(g0, g1, g2, h00, h01, h02, h11, h12, h22, b0, b1, b2, c0, c1, c2, k):
+    """Newton step ``(d1, d2)`` for ``y`` on the family ``x + y1 b + y2 c`` from the
+    gradient ``g`` and Hessian ``H`` of P in the twist, and the decrement
+    ``lambda^2 = -(g . B) d`` (a gradient step where ``B^T H B`` is not
+    positive definite)."""
+    gb = g0 * b0 + g1 * b1 + g2 * b2
+    hb0 = h00 * b0 + h01 * b1 + h02 * b2
+    hb1 = h01 * b0 + h11 * b1 + h12 * b2
+    hb2 = h02 * b0 + h12 * b1 + h22 * b2
+    hbb = b0 * hb0 + b1 * hb1 + b2 * hb2
+    if k == 1:
+        d1 = -gb / hbb if hbb > 0.0 else -gb
+        return d1, 0.0, -gb * d1
+    gc = g0 * c0 + g1 * c1 + g2 * c2
+    hbc = c0 * hb0 + c1 * hb1 + c2 * hb2
+    hcc = (c0 * (h00 * c0 + h01 * c1 + h02 * c2) + c1 * (h01 * c0 + h11 * c1 + h12 * c2)
+           + c2 * (h02 * c0 + h12 * c1 + h22 * c2))
+    det = hbb * hcc - hbc * hbc
+    if det <= 1e-14 * (hbb * hcc) or hbb <= 0.0:
+        d1, d2 = -gb, -gc  # not positive definite here: gradient step
+    else:
+        d1 = -(hcc * gb - hbc * gc) / det
+        d2 = -(hbb * gc - hbc * gb) / det
+    return d1, d2, -(gb * d1 + gc * d2)
+
+
+@jit_inline
+def _model_step(model, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
+    """Improve the start ``y`` with a Newton step on a local quadratic model of P.
+
+    ``model`` is ``(use, m0, m1, m2, g0, g1, g2, h00, h01, h02, h11, h12,
+    h22)``: a twist ``m`` near the start, with a prediction of P's gradient
+    there and a Hessian nearby (from the solves before; see
+    ``rollout._derivative``). The model's gradient at the start
+    ``xi = x + y1 b + y2 c`` is ``g + H (xi - m)``; the step minimises the
+    model over the family, costs no evaluation of P, and is skipped when
+    ``use`` is 0 or the step is longer than ``_MODEL_STEP_MAX (1 + |y|)``.
+
+    Notes
+    -----
+    A warm start extrapolated in the belt travel lies close to the solution
+    for the trajectory, but a Runge-Kutta stage state is off the trajectory
+    by O(h^2), and so is its family of twists. The model step corrects that
+    to first order, which leaves the start O(h^3) off instead of O(h^2):
+    most solves then end with one evaluation and one unchecked Newton step.
+    The answer does not depend on the start (``_minimise`` converges from
+    anywhere).
+    """
+    if model[0] == 0.0:
+        return y1, y2
+    dx0 = x0 + y1 * b0 + y2 * c0 - model[1]
+    dx1 = x1 + y1 * b1 + y2 * c1 - model[2]
+    dx2 = x2 + y1 * b2 + y2 * c2 - model[3]
+    h00, h01, h02, h11, h12, h22 = model[7], model[8], model[9], model[10], model[11], model[12]
+    g0 = model[4] + h00 * dx0 + h01 * dx1 + h02 * dx2
+    g1 = model[5] + h01 * dx0 + h11 * dx1 + h12 * dx2
+    g2 = model[6] + h02 * dx0 + h12 * dx1 + h22 * dx2
+    d1, d2, _ = _newton_direction(g0, g1, g2, h00, h01, h02, h11, h12, h22, b0, b1, b2,
+                                  c0, c1, c2, k)
+    if abs(d1) + abs(d2) <= _MODEL_STEP_MAX * (1.0 + abs(y1) + abs(y2)):
+        return y1 + d1, y2 + d2
+    return y1, y2
+
+
 @jit
-def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
+def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
     """Minimise ``P(x + y1 b + y2 c)`` over ``y`` (``k`` = 1 or 2 unknowns).
 
     Parameters
@@ -64,11 +135,15 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
     x0..x2, b0..b2, c0..c2 : the affine family of twists ``x + y1 b + y2 c``.
     k : number of free parameters (``c`` is ignored when ``k == 1``).
     y1, y2 : warm start.
+    take : the last Newton step is taken unchecked once the decrement is
+        below ``take * P`` (``_DEC_TAKE`` for a converged answer; see Notes).
 
     Returns
     -------
-    (P, y1, y2, gx, gy, converged)
-        The minimum, its parameters and the force part of grad P there.
+    (P, y1, y2, g, H, converged)
+        The minimum and its parameters, the gradient ``(g0, g1, g2)`` of P
+        there (its force part is the pin's force) and the Hessian ``(h00,
+        h01, h02, h11, h12, h22)`` at the last evaluation.
 
     Notes
     -----
@@ -77,11 +152,13 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
     method with an Armijo backtracking line search converges from any start;
     warm-started from the previous integration stages it needs one to three
     iterations. The stopping test is the Newton decrement ``lambda^2 = -g . d``:
-    at rounding level, or below ``_DEC_TAKE * P``, when the relative error of
-    the iterate is about ``sqrt(lambda^2 / P)`` (1e-6) and one more full step,
-    taken without a confirming evaluation, brings it to ~1e-12 by quadratic
-    convergence. The force returned then is the gradient moved along that
-    step to first order, ``g + H d``, with an error of the same order.
+    at rounding level, or below ``take * P``, when the relative error of
+    the iterate is about ``sqrt(lambda^2 / P)`` (1e-6 for ``_DEC_TAKE``) and
+    one more full step, taken without a confirming evaluation, brings it to
+    about ``take`` (~1e-12) by quadratic convergence. The gradient returned
+    then is moved along that step to first order, ``g + H d``, with an error
+    of the same order. A rollout passes a larger ``take`` tied to its step
+    tolerance (``rollout._solve_take``).
     """
     vx = x0 + y1 * b0 + y2 * c0
     vy = x1 + y1 * b1 + y2 * c1
@@ -89,35 +166,16 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
     p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = _power(verts, quad, area, vx, vy, om)
     converged = False
     for _ in range(_NEWTON_MAX_IT):
-        gb = g0 * b0 + g1 * b1 + g2 * b2
-        hb0 = h00 * b0 + h01 * b1 + h02 * b2
-        hb1 = h01 * b0 + h11 * b1 + h12 * b2
-        hb2 = h02 * b0 + h12 * b1 + h22 * b2
-        hbb = b0 * hb0 + b1 * hb1 + b2 * hb2
-        if k == 1:
-            d1 = -gb / hbb if hbb > 0.0 else -gb
-            d2 = 0.0
-            dec = -gb * d1
-        else:
-            gc = g0 * c0 + g1 * c1 + g2 * c2
-            hbc = c0 * hb0 + c1 * hb1 + c2 * hb2
-            hcc = (c0 * (h00 * c0 + h01 * c1 + h02 * c2) + c1 * (h01 * c0 + h11 * c1 + h12 * c2)
-                   + c2 * (h02 * c0 + h12 * c1 + h22 * c2))
-            det = hbb * hcc - hbc * hbc
-            if det <= 1e-14 * (hbb * hcc) or hbb <= 0.0:
-                d1, d2 = -gb, -gc  # not positive definite here: gradient step
-            else:
-                d1 = -(hcc * gb - hbc * gc) / det
-                d2 = -(hbb * gc - hbc * gb) / det
-            dec = -(gb * d1 + gc * d2)
+        d1, d2, dec = _newton_direction(g0, g1, g2, h00, h01, h02, h11, h12, h22, b0, b1, b2,
+                                        c0, c1, c2, k)
         if dec <= 1e-28 * (p + 1e-300):
             converged = True
             break
-        if dec <= _DEC_TAKE * p:
+        if dec <= take * p:
             # Quadratic convergence: the relative error here is about
             # sqrt(dec / p) <= 1e-6, so this Newton step lands near 1e-12;
             # take it without paying for a confirming evaluation, and move
-            # the force (the gradient) along the step to first order.
+            # the gradient along the step to first order.
             y1 += d1
             y2 += d2
             s0 = d1 * b0 + d2 * c0
@@ -125,6 +183,7 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
             s2 = d1 * b2 + d2 * c2
             g0 += h00 * s0 + h01 * s1 + h02 * s2
             g1 += h01 * s0 + h11 * s1 + h12 * s2
+            g2 += h02 * s0 + h12 * s1 + h22 * s2
             converged = True
             break
         t = 1.0
@@ -151,7 +210,7 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
         if t * (abs(d1) + abs(d2)) <= 1e-15 * (1.0 + abs(y1) + abs(y2)):
             converged = True
             break
-    return p, y1, y2, g0, g1, converged
+    return p, y1, y2, (g0, g1, g2), (h00, h01, h02, h11, h12, h22), converged
 
 
 @jit
@@ -187,22 +246,38 @@ def _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy):
 # --------------------------------------------------------------------------- minpower
 
 
+@jit_inline
+def _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm, model, take):
+    """Sticking: minimise P over twists with ``u(c) = v_p`` (1 unknown, omega).
+
+    Returns ``(vx, vy, om, g, H, converged)`` (``g``, ``H``: see ``_minimise``)."""
+    om_warm, _ = _model_step(model, vpx, vpy, 0.0, cy, -cx, 1.0, 0.0, 0.0, 0.0, 1, om_warm,
+                             0.0)
+    _, om, _, g, hess, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
+                                        0.0, 0.0, 0.0, 1, om_warm, 0.0, take)
+    if not conv and om_warm != 0.0:  # a poor warm start: solve again from translation
+        _, om, _, g, hess, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
+                                            0.0, 0.0, 0.0, 1, 0.0, 0.0, take)
+    return vpx + om * cy, vpy - om * cx, om, g, hess, conv
+
+
 @jit
 def _minpower_stick(verts, quad, area, cx, cy, vpx, vpy, om_warm):
-    """Sticking: minimise P over twists with ``u(c) = v_p`` (1 unknown, omega)."""
-    p, om, _, fx, fy, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
-                                       0.0, 0.0, 0.0, 1, om_warm, 0.0)
-    if not conv and om_warm != 0.0:  # a poor warm start: solve again from translation
-        p, om, _, fx, fy, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
-                                           0.0, 0.0, 0.0, 1, 0.0, 0.0)
-    return vpx + om * cy, vpy - om * cx, om, fx, fy, conv
+    """Sticking: minimise P over twists with ``u(c) = v_p`` (1 unknown, omega).
+
+    Returns ``(vx, vy, om, fx, fy, converged)``."""
+    vx, vy, om, g, _, conv = _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm,
+                                          NO_MODEL, _DEC_TAKE)
+    return vx, vy, om, g[0], g[1], conv
 
 
-@jit
-def _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom):
+@jit_inline
+def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take):
     """Sliding: minimise P over twists with ``e . u(c) = 1`` (2 unknowns).
 
-    ``(wvx, wvy, wom)`` is a warm-start twist of any scale."""
+    ``(wvx, wvy, wom)`` is a warm-start twist of any scale, and ``model`` a
+    local model of P at that twist (or ``NO_MODEL``; see ``_model_step``).
+    Returns ``(vx, vy, om, g, H, converged)`` on the family's scale."""
     ke = cx * ey - cy * ex  # e . (z x c)
     uwx, uwy = wvx - wom * cy, wvy + wom * cx
     ue = uwx * ex + uwy * ey
@@ -211,17 +286,37 @@ def _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom):
     if ue > 1e-3 * math.sqrt(uwx * uwx + uwy * uwy):
         y1 = (-wvx * ey + wvy * ex) / ue
         y2 = wom / ue
+        if model[0] != 0.0:
+            # The start is the warm twist / ue: move the model with it (P's
+            # gradient is homogeneous of degree 0, its Hessian of degree -1).
+            iu = 1.0 / ue
+            model = (1.0, model[1] * iu, model[2] * iu, model[3] * iu, model[4], model[5],
+                     model[6], model[7] * ue, model[8] * ue, model[9] * ue, model[10] * ue,
+                     model[11] * ue, model[12] * ue)
+            y1, y2 = _model_step(model, ex, ey, 0.0, -ey, ex, 0.0, -ke * ex, -ke * ey, 1.0, 2,
+                                 y1, y2)
     else:
         y1 = 0.0
         y2 = 0.0
-    p, y1, y2, fx, fy, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
-                                        -ke * ex, -ke * ey, 1.0, 2, y1, y2)
+    _, y1, y2, g, hess, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
+                                         -ke * ex, -ke * ey, 1.0, 2, y1, y2, take)
     if not conv and (y1 != 0.0 or y2 != 0.0):
-        p, y1, y2, fx, fy, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
-                                            -ke * ex, -ke * ey, 1.0, 2, 0.0, 0.0)
+        _, y1, y2, g, hess, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
+                                             -ke * ex, -ke * ey, 1.0, 2, 0.0, 0.0, take)
     vx = ex - y1 * ey - y2 * ke * ex
     vy = ey + y1 * ex - y2 * ke * ey
-    return vx, vy, y2, fx, fy, conv
+    return vx, vy, y2, g, hess, conv
+
+
+@jit
+def _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom):
+    """Sliding: minimise P over twists with ``e . u(c) = 1`` (2 unknowns).
+
+    ``(wvx, wvy, wom)`` is a warm-start twist of any scale.
+    Returns ``(vx, vy, om, fx, fy, converged)``."""
+    vx, vy, om, g, _, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
+                                          NO_MODEL, _DEC_TAKE)
+    return vx, vy, om, g[0], g[1], conv
 
 
 @jit
@@ -232,35 +327,52 @@ def _slip_opposes_friction(vx, vy, om, cx, cy, nx, ny, vpx, vpy, side):
     return side * ut <= 0.0
 
 
-@jit
-def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint):
+@jit_inline
+def _scaled_hessian(hess, scale):
+    """``H / scale``: the Hessian of P at ``scale`` times the twist."""
+    k = 1.0 / scale
+    return (hess[0] * k, hess[1] * k, hess[2] * k, hess[3] * k, hess[4] * k, hess[5] * k)
+
+
+@jit_inline
+def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
+                    model, take):
+    """Minpower twist, force and mode (see ``_contact_twist``), plus P's
+    gradient and Hessian at the twist returned, for the next warm start;
+    ``model`` and ``take`` as for ``_slide_solve`` and ``_minimise``."""
     if mu > 0.0 and (hint == SLIDE_POS or hint == SLIDE_NEG):
         # Shortcut while sliding: the spec's rule (solve sticking, slide on the
         # side its force leaves the cone) has a unique consistent answer, so a
         # sliding solution on the previous side whose slip opposes friction is
         # that answer. Otherwise fall through to the full rule.
         ex, ey = _cone_edge(nx, ny, mu, hint)
-        vx, vy, om, fx, fy, conv = _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx,
-                                                   wvy, wom)
+        vx, vy, om, g, hess, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx,
+                                                 wvy, wom, model, take)
         scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
         if scale > 0.0:
             vx, vy, om = scale * vx, scale * vy, scale * om
             if _slip_opposes_friction(vx, vy, om, cx, cy, nx, ny, vpx, vpy, hint):
-                return TWIST_OK, vx, vy, om, fx, fy, hint
+                return (TWIST_OK, vx, vy, om, g[0], g[1], hint, g,
+                        _scaled_hessian(hess, scale))
     if mu > 0.0:
-        vx, vy, om, fx, fy, conv = _minpower_stick(verts, quad, area, cx, cy, vpx, vpy, wom)
-        side = _cone_side(fx, fy, nx, ny, mu)
+        vx, vy, om, g, hess, conv = _stick_solve(verts, quad, area, cx, cy, vpx, vpy, wom,
+                                                 model, take)
+        side = _cone_side(g[0], g[1], nx, ny, mu)
         if side == STICK:
-            return TWIST_OK, vx, vy, om, fx, fy, STICK
+            return TWIST_OK, vx, vy, om, g[0], g[1], STICK, g, hess
     else:
         side = SLIDE_POS
         vx, vy, om = wvx, wvy, wom
     ex, ey = _cone_edge(nx, ny, mu, side)
-    vx, vy, om, fx, fy, conv = _minpower_slide(verts, quad, area, cx, cy, ex, ey, vx, vy, om)
+    # A model at the sticking twist would not fit the sliding family's start;
+    # with mu = 0 the warm twist is the model's own.
+    vx, vy, om, g, hess, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, vx, vy, om,
+                                             model if mu == 0.0 else NO_MODEL, take)
     scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
     if scale <= 0.0:
-        return TWIST_NO_PUSH, 0.0, 0.0, 0.0, fx, fy, side
-    return TWIST_OK, scale * vx, scale * vy, scale * om, fx, fy, side
+        return TWIST_NO_PUSH, 0.0, 0.0, 0.0, g[0], g[1], side, g, hess
+    return (TWIST_OK, scale * vx, scale * vy, scale * om, g[0], g[1], side, g,
+            _scaled_hessian(hess, scale))
 
 
 # --------------------------------------------------------------------------- tip
@@ -410,13 +522,15 @@ def _contact_twist(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu
     ``(wvx, wvy, wom)`` is the previous twist and ``hint`` the previous mode,
     used to warm-start minpower (the answer does not depend on them).
     A pin moving away from the part (``n . v_p <= 0``) exerts no force and the
-    part stays at rest: mode ``SEPARATE``.
+    part stays at rest: mode ``SEPARATE``. ``rollout._derivative`` calls
+    ``_minpower_twist`` itself, with a local model of P for the warm start.
     """
     if vpx * nx + vpy * ny <= 0.0:
         return TWIST_OK, 0.0, 0.0, 0.0, 0.0, 0.0, SEPARATE
     if model == MINPOWER:
-        return _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom,
-                               hint)
+        res = _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom,
+                              hint, NO_MODEL, _DEC_TAKE)
+        return res[0], res[1], res[2], res[3], res[4], res[5], res[6]
     if model == TIP:
         return _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu)
     return _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max)

@@ -31,11 +31,11 @@ The stages take the part's arrays ``verts`` and ``quad`` (from ``_prepare``)
 as they are, and the rollout's scalar parameters as one record, a tuple
 that Numba passes by value::
 
-    prm = (model, mu, rp, vpwx, vpwy, area, m_max, convex)
+    prm = (model, mu, rp, vpwx, vpwy, area, m_max, convex, take)
 
 (the contact model and friction, the pin radius in units of a, the pin's
-velocity in the belt frame, and the part's area, largest support moment and
-convexity). ``_locate`` takes the arrays of the step it shortens and its
+velocity in the belt frame, the part's area, largest support moment and
+convexity, and the minpower solve's stopping threshold, ``_solve_take``). ``_locate`` takes the arrays of the step it shortens and its
 scratch as two tuples. Tuples of arrays are kept off the per-step path:
 taking an array out of a tuple costs a reference-count update that a plain
 array argument does not (measured: grouping the part and the Runge-Kutta
@@ -51,7 +51,8 @@ import numpy as np
 from ._numba import jit, jit_inline
 from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
                        _ray_first_contact)
-from .models import SEPARATE, SLIDE_NEG, SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide
+from .models import (_DEC_TAKE, MINPOWER, NO_MODEL, SEPARATE, SLIDE_NEG, SLIDE_POS, TWIST_OK,
+                     _contact_twist, _continued_slide, _minpower_twist)
 from .support import _fan_quadrature, _max_moment
 
 OK = 0
@@ -86,6 +87,7 @@ _MAX_CHANGES = 10000
 
 DEFAULT_DS_MAX = 0.1  # units of a
 DEFAULT_TOL = 1e-7  # local error per step, units of a and radians
+_TAKE_PER_TOL = 0.1  # minpower solve threshold per unit of tol (see _solve_take)
 _DTHETA_CAP = 0.2  # radians of contact-normal turn per step
 _GROW_MAX = 2.0  # largest step growth between accepted steps
 
@@ -109,7 +111,33 @@ _W_Y, _W_YNEW, _W_K1, _W_KEND, _W_YLOC, _W_TMP, _W_YI, _W_YTRY = 0, 1, 2, 3, 4, 
 _W_KS = 8  # six rows: the Runge-Kutta stages
 _W_GEND, _W_GWORK, _W_MASK, _W_WARM, _W_WSAVE = 14, 15, 16, 17, 18
 _W_ROWS = 19
-_W_COLS = 14
+_W_COLS = 29
+# The warm-start history (row ``_W_WARM``): three entries of ``_WARM_STRIDE``
+# values, latest first, each the twist (3), the travel and P's gradient (3),
+# then the count of entries, the latest mode and the latest Hessian (6).
+_WARM_STRIDE = 7
+_WARM_S, _WARM_G = 3, 4
+_WARM_COUNT, _WARM_MODE, _WARM_H = 21, 22, 23
+_WARM_SIZE = 29
+
+
+@jit
+def _solve_take(tol):
+    """Stopping threshold of the minpower solves within a rollout of step
+    tolerance ``tol`` (``models._minimise``'s ``take``).
+
+    Notes
+    -----
+    The solve's last Newton step is taken unchecked once the decrement is
+    below ``take * P``, which leaves a relative error of about ``take`` in
+    the twist (quadratic convergence from ``sqrt(take)``). A step of size
+    ``h`` then carries an error of about ``h take`` from the solves, against
+    a local error allowed of ``tol``: ``take = _TAKE_PER_TOL * tol`` keeps the
+    solves an order of magnitude below the integration error, and saves the
+    confirming evaluation of P that ``models._DEC_TAKE`` (1e-12, the answer
+    of a single solve) would need from a start ~1e-4 off.
+    """
+    return max(_DEC_TAKE, _TAKE_PER_TOL * tol)
 
 
 @jit
@@ -156,6 +184,78 @@ def _contact_geometry(verts, kind, idx, qx, qy):
     return vx, vy, -ox / dist, -oy / dist, g_prev, g_next
 
 
+@jit_inline
+def _warm_start(warm, sp):
+    """The minpower warm start at travel ``sp`` from the history ``warm``:
+    ``(vx, vy, om, p_model)``, a twist and a local model of P there
+    (``models._model_step``; ``models.NO_MODEL`` before the first solve).
+
+    Notes
+    -----
+    ``warm`` holds the last three solved twists, the travels at which they
+    were solved and P's gradient there, and the Hessian of the latest (see
+    ``_WARM_*`` for the layout). The twist and the gradient are extrapolated
+    to ``sp`` alike: quadratically (Lagrange) when the three travels differ
+    and ``sp`` lies within 1.5 times their spread of the latest; with only
+    two solves so far, linearly (within 1.5 spans); else the latest. The
+    twist is smooth in the travel within a contact feature, but the stage
+    states of a Runge-Kutta step are off the trajectory by O(ds^2): the
+    extrapolated start is ~1e-4 (median, relative) off, and the model step
+    corrects it to first order for the stage's own family of twists.
+    """
+    wa, wb, wc = 1.0, 0.0, 0.0
+    if warm[_WARM_COUNT] >= 3.0:
+        sa, sb, sc = warm[_WARM_S], warm[_WARM_S + _WARM_STRIDE], warm[_WARM_S + 2 * _WARM_STRIDE]
+        dab, dac, dbc = sa - sb, sa - sc, sb - sc
+        span = max(abs(dab), abs(dac))
+        if dab != 0.0 and dac != 0.0 and dbc != 0.0 and abs(sp - sa) <= 1.5 * span:
+            wa = (sp - sb) * (sp - sc) / (dab * dac)
+            wb = -(sp - sa) * (sp - sc) / (dab * dbc)
+            wc = (sp - sa) * (sp - sb) / (dac * dbc)
+    elif warm[_WARM_COUNT] >= 2.0:
+        span = warm[_WARM_S] - warm[_WARM_S + _WARM_STRIDE]
+        r = (sp - warm[_WARM_S]) / span if span != 0.0 else 0.0
+        if -1.5 <= r <= 1.5:
+            wa, wb = 1.0 + r, -r
+    vx = _extrapolate(warm, 0, wa, wb, wc)
+    vy = _extrapolate(warm, 1, wa, wb, wc)
+    om = _extrapolate(warm, 2, wa, wb, wc)
+    if warm[_WARM_COUNT] < 1.0:
+        return vx, vy, om, NO_MODEL
+    h = _WARM_H
+    return vx, vy, om, (1.0, vx, vy, om, _extrapolate(warm, _WARM_G, wa, wb, wc),
+                        _extrapolate(warm, _WARM_G + 1, wa, wb, wc),
+                        _extrapolate(warm, _WARM_G + 2, wa, wb, wc), warm[h], warm[h + 1],
+                        warm[h + 2], warm[h + 3], warm[h + 4], warm[h + 5])
+
+
+@jit_inline
+def _extrapolate(warm, j, wa, wb, wc):
+    """Value ``j`` of the history's entries, weighted ``wa, wb, wc``."""
+    return wa * warm[j] + wb * warm[j + _WARM_STRIDE] + wc * warm[j + 2 * _WARM_STRIDE]
+
+
+@jit_inline
+def _remember(warm, sp, vx, vy, om, mode, g, hess):
+    """Add a solved twist at travel ``sp`` to the history ``warm``."""
+    if warm[_WARM_COUNT] >= 2.0 and sp == warm[_WARM_S + _WARM_STRIDE] and sp != warm[_WARM_S]:
+        # The travel of the one before last (a step's end slope after its
+        # last stage, at the same travel as the stage before): replace that
+        # one, so the three travels stay distinct.
+        for i in range(_WARM_STRIDE):
+            warm[_WARM_STRIDE + i] = warm[i]
+    elif sp != warm[_WARM_S] or warm[_WARM_COUNT] < 1.0:
+        for i in range(_WARM_STRIDE):
+            warm[2 * _WARM_STRIDE + i] = warm[_WARM_STRIDE + i]
+            warm[_WARM_STRIDE + i] = warm[i]
+        warm[_WARM_COUNT] = min(warm[_WARM_COUNT] + 1.0, 3.0)
+    warm[0], warm[1], warm[2], warm[_WARM_S] = vx, vy, om, sp
+    warm[_WARM_G], warm[_WARM_G + 1], warm[_WARM_G + 2] = g[0], g[1], g[2]
+    warm[_WARM_MODE] = mode
+    for i in range(6):
+        warm[_WARM_H + i] = hess[i]
+
+
 @jit
 def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
     """Right-hand side at state ``y`` (belt travel ``sp``) into ``out``;
@@ -168,7 +268,8 @@ def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
     kind, idx : the contact feature (``geometry.EDGE`` or ``VERTEX``, index).
     y : state ``(theta, q_x, q_y, X_x, X_y)``.
     sp : belt travel at ``y`` (units of a).
-    warm : warm-start history of the contact solve (updated).
+    warm : warm-start history of the contact solve (updated; see
+        ``_warm_start``).
     out : the five slopes ``d y / ds`` (written).
 
     Returns
@@ -179,70 +280,40 @@ def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
 
     Notes
     -----
-    ``warm`` holds the last three solved twists and the travel at which
-    they were solved: ``(vx, vy, om, mode, s, vx', vy', om', s', count,
-    vx'', vy'', om'', s'')``. The minpower solve starts from their quadratic
-    (Lagrange) extrapolation to ``sp`` when the three travels differ and
-    ``sp`` lies within 1.5 times their spread of the latest; with only two
-    solves so far, from the linear extrapolation (within 1.5 spans); else
-    from the last twist. The twist is
-    smooth in the travel within a contact feature; the stage states of a
-    Runge-Kutta step are off the trajectory by O(ds^2), which caps what any
-    extrapolation in ``s`` can gain: the median relative error of the start
-    is ~3e-4 (quadratic) against ~9e-4 (linear), 2.38 instead of 2.56
-    evaluations per solve. The answer does not depend on the start (the
-    solve converges from anywhere).
-
     Where the pin moves away (mode ``SEPARATE``) after sliding, the slope is
     that of the sliding contact continued past the separation
     (``models._continued_slide``), so that a step crossing it sees a smooth
     right-hand side; the rollout ends the contact at the located crossing
     and never integrates past it.
     """
-    model, mu, _, vpwx, vpwy, area, m_max, _ = prm
+    model, mu, _, vpwx, vpwy, area, m_max, _, take = prm
     cx, cy, nx, ny, _, _ = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     vpx = cs * vpwx + sn * vpwy
     vpy = -sn * vpwx + cs * vpwy
-    wvx, wvy, wom = warm[0], warm[1], warm[2]
-    if warm[9] >= 3.0:
-        sa, sb, sc = warm[4], warm[8], warm[13]
-        dab, dac, dbc = sa - sb, sa - sc, sb - sc
-        span = max(abs(dab), abs(dac))
-        if dab != 0.0 and dac != 0.0 and dbc != 0.0 and abs(sp - sa) <= 1.5 * span:
-            la = (sp - sb) * (sp - sc) / (dab * dac)
-            lb = -(sp - sa) * (sp - sc) / (dab * dbc)
-            lc = (sp - sa) * (sp - sb) / (dac * dbc)
-            wvx = la * warm[0] + lb * warm[5] + lc * warm[10]
-            wvy = la * warm[1] + lb * warm[6] + lc * warm[11]
-            wom = la * warm[2] + lb * warm[7] + lc * warm[12]
-    elif warm[9] >= 2.0:
-        span = warm[4] - warm[8]
-        r = (sp - warm[4]) / span if span != 0.0 else 0.0
-        if -1.5 <= r <= 1.5:
-            wvx += r * (warm[0] - warm[5])
-            wvy += r * (warm[1] - warm[6])
-            wom += r * (warm[2] - warm[7])
-    st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
-                                                  nx, ny, vpx, vpy, mu, wvx, wvy, wom,
-                                                  int(warm[3]))
-    if mode == SEPARATE and warm[9] >= 1.0 and (warm[3] == SLIDE_POS or warm[3] == SLIDE_NEG):
-        # Past a separation within a step: the smooth continuation of the
-        # sliding contact (see models._continued_slide); the mode stays
-        # SEPARATE, so a step that starts here still ends the contact.
-        vx, vy, om = _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx,
-                                      vpy, mu, wvx, wvy, wom, int(warm[3]))
-    elif st == TWIST_OK and mode != SEPARATE:
-        if warm[9] >= 2.0 and sp == warm[8] and sp != warm[4]:
-            # The travel of the one before last (a step's end slope after
-            # its last stage, at the same travel as the stage before):
-            # replace that one, so the three travels stay distinct.
-            warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
-        elif sp != warm[4] or warm[9] < 1.0:
-            warm[10], warm[11], warm[12], warm[13] = warm[5], warm[6], warm[7], warm[8]
-            warm[5], warm[6], warm[7], warm[8] = warm[0], warm[1], warm[2], warm[4]
-            warm[9] = min(warm[9] + 1.0, 3.0)
-        warm[0], warm[1], warm[2], warm[3], warm[4] = vx, vy, om, mode, sp
+    hint = int(warm[_WARM_MODE])
+    if vpx * nx + vpy * ny <= 0.0:
+        st, vx, vy, om, fx, fy, mode = TWIST_OK, 0.0, 0.0, 0.0, 0.0, 0.0, SEPARATE
+        if warm[_WARM_COUNT] >= 1.0 and (hint == SLIDE_POS or hint == SLIDE_NEG):
+            # Past a separation within a step: the smooth continuation of the
+            # sliding contact (see models._continued_slide); the mode stays
+            # SEPARATE, so a step that starts here still ends the contact.
+            wvx, wvy, wom, _ = _warm_start(warm, sp)
+            vx, vy, om = _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx,
+                                          vpy, mu, wvx, wvy, wom, hint)
+    elif model == MINPOWER:
+        wvx, wvy, wom, p_model = _warm_start(warm, sp)
+        st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist(
+            verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model, take)
+        if st == TWIST_OK:
+            _remember(warm, sp, vx, vy, om, mode, g, hess)
+    else:
+        # The closed-form models need no warm start: keep the mode only.
+        st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
+                                                      nx, ny, vpx, vpy, mu, 0.0, 0.0, 0.0, hint)
+        if st == TWIST_OK:
+            warm[_WARM_MODE] = mode
+            warm[_WARM_COUNT] = 1.0
     out[0] = om
     out[1] = vpx - (vx - om * y[2])
     out[2] = vpy - (vy + om * y[1])
@@ -342,7 +413,7 @@ def _step(verts, quad, prm, kind, idx, y0, s0, k1, h, y1, ks, tmp, warm):
 def _events(verts, prm, kind, idx, y, g):
     """Event values at ``y`` into ``g``: leave the feature at its start/end,
     separation (``n . v_p``) and a second contact; all negative when crossed."""
-    _, _, rp, vpwx, vpwy, _, _, convex = prm
+    _, _, rp, vpwx, vpwy, _, _, convex, _ = prm
     cx, cy, nx, ny, g[0], g[1] = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
     g[2] = nx * (cs * vpwx + sn * vpwy) + ny * (-sn * vpwx + cs * vpwy)
@@ -596,7 +667,7 @@ def _first_contact(verts, prm, theta_i, d, y, warm, mask):
     frame (``geometry._ray_first_contact``). The warm start is a translation
     along the pin's path.
     """
-    _, _, rp, vpwx, vpwy, _, _, _ = prm
+    _, _, rp, vpwx, vpwy, _, _, _, _ = prm
     v_pin = vpwy
     s0 = -(2.0 + rp + abs(d)) * (1.0 + abs(v_pin))
     px, py = -s0 * 1.0, s0 * v_pin
@@ -607,8 +678,9 @@ def _first_contact(verts, prm, theta_i, d, y, warm, mask):
     sigma, kind, idx = _ray_first_contact(verts, qx, qy, wx, wy, rp, 0.0)
     if math.isfinite(sigma):
         y[0], y[1], y[2], y[3], y[4] = theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d
-        warm[0], warm[1], warm[2], warm[3], warm[4] = wx, wy, 0.0, 0.0, 0.0
-        warm[9] = 0.0
+        warm[0], warm[1], warm[2], warm[_WARM_S] = wx, wy, 0.0, 0.0
+        warm[_WARM_MODE] = 0.0
+        warm[_WARM_COUNT] = 0.0
         for j in range(4):
             mask[j] = 0.0
     return sigma, kind, idx
@@ -623,7 +695,7 @@ def _recontact(verts, prm, y):
     touch (``inf`` if none), the feature touched and the pin's direction in
     the body frame. The caller moves the pin.
     """
-    _, _, rp, vpwx, vpwy, _, _, _ = prm
+    _, _, rp, vpwx, vpwy, _, _, _, _ = prm
     cs, sn = math.cos(y[0]), math.sin(y[0])
     wx, wy = cs * vpwx + sn * vpwy, -sn * vpwx + cs * vpwy
     sigma, kind, idx = _ray_first_contact(verts, y[1], y[2], wx, wy, rp, 1e-9)
@@ -669,14 +741,16 @@ def _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h, tol, y_new, ks, tmp
     """
     rejected = False
     attempts = 0
-    for i in range(warm.shape[0]):
-        warm_saved[i] = warm[i]
+    keep = prm[0] == MINPOWER
+    if keep:
+        for i in range(_WARM_SIZE):
+            warm_saved[i] = warm[i]
     while True:
         attempts += 1
-        if rejected:
+        if rejected and keep:
             # Warm-start a retry from the solves before the rejected attempt
             # (near s), not from the rejected attempt's far stages.
-            for i in range(warm.shape[0]):
+            for i in range(_WARM_SIZE):
                 warm[i] = warm_saved[i]
         ok, err = _step(verts, quad, prm, kind, idx, y, s, k1, h, y_new, ks, tmp, warm)
         if h < 1e-12:
@@ -780,7 +854,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     n_traj = 0
     n_force = 0
     two_pi = 2.0 * math.pi
-    prm = (model, mu_c, rp, -1.0, v_pin, area, m_max, convex)
+    prm = (model, mu_c, rp, -1.0, v_pin, area, m_max, convex, _solve_take(tol))
     y = work[_W_Y]
     y_new = work[_W_YNEW]
     k1 = work[_W_K1]
