@@ -6,7 +6,7 @@ calls as device functions); there is no second copy of the physics. One
 thread computes one rollout of the grid, final state only (no trajectory).
 
 Scratch: each thread holds a fixed-size local array of ``_W_ROWS x _W_COLS``
-float64 (18 x 14, 2.0 KiB) that does not depend on the polygon; the polygon, its
+float64 (19 x 29, 4.3 KiB) that does not depend on the polygon; the polygon, its
 quadrature rule and the grid live in global memory. There is no polygon
 size limit beyond the step budget that applies on the CPU too.
 

@@ -229,8 +229,8 @@ def _cone_edge(nx, ny, mu, side):
     """Unit edge ``normalise(n + side mu t)`` of the friction cone."""
     ex = nx - side * mu * ny
     ey = ny + side * mu * nx
-    norm = math.sqrt(ex * ex + ey * ey)
-    return ex / norm, ey / norm
+    inv = 1.0 / math.sqrt(ex * ex + ey * ey)
+    return ex * inv, ey * inv
 
 
 @jit
@@ -284,12 +284,12 @@ def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take):
     # Rescaling a warm start whose contact velocity is nearly tangent to e
     # would throw it far away: start from translation along e instead.
     if ue > 1e-3 * math.sqrt(uwx * uwx + uwy * uwy):
-        y1 = (-wvx * ey + wvy * ex) / ue
-        y2 = wom / ue
+        iu = 1.0 / ue
+        y1 = (-wvx * ey + wvy * ex) * iu
+        y2 = wom * iu
         if model[0] != 0.0:
             # The start is the warm twist / ue: move the model with it (P's
             # gradient is homogeneous of degree 0, its Hessian of degree -1).
-            iu = 1.0 / ue
             model = (1.0, model[1] * iu, model[2] * iu, model[3] * iu, model[4], model[5],
                      model[6], model[7] * ue, model[8] * ue, model[9] * ue, model[10] * ue,
                      model[11] * ue, model[12] * ue)
