@@ -360,14 +360,16 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
         side = _cone_side(g[0], g[1], nx, ny, mu)
         if side == STICK:
             return TWIST_OK, vx, vy, om, g[0], g[1], STICK, g, hess
+        # Slide from the sticking twist, with P's model there: near the
+        # stick-slip change the two twists are close.
+        model = (1.0, vx, vy, om, g[0], g[1], g[2], hess[0], hess[1], hess[2], hess[3],
+                 hess[4], hess[5])
     else:
         side = SLIDE_POS
         vx, vy, om = wvx, wvy, wom
     ex, ey = _cone_edge(nx, ny, mu, side)
-    # A model at the sticking twist would not fit the sliding family's start;
-    # with mu = 0 the warm twist is the model's own.
     vx, vy, om, g, hess, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, vx, vy, om,
-                                             model if mu == 0.0 else NO_MODEL, take)
+                                             model, take)
     scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
     if scale <= 0.0:
         return TWIST_NO_PUSH, 0.0, 0.0, 0.0, g[0], g[1], side, g, hess
@@ -477,13 +479,16 @@ def _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max):
 
 @jit
 def _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
-                     wvx, wvy, wom, side):
+                     wvx, wvy, wom, side, p_model, take):
     """Sliding twist on cone side ``side`` continued past separation.
 
     For a pin that moves away (``n . v_p <= 0``) the physical answer is no
     force and no motion (``_contact_twist`` returns ``SEPARATE``). The
     integrator wants a smooth right-hand side within a step, so inside a
     step that crosses the separation it uses this continuation instead.
+
+    ``(wvx, wvy, wom)``, ``p_model`` and ``take`` warm-start and stop the
+    minpower solve (see ``_slide_solve``).
 
     Returns ``(vx, vy, om)``: the model's sliding twist for the cone edge
     ``e`` of ``side``, rescaled so that ``n . u(c) = n . v_p`` (a factor
@@ -502,7 +507,8 @@ def _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, 
     """
     ex, ey = _cone_edge(nx, ny, mu, side)
     if model == MINPOWER:
-        vx, vy, om, _, _, _ = _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom)
+        vx, vy, om, _, _, _ = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
+                                           p_model, take)
     elif model == TIP:
         vx, vy, om = _tip_twist_for_line(cx, cy, ex, ey)
     else:

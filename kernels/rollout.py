@@ -231,7 +231,8 @@ def _warm_start(warm, sp):
 
 @jit_inline
 def _extrapolate(warm, j, wa, wb, wc):
-    """Value ``j`` of the history's entries, weighted ``wa, wb, wc``."""
+    """Value ``j`` of the history's entries, weighted ``wa, wb, wc``
+    (entries not filled yet are zero, from ``_first_contact``)."""
     return wa * warm[j] + wb * warm[j + _WARM_STRIDE] + wc * warm[j + 2 * _WARM_STRIDE]
 
 
@@ -298,9 +299,9 @@ def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
             # Past a separation within a step: the smooth continuation of the
             # sliding contact (see models._continued_slide); the mode stays
             # SEPARATE, so a step that starts here still ends the contact.
-            wvx, wvy, wom, _ = _warm_start(warm, sp)
+            wvx, wvy, wom, p_model = _warm_start(warm, sp)
             vx, vy, om = _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx,
-                                          vpy, mu, wvx, wvy, wom, hint)
+                                          vpy, mu, wvx, wvy, wom, hint, p_model, take)
     elif model == MINPOWER:
         wvx, wvy, wom, p_model = _warm_start(warm, sp)
         st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist(
@@ -678,9 +679,9 @@ def _first_contact(verts, prm, theta_i, d, y, warm, mask):
     sigma, kind, idx = _ray_first_contact(verts, qx, qy, wx, wy, rp, 0.0)
     if math.isfinite(sigma):
         y[0], y[1], y[2], y[3], y[4] = theta_i, qx + sigma * wx, qy + sigma * wy, 0.0, -d
-        warm[0], warm[1], warm[2], warm[_WARM_S] = wx, wy, 0.0, 0.0
-        warm[_WARM_MODE] = 0.0
-        warm[_WARM_COUNT] = 0.0
+        for j in range(_WARM_SIZE):
+            warm[j] = 0.0
+        warm[0], warm[1] = wx, wy
         for j in range(4):
             mask[j] = 0.0
     return sigma, kind, idx
