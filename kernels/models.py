@@ -12,7 +12,8 @@ Models (spec section 3):
     allows (Peshkin and Sanderson). Sticking: ``u(c) = v_p``; sliding:
     ``e . u(c) = 1`` with ``e`` the friction-cone edge, then rescaled so the
     pin does not penetrate. Both are convex problems in 1 or 2 unknowns,
-    solved by ``_minimise`` (damped Newton, warm-started).
+    solved by ``_minimise`` (damped Newton, warm-started; inside a rollout
+    the start is first improved on a local model of P, ``_model_step``).
 ``TIP``
     The centre of rotation is the tip of Peshkin's COR locus for the force
     line: on the perpendicular from the centroid to the line, on the far
