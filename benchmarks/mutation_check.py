@@ -72,11 +72,11 @@ MUTATIONS = [
              "ex = nx - side * mu * ny\n    ey = ny + side * mu * nx",
              "ex = nx - side * math.tan(mu) * ny\n    ey = ny + side * math.tan(mu) * nx",
              ("tests/kernels/test_models.py", "-k", "cone")),
-    Mutation("model-hessian-scale", "minpower warm-start model moved onto the sliding family with H / ue "
-             "instead of H ue (Hessian homogeneous of degree -1)",
+    Mutation("model-hessian-scale", "minpower warm-start model moved onto the sliding family with H / |ue| "
+             "instead of H |ue| (Hessian homogeneous of degree -1)",
              "kernels/models.py",
-             "model[7] * ue, model[8] * ue, model[9] * ue, model[10] * ue,\n                     model[11] * ue, model[12] * ue)",
-             "model[7] * iu, model[8] * iu, model[9] * iu, model[10] * iu,\n                     model[11] * iu, model[12] * iu)",
+             "model[7] * au, model[8] * au, model[9] * au,\n                     model[10] * au, model[11] * au, model[12] * au)",
+             "model[7] / au, model[8] / au, model[9] / au,\n                     model[10] / au, model[11] / au, model[12] / au)",
              ("tests/kernels/test_warm_start.py",)),
     Mutation("lattice-skips-key", "stored refinement lattice reused without comparing the kernel tolerance",
              "pipeline/planning/lattice_store.py",

@@ -283,17 +283,21 @@ def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take):
     uwx, uwy = wvx - wom * cy, wvy + wom * cx
     ue = uwx * ex + uwy * ey
     # Rescaling a warm start whose contact velocity is nearly tangent to e
-    # would throw it far away: start from translation along e instead.
-    if ue > 1e-3 * math.sqrt(uwx * uwx + uwy * uwy):
+    # would throw it far away: start from translation along e instead. A
+    # negative ue (a twist continued past separation, ``_continued_slide``)
+    # rescales too: P is even, P(-xi) = P(xi).
+    if abs(ue) > 1e-3 * math.sqrt(uwx * uwx + uwy * uwy):
         iu = 1.0 / ue
         y1 = (-wvx * ey + wvy * ex) * iu
         y2 = wom * iu
         if model[0] != 0.0:
             # The start is the warm twist / ue: move the model with it (P's
-            # gradient is homogeneous of degree 0, its Hessian of degree -1).
-            model = (1.0, model[1] * iu, model[2] * iu, model[3] * iu, model[4], model[5],
-                     model[6], model[7] * ue, model[8] * ue, model[9] * ue, model[10] * ue,
-                     model[11] * ue, model[12] * ue)
+            # gradient is odd and homogeneous of degree 0, its Hessian even
+            # and of degree -1).
+            sg, au = (1.0, ue) if ue > 0.0 else (-1.0, -ue)
+            model = (1.0, model[1] * iu, model[2] * iu, model[3] * iu, sg * model[4],
+                     sg * model[5], sg * model[6], model[7] * au, model[8] * au, model[9] * au,
+                     model[10] * au, model[11] * au, model[12] * au)
             y1, y2 = _model_step(model, ex, ey, 0.0, -ey, ex, 0.0, -ke * ex, -ke * ey, 1.0, 2,
                                  y1, y2)
     else:

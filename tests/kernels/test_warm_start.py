@@ -118,6 +118,37 @@ def test_model_step_makes_the_sliding_start_second_order(xy, edge, mu, side):
         assert err_model <= 1e-2 * err_raw + 1e-13, (delta, err_raw, err_model)
 
 
+@pytest.mark.parametrize("scale", [-0.5, -2.0, 0.5])
+def test_model_step_on_a_twist_of_any_sign(scale):
+    """A sliding twist continued past separation (``_continued_slide``) is
+    the family's twist times a factor <= 0: the start and its model are
+    rescaled with that sign (P is even: its gradient is odd, its Hessian
+    even, of degrees 0 and -1), and stay second order."""
+    verts, quad, area = part(TRIANGLE)
+    c0, n = edge_contact(verts, 0, 0.6)
+    mu, side = 0.3, 1
+    vp0 = 0.8 * n - 0.5 * side * np.array([-n[1], n[0]])
+    xi0, g0, h0 = slide(verts, quad, area, c0, n, vp0, mu, side, (1.0, 0.0, 0.0), NO_MODEL,
+                        _DEC_TAKE)
+    warm = scale * xi0
+    model = model_of(warm, np.sign(scale) * g0, h0 / abs(scale))
+    ex, ey = _cone_edge(float(n[0]), float(n[1]), mu, side)
+
+    def family_twist(c, start, model, take):
+        vx, vy, om, *_ = _slide_solve(verts, quad, area, float(c[0]), float(c[1]), ex, ey,
+                                      *map(float, start), model, float(take))
+        return np.array([vx, vy, om])
+
+    c1 = c0 + 3e-3 * np.array([-n[1], n[0]])
+    exact = family_twist(c1, (1.0, 0.0, 0.0), NO_MODEL, _DEC_TAKE)
+    raw = family_twist(c1, warm, NO_MODEL, 1.0)
+    modelled = family_twist(c1, warm, model, 1.0)
+    err_raw = np.linalg.norm(raw - exact) / np.linalg.norm(exact)
+    err_model = np.linalg.norm(modelled - exact) / np.linalg.norm(exact)
+    assert err_raw > 1e-9
+    assert err_model <= 1e-2 * err_raw + 1e-13, (scale, err_raw, err_model)
+
+
 def test_a_model_never_changes_the_converged_answer():
     """The model only moves the start: a strict solve from a poor model (the
     Hessian of another contact, a wrong gradient) ends at the same twist."""
