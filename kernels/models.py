@@ -262,16 +262,6 @@ def _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm, model, take):
     return vpx + om * cy, vpy - om * cx, om, g, hess, conv
 
 
-@jit
-def _minpower_stick(verts, quad, area, cx, cy, vpx, vpy, om_warm):
-    """Sticking: minimise P over twists with ``u(c) = v_p`` (1 unknown, omega).
-
-    Returns ``(vx, vy, om, fx, fy, converged)``."""
-    vx, vy, om, g, _, conv = _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm,
-                                          NO_MODEL, _DEC_TAKE)
-    return vx, vy, om, g[0], g[1], conv
-
-
 @jit_inline
 def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take):
     """Sliding: minimise P over twists with ``e . u(c) = 1`` (2 unknowns).
@@ -311,17 +301,6 @@ def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take):
     vx = ex - y1 * ey - y2 * ke * ex
     vy = ey + y1 * ex - y2 * ke * ey
     return vx, vy, y2, g, hess, conv
-
-
-@jit
-def _minpower_slide(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom):
-    """Sliding: minimise P over twists with ``e . u(c) = 1`` (2 unknowns).
-
-    ``(wvx, wvy, wom)`` is a warm-start twist of any scale.
-    Returns ``(vx, vy, om, fx, fy, converged)``."""
-    vx, vy, om, g, _, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
-                                          NO_MODEL, _DEC_TAKE)
-    return vx, vy, om, g[0], g[1], conv
 
 
 @jit

@@ -29,8 +29,10 @@ from kernels.models import (
     STICK,
     TIP,
     TWIST_OK,
+    _DEC_TAKE,
+    NO_MODEL,
     _contact_twist,
-    _minpower_stick,
+    _stick_solve,
 )
 from kernels.rollout import _prepare
 from kernels.support import _fan_quadrature
@@ -223,8 +225,8 @@ def test_minpower_stick_converges_from_any_warm_start(case):
     b = np.array([c[1], -c[0], 1.0])
     oms = []
     for warm in warms:
-        vx, vy, om, _fx, _fy, _conv = _minpower_stick(verts, quad, area, c[0], c[1], vp[0],
-                                                      vp[1], float(warm))
+        vx, vy, om, _g, _h, _conv = _stick_solve(verts, quad, area, c[0], c[1], vp[0], vp[1],
+                                                 float(warm), NO_MODEL, _DEC_TAKE)
         _, g_ref, _ = ref.power_ref(verts, vx, vy, om, derivatives=True)
         assert abs(g_ref @ b) <= 1e-10, (
             f"warm={warm}: omega={om!r} not stationary, dP/domega={g_ref @ b:.3g}")
@@ -253,8 +255,8 @@ def test_minpower_stick_independent_of_warm_start():
         al = rng.uniform(-1.45, 1.45)
         vp = math.cos(al) * n + math.sin(al) * tangent(n)
         warms = (0.0, rng.normal(), rng.normal() * 0.01)
-        oms = [_minpower_stick(part.verts, part.quad, part.area, c[0], c[1], vp[0], vp[1], w)[2]
-               for w in warms]
+        oms = [_stick_solve(part.verts, part.quad, part.area, c[0], c[1], vp[0], vp[1], w,
+                            NO_MODEL, _DEC_TAKE)[2] for w in warms]
         spread = max(oms) - min(oms)
         if spread > worst[0]:
             worst = (spread, (part.verts.tolist(), c.tolist(), vp.tolist(), warms, oms))
@@ -343,9 +345,9 @@ def test_sliding_side_follows_sticking_force_when_it_pulls(case, mu):
     """Spec: the sliding side is the sign of the sticking force's f.t, also
     when f.n <= 0 (the sticking solution would need the pin to pull)."""
     part, c, n, vp, _ = case
-    vx, vy, om, fx, fy, _ = _minpower_stick(part.verts, part.quad, part.area,
-                                            c[0], c[1], vp[0], vp[1], 0.0)
-    f_s = np.array([fx, fy])
+    vx, vy, om, g, _, _ = _stick_solve(part.verts, part.quad, part.area,
+                                       c[0], c[1], vp[0], vp[1], 0.0, NO_MODEL, _DEC_TAKE)
+    f_s = np.array([g[0], g[1]])
     assume(f_s @ n <= 0.0)
     xi_s = np.array([vx, vy, om])
     np.testing.assert_allclose(u_at(xi_s, c), vp, atol=1e-10)
