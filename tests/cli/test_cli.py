@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from cli_runs import run_cli as run
 from conftest import TRIANGLE, circular_diff
 from images import assert_png_figure
-from pipeline.cli import main
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
 
@@ -28,16 +28,6 @@ BASE = ["rollout", "--vertices", VERTS, "--d", "0.3", "--mu-c", "0.2", "--pin-ra
 CONTRACT_KEYS = {"theta_i", "status", "theta_f", "dy", "contact_travel", "feature_changes",
                  "peak_force"}
 PINFEED = Path(sys.executable).with_name("pinfeed")
-
-
-def run(capsys, argv):
-    """Run the CLI in-process; return (exit code, stdout, stderr)."""
-    try:
-        code = main(argv)
-    except SystemExit as exc:  # argparse errors
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def with_options(pairs):

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from pipeline.cli import main
+from cli_runs import run_cli
 from pipeline.config import validate_config
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
@@ -39,11 +39,7 @@ MAP = ["map", "--vertices", "0,0 60,0 15,35", "--mu-c", "0.2", "--pin-radius", "
 
 def cli(capsys, argv):
     """Run the CLI in-process: (exit code, stdout, stderr lines)."""
-    try:
-        code = main(argv)
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
+    code, out, err = run_cli(capsys, argv)
     return code, out, err.strip().splitlines()
 
 

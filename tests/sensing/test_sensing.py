@@ -4,6 +4,7 @@ import json
 import numpy as np
 import pytest
 
+from cli_runs import run_cli
 from pipeline.errors import PinfeedError
 from pipeline.sensing.profiles import (Profile, Sensor, classify, measure, profile_from_rollout, read_profile_csv,
                               score, sensor_groups, sign_matrix)
@@ -424,16 +425,6 @@ def test_sensor_stage_without_a_verified_plan(stored_tri, tmp_path):
 # ---------------------------------------------------------------- pinfeed sense classify
 
 
-def _run(argv, capsys):
-    from pipeline.cli import main
-    try:
-        code = main(argv)
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 def _write_csv(path, profile, scale=1.0, t0=0.0, header=True, extra=True):
     with open(path, "w") as fh:
         if header:
@@ -463,7 +454,7 @@ def test_cli_classify_reads_a_profile_and_names_the_final_orientation(stored_tri
                               res["pin_radius"], res["model"], sensor)["state 2"]
     csv_path = _write_csv(tmp_path / "state2.csv", prof, scale=9.81, t0=12.5)
     argv = _classify_args(stored_tri, "partial", "--part", "tri", "--profile", str(csv_path))
-    code, out, err = _run(argv + ["--json"], capsys)
+    code, out, err = run_cli(capsys, argv + ["--json"])
     assert code == 0, err
     got = json.loads(out)
     assert {"part", "y_pin", "y_pin_source", "scores", "best", "candidates", "decided", "margin",
@@ -474,12 +465,12 @@ def test_cli_classify_reads_a_profile_and_names_the_final_orientation(stored_tri
     assert got["scores"]["state 2"] == 40 and "state 2" in got["candidates"]
     assert got["final_sets"] == final_for_verdict(res, got["candidates"])
     assert got["final_known"] == (len(got["final_sets"]) == 1)
-    code, out, err = _run(argv, capsys)
+    code, out, err = run_cli(capsys, argv)
     assert code == 0, err
     assert "verdict:" in out and "state 2: 40" in out and "final orientation" in out
     assert "profiles simulated at 0" in out
     # Another pin: no final orientation from the stored sensor plan.
-    code, out, err = _run(argv + ["--y-pin", "-2.5", "--json"], capsys)
+    code, out, err = run_cli(capsys, argv + ["--y-pin", "-2.5", "--json"])
     assert code == 0, err
     got = json.loads(out)
     assert got["y_pin"] == -2.5 and got["final_sets"] is None and got["final_known"] is None
@@ -497,22 +488,22 @@ def test_cli_classify_bad_input(stored_tri, sensed, tmp_path, capsys):
     good = _write_csv(tmp_path / "ok.csv", _timed(np.linspace(1, 0.2, 400), 0.3 * np.ones(400)),
                       header=False, extra=False)
     base = _classify_args(stored_tri, "partial")
-    _one_line_error(*_run(base + ["--part", "tri", "--profile", str(tmp_path / "none.csv")],
-                          capsys)[::2], "no profile file")
+    _one_line_error(*run_cli(capsys, base + ["--part", "tri", "--profile",
+                                             str(tmp_path / "none.csv")])[::2], "no profile file")
     bad = tmp_path / "bad.csv"
     bad.write_text("t,fx,fy\n0,1,2\n0.01,abc,2\n")
-    _one_line_error(*_run(base + ["--part", "tri", "--profile", str(bad)], capsys)[::2],
+    _one_line_error(*run_cli(capsys, base + ["--part", "tri", "--profile", str(bad)])[::2],
                     "line 3", "not three numbers")
-    _one_line_error(*_run(base + ["--part", "nope", "--profile", str(good)], capsys)[::2],
+    _one_line_error(*run_cli(capsys, base + ["--part", "nope", "--profile", str(good)])[::2],
                     "unknown part 'nope'", "pinfeed catalog list")
-    _one_line_error(*_run(["sense", "classify", "--part", "tri"], capsys)[::2], "--profile")
+    _one_line_error(*run_cli(capsys, ["sense", "classify", "--part", "tri"])[::2], "--profile")
     old = stored_tri["partial"] / "old"  # a sensing result of the format before issue 11
     (old / "sensing").mkdir(parents=True, exist_ok=True)
     before = {k: v for k, v in sensed["partial"].items() if k not in ("mu_c_profiles", "symmetry_order")}
     (old / "sensing" / "tri.json").write_text(json.dumps(before))
     argv = ["sense", "classify", "--catalog", str(stored_tri["catalog"]), "--results", str(old),
             "--part", "tri", "--profile", str(good)]
-    _one_line_error(*_run(argv, capsys)[::2], "not a pinfeed sensing result", "re-run the workflow")
+    _one_line_error(*run_cli(capsys, argv)[::2], "not a pinfeed sensing result", "re-run the workflow")
 
 
 def test_cli_classify_pin_from_the_stored_plan_or_y_pin(stored_tri, sensed, tmp_path, capsys):
@@ -524,7 +515,7 @@ def test_cli_classify_pin_from_the_stored_plan_or_y_pin(stored_tri, sensed, tmp_
     shutil.copytree(stored_tri["full"] / "plans", results / "plans")
     argv = ["sense", "classify", "--part", "tri", "--profile", str(good), "--catalog",
             str(stored_tri["catalog"]), "--results", str(results)]
-    code, out, err = _run(argv + ["--json"], capsys)
+    code, out, err = run_cli(capsys, argv + ["--json"])
     assert code == 0, err
     got = json.loads(out)
     rec = json.loads((results / "plans" / "tri.json").read_text())["tight"][0]["recommended"]
@@ -533,8 +524,8 @@ def test_cli_classify_pin_from_the_stored_plan_or_y_pin(stored_tri, sensed, tmp_
     stored = json.loads((results / "plans" / "tri.json").read_text())
     stored["tight"][0].update(plans=[], recommended=None)
     (results / "plans" / "tri.json").write_text(json.dumps(stored))
-    _one_line_error(*_run(argv, capsys)[::2], "--y-pin", "pinfeed plan --part tri")
-    code, out, err = _run(argv + ["--y-pin", "27.5", "--json"], capsys)
+    _one_line_error(*run_cli(capsys, argv)[::2], "--y-pin", "pinfeed plan --part tri")
+    code, out, err = run_cli(capsys, argv + ["--y-pin", "27.5", "--json"])
     assert code == 0, err
     assert json.loads(out)["final_sets"] is None
 
