@@ -323,7 +323,7 @@ def cmd_plan(args):
     config = planner_settings(load_config(args.config), catalog=args.catalog, mu_c=args.mu_c,
                               depth=args.depth, model=args.model, coverage=args.coverage, speeds=speeds,
                               dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
-                              mu_s=args.mu_s)
+                              mu_s=args.mu_s, tolerance=args.tolerance)
     part = _plan_part_arg(args, config)
     result = plan_command(part, config, args.mode, progress=None if args.json else _progress)
     if args.out:
@@ -684,7 +684,12 @@ def _add_sweep_plan_commands(sub) -> None:
                    help="tight propagation (default), the paper's adjusted bands, or both side by side")
     p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"])
     p.add_argument("--depth", type=int, default=None, help="largest number of pins (>= 1)")
-    p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step'")
+    p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step' "
+                   "(default: the config's planner.pins; 'auto' there fits them to the part)")
+    p.add_argument("--tolerance", type=float, default=None, metavar="DEG",
+                   help="full width (deg) the final orientation set may have (default: planner.tolerance_deg, "
+                   "10): a plan orients the part when verify.required (99.5%%) of its trials end in one "
+                   "set this narrow")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"])
     p.add_argument("--speeds", default=None,
                    help="dynamic pin speeds v_pin/v_b after the static pins: 'a,b' ('' for none)")
