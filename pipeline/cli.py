@@ -704,6 +704,14 @@ def _add_sweep_plan_commands(sub) -> None:
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plan)
 
+    p = sub.add_parser("atlas", help="the feedability atlas: which planned parts pins orient, with how "
+                       "many pins, how precisely and how fast (RESULTS/atlas.json, made by the workflow)")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--results", default=None, help="results folder holding atlas.json "
+                   "(default: the config's results_dir/NAME)")
+    p.add_argument("--json", action="store_true", help="print the atlas JSON")
+    p.set_defaults(func=cmd_atlas)
+
 
 def _add_catalog_commands(sub) -> None:
     """``catalog index|list|show|query|plot``: the map database."""
@@ -766,6 +774,35 @@ def _add_sense_commands(sub) -> None:
                    "(default: the config's, RESULTS_DIR/NAME)")
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
+
+
+def cmd_atlas(args):
+    """``pinfeed atlas``: the feedability atlas of a config's planned parts."""
+    from pipeline.config import load_config, results_folder
+    from pipeline.workflow.atlas import read_atlas
+    config = load_config(args.config)
+    path = (Path(args.results) if args.results else results_folder(config)) / "atlas.json"
+    if not path.is_file():
+        hint = f"snakemake --cores all --configfile {args.config}" if args.config else "make run"
+        raise PinfeedError(f"no atlas at {path}; run the workflow first ('{hint}')")
+    try:
+        atlas = read_atlas(path)
+    except (ValueError, KeyError):
+        raise PinfeedError(f"{path} is corrupt; delete it and re-run the workflow") from None
+    if args.json:
+        _print_json(atlas)
+        return
+    print(f"feedability atlas of config {atlas['config']}: tolerance {atlas['tolerance_deg']:g} deg, "
+          f"depth {atlas['depth']} ({path})")
+    print(f"{'part':<18} {'outcome':<12} {'fixed':>5} {'moving':>6} {'width':>7} {'in set':>11} "
+          f"{'limit':>7} {'parts/min':>9} {'plan s':>7}  plan")
+    for r in atlas["rows"]:
+        def num(key, fmt):
+            return "-" if r.get(key) is None else format(r[key], fmt)
+        inset = "-" if r.get("in_set") is None else f"{r['in_set']}/{r['trials']}"
+        print(f"{r['part']:<18} {r['outcome']:<12} {num('fixed_pins', 'd'):>5} {num('moving_pins', 'd'):>6} "
+              f"{num('verified_width_deg', '.1f'):>7} {inset:>11} {num('speed_limit_mm_s', '.0f'):>7} "
+              f"{num('throughput_per_min', '.0f'):>9} {num('planning_seconds', '.0f'):>7}  {r['plan'] or '-'}")
 
 
 def _add_stored_plan_commands(sub) -> None:

@@ -20,6 +20,7 @@ replays with the dynamic model at the same speed.
 """
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
@@ -324,7 +325,9 @@ def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progre
                 for v in speeds}
     out = []
     for mu_c in plan_frictions(config):
+        t0 = time.perf_counter()
         res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep, progress=progress)
+        res["stats"]["wall_seconds"] = round(time.perf_counter() - t0, 2)  # search, verification and all
         res.pop("lattices")
         out.append(res)
     for lattice in lattices.values():
