@@ -360,9 +360,19 @@ def _verification_counts(plan) -> dict | None:
 
 def _plan_summary(plan, pins=None) -> dict:
     heights = plan.get("pin_heights_mm") or [pins[p] for p in plan["pins"]]
+    orientation = (plan.get("verification") or {}).get("orientation")
     return {"pins": list(plan["pins"]), "pin_heights_mm": list(heights),
             "final_sets": plan["final_sets"], "n_final_sets": plan["n_final_sets"],
+            "claimed_width_deg": _claimed_width(plan), "claim": plan.get("claim"),
+            "verified_width_deg": orientation["width_deg"] if orientation else None,
+            "orients": orientation["orients"] if orientation else None,
             "verification": _verification_counts(plan)}
+
+
+def _claimed_width(plan) -> float | None:
+    """Width (deg) of the claimed final orientation, if it is one arc."""
+    sets = plan.get("final_sets") or []
+    return float(sets[0]["width"]) if len(sets) == 1 else None
 
 
 def _plan_json(result, mode) -> dict:
@@ -371,7 +381,9 @@ def _plan_json(result, mode) -> dict:
     tight = result.get("tight")
     if tight:
         first = tight[0]
-        out.update(mu_c=first["mu_c"], warning=first["warning"],
+        out.update(mu_c=first["mu_c"], warning=first["warning"], tolerance_deg=first.get("tolerance_deg"),
+                   orients=first.get("orients"), pins_used=first.get("pins_used"),
+                   evidence=(first.get("fixed_pin_search") or {}).get("evidence"),
                    plans=[_plan_summary(p) for p in first["plans"]],
                    rejected=[_plan_summary(p) for p in first["rejected"]],
                    frictions=[{"mu_c": t["mu_c"], "warning": t["warning"],
@@ -399,14 +411,18 @@ def _print_plan_result(result, part, config, mode):
         st = t.stats
         print(f"tight planner, friction {t.friction}: {st['rollouts']} new rollouts in "
               f"{st['seconds']:.0f} s, stored under {config['catalog_dir']}/refine/{part.id}/")
+        search = t.extra.get("fixed_pin_search")
+        if search:
+            print(f"  {search['evidence']}")
         if t.warning:
             print(f"  WARNING: {t.warning}")
         for k, plan in enumerate(t.plans, start=1):
             v = plan.verification
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))
-            print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
-                  f"{format_arcs(plan.final_arcs)}; "
-                  f"verified {v.successes}/{v.trials} trials; margin in d " + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
+            print(f"  #{k}: {heights} -> claimed {plan.n_final_sets} set(s) "
+                  f"({plan.extra.get('claim', 'propagated')}): {format_arcs(plan.final_arcs)}; "
+                  f"{_orientation_text(v)}; margin in d "
+                  + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
     if mode == "tight" or result.plans is None:
         return
     print(f"paper-mode planner (adjusted bands), {result.extra['selection']}:")
@@ -419,6 +435,17 @@ def _print_plan_result(result, part, config, mode):
         print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
               f"{format_arcs(plan.final_arcs)}; "
               f"margin in d {plan.margin:.3f}")
+
+
+def _orientation_text(v) -> str:
+    """Verified width next to the claim: how many trials ended in one set within the tolerance."""
+    o = v.extra.get("orientation") if v else None
+    if not o:
+        return f"verified {v.successes}/{v.trials} trials in the claimed sets" if v else "not verified"
+    width = "n/a" if o["width_deg"] is None else f"{o['width_deg']:.1f} deg"
+    verdict = "orients" if o["orients"] else f"{o['sets_within_tolerance']} sets of {o['tolerance_deg']:g} deg"
+    return (f"verified width {width} ({verdict}: {o['in_tolerance']}/{v.trials} trials in one set of "
+            f"{o['tolerance_deg']:g} deg; {v.successes}/{v.trials} in the claimed sets)")
 
 
 def _results_arg(args, config) -> Path:
