@@ -214,10 +214,10 @@ def cmd_demo(args):
 
 
 def _catalog(args):
-    from pipeline.maps.catalog import Catalog
+    from pipeline.maps.catalog import RECOMPUTE, Catalog
     cat = Catalog.open(args.catalog)
     for problem in cat.problems:
-        print(f"pinfeed: warning: {problem} (not served)", file=sys.stderr)
+        print(f"pinfeed: warning: {problem} (not served; {RECOMPUTE})", file=sys.stderr)
     return cat
 
 
