@@ -254,7 +254,7 @@ def _svg_units(svg, override) -> tuple[Units, float]:
     if override is not None:
         return Units(override, "--units", MM_PER_UNIT[override]), 1.0 / px_per_user
     if user_mm is None:
-        return Units("px", "SVG user units (no physical width/viewBox: CSS pixels, 96 per inch)",
+        return Units("px", "SVG user units (no physical width over a viewBox: CSS pixels, 96 per inch)",
                      _SVG_MM["px"]), 1.0 / px_per_user
     name = next((n for n, f in MM_PER_UNIT.items() if math.isclose(f, user_mm, rel_tol=1e-12)),
                 f"user units of {user_mm:g} mm")
