@@ -443,7 +443,11 @@ def _choose(loops: list[_Piece], chains: list[_Piece], path: Path, unit: Units) 
     loops = sorted((lp for lp in loops if len(lp.points) >= 3),
                    key=lambda lp: -abs(_signed_area(lp.points)))
     chains = sorted(chains, key=lambda c: -_diagonal(c.points))
-    if chains and (not loops or _diagonal(chains[0].points) > _diagonal(loops[0].points)):
+    # A lone straight line (a centre line, a dimension) is never an outline left open.
+    could_be_outlines = [c for c in chains if len(c.points) > 2]
+    if could_be_outlines and (not loops or _diagonal(could_be_outlines[0].points) > _diagonal(loops[0].points)):
+        raise _open_error(could_be_outlines[0], path, unit)
+    if chains and not loops:
         raise _open_error(chains[0], path, unit)
     if not loops:
         raise OutlineError(f"{path}: no closed outline with an area")
@@ -472,4 +476,5 @@ def _open_error(chain: _Piece, path: Path, unit: Units) -> OutlineError:
     gap = np.hypot(*(chain.points[-1] - chain.points[0])) * unit.scale
     return OutlineError(
         f"{path}: open outline: {chain.name} ends at ({end[0]:.3f}, {end[1]:.3f}) mm, {gap:.3f} mm from "
-        f"its start; close the outline in the drawing, or raise --join-tol (drawing units) over the gaps")
+        f"its start; close the outline in the drawing, raise --join-tol (drawing units) over the gaps, "
+        f"or pick the outline with --layer/--id")

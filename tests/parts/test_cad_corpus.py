@@ -186,6 +186,15 @@ def test_svg_slot_with_transforms_and_arcs(tmp_path, transform, turn):
     _assert_same_rollouts(part, reference, 0.5)
 
 
+def test_centre_line_longer_than_the_part_is_left_out(tmp_path):
+    def build(msp):
+        _slot_issue(msp)
+        msp.add_line((-20, 0), (SL + 20, 0), dxfattribs={"layer": "CENTER"})  # 80 mm, across the slot
+    out = read_outline(_dxf(tmp_path / "c.dxf", build))
+    assert "chain of 4 pieces" in out.name
+    assert len(out.left_out) == 1 and "open chain LINE" in out.left_out[0] and "80 mm apart" in out.left_out[0]
+
+
 def test_ellipse_and_spline_pieces_join(tmp_path):
     def build(msp):
         # A D shape: the right half of an ellipse (semi-axes 20, 10) closed by a SPLINE through
