@@ -1,6 +1,7 @@
 """CAD outlines as CAD tools write them (issue 26): a corpus of DXF and SVG
 files built here with ezdxf (no binary files checked in), each compared with
 the same part given as vertices, by its rollouts at a few (theta_i, d)."""
+import functools
 import math
 import random
 
@@ -42,14 +43,9 @@ def _fine_slot(sagitta=1e-3):
     return Part.from_vertices(right + left, name="slot")
 
 
-FINE_SLOT = None
-
-
+@functools.lru_cache(maxsize=1)
 def _fine():
-    global FINE_SLOT
-    if FINE_SLOT is None:
-        FINE_SLOT = _fine_slot()
-    return FINE_SLOT
+    return _fine_slot()
 
 
 def _dxf(path, build, insunits=4):
@@ -280,18 +276,24 @@ def test_bad_outlines_are_one_line_errors(tmp_path, capsys):
     code, _, err = run_cli(capsys, _rollout_args(path, "--layer", "0"))  # the way out works
     assert code == 0 and "chain of 4 pieces" in err
 
-    def gapped(msp):
-        _shuffled_lines(msp)
-        msp.add_line((0, 0), (0, 0))  # a zero-length line is ignored
-    gap_path = _dxf(tmp_path / "gap.dxf", lambda m: (m.add_lwpolyline(L_XY[:4]),
-                                                     m.add_lwpolyline([(0, 0.05)] + L_XY[5:2:-1])))
+    def gapped(msp):  # the L in two open polylines, 0.05 mm apart at (0, 0)
+        msp.add_lwpolyline(L_XY[:4])
+        msp.add_lwpolyline([(0, 0.05)] + L_XY[5:2:-1])
+    gap_path = _dxf(tmp_path / "gap.dxf", gapped)
     _one_line_error(capsys, _rollout_args(gap_path), "open outline", "0.050 mm from its start", "--join-tol")
     code, _, err = run_cli(capsys, _rollout_args(gap_path, "--join-tol", "0.1"))
     assert code == 0 and "6 vertices" in err
     _one_line_error(capsys, _rollout_args(gap_path, "--join-tol", "-1"), "--join-tol must be")
     _one_line_error(capsys, ["rollout", "--vertices", "0,0 60,0 15,35", "--units", "in", "--mu-c", "0.2",
                              "--pin-radius", "3", "--theta-i", "30", "--d", "0.3"], "--units", "--outline")
-    assert read_outline(_dxf(tmp_path / "z.dxf", gapped)).n_vertices == 6
+
+
+def test_zero_length_line_is_ignored(tmp_path):
+    def build(msp):
+        _shuffled_lines(msp)
+        msp.add_line((0, 0), (0, 0))
+    out = read_outline(_dxf(tmp_path / "z.dxf", build))
+    assert out.n_vertices == 6 and not out.left_out
 
 
 def test_help_says_join_tol_units_and_holes(capsys):
