@@ -301,3 +301,24 @@ def test_help_says_join_tol_units_and_holes(capsys):
     text = " ".join(out.split())
     assert code == 0 and "in the drawing's units" in text and "Holes are refused" in text
     assert "--units {mm,cm,m,in}" in text
+
+
+def test_config_part_takes_units_and_join_tol(tmp_path):
+    import yaml
+
+    from pipeline.config import DEFAULT_CONFIG, validate_config
+    from pipeline.errors import PinfeedError
+    from pipeline.parts.families import family_parts
+
+    def gapped(msp):  # the L drawn in inches, read as mm unless told, 0.002 in apart at (0, 0)
+        msp.add_lwpolyline(np.divide(L_XY[:4], 25.4).tolist())
+        msp.add_lwpolyline((np.array([(0, 0.05)] + L_XY[5:2:-1]) / 25.4).tolist())
+    path = _dxf(tmp_path / "l.dxf", gapped, insunits=0)
+    cfg = yaml.safe_load(DEFAULT_CONFIG.read_text())
+    cfg["planner"]["parts"] = []
+    cfg["families"] = {"cad": {"parts": [{"name": "l", "outline": str(path), "units": "in", "join_tol": 0.01}]}}
+    (part,) = family_parts("cad", validate_config(cfg)["families"]["cad"])
+    assert part.area == pytest.approx(900.0, rel=1e-3)
+    cfg["families"]["cad"]["parts"][0]["units"] = "furlong"
+    with pytest.raises(PinfeedError, match="units"):
+        validate_config(cfg)
