@@ -55,12 +55,15 @@ def _part_from_args(args):
     from pipeline.parts.part import Part, parse_vertices
     if getattr(args, "outline", None):
         from pipeline.parts.outlines import read_outline
-        out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol)
+        out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol,
+                           units=args.units, join_tol=args.join_tol)
         print(f"outline {out.describe()}", file=sys.stderr)
+        for line in out.warnings():
+            print(f"pinfeed: warning: {line}", file=sys.stderr)
         name = args.name or re.sub(r"[^A-Za-z0-9_]", "_", Path(args.outline).stem) or "part"
         return Part.from_vertices(out.vertices, name=name)
-    if getattr(args, "layer", None) or getattr(args, "id", None):
-        raise PinfeedError("--layer and --id pick an outline in an --outline file")
+    if any(getattr(args, k, None) is not None for k in ("layer", "id", "units", "join_tol")):
+        raise PinfeedError("--layer, --id, --units and --join-tol apply to an --outline file")
     return Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
 
 
@@ -69,10 +72,18 @@ def _add_outline_args(p, required=True):
     g = p.add_mutually_exclusive_group(required=required)
     g.add_argument("--vertices", help='part outline "x0,y0 x1,y1 ..." (mm)')
     g.add_argument("--outline", metavar="FILE",
-                   help="or a CAD outline: a .dxf or .svg file holding one closed outline")
+                   help="or a CAD outline: a .dxf or .svg file; its pieces are joined into closed loops "
+                   "and the largest is the part (the others are reported). Holes are refused (not "
+                   "modelled): put them on another layer and pick the outline with --layer")
     p.add_argument("--layer", default=None, metavar="NAME",
                    help="DXF layer of the outline (when the file holds several)")
     p.add_argument("--id", default=None, help="SVG element id or DXF entity handle of the outline")
+    p.add_argument("--units", default=None, choices=["mm", "cm", "m", "in"],
+                   help="units of the outline file's coordinates, overriding the file's own "
+                   "(DXF $INSUNITS, unitless: mm; SVG width/height over viewBox)")
+    p.add_argument("--join-tol", dest="join_tol", type=float, default=None, metavar="TOL",
+                   help="largest gap between piece ends that are joined, in the drawing's units "
+                   "(default 1e-4 of the drawing's size)")
     p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=0.05, metavar="MM",
                    help="chordal tolerance for flattening arcs and curves, mm (default 0.05)")
     p.add_argument("--name", default=None, help="part name used in outputs (default: part, or the "
@@ -203,10 +214,10 @@ def cmd_demo(args):
 
 
 def _catalog(args):
-    from pipeline.maps.catalog import Catalog
+    from pipeline.maps.catalog import RECOMPUTE, Catalog
     cat = Catalog.open(args.catalog)
     for problem in cat.problems:
-        print(f"pinfeed: warning: {problem} (not served)", file=sys.stderr)
+        print(f"pinfeed: warning: {problem} (not served; {RECOMPUTE})", file=sys.stderr)
     return cat
 
 

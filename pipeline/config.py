@@ -65,7 +65,7 @@ def resolve_outlines(cfg: dict, base_dir) -> None:
             if ("vertices" in p) == ("outline" in p):
                 raise PinfeedError(f"{where}: give either vertices or outline (a DXF or SVG file), "
                                    f"{'not both' if 'vertices' in p else 'one of them'}")
-            extra = [k for k in ("layer", "id", "flatten_tol") if k in p and "outline" not in p]
+            extra = [k for k in ("layer", "id", "flatten_tol", "units", "join_tol") if k in p and "outline" not in p]
             if extra:
                 raise PinfeedError(f"{where}: {', '.join(extra)} only apply to an outline file")
             if isinstance(p.get("outline"), str):
