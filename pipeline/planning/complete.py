@@ -16,16 +16,19 @@ trying every sequence, level by level:
 1. enumerate all sequences of the level by nominal rollouts;
 2. keep those whose nominal finals span at most ``T + SLACK_DEG`` (modulo the
    part's symmetry), narrowest first;
-3. replay a fixed subset of the verification trials (``SCREEN_RANDOM`` random
-   trials per state and ``SCREEN_CORNERS`` corners) for all of them at once;
-   a sequence whose subset already has more failures than the whole
-   verification allows is rejected (exact: more trials cannot mend it);
+3. replay a small subset of the verification trials (``PROBE``: two random
+   trials and two corners per state) for all of them at once, and order them
+   by its failures; then, in blocks of ``SCREEN_BLOCK`` in that order, a larger
+   subset (``SCREEN``: 12 and 8). A sequence whose subset already has more
+   failures than the whole verification allows is rejected (exact: more
+   trials cannot mend it);
 4. replay all the verification trials for the survivors and judge them;
 5. stop at the first level where some sequence orients.
 
 Among the orienting sequences of that level the narrowest verified width
 wins, then the larger margin in d; at least ``candidates`` survivors of step
-3 are judged (all of them if fewer), so the width ranking is over those.
+3 are judged (all of them if fewer), so the width ranking is over those;
+blocks after that are not screened (``not_screened`` in the level's counts).
 
 When no sequence of up to ``N`` pins orients, the result says so with the
 evidence: per level, how many sequences were enumerated, kept, screened out
@@ -49,8 +52,9 @@ from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import replay, trial_inputs
 
 SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
-SCREEN_RANDOM = 12  # random trials per resting state in the screen
-SCREEN_CORNERS = 8  # corners per resting state in the screen
+PROBE = (2, 2)  # random trials and corners per resting state that order the candidates
+SCREEN = (12, 8)  # random trials and corners per resting state in the screen
+SCREEN_BLOCK = 96  # candidates screened at once
 MAX_ROWS = 150_000  # trials replayed in one batch
 
 
@@ -168,7 +172,7 @@ class FixedPinSearch:
         """Search levels 1 to ``depth``; stop at the first level with an orienting plan."""
         t0 = time.perf_counter()
         result = FixedSearch([], [], int(depth), self.tolerance, self.required)
-        runners_up = []
+        runners_up, levels = [], []
         for level in self.tree.levels(int(depth)):
             n_pins = level.seq.shape[1] if level.size else len(result.levels) + 1
             found, judged, record = self._level(level, candidates)
@@ -181,8 +185,10 @@ class FixedPinSearch:
             if found:
                 result.plans = sorted(found, key=FixedPlan.rank_key)[:keep]
                 break
-            runners_up.extend(self._several_sets(level, candidates))
-        if not result.plans:
+            levels.append(level)
+        if not result.plans:  # the evidence: the best several-set results of every level
+            for level in levels:
+                runners_up.extend(self._several_sets(level, candidates))
             result.best_effort = sorted(runners_up, key=FixedPlan.rank_key)[:keep]
         result.rollouts = self.tree.rollouts
         result.seconds = time.perf_counter() - t0
@@ -193,7 +199,7 @@ class FixedPinSearch:
     def _level(self, level, candidates):
         """``(orienting plans, every judged plan, the level's counts)``."""
         record = {"sequences": level.size, "nominal_within": 0, "screened_out": 0, "judged": 0,
-                  "orienting": 0}
+                  "orienting": 0, "not_screened": 0}
         if level.size == 0:
             return [], [], record
         span = orient.row_spans(level.theta, self.order)
@@ -206,24 +212,32 @@ class FixedPinSearch:
         inputs = trial_inputs(self.states, self.mu_c, n_pins, self.cfg)
         n_total = sum(x[0].size for x in inputs)
         allowed = n_total - orient.needed(n_total, self.required)
-        screen = self._screen_rows(inputs)
-        fails = self._failures(level, within, screen)
-        alive = within[fails <= allowed]
-        alive = alive[np.argsort(fails[fails <= allowed], kind="stable")]
-        record["screened_out"] = int(within.size - alive.size)
+        # A probe of a few trials per state orders the candidates (most promising
+        # first) and already rejects the hopeless ones.
+        probe_fails = self._failures(level, within, self._screen_rows(inputs, *PROBE))
+        order = within[probe_fails <= allowed][np.argsort(probe_fails[probe_fails <= allowed], kind="stable")]
+        record["screened_out"] = int(within.size - order.size)
+        screen, full = self._screen_rows(inputs, *SCREEN), self._all_rows(inputs)
         found, judged = [], []
-        full = self._all_rows(inputs)
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
-        for start in range(0, alive.size, step):
-            chunk = alive[start:start + step]
-            for idx, verdict in zip(chunk, self._judge(level, chunk, full)):
-                plan = self._plan(level, idx, span[idx], verdict)
-                judged.append(plan)
-                if verdict["orients"]:
-                    found.append(plan)
-            if found and len(judged) >= candidates:
-                break
+        done = 0
+        while done < order.size and not (found and len(judged) >= candidates):
+            block = order[done:done + SCREEN_BLOCK]
+            done += block.size
+            fails = self._failures(level, block, screen)
+            alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
+            record["screened_out"] += int(block.size - alive.size)
+            for start in range(0, alive.size, step):
+                chunk = alive[start:start + step]
+                for idx, verdict in zip(chunk, self._judge(level, chunk, full)):
+                    plan = self._plan(level, idx, span[idx], verdict)
+                    judged.append(plan)
+                    if verdict["orients"]:
+                        found.append(plan)
+                if found and len(judged) >= candidates:
+                    break
         record["judged"], record["orienting"] = len(judged), len(found)
+        record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
         return found, judged, record
 
     def _plan(self, level, idx, span, verdict) -> FixedPlan:
@@ -231,16 +245,17 @@ class FixedPinSearch:
         return FixedPlan(tuple(self.labels[i] for i in seq), tuple(float(self.heights[i]) for i in seq),
                          float(span), float(level.margin[idx]), verdict)
 
-    def _screen_rows(self, inputs):
-        """The screen's trials: the first random trials and evenly spread corners of each state."""
+    def _screen_rows(self, inputs, n_first: int, n_corners_wanted: int):
+        """A subset of the verification trials: the first ``n_first`` random trials
+        and ``n_corners_wanted`` evenly spread corners of each state."""
         n_random = int(self.cfg["trials"])
         rows = []
         for th, yc, mu, offs in inputs:
             n_corners = th.size - n_random
-            pick = list(range(min(SCREEN_RANDOM, n_random)))
+            pick = list(range(min(n_first, n_random)))
             if n_corners:
-                step = max(1, n_corners // SCREEN_CORNERS)
-                pick += list(range(n_random, th.size, step))[:SCREEN_CORNERS]
+                step = max(1, n_corners // n_corners_wanted)
+                pick += list(range(n_random, th.size, step))[:n_corners_wanted]
             rows.append((th[pick], yc[pick], mu[pick], offs[pick]))
         return self._stack(rows)
 

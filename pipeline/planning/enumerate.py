@@ -5,8 +5,8 @@ on the fence (no perturbation) and rolls it past each pin in turn at one
 friction. All sequences of one length are one level: the level's states are
 arrays ``(sequences, resting states)``, and going one pin deeper repeats
 each sequence once per candidate pin and rolls out every (state, pin) pair
-in one parallel batch. Pairs that start from the same pose (to within
-``QUANTUM`` degrees and millimetres) share one rollout: different
+in one parallel batch. Pairs whose start poses round to the same multiple
+of ``QUANTUM`` (degrees and millimetres) share one rollout: different
 sequences often bring a state to the same pose (a pin that misses leaves it
 as it was; a vertex pushed to rest ends where the vertex sits behind the
 centroid whatever the offset was).
@@ -34,7 +34,7 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
 
-QUANTUM = 0.01  # deg and mm: poses closer than this share one nominal rollout
+QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout
 
 
 @dataclass
