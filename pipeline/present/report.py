@@ -236,6 +236,17 @@ def _speed_cell(speed: dict | None, friction: str, pins) -> str:
     return f"<td>{speed['speed_limit_mm_s']:g}</td>"
 
 
+def _width_cell(plan: dict) -> str:
+    """The verified width beside the claim: red when the plan does not orient the part."""
+    o = (plan.get("verification") or {}).get("orientation")
+    if not o:
+        return "<td>n/a</td>"
+    width = "n/a" if o["width_deg"] is None else f"{o['width_deg']:.1f}"
+    text = (f"{width}: {o['in_tolerance']}/{o['trials']} in {o['tolerance_deg']:g} deg"
+            + ("" if o["orients"] else f" (does not orient: {o['sets_within_tolerance']} sets)"))
+    return f"<td>{html.escape(text)}</td>" if o["orients"] else f"<td style='color:#b00'>{html.escape(text)}</td>"
+
+
 def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> list[str]:
     """The paper-mode plan beside the tight planner's, with verification counts
     and the speed limit (mm/s, dynamic model) of the plan the speed stage replayed."""
@@ -243,6 +254,7 @@ def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> lis
     p = ['<h4>Paper mode beside the tight planner</h4><table class="side-by-side"><tr><th>planner</th>'
          "<th>friction mu_c</th><th>pins (height, mm)</th><th>final sets</th>"
          "<th>orientation sets</th><th>verified (successes/trials)</th>"
+         "<th>verified width (deg): trials in one set of the tolerance</th>"
          "<th>speed limit (mm/s)</th></tr>"]
     static = res.get("best_static")
     if static:
@@ -250,11 +262,11 @@ def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> lis
         sets = format_arcs(static["final_sets"])
         p.append(f"<tr><td>paper mode, fixed pins</td><td>{res['mu_c']:g} (stored maps)</td>"
                  f"<td>{html.escape(pins)}</td><td>{static['n_final_sets']}</td><td>{sets}</td>"
-                 f"<td>{_counts(checks.get('paper mode, fixed pins'))}</td><td>n/a</td></tr>")
+                 f"<td>{_counts(checks.get('paper mode, fixed pins'))}</td><td>n/a</td><td>n/a</td></tr>")
     for t in res.get("tight", []):
         plan = t["recommended"]
         if plan is None:
-            p.append(f"<tr><td>tight</td><td>{t['friction']}</td><td colspan=5 style='color:#b00'>"
+            p.append(f"<tr><td>tight</td><td>{t['friction']}</td><td colspan=6 style='color:#b00'>"
                      f"{html.escape(t['warning'] or 'no plan')}</td></tr>")
             continue
         pins = ", ".join(f"{q} ({y:g})" for q, y in zip(plan["pins"], plan["pin_heights_mm"]))
@@ -263,7 +275,7 @@ def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> lis
         p.append(f"<tr><td>{planner}</td><td>{t['friction']}</td><td>{html.escape(pins)}</td>"
                  f"<td>{plan['n_final_sets']}</td><td>{sets}</td>"
                  f"<td>{_counts(checks.get('tight, mu_c ' + t['friction']))}</td>"
-                 f"{_speed_cell(speed, t['friction'], plan['pins'])}</tr>")
+                 f"{_width_cell(plan)}{_speed_cell(speed, t['friction'], plan['pins'])}</tr>")
     p.append("</table>")
     return p
 
