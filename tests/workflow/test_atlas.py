@@ -1,0 +1,122 @@
+"""The feedability atlas (issue 23): its rows against the plan files they
+summarise, its CSV against its JSON, ``pinfeed atlas``, and planner.parts
+naming families, ``all`` and bad names."""
+import copy
+import csv
+import json
+
+import pytest
+
+from cli_runs import run_cli
+
+from pipeline.config import load_config, validate_config
+from pipeline.errors import PinfeedError
+from pipeline.maps.io import write_json
+from pipeline.parts.part import Part
+from pipeline.workflow.atlas import COLUMNS, build_atlas, write_atlas
+from pipeline.workflow.commands import plan_tight_only
+
+PARTS = {"right_triangle": [[0, 0], [50, 0], [0, 30]],
+         "flat_bar": [[0, 0], [60, 0], [60, 12], [0, 12]]}
+
+
+@pytest.fixture(scope="module")
+def planned(tmp_path_factory):
+    """Plan files of two parts made by the real planner (small settings), with a
+    speed and a layout file for one of them."""
+    root = tmp_path_factory.mktemp("atlas")
+    config = load_config()
+    config["catalog_dir"] = str(root / "catalog")
+    pc = config["planner"]
+    pc.update(depth=2, mu_c=0.15, frictions=[], tolerance_deg=12.0)
+    pc["dynamic"].update(depth=0, speeds=[])
+    config["verify"].update(trials=10)
+    paths = []
+    for name, vertices in PARTS.items():
+        path = root / "plans" / f"{name}.json"
+        write_json(plan_tight_only(Part.from_vertices(vertices, name=name), config), path)
+        paths.append(path)
+    speed = write_json({"part": "right_triangle", "speed_limit_mm_s": 210.0}, root / "speed" / "right_triangle.json")
+    layout = write_json({"part": "right_triangle", "belt_speed_mm_s": 168.0, "throughput_per_min": 55.5},
+                        root / "layout_right_triangle.json")
+    return config, root, paths, [speed], [layout]
+
+
+def test_atlas_rows_match_the_plan_files(planned):
+    config, root, paths, speeds, layouts = planned
+    atlas = build_atlas(config, paths, speeds, layouts)
+    assert [r["part"] for r in atlas["rows"]] == list(PARTS)
+    for row, path in zip(atlas["rows"], paths):
+        entry = json.loads(path.read_text())["tight"][0]
+        rec = entry["recommended"]
+        verdict = rec["verification"]["orientation"] if rec else {}
+        assert row["plan"] == (" ".join(rec["pins"]) if rec else None)
+        assert row["orients"] == bool(verdict.get("orients"))
+        assert row["verified_width_deg"] == verdict.get("width_deg")
+        assert row["in_set"] == verdict.get("in_tolerance") and row["trials"] == verdict.get("trials")
+        assert row["tolerance_deg"] == 12.0
+        if rec:
+            assert row["fixed_pins"] + row["moving_pins"] == len(rec["pins"])
+        assert row["sensor_needed"] == (not row["orients"])
+        assert row["evidence"] == entry["fixed_pin_search"]["evidence"]
+    tri = atlas["rows"][0]
+    assert (tri["speed_limit_mm_s"], tri["throughput_per_min"]) == (210.0, 55.5)
+    assert atlas["rows"][1]["speed_limit_mm_s"] is None  # no speed file: left empty, not invented
+
+
+def test_atlas_csv_matches_its_json_and_cli_prints_it(planned, capsys):
+    config, root, paths, speeds, layouts = planned
+    results = root / "results"
+    write_atlas(build_atlas(config, paths, speeds, layouts), results / "atlas.json", results / "atlas.csv")
+    stored = json.loads((results / "atlas.json").read_text())
+    with open(results / "atlas.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(rows[0]) == list(COLUMNS)
+    for got, want in zip(rows, stored["rows"], strict=True):
+        assert got == {k: "" if want[k] is None else str(want[k]) for k in COLUMNS}
+    code, out, err = run_cli(capsys, ["atlas", "--results", str(results)])
+    assert code == 0, err
+    for row in stored["rows"]:
+        assert any(line.startswith(row["part"]) and row["outcome"] in line for line in out.splitlines())
+    code, out, _ = run_cli(capsys, ["atlas", "--results", str(results), "--json"])
+    assert code == 0 and json.loads(out)["rows"] == stored["rows"]
+
+
+def test_atlas_missing_is_one_line(tmp_path, capsys):
+    code, out, err = run_cli(capsys, ["atlas", "--results", str(tmp_path)])
+    assert code != 0 and "no atlas at" in err and "make run" in err and len(err.strip().splitlines()) == 1
+
+
+def _config(parts, families=None):
+    cfg = copy.deepcopy(load_config())
+    if families is not None:
+        cfg["families"] = families
+    cfg["planner"]["parts"] = parts
+    cfg["sensing"]["parts"] = []
+    return cfg
+
+
+def test_planner_parts_take_families_and_all():
+    fams = {"a": {"parts": [{"name": "p1", "vertices": PARTS["right_triangle"]}]},
+            "b": {"parts": [{"name": "p2", "vertices": PARTS["flat_bar"]},
+                            {"name": "p3", "vertices": [[0, 0], [40, 0], [20, 60]]}]}}
+    assert validate_config(_config(["b"], fams))["planner"]["parts"] == ["p2", "p3"]
+    assert validate_config(_config(["all"], fams))["planner"]["parts"] == ["p1", "p2", "p3"]
+    assert validate_config(_config(["p3", "b", "p1"], fams))["planner"]["parts"] == ["p3", "p2", "p1"]
+
+
+@pytest.mark.parametrize("parts, families, words", [
+    (["nope"], None, "nope is neither a part, a family nor 'all'"),
+    (["empty"], {"empty": {"parts": []}, "a": {"parts": [{"name": "p1", "vertices": PARTS["flat_bar"]}]}},
+     "family empty has no parts"),
+])
+def test_planner_parts_bad_names_are_one_line(parts, families, words):
+    with pytest.raises(PinfeedError) as exc:
+        validate_config(_config(parts, families))
+    assert words in str(exc.value) and "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("bad", ["0", "-5", "360", "1e9"])
+def test_plan_tolerance_out_of_range_is_one_line(bad, capsys):
+    code, out, err = run_cli(capsys, ["plan", "--vertices", "0,0 50,0 0,30", f"--tolerance={bad}"])
+    assert code != 0 and "tolerance" in err and len(err.strip().splitlines()) == 1
