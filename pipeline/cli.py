@@ -310,7 +310,8 @@ def cmd_sweep(args):
         config["catalog_dir"] = args.catalog
     written = run_sweep(config, scheduler=args.scheduler, threads=args.threads,
                         progress=not args.quiet, backend=args.backend)
-    print(f"computed {len(written)} shards; catalog index at {config['catalog_dir']}/index.json")
+    index = Path(config["catalog_dir"]).resolve() / "index.json"
+    print(f"computed {len(written)} shards; catalog index at {index}")
 
 
 
