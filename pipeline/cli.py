@@ -318,7 +318,7 @@ def cmd_sweep(args):
 def cmd_plan(args):
     """Plan a part (see :func:`pipeline.workflow.commands.plan_command`)."""
     from pipeline.config import load_config
-    from pipeline.workflow.commands import plan_command, planner_settings
+    from pipeline.workflow.commands import plan_command, plan_store_path, planner_settings
     speeds = None if args.speeds is None else (parse_values(args.speeds, "--speeds") if args.speeds else [])
     pins = parse_values(args.pins, "--pins") if args.pins else None
     config = planner_settings(load_config(args.config), catalog=args.catalog, mu_c=args.mu_c,
@@ -326,14 +326,33 @@ def cmd_plan(args):
                               dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
                               mu_s=args.mu_s)
     part = _plan_part_arg(args, config)
+    out = plan_store_path(config, part.name, args.out)  # checked before any work
     result = plan_command(part, config, args.mode, progress=None if args.json else _progress)
-    if args.out:
+    if out is not None:
         from pipeline.maps.io import write_json
-        write_json(result, args.out)
+        write_json(result, out)
     if args.json:
         _print_json(_plan_json(result, args.mode), default=float)
+    else:
+        _print_plan_result(result, part, config, args.mode)
+    _print_stored(result, out, config, args.config, sys.stderr if args.json else sys.stdout)
+
+
+def _print_stored(result, out, config, config_path, stream):
+    """Where the plan went and the commands that use it (``stream``: stderr with
+    ``--json``, which keeps stdout one JSON document)."""
+    from pipeline.workflow.commands import next_step_hints
+    if out is None:
+        print(f"not stored: the workflow stores {result['part']['name']}'s plan; give --out FILE.json "
+              f"to keep this one", file=stream)
         return
-    _print_plan_result(result, part, config, args.mode)
+    print(f"stored the plan at {out}", file=stream)
+    hints = next_step_hints(result, out, config, config_path)
+    if hints:
+        print("next: " + "\n      ".join(hints), file=stream)
+    else:
+        print("(speed, layout and animate read RESULTS/plans/NAME.json: store it there to use them)",
+              file=stream)
 
 
 def _progress(message):
@@ -432,17 +451,14 @@ def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from pipeline.config import load_config
     from pipeline.planning.speed_limit import stored_plan_speed
-    from pipeline.planning.types import validate_plan_file
+    from pipeline.workflow.commands import stored_plan
     config = load_config(args.config)
-    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
-    if not path.is_file():
-        raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
-                           f"{args.part} --mode both --out {path}' or the workflow ('make run') first")
+    result, _ = stored_plan(config, _results_arg(args, config), args.part, args.config)
     if not (args.mu_s > 0):
         raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
     if args.trials < 1:
         raise PinfeedError(f"--trials must be at least 1, got {args.trials}")
-    out = stored_plan_speed(validate_plan_file(path), config, plan=args.plan, mu_text=args.mu_c,
+    out = stored_plan_speed(result, config, plan=args.plan, mu_text=args.mu_c,
                             mu_s=args.mu_s, trials=args.trials)
     if args.json:
         _print_json(out, default=float)
@@ -456,19 +472,24 @@ def cmd_speed(args):
 
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
+    from pipeline.checks import check_out_path
     from pipeline.config import load_config
     from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
     from pipeline.workflow.commands import layout_settings, stored_plan
     config = load_config(args.config)
-    if args.out:
-        check_drawing_path(args.out)  # before minutes of trials
+    as_json = args.out is not None and Path(args.out).suffix.lower() == ".json"
+    if args.out:  # before minutes of trials
+        check_out_path(args.out, (".json",)) if as_json else check_drawing_path(args.out)
     settings = layout_settings(args.margin, args.trials)
-    result, _ = stored_plan(config, _results_arg(args, config), args.part)
+    result, _ = stored_plan(config, _results_arg(args, config), args.part, args.config)
     out = layout_stored(result, config, args.plan, args.mu_c, belt_speed=args.belt_speed,
                         mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
     for warning in out["warnings"]:
         print(f"pinfeed: warning: {warning}", file=sys.stderr)
-    if args.out:
+    if as_json:
+        from pipeline.maps.io import write_json
+        write_json(out, args.out)
+    elif args.out:
         write_drawing(out, args.out)
     if args.json:
         _print_json(out, default=float)
@@ -503,9 +524,10 @@ def cmd_animate(args):
     from pipeline.present.animate import animate_stored
     from pipeline.workflow.commands import animation_inputs, stored_plan
     config = load_config(args.config)
-    result, path = stored_plan(config, _results_arg(args, config), args.part)
+    result, path = stored_plan(config, _results_arg(args, config), args.part, args.config)
     stored_layout = path.parent.parent / f"layout_{args.part}.json"
-    inputs, layout = animation_inputs(result, config, args.part, args.plan, args.layout, stored_layout)
+    inputs, layout = animation_inputs(result, config, args.part, args.plan, args.layout, stored_layout,
+                                      dict(config_path=args.config, results=args.results))
     if layout is not None:
         pins = " -> ".join(f"{r['label']} at x {r['x_mm']:.1f}, y {r['y_mm']:g} mm" for r in layout["stations"])
         print(f"animating the laid-out {inputs['what']} of {args.part}: {pins}; pitch "
@@ -815,7 +837,8 @@ def _add_layout_commands(sub) -> None:
                    help="station margin, mm (default: the config's layout.station_margin_mm, 5)")
     p.add_argument("--trials", type=int, default=None,
                    help="random trials per initial state (default: the config's layout.trials)")
-    p.add_argument("--out", default=None, help="also draw the feeder: .dxf, .svg or .png")
+    p.add_argument("--out", default=None, help="also draw the feeder (.dxf, .svg or .png) or write "
+                   "the layout JSON (.json; 'pinfeed animate --layout' reads RESULTS/layout_NAME.json)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--results", default=None, help="results folder holding plans/ "
                    "(default: the config's, RESULTS_DIR/NAME)")
@@ -845,6 +868,10 @@ def main(argv=None) -> int:
         return 2
     except BrokenPipeError:  # e.g. piped into head
         return 0
+    except KeyboardInterrupt:  # Ctrl-C: one line; writes are atomic, finished work is kept
+        print("pinfeed: interrupted; finished files and the rollouts computed so far are kept "
+              "(the next run reuses them)", file=sys.stderr)
+        return 130
     return 0
 
 

@@ -248,10 +248,20 @@ def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progre
                                 belt_speed=belt_speed, mu_s=mu_s)
                 for v in speeds}
     out = []
-    for mu_c in plan_frictions(config):
-        res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep, progress=progress)
-        res.pop("lattices")
-        out.append(res)
-    for lattice in lattices.values():
-        save_lattice(catalog_root, lattice)
+    try:
+        for mu_c in plan_frictions(config):
+            res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep,
+                             progress=_labelled(progress, f"mu_c {friction_label(mu_c)}"))
+            res.pop("lattices")
+            out.append(res)
+    finally:  # also on Ctrl-C: the rollouts done so far are reused by the next run
+        for lattice in lattices.values():
+            save_lattice(catalog_root, lattice)
     return out
+
+
+def _labelled(progress, label: str):
+    """``progress`` with each message prefixed by ``label`` (which friction it is for)."""
+    if progress is None:
+        return None
+    return lambda message: progress(f"{label}: {message}")
