@@ -450,22 +450,19 @@ def _results_arg(args, config) -> Path:
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from pipeline.config import load_config
-    from pipeline.planning.speed_limit import stored_plan_speed
-    from pipeline.workflow.commands import stored_plan
+    from pipeline.planning.speed_limit import speed_label
+    from pipeline.workflow.commands import speed_command, stored_plan
     config = load_config(args.config)
     result, _ = stored_plan(config, _results_arg(args, config), args.part, args.config)
-    if not (args.mu_s > 0):
-        raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
-    if args.trials < 1:
-        raise PinfeedError(f"--trials must be at least 1, got {args.trials}")
-    out = stored_plan_speed(result, config, plan=args.plan, mu_text=args.mu_c,
-                            mu_s=args.mu_s, trials=args.trials)
+    out, stored = speed_command(result, config, args.plan, args.mu_c, args.mu_s, args.trials)
     if args.json:
         _print_json(out, default=float)
         return
+    same = out["source"] == "stored with the plan"
+    other = "" if same or not stored else f"; the plan file stores {speed_label(stored)}"
     print(f"{out['part']}, plan {' '.join(out['pin_labels'])} (mu_c {out['friction']}, mu_s "
-          f"{args.mu_s:g}): speed limit {out['speed_limit_mm_s']:g} mm/s "
-          f"({out['trials_per_speed']} trials per speed, {out['seconds']:.0f} s)")
+          f"{out['mu_s']:g}): speed limit {speed_label(out)}"
+          + (", stored with the plan" if same else f", {out['seconds']:.0f} s") + other)
     for speed, frac in out["curve"]:
         print(f"  {speed:7.1f} mm/s: {100 * frac:5.1f} % of trials in the final set")
 
@@ -501,6 +498,7 @@ def cmd_layout(args):
 
 def _print_layout(out: dict):
     """The stations, belt, pitch and throughput of a layout, for people."""
+    from pipeline.present.layout import speed_limit_text
     m = out["method"]
     print(f"{out['part']}, plan {out['plan']['number']}: {' '.join(out['plan']['pins'])} "
           f"(mu_c {out['plan']['friction']}); model {m['model']}, {m['trials']['replayed']} trials "
@@ -510,7 +508,7 @@ def _print_layout(out: dict):
               f"radius {s['radius_mm']:g} mm")
     speed = out["belt_speed_mm_s"]
     print(f"belt speed {'n/a' if speed is None else f'{speed:.1f} mm/s'} ({m['belt_speed']}); "
-          f"speed limit {out['speed_limit_mm_s']:g} mm/s")
+          f"speed limit {speed_limit_text(out)}")
     print(f"pitch {out['pitch_mm']:.1f} mm; belt width {out['belt_width_mm']:.1f} mm "
           f"(y {out['belt_y_mm'][0]:.1f} to {out['belt_y_mm'][1]:.1f}); fence at y = 0 up to "
           f"x = {out['fence_end_x_mm']:.1f} mm")
@@ -810,8 +808,12 @@ def _add_stored_plan_commands(sub) -> None:
     p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
     p.add_argument("--plan", type=int, default=1, help="which tight plan, 1 = the recommended one")
     p.add_argument("--mu-c", dest="mu_c", default=None, help="which planned friction: X or LO:HI")
-    p.add_argument("--mu-s", dest="mu_s", type=float, default=0.5, help="belt friction (default 0.5)")
-    p.add_argument("--trials", type=int, default=300, help="random trials per initial state (default 300)")
+    p.add_argument("--mu-s", dest="mu_s", type=float, default=None,
+                   help="belt friction (default: the plan's stored speed limit's, else the config's "
+                        "speed.mu_s, 0.5)")
+    p.add_argument("--trials", type=int, default=None,
+                   help="random trials per initial state (default: those of the speed limit stored "
+                        "with the plan, else the config's speed.trials); other settings recompute it")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--results", default=None, help="results folder holding plans/ "
                    "(default: the config's, RESULTS_DIR/NAME)")

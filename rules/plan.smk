@@ -22,7 +22,7 @@ rule plan:
     output:
         plan=f"{RESULTS}/plans/{{name}}.json",
     params:
-        settings={k: config[k] for k in ("planner", "bands", "verify")},
+        settings={k: config[k] for k in ("planner", "bands", "verify", "speed")},
         sweep={k: config["sweep"][k] for k in ("pin_radius", "kernel")},
     log:
         f"{LOGS}/plan/{{name}}.log",

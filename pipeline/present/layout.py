@@ -352,9 +352,12 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     (``RESULTS/plans/NAME.json``; a :class:`~pipeline.planning.types.PlanFile`
     or its dict), as ``pinfeed layout`` and the workflow make it.
 
-    The plan's speed limit is computed (``speed_limit.speed_curve`` with
-    ``speed_trials`` trials per state); without ``belt_speed`` the belt runs at
-    ``speed_fraction`` (80 %) of it. A belt speed above the limit is kept and
+    The plan's speed limit is the one stored with the plan (at the same belt
+    friction; ``speed_limit.attach_speed_limits``), else computed
+    (``speed_limit.speed_curve`` with ``speed_trials`` trials per state);
+    ``speed_limit_trials`` says which trials it comes from and
+    ``stored_speed_limit`` the plan file's figure. Without ``belt_speed`` the
+    belt runs at ``speed_fraction`` (80 %) of it. A belt speed above the limit is kept and
     named in ``warnings``. Trials use the dynamic model at that speed, or the
     plan's quasi-static model with ``quasi_static`` (or when no belt speed
     passes the speed grid at all: then there is no belt speed and no
@@ -362,7 +365,8 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     """
     from pipeline.maps import simulate
     from pipeline.planning.settings import friction_label
-    from pipeline.planning.speed_limit import DEFAULT_SPEEDS, perturbation_from_verify, speed_curve
+    from pipeline.planning.speed_limit import (DEFAULT_SPEEDS, perturbation_from_verify, speed_curve,
+                                               stored_speed_limit)
     from pipeline.planning.types import as_plan_file
     from pipeline.provenance import provenance_attrs
     cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})
@@ -375,9 +379,14 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     arcs = plan.final_arcs
     # A bad belt speed or mu_s is refused before any work.
     simulate.check_belt(part, min(DEFAULT_SPEEDS) if belt_speed is None else belt_speed, mu_s)
-    curve = speed_curve(part, heights, [0.0] * len(heights), list(states.values()), arcs, mu_c,
-                        mu_s=mu_s, perturb=perturbation_from_verify(config.get("verify", {})),
-                        trials=cfg["speed_trials"], r_pin=pin_radius, seed=cfg["seed"])
+    stored = stored_speed_limit(plan)
+    if stored and stored["settings"]["mu_s"] == mu_s:  # one speed limit per plan: the plan file's
+        curve, trials = stored, stored["trials"]
+    else:
+        trials = cfg["speed_trials"]
+        curve = speed_curve(part, heights, [0.0] * len(heights), list(states.values()), arcs, mu_c,
+                            mu_s=mu_s, perturb=perturbation_from_verify(config.get("verify", {})),
+                            trials=trials, r_pin=pin_radius, seed=cfg["seed"])
     limit = curve["speed_limit_mm_s"]
     belt_speed, source, quasi_static, warnings = _belt_speed_choice(belt_speed, limit, cfg,
                                                                     quasi_static)
@@ -395,8 +404,12 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     out["warnings"] = warnings
     out["method"]["belt_speed"] = source
     out["method"]["throughput"] = "60 x belt speed / pitch" if belt_speed else "none: no belt speed"
+    out["speed_limit_trials"] = int(trials)
+    out["stored_speed_limit"] = None if stored is None else {
+        k: stored[k] for k in ("speed_limit_mm_s", "trials", "mu_s")}
     out["method"]["speed_limit"] = {
-        "model": "dynamic", "trials_per_state": cfg["speed_trials"], "corners_per_state": 4,
+        "model": "dynamic", "trials_per_state": int(trials), "corners_per_state": 4,
+        "source": "stored with the plan" if curve is stored else "computed for this layout",
         "required_fraction": 0.99, "speeds_mm_s": list(DEFAULT_SPEEDS), "bisection_mm_s": 5.0,
         "curve": curve["curve"]}
     out.update(provenance_attrs())
@@ -412,8 +425,12 @@ def _fixed_pin_plan(result, plan_number, mu_text):
     from pipeline.planning.plan import pick_tight_plan
     plan, mu_c, entry = pick_tight_plan(result, int(plan_number), mu_text)
     if any(float(v) for v in plan.pin_speeds or ()):
+        fixed = [f"--plan {k} ({' '.join(p.pins)})" for k, p in enumerate(entry.plans, start=1)
+                 if not any(float(v) for v in p.pin_speeds or ())]
+        usable = (f"plans of fixed pins: {', '.join(fixed)}" if fixed else
+                  "no stored plan at this friction has fixed pins only; re-plan with --dynamic-depth 0")
         raise PinfeedError(f"plan {plan_number} ({' '.join(plan.pins)}) has moving pins; a layout "
-                           f"places fixed pins only: choose a plan of fixed pins with --plan N")
+                           f"places fixed pins only; {usable}")
     stored_states = entry.initial_states or result.initial_states or {}
     return plan, mu_c, {k: (float(s.theta), float(s.y_c)) for k, s in stored_states.items()}
 
@@ -442,6 +459,18 @@ def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
             warnings.append(f"belt speed {belt_speed:g} mm/s is above the plan's speed limit "
                             f"{limit:g} mm/s (fewer than 99 % of its trials end in the final set)")
     return belt_speed, source, quasi_static, warnings
+
+
+def speed_limit_text(layout: dict) -> str:
+    """A layout's speed limit with the trials it comes from, and the plan file's
+    figure when that differs: one speed limit per plan, or a labelled other one."""
+    trials = layout.get("speed_limit_trials")
+    text = f"{layout['speed_limit_mm_s']:g} mm/s" + (f" ({trials} trials per state)" if trials else "")
+    stored = layout.get("stored_speed_limit")
+    if stored and (stored["speed_limit_mm_s"], stored["trials"]) != (layout["speed_limit_mm_s"], trials):
+        text += (f"; the plan file stores {stored['speed_limit_mm_s']:g} mm/s ({stored['trials']} trials "
+                 f"per state, mu_s {stored['mu_s']:g})")
+    return text
 
 
 DRAWING_SUFFIXES = (".dxf", ".svg", ".png")

@@ -16,6 +16,7 @@ from pipeline.config import config_hash
 from pipeline.maps.io import write_text_atomic
 from pipeline.planning.arcs import format_arcs
 from pipeline.present.figures.tables import HEADER, verification_rows
+from pipeline.present.layout import speed_limit_text
 from pipeline.provenance import creation_time, git_commit
 
 SECTIONS = (("outline", "Outline"), ("maps", "Configuration maps"), ("plans", "Plans"),
@@ -135,7 +136,7 @@ def _layout_section(lay: dict, files: dict, base) -> list[str]:
     p = [f"<p>Plan {lay['plan']['number']} ({html.escape(' '.join(lay['plan']['pins']))}): "
          f"<b>throughput {'n/a' if tp is None else f'{tp:.1f}'} parts/min</b> at belt speed "
          f"{'n/a' if v is None else f'{v:.1f}'} mm/s ({html.escape(lay['method']['belt_speed'])}); "
-         f"<b>speed limit {lay['speed_limit_mm_s']:g} mm/s</b>; pitch {lay['pitch_mm']:.1f} mm; belt "
+         f"<b>speed limit {html.escape(speed_limit_text(lay))}</b>; pitch {lay['pitch_mm']:.1f} mm; belt "
          f"width {lay['belt_width_mm']:.1f} mm; model {html.escape(lay['method']['model'])}, "
          f"{lay['method']['trials']['replayed']} trials. Stations: " + ", ".join(
              f"{html.escape(s['label'])} at x = {s['x_mm']:.1f} mm, y = {s['y_mm']:g} mm"
@@ -227,7 +228,7 @@ def _speed_cell(speed: dict | None, friction: str, pins) -> str:
         return "<td>n/a</td>"
     if speed.get("friction") != friction or list(speed.get("pin_labels", [])) != list(pins):
         return "<td>n/a</td>"
-    return f"<td>{speed['speed_limit_mm_s']:g}</td>"
+    return f"<td>{speed['speed_limit_mm_s']:g} ({speed['trials']} trials per state)</td>"
 
 
 def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> list[str]:

@@ -94,14 +94,16 @@ def plan_tight_only(part: Part, config: dict, progress=None) -> dict:
 
 def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     """What ``pinfeed plan`` stores: plans of ``part`` with the planner(s) of
-    ``mode`` (``tight``, ``paper`` or ``both``), each verified. A belt speed
+    ``mode`` (``tight``, ``paper`` or ``both``), each verified, the tight ones
+    with their speed limit (``speed_limit.attach_speed_limits``). A belt speed
     plans with the tight planner only (a one-line error otherwise)."""
     belt_speed, _ = planner_belt(config, part)  # a bad belt: a one-line error before any work
     if belt_speed is not None and mode != "tight":
         raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
                            "the paper-mode planner uses the quasi-static map shards: use --mode tight")
+    from pipeline.planning.speed_limit import attach_speed_limits
     if mode == "tight":
-        return plan_tight_only(part, config, progress=progress)
+        return attach_speed_limits(plan_tight_only(part, config, progress=progress), config)
     from pipeline.workflow.plan import ensure_maps, plan_part
     cat = ensure_maps(config, part)
     if mode == "paper":
@@ -110,7 +112,7 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     result = plan_part(cat, part.id, config, progress=progress, tight=mode == "both")
     if mode == "paper":
         result.pop("tight")
-    return result
+    return attach_speed_limits(result, config)
 
 
 def layout_settings(margin=None, trials=None) -> dict:
@@ -305,3 +307,27 @@ def layout_hint(result, part_name: str, layout_path, hint_opts=None) -> str:
     plan = [] if fixed[0] == 1 else ["--plan", fixed[0]]
     return (f"run '{pinfeed_command('layout', '--part', part_name, *plan, '--out', layout_path, **(hint_opts or {}))}' "
             f"first")
+
+
+def speed_command(result, config: dict, plan: int = 1, mu_text=None, mu_s=None, trials=None) -> tuple:
+    """``pinfeed speed``: ``(speed result, stored record or None)``. The settings
+    default to those of the speed limit stored with the plan (else the config's
+    ``speed`` section); with the same settings the stored figure is returned
+    (``source``: ``stored with the plan``), else it is computed (``computed``)."""
+    from pipeline.planning.plan import pick_tight_plan
+    from pipeline.planning.speed_limit import speed_settings, stored_plan_speed, stored_speed_limit
+    chosen, _, _ = pick_tight_plan(result, plan, mu_text)
+    stored = stored_speed_limit(chosen)
+    settings = dict(stored["settings"]) if stored else speed_settings(config)
+    if mu_s is not None:
+        if not mu_s > 0:
+            raise PinfeedError(f"--mu-s must be > 0, got {mu_s}")
+        settings["mu_s"] = float(mu_s)
+    if trials is not None:
+        if trials < 1:
+            raise PinfeedError(f"--trials must be at least 1, got {trials}")
+        settings["trials"] = int(trials)
+    if stored and stored["settings"] == settings:
+        return dict({k: v for k, v in stored.items() if k != "settings"}, source="stored with the plan"), stored
+    out = stored_plan_speed(result, config, plan=plan, mu_text=mu_text, **settings)
+    return dict(out, source="computed"), stored
