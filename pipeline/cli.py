@@ -871,10 +871,30 @@ def main(argv=None) -> int:
     except BrokenPipeError:  # e.g. piped into head
         return 0
     except KeyboardInterrupt:  # Ctrl-C: one line; writes are atomic, finished work is kept
-        print("pinfeed: interrupted; finished files and the rollouts computed so far are kept "
-              "(the next run reuses them)", file=sys.stderr)
-        return 130
+        return _interrupted()
+    except SystemError as exc:  # Ctrl-C inside a Numba kernel call arrives wrapped
+        if not _caused_by_interrupt(exc):
+            raise
+        return _interrupted()
     return 0
+
+
+def _interrupted() -> int:
+    """Ctrl-C: one line on stderr and the shell's status 130 (128 + SIGINT)."""
+    print("pinfeed: interrupted; finished files and the rollouts computed so far are kept "
+          "(the next run reuses them)", file=sys.stderr)
+    return 130
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """Whether ``exc`` was raised because of a KeyboardInterrupt (its cause chain)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 if __name__ == "__main__":
