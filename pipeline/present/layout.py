@@ -365,8 +365,7 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     """
     from pipeline.maps import simulate
     from pipeline.planning.settings import friction_label
-    from pipeline.planning.speed_limit import (DEFAULT_SPEEDS, perturbation_from_verify, speed_curve,
-                                               stored_speed_limit)
+    from pipeline.planning.speed_limit import DEFAULT_SPEEDS
     from pipeline.planning.types import as_plan_file
     from pipeline.provenance import provenance_attrs
     cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})
@@ -376,17 +375,10 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     pin_radius = float(result.extra.get("pin_radius", config["sweep"]["pin_radius"]))
     mu_s = float(cfg["mu_s"] if mu_s is None else mu_s)
     heights = [float(h) for h in plan.pin_heights_mm]
-    arcs = plan.final_arcs
     # A bad belt speed or mu_s is refused before any work.
     simulate.check_belt(part, min(DEFAULT_SPEEDS) if belt_speed is None else belt_speed, mu_s)
-    stored = stored_speed_limit(plan)
-    if stored and stored["settings"]["mu_s"] == mu_s:  # one speed limit per plan: the plan file's
-        curve, trials = stored, stored["trials"]
-    else:
-        trials = cfg["speed_trials"]
-        curve = speed_curve(part, heights, [0.0] * len(heights), list(states.values()), arcs, mu_c,
-                            mu_s=mu_s, perturb=perturbation_from_verify(config.get("verify", {})),
-                            trials=trials, r_pin=pin_radius, seed=cfg["seed"])
+    curve, trials, stored = _speed_limit(plan, part, list(states.values()), mu_c, mu_s, pin_radius,
+                                         config, cfg)
     limit = curve["speed_limit_mm_s"]
     belt_speed, source, quasi_static, warnings = _belt_speed_choice(belt_speed, limit, cfg,
                                                                     quasi_static)
@@ -400,8 +392,9 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     out["mu_c"] = list(mu_c) if isinstance(mu_c, tuple) else mu_c
     out["plan"] = {"number": int(plan_number), "friction": friction_label(mu_c),
                    "pins": list(plan.pins), "pin_heights_mm": heights,
-                   "final_sets": [s.to_dict() for s in plan.final_sets]}
-    out["warnings"] = warnings
+                   "final_sets": [s.to_dict() for s in plan.final_sets],
+                   "n_final_sets": plan.n_final_sets}
+    out["warnings"] = warnings + final_sets_warning(out["plan"])
     out["method"]["belt_speed"] = source
     out["method"]["throughput"] = "60 x belt speed / pitch" if belt_speed else "none: no belt speed"
     out["speed_limit_trials"] = int(trials)
@@ -414,6 +407,21 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
         "curve": curve["curve"]}
     out.update(provenance_attrs())
     return out
+
+
+def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, config, cfg) -> tuple:
+    """``(curve, trials, stored)``: the speed limit stored with ``plan`` when it was
+    computed at belt friction ``mu_s`` (one speed limit per plan), else one computed
+    here with ``speed_trials`` trials per state; ``stored``: the plan's record or None."""
+    from pipeline.planning.speed_limit import perturbation_from_verify, speed_curve, stored_speed_limit
+    stored = stored_speed_limit(plan)
+    if stored and stored["settings"]["mu_s"] == mu_s:
+        return stored, stored["trials"], stored
+    heights = [float(h) for h in plan.pin_heights_mm]
+    curve = speed_curve(part, heights, [0.0] * len(heights), states, plan.final_arcs, mu_c, mu_s=mu_s,
+                        perturb=perturbation_from_verify(config.get("verify", {})),
+                        trials=cfg["speed_trials"], r_pin=pin_radius, seed=cfg["seed"])
+    return curve, cfg["speed_trials"], stored
 
 
 def _fixed_pin_plan(result, plan_number, mu_text):
@@ -459,6 +467,17 @@ def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
             warnings.append(f"belt speed {belt_speed:g} mm/s is above the plan's speed limit "
                             f"{limit:g} mm/s (fewer than 99 % of its trials end in the final set)")
     return belt_speed, source, quasi_static, warnings
+
+
+def final_sets_warning(plan: dict) -> list[str]:
+    """A warning (a list of none or one line) when a laid-out plan leaves the parts in
+    several final orientation sets: such a feeder does not orient them fully."""
+    from pipeline.planning.arcs import format_arcs
+    n = plan.get("n_final_sets") or len(plan.get("final_sets") or ())
+    if n <= 1:
+        return []
+    return [f"plan {plan['number']} leaves {n} final orientation sets ({format_arcs(plan['final_sets'])}): "
+            f"parts leave this feeder in more than one orientation"]
 
 
 def speed_limit_text(layout: dict) -> str:

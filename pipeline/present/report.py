@@ -22,7 +22,7 @@ from pipeline.provenance import creation_time, git_commit
 SECTIONS = (("outline", "Outline"), ("maps", "Configuration maps"), ("plans", "Plans"),
             ("verification", "Verification"), ("animation", "Animation"), ("layout", "Feeder layout"),
             ("sensing", "Sensing"))
-STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto}img{max-width:100%}"
+STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto}img{max-width:100%}.warn{color:#b00}"
          "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;font-size:90%}"
          "tr.fail td{background:#f8d0d0}.files{font-size:90%}")
 

@@ -119,7 +119,7 @@ def test_report_numbers_match_the_verify_json(workflow):
         speed = json.loads((results / "speed" / f"{name}.json").read_text())
         if plan["tight"][0]["recommended"]:  # the speed stage replays the first friction's plan
             assert speed["pin_labels"] == plan["tight"][0]["recommended"]["pins"]
-            limits.append(f"{speed['speed_limit_mm_s']:g}")
+            limits.append(f"{speed['speed_limit_mm_s']:g} ({speed['trials']} trials per state)")
         else:
             assert speed["speed_limit_mm_s"] is None
         checks = {c["kind"]: c for c in json.loads((results / "verify" / f"{name}.json").read_text())["checks"]}
