@@ -392,6 +392,7 @@ def _plan_json(result, mode) -> dict:
     if tight:
         first = tight[0]
         out.update(mu_c=first["mu_c"], warning=first["warning"],
+                   recommended=_plan_summary(first["recommended"]) if first["recommended"] else None,
                    plans=[_plan_summary(p) for p in first["plans"]],
                    rejected=[_plan_summary(p) for p in first["rejected"]],
                    frictions=[{"mu_c": t["mu_c"], "warning": t["warning"],
@@ -424,7 +425,8 @@ def _print_plan_result(result, part, config, mode):
         for k, plan in enumerate(t.plans, start=1):
             v = plan.verification
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))
-            print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
+            mark = " (recommended)" if t.recommended is not None and plan == t.recommended else ""
+            print(f"  #{k}{mark}: {heights} -> {plan.n_final_sets} final set(s): "
                   f"{format_arcs(plan.final_arcs)}; "
                   f"verified {v.successes}/{v.trials} trials; margin in d " + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
     if mode == "tight" or result.plans is None:
@@ -703,10 +705,16 @@ def _add_sweep_plan_commands(sub) -> None:
                    help="friction the plan must work for: a value X or a range LO:HI (default: the config's)")
     p.add_argument("--mode", default="tight", choices=["tight", "paper", "both"],
                    help="tight propagation (default), the paper's adjusted bands, or both side by side")
-    p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"])
+    p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"],
+                   help="quasi-static contact model the plans are computed and verified with "
+                        "(default: the config's planner.model, minpower)")
     p.add_argument("--depth", type=int, default=None, help="largest number of pins (>= 1)")
     p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step'")
-    p.add_argument("--coverage", default=None, choices=["bracket", "nearest"])
+    p.add_argument("--coverage", default=None, choices=["bracket", "nearest"],
+                   help="paper mode only: which stored maps stand for an uncertain state; bracket "
+                        "(the d maps around its d range and one theta_i step either side; "
+                        "conservative) or nearest (the nearest d map, the grid points inside the "
+                        "arc); default: the config's planner.coverage, bracket")
     p.add_argument("--speeds", default=None,
                    help="dynamic pin speeds v_pin/v_b after the static pins: 'a,b' ('' for none)")
     p.add_argument("--dynamic-depth", dest="dynamic_depth", type=int, default=None,
@@ -716,7 +724,9 @@ def _add_sweep_plan_commands(sub) -> None:
                         "(default: the config's planner.belt_speed; none = quasi-static)")
     p.add_argument("--mu-s", dest="mu_s", type=float, default=None,
                    help="belt friction with --belt-speed (default: planner.mu_s, 0.5)")
-    p.add_argument("--out", default=None, help="also write the result JSON here")
+    p.add_argument("--out", default=None, help="store the plan JSON here (default: RESULTS/plans/NAME.json, "
+                   "where speed, layout and animate look; a part the workflow plans is stored only "
+                   "with --out)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plan)
 

@@ -18,7 +18,10 @@ rule bands:
 
 rule plan:
     input:
-        index=rules.catalog_index.output.index,
+        # The part's own shards: a re-index ('pinfeed catalog index') or another
+        # part's new shards do not re-plan it; the index must exist (ancient).
+        shards=part_shards,
+        index=ancient(rules.catalog_index.output.index),
     output:
         plan=f"{RESULTS}/plans/{{name}}.json",
     params:

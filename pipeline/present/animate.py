@@ -321,6 +321,17 @@ def layout_inputs(result, layout: dict) -> dict:
             "what": f"tight plan {number} at mu_c {entry.friction}"}
 
 
+def animation_subject(result, config: dict, layout: dict | None = None) -> str:
+    """What the workflow's animation of a stored plan result shows, in words, from
+    the records it is drawn from (the caption of that animation): the laid-out
+    plan of ``layout`` when it has stations, else the recommended plan
+    (:func:`recommended_index`); ``'no plan'`` without one."""
+    if layout is not None and layout.get("stations"):
+        return f"the laid-out {layout_inputs(result, layout)['what']}"
+    which = recommended_index(result)
+    return "no plan" if which is None else f"the {plan_inputs(result, which, config)['what']}"
+
+
 def animate_stored(result, config: dict, out, plan_index=None, frames: int = 120,
                    fps: int = 20, layout: dict | None = None) -> dict:
     """Animate a plan of a stored plan result (``plan_index`` as in :func:`plan_inputs`;

@@ -66,6 +66,11 @@ def test_outline_to_animation_with_the_printed_commands(fresh, capsys):
     assert code == 0, err
     plan_file = fresh / "res" / "tiny" / "plans" / "tri.json"
     assert plan_file.is_file() and f"stored the plan at {Path('res/tiny/plans/tri.json')}" in out
+    progress = [ln for ln in out.splitlines() if ln.startswith("  ... ")]
+    assert progress and all(ln.startswith("  ... mu_c 0: ") for ln in progress)  # which friction
+    stored_plans = json.loads(plan_file.read_text())["tight"][0]
+    rec = [ln for ln in out.splitlines() if "(recommended)" in ln]
+    assert len(rec) == 1 and rec[0].startswith(f"  #{stored_plans['plans'].index(stored_plans['recommended']) + 1}")
     steps = hints(out)
     assert [shlex.split(h)[1] for h in steps] == ["speed", "layout", "animate"]
     speed, layout, animate = steps
@@ -129,3 +134,11 @@ def test_ctrl_c_is_one_line_exit_130_and_the_rollouts_are_kept(fresh):
     again = subprocess.run(cmd[:-1] + ["1"], capture_output=True, text=True, env=env, timeout=300)
     assert again.returncode == 0, again.stderr
     assert re.search(r"friction 0: 0 new rollouts", again.stdout), again.stdout
+
+
+def test_plan_help_explains_model_and_coverage(capsys):
+    code, out, _ = run_cli(capsys, ["plan", "--help"])
+    assert code == 0
+    text = " ".join(out.split())
+    assert "--model {minpower,tip,ellipsoid} quasi-static contact model" in text
+    assert "--coverage {bracket,nearest} paper mode only" in text
