@@ -397,6 +397,16 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     out["warnings"] = warnings + final_sets_warning(out["plan"])
     out["method"]["belt_speed"] = source
     out["method"]["throughput"] = "60 x belt speed / pitch" if belt_speed else "none: no belt speed"
+    _record_speed_limit(out, curve, trials, stored)
+    out.update(provenance_attrs())
+    return out
+
+
+def _record_speed_limit(out: dict, curve: dict, trials: int, stored: dict | None) -> None:
+    """Write into the layout ``out`` where its speed limit comes from: the trials per
+    state (``speed_limit_trials``), the plan file's figure (``stored_speed_limit``)
+    and ``method.speed_limit``."""
+    from pipeline.planning.speed_limit import DEFAULT_SPEEDS
     out["speed_limit_trials"] = int(trials)
     out["stored_speed_limit"] = None if stored is None else {
         k: stored[k] for k in ("speed_limit_mm_s", "trials", "mu_s")}
@@ -405,8 +415,6 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
         "source": "stored with the plan" if curve is stored else "computed for this layout",
         "required_fraction": 0.99, "speeds_mm_s": list(DEFAULT_SPEEDS), "bisection_mm_s": 5.0,
         "curve": curve["curve"]}
-    out.update(provenance_attrs())
-    return out
 
 
 def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, config, cfg) -> tuple:
