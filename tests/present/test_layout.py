@@ -275,4 +275,4 @@ def test_belt_speed_above_limit_warns_naming_the_limit(stored, capsys):
     assert code == 0
     warning = [ln for ln in captured.err.splitlines() if ln.startswith("pinfeed: warning: belt speed")]
     assert len(warning) == 1 and f"{limit:g} mm/s" in warning[0]
-    assert json.loads(captured.out)["warnings"] == [warning[0].removeprefix("pinfeed: warning: ")]
+    assert json.loads(captured.out)["warnings"][0] == warning[0].removeprefix("pinfeed: warning: ")
