@@ -142,3 +142,27 @@ def test_plan_help_explains_model_and_coverage(capsys):
     text = " ".join(out.split())
     assert "--model {minpower,tip,ellipsoid} quasi-static contact model" in text
     assert "--coverage {bracket,nearest} paper mode only" in text
+
+
+def test_layout_names_the_fixed_pin_plans_and_speed_labels_other_trials(fresh, capsys):
+    code, _, err = run_cli(capsys, ["plan", "--config", "tiny.yaml", "--outline", "tri.svg", "--name", "tri"])
+    assert code == 0, err
+    path = fresh / "res" / "tiny" / "plans" / "tri.json"
+    stored = json.loads(path.read_text())
+    limit = stored["tight"][0]["plans"][0]["speed_limit"]
+    code, out, _ = run_cli(capsys, ["speed", "--part", "tri", "--config", "tiny.yaml", "--trials", "4"])
+    assert code == 0 and "(4 trials per state)" in out
+    assert (f"the plan file stores {limit['speed_limit_mm_s']:g} mm/s ({limit['trials']} trials per state)"
+            in out)
+    # Make plan 1 a plan with a moving pin: the layout names the others, which have fixed pins.
+    plans = stored["tight"][0]["plans"]
+    plans[0]["pin_speeds"] = [0.0] * (len(plans[0]["pins"]) - 1) + [2.0]
+    path.write_text(json.dumps(stored))
+    code, _, err = run_cli(capsys, ["layout", "--part", "tri", "--config", "tiny.yaml"])
+    fixed = ", ".join(f"--plan {k} ({' '.join(p['pins'])})" for k, p in enumerate(plans, start=1) if k > 1)
+    assert code == 2 and err.strip().endswith(f"plans of fixed pins: {fixed}")
+    for p in plans:
+        p["pin_speeds"] = [2.0] * len(p["pins"])
+    path.write_text(json.dumps(stored))
+    code, _, err = run_cli(capsys, ["layout", "--part", "tri", "--config", "tiny.yaml"])
+    assert code == 2 and "no stored plan at this friction has fixed pins only" in err
