@@ -263,7 +263,9 @@ def attach_speed_limits(result: dict, config: dict) -> dict:
     each such plan gets ``speed_limit``, the :func:`stored_plan_speed` result
     with the config's :func:`speed_settings` (kept under ``settings``), so
     that the report, ``pinfeed speed`` and ``pinfeed layout`` show one figure
-    per plan. Returns ``result`` (changed in place)."""
+    per plan. A plan whose speed limit cannot be computed (a part any grid
+    speed would throw) gets none: the speed stage then says why. Returns
+    ``result`` (changed in place)."""
     tight = result.get("tight") or []
     if not tight or not tight[0]["plans"]:
         return result
@@ -271,8 +273,11 @@ def attach_speed_limits(result: dict, config: dict) -> dict:
     plans = entry["plans"]
     fixed = [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.get("pin_speeds") or ())]
     for number in sorted({1, *fixed[:1]}):
-        record = stored_plan_speed(result, config, plan=number, **settings)
+        try:
+            record = stored_plan_speed(result, config, plan=number, **settings)
+        except PinfeedError:
+            continue
         plans[number - 1]["speed_limit"] = dict(record, settings=settings)
-    if entry.get("recommended") is not None:
+    if entry.get("recommended") is not None and "speed_limit" in plans[0]:
         entry["recommended"]["speed_limit"] = plans[0]["speed_limit"]
     return result
