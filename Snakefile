@@ -50,6 +50,7 @@ include: "rules/plan.smk"
 include: "rules/sense.smk"
 include: "rules/layout.smk"
 include: "rules/speed.smk"
+include: "rules/atlas.smk"
 include: "rules/report.smk"
 
 
@@ -57,5 +58,6 @@ rule all:
     input:
         rules.catalog_index.output.index,
         BAND_FILES,
+        rules.atlas.output.json,
         rules.report.output.report,
     default_target: True

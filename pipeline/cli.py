@@ -55,12 +55,15 @@ def _part_from_args(args):
     from pipeline.parts.part import Part, parse_vertices
     if getattr(args, "outline", None):
         from pipeline.parts.outlines import read_outline
-        out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol)
+        out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol,
+                           units=args.units, join_tol=args.join_tol)
         print(f"outline {out.describe()}", file=sys.stderr)
+        for line in out.warnings():
+            print(f"pinfeed: warning: {line}", file=sys.stderr)
         name = args.name or re.sub(r"[^A-Za-z0-9_]", "_", Path(args.outline).stem) or "part"
         return Part.from_vertices(out.vertices, name=name)
-    if getattr(args, "layer", None) or getattr(args, "id", None):
-        raise PinfeedError("--layer and --id pick an outline in an --outline file")
+    if any(getattr(args, k, None) is not None for k in ("layer", "id", "units", "join_tol")):
+        raise PinfeedError("--layer, --id, --units and --join-tol apply to an --outline file")
     return Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
 
 
@@ -69,10 +72,18 @@ def _add_outline_args(p, required=True):
     g = p.add_mutually_exclusive_group(required=required)
     g.add_argument("--vertices", help='part outline "x0,y0 x1,y1 ..." (mm)')
     g.add_argument("--outline", metavar="FILE",
-                   help="or a CAD outline: a .dxf or .svg file holding one closed outline")
+                   help="or a CAD outline: a .dxf or .svg file; its pieces are joined into closed loops "
+                   "and the largest is the part (the others are reported). Holes are refused (not "
+                   "modelled): put them on another layer and pick the outline with --layer")
     p.add_argument("--layer", default=None, metavar="NAME",
                    help="DXF layer of the outline (when the file holds several)")
     p.add_argument("--id", default=None, help="SVG element id or DXF entity handle of the outline")
+    p.add_argument("--units", default=None, choices=["mm", "cm", "m", "in"],
+                   help="units of the outline file's coordinates, overriding the file's own "
+                   "(DXF $INSUNITS, unitless: mm; SVG width/height over viewBox)")
+    p.add_argument("--join-tol", dest="join_tol", type=float, default=None, metavar="TOL",
+                   help="largest gap between piece ends that are joined, in the drawing's units "
+                   "(default 1e-4 of the drawing's size)")
     p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=0.05, metavar="MM",
                    help="chordal tolerance for flattening arcs and curves, mm (default 0.05)")
     p.add_argument("--name", default=None, help="part name used in outputs (default: part, or the "
@@ -203,10 +214,10 @@ def cmd_demo(args):
 
 
 def _catalog(args):
-    from pipeline.maps.catalog import Catalog
+    from pipeline.maps.catalog import RECOMPUTE, Catalog
     cat = Catalog.open(args.catalog)
     for problem in cat.problems:
-        print(f"pinfeed: warning: {problem} (not served)", file=sys.stderr)
+        print(f"pinfeed: warning: {problem} (not served; {RECOMPUTE})", file=sys.stderr)
     return cat
 
 
@@ -324,7 +335,7 @@ def cmd_plan(args):
     config = planner_settings(load_config(args.config), catalog=args.catalog, mu_c=args.mu_c,
                               depth=args.depth, model=args.model, coverage=args.coverage, speeds=speeds,
                               dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
-                              mu_s=args.mu_s)
+                              mu_s=args.mu_s, tolerance=args.tolerance)
     part = _plan_part_arg(args, config)
     out = plan_store_path(config, part.name, args.out)  # checked before any work
     result = plan_command(part, config, args.mode, progress=None if args.json else _progress)
@@ -380,9 +391,19 @@ def _verification_counts(plan) -> dict | None:
 
 def _plan_summary(plan, pins=None) -> dict:
     heights = plan.get("pin_heights_mm") or [pins[p] for p in plan["pins"]]
+    orientation = (plan.get("verification") or {}).get("orientation")
     return {"pins": list(plan["pins"]), "pin_heights_mm": list(heights),
             "final_sets": plan["final_sets"], "n_final_sets": plan["n_final_sets"],
+            "claimed_width_deg": _claimed_width(plan), "claim": plan.get("claim"),
+            "verified_width_deg": orientation["width_deg"] if orientation else None,
+            "orients": orientation["orients"] if orientation else None,
             "verification": _verification_counts(plan)}
+
+
+def _claimed_width(plan) -> float | None:
+    """Width (deg) of the claimed final orientation, if it is one arc."""
+    sets = plan.get("final_sets") or []
+    return float(sets[0]["width"]) if len(sets) == 1 else None
 
 
 def _plan_json(result, mode) -> dict:
@@ -391,7 +412,9 @@ def _plan_json(result, mode) -> dict:
     tight = result.get("tight")
     if tight:
         first = tight[0]
-        out.update(mu_c=first["mu_c"], warning=first["warning"],
+        out.update(mu_c=first["mu_c"], warning=first["warning"], tolerance_deg=first.get("tolerance_deg"),
+                   orients=first.get("orients"), pins_used=first.get("pins_used"),
+                   evidence=(first.get("fixed_pin_search") or {}).get("evidence"),
                    recommended=_plan_summary(first["recommended"]) if first["recommended"] else None,
                    plans=[_plan_summary(p) for p in first["plans"]],
                    rejected=[_plan_summary(p) for p in first["rejected"]],
@@ -420,15 +443,19 @@ def _print_plan_result(result, part, config, mode):
         st = t.stats
         print(f"tight planner, friction {t.friction}: {st['rollouts']} new rollouts in "
               f"{st['seconds']:.0f} s, stored under {config['catalog_dir']}/refine/{part.id}/")
+        search = t.extra.get("fixed_pin_search")
+        if search:
+            print(f"  {search['evidence']}")
         if t.warning:
             print(f"  WARNING: {t.warning}")
         for k, plan in enumerate(t.plans, start=1):
             v = plan.verification
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))
             mark = " (recommended)" if t.recommended is not None and plan == t.recommended else ""
-            print(f"  #{k}{mark}: {heights} -> {plan.n_final_sets} final set(s): "
-                  f"{format_arcs(plan.final_arcs)}; "
-                  f"verified {v.successes}/{v.trials} trials; margin in d " + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
+            print(f"  #{k}{mark}: {heights} -> claimed {plan.n_final_sets} set(s) "
+                  f"({plan.extra.get('claim', 'propagated')}): {format_arcs(plan.final_arcs)}; "
+                  f"{_orientation_text(v)}; margin in d "
+                  + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
     if mode == "tight" or result.plans is None:
         return
     print(f"paper-mode planner (adjusted bands), {result.extra['selection']}:")
@@ -441,6 +468,17 @@ def _print_plan_result(result, part, config, mode):
         print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
               f"{format_arcs(plan.final_arcs)}; "
               f"margin in d {plan.margin:.3f}")
+
+
+def _orientation_text(v) -> str:
+    """Verified width next to the claim: how many trials ended in one set within the tolerance."""
+    o = v.extra.get("orientation") if v else None
+    if not o:
+        return f"verified {v.successes}/{v.trials} trials in the claimed sets" if v else "not verified"
+    width = "n/a" if o["width_deg"] is None else f"{o['width_deg']:.1f} deg"
+    verdict = "orients" if o["orients"] else f"{o['sets_within_tolerance']} sets of {o['tolerance_deg']:g} deg"
+    return (f"verified width {width} ({verdict}: {o['in_tolerance']}/{v.trials} trials in one set of "
+            f"{o['tolerance_deg']:g} deg; {v.successes}/{v.trials} in the claimed sets)")
 
 
 def _results_arg(args, config) -> Path:
@@ -709,7 +747,12 @@ def _add_sweep_plan_commands(sub) -> None:
                    help="quasi-static contact model the plans are computed and verified with "
                         "(default: the config's planner.model, minpower)")
     p.add_argument("--depth", type=int, default=None, help="largest number of pins (>= 1)")
-    p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step'")
+    p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step' "
+                   "(default: the config's planner.pins; 'auto' there fits them to the part)")
+    p.add_argument("--tolerance", type=float, default=None, metavar="DEG",
+                   help="full width (deg) the final orientation set may have (default: planner.tolerance_deg, "
+                   "10): a plan orients the part when verify.required (99.5%%) of its trials end in one "
+                   "set this narrow")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"],
                    help="paper mode only: which stored maps stand for an uncertain state; bracket "
                         "(the d maps around its d range and one theta_i step either side; "
@@ -729,6 +772,14 @@ def _add_sweep_plan_commands(sub) -> None:
                    "with --out)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plan)
+
+    p = sub.add_parser("atlas", help="the feedability atlas: which planned parts pins orient, with how "
+                       "many pins, how precisely and how fast (RESULTS/atlas.json, made by the workflow)")
+    p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
+    p.add_argument("--results", default=None, help="results folder holding atlas.json "
+                   "(default: the config's results_dir/NAME)")
+    p.add_argument("--json", action="store_true", help="print the atlas JSON")
+    p.set_defaults(func=cmd_atlas)
 
 
 def _add_catalog_commands(sub) -> None:
@@ -792,6 +843,35 @@ def _add_sense_commands(sub) -> None:
                    "(default: the config's, RESULTS_DIR/NAME)")
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
+
+
+def cmd_atlas(args):
+    """``pinfeed atlas``: the feedability atlas of a config's planned parts."""
+    from pipeline.config import load_config, results_folder
+    from pipeline.workflow.atlas import read_atlas
+    config = load_config(args.config)
+    path = (Path(args.results) if args.results else results_folder(config)) / "atlas.json"
+    if not path.is_file():
+        hint = f"snakemake --cores all --configfile {args.config}" if args.config else "make run"
+        raise PinfeedError(f"no atlas at {path}; run the workflow first ('{hint}')")
+    try:
+        atlas = read_atlas(path)
+    except (ValueError, KeyError):
+        raise PinfeedError(f"{path} is corrupt; delete it and re-run the workflow") from None
+    if args.json:
+        _print_json(atlas)
+        return
+    print(f"feedability atlas of config {atlas['config']}: tolerance {atlas['tolerance_deg']:g} deg, "
+          f"depth {atlas['depth']} ({path})")
+    print(f"{'part':<18} {'outcome':<12} {'fixed':>5} {'moving':>6} {'width':>7} {'in set':>11} "
+          f"{'limit':>7} {'parts/min':>9} {'plan s':>7}  plan")
+    for r in atlas["rows"]:
+        def num(key, fmt):
+            return "-" if r.get(key) is None else format(r[key], fmt)
+        inset = "-" if r.get("in_set") is None else f"{r['in_set']}/{r['trials']}"
+        print(f"{r['part']:<18} {r['outcome']:<12} {num('fixed_pins', 'd'):>5} {num('moving_pins', 'd'):>6} "
+              f"{num('verified_width_deg', '.1f'):>7} {inset:>11} {num('speed_limit_mm_s', '.0f'):>7} "
+              f"{num('throughput_per_min', '.0f'):>9} {num('planning_seconds', '.0f'):>7}  {r['plan'] or '-'}")
 
 
 def _add_stored_plan_commands(sub) -> None:

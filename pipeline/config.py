@@ -65,7 +65,7 @@ def resolve_outlines(cfg: dict, base_dir) -> None:
             if ("vertices" in p) == ("outline" in p):
                 raise PinfeedError(f"{where}: give either vertices or outline (a DXF or SVG file), "
                                    f"{'not both' if 'vertices' in p else 'one of them'}")
-            extra = [k for k in ("layer", "id", "flatten_tol") if k in p and "outline" not in p]
+            extra = [k for k in ("layer", "id", "flatten_tol", "units", "join_tol") if k in p and "outline" not in p]
             if extra:
                 raise PinfeedError(f"{where}: {', '.join(extra)} only apply to an outline file")
             if isinstance(p.get("outline"), str):
@@ -113,11 +113,7 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
         check_grid_size(len(cfg["sweep"]["d"]) * round(steps), "one shard (d x theta_i)", MAX_MAP)
     except PinfeedError as exc:
         raise PinfeedError(f"config error at sweep/d: {exc}") from None
-    names = _part_names(cfg)
-    unknown = [p for p in cfg["planner"]["parts"] if p not in names]
-    if unknown:
-        raise PinfeedError(f"config error at planner/parts: {', '.join(unknown)} not in any family; "
-                           f"known parts: {', '.join(sorted(names))}")
+    cfg["planner"]["parts"] = planned_parts(cfg["planner"]["parts"], _part_homes(cfg), cfg["families"])
     if cfg["planner"]["parts"] and 0 not in cfg["sweep"]["v_pin"]:
         raise PinfeedError("config error at sweep/v_pin: the planner needs static maps; add 0 to the "
                            "speeds (or plan no parts)")
@@ -153,9 +149,33 @@ def _check_planner_belt(cfg: dict) -> None:
                     raise PinfeedError(f"config error at planner/belt_speed ({part.name}): {exc}") from None
 
 
-def _part_names(cfg: dict) -> set:
-    """Names of every part; raises on a bad outline, a name in two families, or a
-    pin too large for a part."""
+def planned_parts(wanted, homes: dict, families: dict) -> list:
+    """``planner.parts`` as part names: each entry a part name, a family name (its
+    parts) or ``all`` (every part), in order, without repeats. ``homes`` maps
+    every part name to its family. An unknown name or an empty family is a
+    one-line :class:`PinfeedError`."""
+    out = []
+    for entry in wanted:
+        if entry == "all":
+            names = list(homes)
+        elif entry in homes:
+            names = [entry]
+        elif entry in families:
+            names = [n for n, fam in homes.items() if fam == entry]
+            if not names:
+                raise PinfeedError(f"config error at planner/parts: family {entry} has no parts; "
+                                   f"give it parts or generators, or leave it out of planner/parts")
+        else:
+            raise PinfeedError(f"config error at planner/parts: {entry} is neither a part, a family "
+                               f"nor 'all'; families: {', '.join(families) or 'none'}; parts: "
+                               f"{', '.join(homes) or 'none'}")
+        out.extend(n for n in names if n not in out)
+    return out
+
+
+def _part_homes(cfg: dict) -> dict:
+    """Part name -> family, in config order; raises on a bad outline, a name in
+    two families, or a pin too large for a part."""
     home = {}
     for family, spec in cfg["families"].items():
         for part in family_parts(family, spec):  # raises on a bad outline
@@ -168,7 +188,7 @@ def _part_names(cfg: dict) -> set:
                 check_pin_ratio(part, cfg["sweep"]["pin_radius"])
             except PinfeedError as exc:
                 raise PinfeedError(f"config error at sweep/pin_radius: {exc}") from None
-    return set(home)
+    return home
 
 
 def load_config(path=None) -> dict:

@@ -86,6 +86,8 @@ rule report:
         # speed limit (rules/speed.smk): JSON and figure of every planned part
         speed=expand(rules.speed.output.speed, name=PLANNED),
         speed_figures=expand(rules.speed.output.figure, name=PLANNED),
+        # the feedability atlas (rules/atlas.smk), shown first
+        atlas=rules.atlas.output.json,
     output:
         report=f"{RESULTS}/report.html",
     log:

@@ -75,3 +75,71 @@ def one_set_sequences(part, pins: dict, depth, trials_for):
             if n_clusters([t for st in finals for t, _ in st], order) == 1:
                 found.append(seq)
     return found
+
+
+# ---------------------------------------------------------------------- orientation within a tolerance
+# A second oracle for the complete search (pipeline/planning/complete.py): its
+# own trials (uniform in the perturbation box, its corners and the nominal
+# start), its own replay through the public batch rollout API and its own
+# judgement of "one set within the tolerance". Nothing of the planner's
+# enumeration, screening, verification or orient.py is used.
+
+
+def box_trials(part, n_pins, n_random, seed, mu_range, theta_half=2.0, y_half=0.5, pin_half=0.3):
+    """Per resting state: arrays (theta, y_c, mu, offsets (n, n_pins)); row 0 is the
+    nominal start (middle friction, no pin error), then random trials, then corners."""
+    rng = np.random.default_rng(seed)
+    mu_lo, mu_hi = mu_range
+    out = []
+    for theta, y_c in part.stable_states():
+        rows = [(theta, y_c, 0.5 * (mu_lo + mu_hi), np.zeros(n_pins))]
+        for _ in range(n_random):
+            rows.append((theta + rng.uniform(-theta_half, theta_half), y_c + rng.uniform(-y_half, y_half),
+                         rng.uniform(mu_lo, mu_hi), rng.uniform(-pin_half, pin_half, n_pins)))
+        for c in itertools.product((-1, 1), (-1, 1), (mu_lo, mu_hi), *[(-pin_half, pin_half)] * n_pins):
+            rows.append((theta + c[0] * theta_half, y_c + c[1] * y_half, c[2], np.array(c[3:], float)))
+        out.append(tuple(np.array([r[k] for r in rows], float) for k in range(4)))
+    return out
+
+
+def replay_box(part, heights, trials, pin_radius=3.0, model="minpower", pin_half=0.3, strict=True):
+    """Final orientations of every trial of every state (one array). ``strict``:
+    None if a trial jams or the nominal start passes a pin it touches within
+    ``pin_half`` of the centroid (the complete search's admissibility rule);
+    otherwise jammed trials are NaN."""
+    finals = []
+    for theta, y_c, mu, offs in trials:
+        theta, y_c = theta.copy(), y_c.copy()
+        for k, y_pin in enumerate(heights):
+            gap = y_pin + offs[:, k] - y_c
+            r = simulate.rollout_points(part, theta, gap / part.a, mu, pin_radius, model)
+            stuck = r["status"] >= 2  # jammed or truncated
+            if strict and (stuck.any() or (r["status"][0] != 1 and abs(y_pin - y_c[0]) < pin_half)):
+                return None
+            theta, y_c = np.where(stuck, np.nan, r["theta_f"]), y_c + r["dy"]
+        finals.append(theta)
+    return np.concatenate(finals)
+
+
+def most_in_arc(thetas, width, order=1) -> int:
+    """The most angles one arc of ``width`` degrees holds (modulo 360 / order), by brute force."""
+    period = 360.0 / order
+    t = np.mod(np.asarray(thetas, float), period)
+    t = t[np.isfinite(t)]  # jammed trials are in no arc
+    best = 0
+    for start in t:
+        best = max(best, int(np.sum(np.mod(t - start, period) <= width + 1e-9)))
+    return best
+
+
+def orienting_sequences(part, pins: dict, depth, width, trials_for, order=1):
+    """Every admissible sequence up to ``depth`` whose trials all end within one
+    arc of ``width`` degrees: list of label tuples."""
+    found = []
+    for n in range(1, depth + 1):
+        trials = trials_for(n)
+        for seq in itertools.product(list(pins), repeat=n):
+            finals = replay_box(part, [pins[p] for p in seq], trials)
+            if finals is not None and most_in_arc(finals, width, order) == finals.size:
+                found.append(seq)
+    return found

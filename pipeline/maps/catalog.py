@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +44,8 @@ INDEX_NAME = "index.json"
 # ROOT/refine/PART_ID/...: listed by the index apart from the maps.
 REFINE_FOLDER = "refine"
 INDEX_VERSION = 1
+RECOMPUTE = ("recompute it with 'make run' (snakemake) or 'pinfeed sweep --config CONFIG', "
+             "which re-indexes the catalog")
 
 _NUM = {"type": "number"}
 _STR = {"type": "string"}
@@ -168,13 +171,40 @@ def refinement_fields(relative_path) -> dict:
         return {}  # not named by lattice_path: listed by file only
 
 
+def damaged_shard(root: Path, problem: str, entry: dict | None = None) -> dict:
+    """What a damaged shard held, for naming it to a command that would have
+    used it: from its index entry, else from its path (``shard_path``'s
+    ``FAMILY/PART_ID/MODEL/mu_c=M[_v_pin=V][_belt=S_mu_s=X].h5``)."""
+    if entry is not None:
+        return {"file": entry["file"], "problem": problem, "family": entry["family"],
+                "part_id": entry["part_id"], "part_name": entry["part_name"], "model": entry["model"],
+                "mu_c": entry["mu_c"], "v_pin": entry.get("v_pin", 0.0),
+                "belt_speed": entry.get("belt_speed", 0.0)}
+    file = problem.split(".h5: ", 1)[0] + ".h5" if ".h5: " in problem else ""
+    try:
+        rel = Path(file).resolve().relative_to(Path(root).resolve())
+    except (ValueError, OSError):
+        rel = Path(file)
+    parts = rel.parts
+    tag = dict(re.findall(r"(mu_c|v_pin|belt)=(-?[0-9.eE+-]+?)(?=_[a-z]|$)", rel.stem))
+    known = len(parts) == 4
+    part_id = parts[1] if known else None
+    return {"file": rel.as_posix(), "problem": problem, "family": parts[0] if known else None,
+            "part_id": part_id, "part_name": part_id.rsplit("-", 1)[0] if part_id else None,
+            "model": parts[2] if known else None,
+            "mu_c": float(tag["mu_c"]) if "mu_c" in tag else None,
+            "v_pin": float(tag.get("v_pin", 0.0)), "belt_speed": float(tag.get("belt", 0.0))}
+
+
 class Catalog:
     """An opened catalog: verified entries plus the problems found on disk."""
 
-    def __init__(self, root: Path, entries: list[dict], problems: list[str]):
+    def __init__(self, root: Path, entries: list[dict], problems: list[str], damaged: list[dict] | None = None):
         self.root = Path(root)
         self.entries = entries
         self.problems = problems
+        # shards not served, with what they held: named by the commands that would use them
+        self.damaged = damaged if damaged is not None else [damaged_shard(self.root, p) for p in problems]
         self._verified = set()  # files whose checksum was checked when served
 
     # ------------------------------------------------------------------ building
@@ -215,13 +245,15 @@ class Catalog:
                                f"or 'pinfeed catalog index --catalog {root}'")
         data = read_index(index, root)
         entries, problems = [], list(data.get("problems", []))
+        damaged = [damaged_shard(root, p) for p in problems]
         for e in data["entries"]:
             problem = disk_problem(root / e["file"], e)
             if problem:
                 problems.append(problem)
+                damaged.append(damaged_shard(root, problem, e))
             else:
                 entries.append(e)
-        return cls(root, entries, problems)
+        return cls(root, entries, problems, damaged)
 
     # ------------------------------------------------------------------ queries
 
@@ -247,6 +279,7 @@ class Catalog:
         """
         found = [e for e in self.entries if part in (e["part_id"], e["part_name"])]
         if not found:
+            _refuse_damaged(self.damaged_of(part), part)
             known = sorted({e["part_name"] for e in self.entries})
             raise PinfeedError(f"unknown part {part!r}; known parts: {', '.join(known) or 'none'} "
                                f"('pinfeed catalog list' shows them)")
@@ -259,14 +292,33 @@ class Catalog:
             raise PinfeedError(f"part name {part!r} matches several parts ({', '.join(ids)}); give the id")
         return found
 
+    def damaged_of(self, part: str, **fields) -> list[dict]:
+        """The damaged shards of ``part`` (name or id) whose known ``fields``
+        (``model``, ``belt_speed``, ``v_pin``, ...) match; unknown ones match."""
+        return [d for d in self.damaged if part in (d["part_id"], d["part_name"])
+                and all(d.get(k) is None or d[k] == v for k, v in fields.items())]
+
+    def _refuse_damaged_in(self, part, model, mu_c, method, v_pin, belt_speed) -> None:
+        """Raise when a damaged shard would have been served by this query: its
+        friction is the one (or one of those) chosen among all the part's
+        frictions, whole or damaged."""
+        where = {"model": model, "v_pin": float(v_pin), "belt_speed": float(belt_speed)}
+        bad = self.damaged_of(part, **where)
+        if mu_c is not None and bad:
+            whole = {e["mu_c"] for e in self.entries if part in (e["part_id"], e["part_name"])
+                     and all(e.get(k, 0.0) == v for k, v in where.items())}
+            stored = sorted(whole | {b["mu_c"] for b in bad if b["mu_c"] is not None})
+            chosen = _select(stored, float(mu_c), method) if stored else []
+            bad = [b for b in bad if b["mu_c"] is None or b["mu_c"] in chosen]
+        _refuse_damaged(bad, part)
+
     def _open_entry(self, e: dict) -> xr.Dataset:
         path = self.root / e["file"]
         if not path.is_file():
-            raise PinfeedError(f"{path} is gone from disk; re-run the workflow to recompute it")
+            raise PinfeedError(f"{path} is gone from disk; {RECOMPUTE}")
         if path not in self._verified:
             if _sha256(path) != e["sha256"]:
-                raise PinfeedError(f"{path} changed since it was indexed (checksum); re-run the "
-                                   f"workflow ('make run') to recompute it")
+                raise PinfeedError(f"{path} changed since it was indexed (checksum); {RECOMPUTE}")
             self._verified.add(path)
         return xr.open_dataset(path, engine="h5netcdf", chunks={})
 
@@ -289,6 +341,9 @@ class Catalog:
         if method not in ("nearest", "bracket"):
             raise PinfeedError(f"unknown selection method {method!r}; use nearest or bracket")
         _check_finite(mu_c=mu_c, d=d, v_pin=v_pin)
+        if mu_c is not None and float(mu_c) < 0:
+            raise PinfeedError(f"mu_c must be a finite number >= 0, got {mu_c!r}")
+        self._refuse_damaged_in(part, model, mu_c, method, v_pin, belt_speed)
         found = [e for e in self.entries_for(part) if e["model"] == model]
         if not found:
             models = sorted({e["model"] for e in self.entries_for(part)})
@@ -330,6 +385,8 @@ class Catalog:
         # Quasi-static maps only: dynamic maps at belt speed > 0 are queried
         # one speed at a time (``query(..., belt_speed=...)``).
         found = [e for e in self.entries if e["family"] == family and not e.get("belt_speed", 0.0)]
+        _refuse_damaged([d for d in self.damaged if d["family"] in (family, None) and not d["belt_speed"]],
+                        f"family {family}")
         if not found:
             fams = sorted({e["family"] for e in self.entries})
             raise PinfeedError(f"unknown family {family!r}; known families: {', '.join(fams) or 'none'}")
@@ -343,6 +400,14 @@ class Catalog:
         cube.attrs.update(family=family, title=f"pinfeed map cube of family {family}")
         cube["v_pin"].attrs.update(units="1", long_name="pin speed across the belt over belt speed")
         return cube
+
+
+def _refuse_damaged(bad: list[dict], what: str) -> None:
+    """Raise naming the damaged shard(s) a query would have used, with the way back."""
+    if not bad:
+        return
+    more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+    raise PinfeedError(f"{what}: a shard it needs is damaged: {bad[0]['problem']}{more}; {RECOMPUTE}")
 
 
 def _check_finite(**values) -> None:

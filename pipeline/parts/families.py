@@ -55,7 +55,8 @@ def _explicit_vertices(family: str, p: dict):
     from pipeline.parts.outlines import read_outline
     try:
         return read_outline(p["outline"], layer=p.get("layer"), id=p.get("id"),
-                            flatten_tol=p.get("flatten_tol", 0.05)).vertices
+                            flatten_tol=p.get("flatten_tol", 0.05), units=p.get("units"),
+                            join_tol=p.get("join_tol")).vertices
     except PinfeedError as exc:
         raise PinfeedError(f"family {family}, part {p['name']}: {exc}") from None
 

@@ -1,22 +1,29 @@
 """Part outlines from CAD files: DXF (ezdxf) and SVG (svgelements).
 
-A drawing may hold loose LINE/ARC pieces, polylines with bulges, circles,
-paths, polygons and rects. Every curve is flattened to a polygon whose chords
-stay within ``flatten_tol`` mm of the curve, pieces are joined end to end into
-closed loops, and exactly one simple loop must remain: the part. Holes are
-refused, because the support integrals (spec section 2) assume the pressure
-spreads over a simple polygon.
+A drawing may hold loose LINE/ARC pieces in any order and direction,
+polylines with bulges, circles, ellipses, splines, paths, polygons and rects.
+Every curve is flattened to a polygon whose chords stay within
+``flatten_tol`` mm of the curve; duplicate pieces are dropped; pieces whose
+ends lie within ``join_tol`` (drawing units; default 1e-4 of the drawing's
+size) are joined end to end into closed loops. The largest closed loop is the
+part (or the loop picked by ``layer`` / ``id``); the loops and open chains
+left out are reported. A loop inside the outline is a hole: refused, because
+no pressure acts under a hole, which moves the centroid and changes the
+support integrals (spec section 2) that the kernels compute for a solid
+polygon.
 
-Units: a DXF's ``$INSUNITS`` is honoured (unitless files are read as mm); an
-SVG's document units are honoured through its width/height and viewBox (user
-units without a physical size are CSS pixels, 96 per inch). SVG's y axis
-points down; it is flipped so the part looks as it does in the viewer (a
-mirrored part would be a different part).
+Units are said out loud (:meth:`Outline.describe`): a DXF's ``$INSUNITS``
+(unitless: mm), an SVG's width/height over its viewBox (no physical size: CSS
+pixels, 96 per inch), or ``units`` given by the user. Conversion factors are
+exact (25.4 mm per inch), so one shape gives one part id from DXF and SVG.
+SVG's y axis points down; it is flipped so the part looks as it does in the
+viewer (a mirrored part would be a different part).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import re
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -25,11 +32,28 @@ from pipeline.errors import PinfeedError
 from pipeline.parts.part import PolygonError, check_outline
 
 DEFAULT_FLATTEN_TOL = 0.05  # mm
-_JOIN_TOL = 1e-3  # mm: pieces whose ends are closer than this are joined
+JOIN_TOL_FRACTION = 1e-4  # default join tolerance, as a fraction of the drawing's size
+# Exact millimetres per unit: the same shape must hash to the same part id
+# whichever file it came from (ezdxf's inch factor is 25.4000000001,
+# svgelements' mm is 1.00000054 of the CSS one).
+MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+_SVG_MM = dict(MM_PER_UNIT, pt=25.4 / 72, pc=25.4 / 6, px=25.4 / 96, q=0.25)
+_DXF_UNITS = {1: "in", 2: "ft", 4: "mm", 5: "cm", 6: "m", 9: "mil", 10: "yd", 13: "um", 14: "dm"}
+_DXF_MM = dict(MM_PER_UNIT, ft=304.8, mil=0.0254, yd=914.4, um=1e-3, dm=100.0)
+SIZE_WARN_MM = (2.0, 2000.0)  # a part outside this many mm across gets a units warning
 
 
 class OutlineError(PinfeedError):
-    """The CAD file does not hold exactly one closed, simple outline."""
+    """The CAD file does not give one closed, simple outline without holes."""
+
+
+@dataclass
+class Units:
+    """How drawing coordinates became millimetres."""
+
+    name: str  # e.g. "mm", "in", "px"
+    source: str  # e.g. "$INSUNITS=1", "SVG width/viewBox", "default (unitless DXF)", "--units"
+    scale: float  # mm per drawing unit
 
 
 @dataclass
@@ -40,70 +64,135 @@ class Outline:
     source: str  # the file
     name: str  # which loop: layer/handle (DXF) or element id (SVG)
     flatten_tol: float
+    units: Units = field(default_factory=lambda: Units("mm", "default", 1.0))
+    left_out: list = field(default_factory=list)  # loops and open chains not used, described
 
     @property
     def n_vertices(self) -> int:
         """Number of vertices after flattening."""
         return int(self.vertices.shape[0])
 
+    @property
+    def size_mm(self) -> tuple:
+        """Bounding box width and height, and ``a`` (area centroid to farthest vertex), in mm."""
+        w, h = np.ptp(self.vertices, axis=0)
+        return float(w), float(h), float(np.max(np.hypot(*(self.vertices - _centroid(self.vertices)).T)))
+
     def describe(self) -> str:
-        """One line saying where the outline came from and how it was flattened."""
+        """One line: the loop, its vertex count, units (whence, scale) and size in mm."""
+        w, h, a = self.size_mm
+        u = self.units
         return (f"{self.source}: {self.name}, flattened to {self.n_vertices} vertices "
-                f"(chordal tolerance {self.flatten_tol:g} mm)")
+                f"(chordal tolerance {self.flatten_tol:g} mm); units {u.name} from {u.source}, "
+                f"{u.scale:g} mm per unit; size {w:.4g} x {h:.4g} mm, a = {a:.4g} mm")
+
+    def warnings(self) -> list[str]:
+        """Lines worth a warning: loops left out, and a size that suggests wrong units."""
+        out = [f"{self.source}: left out {item}" for item in self.left_out]
+        across = max(self.size_mm[:2])
+        if not SIZE_WARN_MM[0] <= across <= SIZE_WARN_MM[1]:
+            out.append(f"{self.source}: the part is {across:.4g} mm across (units {self.units.name} from "
+                       f"{self.units.source}); if the drawing is in other units, give --units mm|cm|m|in")
+        return out
 
 
 @dataclass
 class _Piece:
-    """A flattened, possibly open, polyline from one drawing entity."""
+    """A flattened, possibly open, polyline from one drawing entity (drawing units)."""
 
-    points: np.ndarray  # (n, 2), mm
+    points: np.ndarray  # (n, 2)
     name: str
     closed: bool
 
 
 def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa: A002 (CLI's --id)
-                 flatten_tol: float = DEFAULT_FLATTEN_TOL) -> Outline:
-    """The one closed outline in ``path`` (.dxf or .svg), optionally chosen by
-    DXF ``layer`` or element ``id`` (SVG id, DXF entity handle)."""
+                 flatten_tol: float = DEFAULT_FLATTEN_TOL, units: str | None = None,
+                 join_tol: float | None = None) -> Outline:
+    """The part outline in ``path`` (.dxf or .svg).
+
+    Parameters
+    ----------
+    layer, id : pick the outline by DXF layer, or by SVG element id / DXF
+        entity handle; otherwise the largest closed loop is the outline.
+    flatten_tol : chordal tolerance for curves, mm.
+    units : ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``: overrides the file's units.
+    join_tol : largest gap between piece ends that are joined, in drawing
+        units (``None``: 1e-4 of the drawing's size).
+
+    Raises
+    ------
+    OutlineError
+        No closed loop, a hole, loops that cross, a self-intersection, or a
+        file that cannot be read: one line naming the problem and the way out.
+    """
     path = Path(path)
-    if not (isinstance(flatten_tol, (int, float)) and math.isfinite(flatten_tol) and flatten_tol > 0):
-        raise OutlineError(f"--flatten-tol must be a length in mm > 0, got {flatten_tol!r}")
+    _check_options(flatten_tol, units, join_tol)
     if not path.is_file():
         raise OutlineError(f"no outline file at {path}")
     suffix = path.suffix.lower()
     if suffix == ".dxf":
-        pieces = _dxf_pieces(path, layer, id, flatten_tol)
+        pieces, unit = _dxf_pieces(path, layer, id, flatten_tol, units)
     elif suffix == ".svg":
         if layer is not None:
             raise OutlineError(f"{path}: --layer picks a DXF layer; pick an SVG element with --id")
-        pieces = _svg_pieces(path, id, flatten_tol)
+        pieces, unit = _svg_pieces(path, id, flatten_tol, units)
     else:
         raise OutlineError(f"{path}: unknown outline format {suffix or '(none)'}; give a .dxf or .svg file")
     if not pieces:
         which = f" on layer {layer!r}" if layer else (f" with id {id!r}" if id else "")
         raise OutlineError(f"{path}: no lines, arcs, polylines or shapes{which}")
-    loops = _join(pieces, path)
-    loop = _choose(loops, path)
+    tol = join_tol if join_tol is not None else JOIN_TOL_FRACTION * _extent(pieces)
+    loops, chains = _join(_unique(pieces, tol), tol)
+    loop, left_out = _choose(loops, chains, path, unit)
     try:
-        xy = check_outline(loop.points)
+        xy = check_outline(loop.points * unit.scale)
     except PolygonError as exc:
         raise OutlineError(f"{path}: outline {loop.name}: {exc}") from None
-    return Outline(vertices=xy, source=str(path), name=loop.name, flatten_tol=float(flatten_tol))
+    return Outline(vertices=xy, source=str(path), name=loop.name, flatten_tol=float(flatten_tol),
+                   units=unit, left_out=left_out)
+
+
+def _check_options(flatten_tol, units, join_tol) -> None:
+    def positive(x):
+        return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and x > 0
+    if not positive(flatten_tol):
+        raise OutlineError(f"--flatten-tol must be a length in mm > 0, got {flatten_tol!r}")
+    if join_tol is not None and not positive(join_tol):
+        raise OutlineError(f"--join-tol must be a length in drawing units > 0, got {join_tol!r}")
+    if units is not None and units not in MM_PER_UNIT:
+        raise OutlineError(f"--units must be one of {', '.join(MM_PER_UNIT)}, got {units!r}")
+
+
+def _extent(pieces) -> float:
+    allpts = np.vstack([p.points for p in pieces])
+    return float(np.max(np.ptp(allpts, axis=0))) if len(allpts) else 0.0
 
 
 # ---------------------------------------------------------------------- DXF
 
 
-def _dxf_pieces(path: Path, layer, handle, tol) -> list[_Piece]:
+def _dxf_units(doc, override) -> Units:
+    if override is not None:
+        return Units(override, "--units", MM_PER_UNIT[override])
+    code = int(doc.header.get("$INSUNITS", 0) or 0)
+    if code == 0:
+        return Units("mm", "the default (unitless DXF, $INSUNITS=0)", 1.0)
+    name = _DXF_UNITS.get(code)
+    if name is not None:
+        return Units(name, f"$INSUNITS={code}", _DXF_MM[name])
+    from ezdxf import units
+    return Units(units.unit_name(code) or f"code {code}", f"$INSUNITS={code}",
+                 units.conversion_factor(code, units.MM))
+
+
+def _dxf_pieces(path: Path, layer, handle, tol, override) -> tuple[list[_Piece], Units]:
     import ezdxf
     from ezdxf import path as ezpath
-    from ezdxf import units
     try:
         doc = ezdxf.readfile(str(path))
-    except (OSError, ezdxf.DXFStructureError) as exc:
+    except (OSError, ezdxf.DXFStructureError, UnicodeDecodeError) as exc:
         raise OutlineError(f"{path} is not a readable DXF file: {exc}".splitlines()[0]) from None
-    code = doc.header.get("$INSUNITS", 0)
-    scale = units.conversion_factor(code, units.MM) if code else 1.0
+    unit = _dxf_units(doc, override)
     kinds = {"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE"}
     pieces = []
     for e in _dxf_entities(doc.modelspace()):
@@ -114,12 +203,14 @@ def _dxf_pieces(path: Path, layer, handle, tol) -> list[_Piece]:
             continue
         if handle is not None and e.dxf.handle.upper() != str(handle).upper():
             continue
-        p = ezpath.make_path(e)
         # ezdxf flattens with a maximum chord-to-curve distance: the chordal tolerance.
-        pts = np.array([(v.x, v.y) for v in p.flattening(distance=tol / scale)], dtype=float) * scale
+        pts = np.array([(v.x, v.y) for v in ezpath.make_path(e).flattening(distance=tol / unit.scale)],
+                       dtype=float)
+        if len(pts) < 2:
+            continue
         closed = bool(getattr(e, "closed", False) or getattr(e, "is_closed", False)) or kind == "CIRCLE"
         pieces.append(_Piece(pts, f"{kind} {e.dxf.handle} on layer {e.dxf.layer}", closed))
-    return pieces
+    return pieces, unit
 
 
 def _dxf_entities(space):
@@ -134,13 +225,51 @@ def _dxf_entities(space):
 # ---------------------------------------------------------------------- SVG
 
 
-def _svg_pieces(path: Path, want_id, tol) -> list[_Piece]:
+def _svg_length_mm(text) -> float | None:
+    """An SVG width/height in mm, or None when it is missing, relative or unitless."""
+    m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-zA-Z]*)\s*", str(text or ""))
+    if not m or m.group(2).lower() not in _SVG_MM:
+        return None
+    try:
+        return float(m.group(1)) * _SVG_MM[m.group(2).lower()]
+    except ValueError:
+        return None
+
+
+def _svg_units(svg, override) -> tuple[Units, float]:
+    """The units, and the factor from svgelements' pixels to drawing units.
+
+    svgelements has already scaled user units by the viewBox and its own
+    (inexact) unit factors; the factor undoes that so the drawing units are
+    the viewBox's user units, which are then scaled exactly."""
+    vb = svg.viewbox
+    if vb is None or not vb.width or not vb.height:
+        px_per_user, user_mm = 1.0, None  # user units are CSS pixels
+    else:
+        # preserveAspectRatio "meet" (the default): the smaller scale wins.
+        px_per_user = min(svg.width / vb.width, svg.height / vb.height)
+        w, h = _svg_length_mm(svg.values.get("width")), _svg_length_mm(svg.values.get("height"))
+        sizes = [s for s in (w and w / vb.width, h and h / vb.height) if s]
+        user_mm = min(sizes) if sizes else None
+    if override is not None:
+        return Units(override, "--units", MM_PER_UNIT[override]), 1.0 / px_per_user
+    if user_mm is None:
+        return Units("px", "SVG user units (no physical width over a viewBox: CSS pixels, 96 per inch)",
+                     _SVG_MM["px"]), 1.0 / px_per_user
+    name = next((n for n, f in MM_PER_UNIT.items() if math.isclose(f, user_mm, rel_tol=1e-12)),
+                f"user units of {user_mm:g} mm")
+    return Units(name, f"SVG width/viewBox ({svg.values.get('width')} over {vb.width:g} user units)",
+                 user_mm), 1.0 / px_per_user
+
+
+def _svg_pieces(path: Path, want_id, tol, override) -> tuple[list[_Piece], Units]:
     import svgelements as se
     try:
         svg = se.SVG.parse(str(path), ppi=96.0)  # transforms and viewBox applied
     except Exception as exc:  # svgelements raises many kinds on bad XML
         raise OutlineError(f"{path} is not a readable SVG file: {exc}".splitlines()[0]) from None
-    mm_per_px = 25.4 / 96.0
+    unit, user_per_px = _svg_units(svg, override)
+    flip = np.array([user_per_px, -user_per_px])
     pieces = []
     for k, el in enumerate(svg.elements()):
         if not isinstance(el, se.Shape) or isinstance(el, se.Group):
@@ -151,11 +280,12 @@ def _svg_pieces(path: Path, want_id, tol) -> list[_Piece]:
         label = f"<{type(el).__name__.lower()} id={eid!r}>" if eid else f"{type(el).__name__.lower()} #{k}"
         shape = se.Path(el)
         shape.reify()  # bake the transform into the coordinates
-        subs = [(sub, closed) for sub, closed in _subpaths(shape, tol / mm_per_px) if len(sub) >= 2]
+        tol_px = tol / (unit.scale * user_per_px)
+        subs = [(sub, closed) for sub, closed in _subpaths(shape, tol_px) if len(sub) >= 2]
         for i, (sub, closed) in enumerate(subs, start=1):
-            pts = np.array(sub, dtype=float) * mm_per_px * np.array([1.0, -1.0])
+            pts = np.array(sub, dtype=float) * flip
             pieces.append(_Piece(pts, label + (f" subpath {i}" if len(subs) > 1 else ""), closed))
-    return pieces
+    return pieces, unit
 
 
 def _subpaths(shape, tol_px):
@@ -200,61 +330,98 @@ def _dist_to_segment(p, a, b) -> float:
 # ---------------------------------------------------------------------- loops
 
 
-def _dedupe(points: np.ndarray) -> np.ndarray:
+def _dedupe(points: np.ndarray, tol: float) -> np.ndarray:
     """Drop consecutive repeated points and a closing copy of the first point."""
     keep = [points[0]]
     for p in points[1:]:
-        if np.hypot(*(p - keep[-1])) > _JOIN_TOL:
+        if np.hypot(*(p - keep[-1])) > tol:
             keep.append(p)
-    if len(keep) > 1 and np.hypot(*(keep[-1] - keep[0])) <= _JOIN_TOL:
+    if len(keep) > 1 and np.hypot(*(keep[-1] - keep[0])) <= tol:
         keep.pop()
     return np.array(keep)
 
 
-def _join(pieces: list[_Piece], path: Path) -> list[_Piece]:
-    """Closed loops from the pieces: closed ones as they are, open ones chained
-    end to end (either direction). An open chain left over is an error."""
-    loops = []
-    open_ = []
+def _unique(pieces: list[_Piece], tol: float) -> list[_Piece]:
+    """The pieces without duplicates (the same points, in either direction),
+    which CAD exports repeat and which would otherwise branch the chains."""
+    out = []
+    for p in pieces:
+        if not any(_same(p.points, q.points, tol) for q in out):
+            out.append(p)
+    return out
+
+
+def _same(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
+    if a.shape != b.shape:
+        return False
+    return bool(np.all(np.hypot(*(a - b).T) <= tol) or np.all(np.hypot(*(a - b[::-1]).T) <= tol))
+
+
+def _join(pieces: list[_Piece], tol: float) -> tuple[list[_Piece], list[_Piece]]:
+    """Closed loops and open chains from the pieces: closed ones as they are,
+    open ones chained end to end (either direction, any order) wherever an end
+    lies within ``tol`` of another (the nearest one first)."""
+    loops, open_ = [], []
     for p in pieces:
         gap = np.hypot(*(p.points[-1] - p.points[0]))
-        if p.closed or (len(p.points) > 2 and gap <= _JOIN_TOL):
-            loops.append(_Piece(_dedupe(p.points), p.name, True))
-        else:
+        if p.closed or (len(p.points) > 2 and gap <= tol):
+            loops.append(_Piece(_dedupe(p.points, tol), p.name, True))
+        elif np.max(np.ptp(p.points, axis=0)) > tol:  # a zero-length LINE joins nothing
             open_.append(p)
+    chains = []
     while open_:
-        chain = [open_.pop(0)]
-        pts = chain[0].points
-        while np.hypot(*(pts[-1] - pts[0])) > _JOIN_TOL:
-            nxt = _next_piece(open_, pts[-1])
-            if nxt is None:
-                names = ", ".join(c.name for c in chain[:3]) + (" ..." if len(chain) > 3 else "")
-                raise OutlineError(
-                    f"{path}: open outline: the chain of {len(chain)} piece(s) ({names}) ends at "
-                    f"({pts[-1][0]:.3f}, {pts[-1][1]:.3f}) mm, {np.hypot(*(pts[-1] - pts[0])):.3f} mm "
-                    f"from its start; close the outline in the drawing")
-            piece, reverse = nxt
-            open_.remove(piece)
-            more = piece.points[::-1] if reverse else piece.points
-            pts = np.vstack([pts, more[1:]])
-            chain.append(piece)
-        name = chain[0].name if len(chain) == 1 else f"chain of {len(chain)} pieces from {chain[0].name}"
-        loops.append(_Piece(_dedupe(pts), name, True))
-    return loops
+        first = open_.pop(0)
+        pts, names = first.points, [first.name]
+        pts = _grow(pts, names, open_, tol)
+        if np.hypot(*(pts[-1] - pts[0])) > tol:  # a dead end: grow the start too
+            pts = _grow(pts[::-1], names, open_, tol)[::-1]
+        name = names[0] if len(names) == 1 else f"chain of {len(names)} pieces from {names[0]}"
+        closed = np.hypot(*(pts[-1] - pts[0])) <= tol and len(pts) > 2
+        (loops if closed else chains).append(_Piece(_dedupe(pts, tol) if closed else pts, name, closed))
+    return loops, chains
 
 
-def _next_piece(candidates, end):
-    for piece in candidates:
-        if np.hypot(*(piece.points[0] - end)) <= _JOIN_TOL:
-            return piece, False
-        if np.hypot(*(piece.points[-1] - end)) <= _JOIN_TOL:
-            return piece, True
-    return None
+def _grow(pts, names, open_, tol):
+    """``pts`` extended at its end by the pieces of ``open_`` that chain on
+    (taken out of ``open_``, their names appended to ``names``)."""
+    while np.hypot(*(pts[-1] - pts[0])) > tol:
+        k, reverse = _next_piece(open_, pts[-1], tol)
+        if k is None:
+            break
+        piece = open_.pop(k)  # by index: pieces hold arrays, so list.remove would compare them
+        more = piece.points[::-1] if reverse else piece.points
+        pts = np.vstack([pts, more[1:]])
+        names.append(piece.name)
+    return pts
+
+
+def _next_piece(candidates, end, tol):
+    """Index of the candidate with an end nearest ``end`` (within ``tol``), and
+    whether it runs backwards; ``(None, False)`` when none is that near."""
+    if not candidates:
+        return None, False
+    starts = np.array([c.points[0] for c in candidates])
+    ends = np.array([c.points[-1] for c in candidates])
+    gaps = np.concatenate([np.hypot(*(starts - end).T), np.hypot(*(ends - end).T)])
+    j = int(np.argmin(gaps))
+    if gaps[j] > tol:
+        return None, False
+    return j % len(candidates), j >= len(candidates)
 
 
 def _signed_area(xy) -> float:
     x, y = xy[:, 0], xy[:, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def _centroid(xy) -> np.ndarray:
+    """Area centroid of a simple polygon (after centring, for precision)."""
+    c0 = xy.mean(axis=0)
+    x, y = (xy - c0).T
+    xn, yn = np.roll(x, -1), np.roll(y, -1)
+    cross = x * yn - xn * y
+    area = 0.5 * cross.sum()
+    return c0 + np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6.0 * area)
 
 
 def _inside(pt, poly) -> bool:
@@ -266,25 +433,48 @@ def _inside(pt, poly) -> bool:
     return bool(np.count_nonzero(crosses) % 2)
 
 
-def _choose(loops: list[_Piece], path: Path) -> _Piece:
-    """The single outline, or a clear error: holes, or several disjoint loops."""
-    loops = [lp for lp in loops if len(lp.points) >= 3]
+def _diagonal(xy) -> float:
+    return float(np.hypot(*np.ptp(xy, axis=0)))
+
+
+def _choose(loops: list[_Piece], chains: list[_Piece], path: Path, unit: Units) -> tuple[_Piece, list]:
+    """The largest closed loop and descriptions of what was left out; an error
+    for holes, crossing loops, or an open chain that looks like the outline."""
+    loops = sorted((lp for lp in loops if len(lp.points) >= 3),
+                   key=lambda lp: -abs(_signed_area(lp.points)))
+    chains = sorted(chains, key=lambda c: -_diagonal(c.points))
+    # A lone straight line (a centre line, a dimension) is never an outline left open.
+    could_be_outlines = [c for c in chains if len(c.points) > 2]
+    if could_be_outlines and (not loops or _diagonal(could_be_outlines[0].points) > _diagonal(loops[0].points)):
+        raise _open_error(could_be_outlines[0], path, unit)
+    if chains and not loops:
+        raise _open_error(chains[0], path, unit)
     if not loops:
         raise OutlineError(f"{path}: no closed outline with an area")
-    if len(loops) == 1:
-        return loops[0]
-    loops.sort(key=lambda lp: -abs(_signed_area(lp.points)))
     outer = loops[0]
     inside = {id(lp): [_inside(pt, outer.points) for pt in lp.points] for lp in loops[1:]}
     crossing = [lp for lp in loops[1:] if any(inside[id(lp)]) and not all(inside[id(lp)])]
     if crossing:
         raise OutlineError(f"{path}: outlines {outer.name} and {crossing[0].name} cross each other; "
-                           f"draw the part as one closed outline")
+                           f"draw the part as one closed outline, or pick one with --layer/--id")
     holes = [lp for lp in loops[1:] if all(inside[id(lp)])]
     if holes:
         raise OutlineError(
-            f"{path}: outline {outer.name} has {len(holes)} hole(s) ({', '.join(h.name for h in holes)}); "
-            f"parts with holes are not supported (the support integrals assume a simple polygon): "
-            f"remove the inner loops or pick another outline with --layer/--id")
-    raise OutlineError(f"{path}: {len(loops)} disjoint outlines: {'; '.join(lp.name for lp in loops)}; "
-                       f"choose one with --layer NAME (DXF) or --id ID (SVG id or DXF handle)")
+            f"{path}: outline {outer.name} has {len(holes)} hole(s) ({', '.join(h.name for h in holes[:3])}"
+            f"{' ...' if len(holes) > 3 else ''}); parts with holes are not supported (no pressure acts "
+            f"under a hole, which moves the centroid and the support integrals): put the holes on another "
+            f"layer and pick the outline with --layer, or delete them to plan the part as if solid")
+    left = [f"closed loop {lp.name} (area {abs(_signed_area(lp.points)) * unit.scale ** 2:.4g} mm^2)"
+            for lp in loops[1:]]
+    left += [f"open chain {c.name} (ends {np.hypot(*(c.points[-1] - c.points[0])) * unit.scale:.4g} mm "
+             f"apart)" for c in chains]
+    return outer, left
+
+
+def _open_error(chain: _Piece, path: Path, unit: Units) -> OutlineError:
+    end = chain.points[-1] * unit.scale
+    gap = np.hypot(*(chain.points[-1] - chain.points[0])) * unit.scale
+    return OutlineError(
+        f"{path}: open outline: {chain.name} ends at ({end[0]:.3f}, {end[1]:.3f}) mm, {gap:.3f} mm from "
+        f"its start; close the outline in the drawing, raise --join-tol (drawing units) over the gaps, "
+        f"or pick the outline with --layer/--id")

@@ -15,9 +15,18 @@ as attributes. A file whose part, pin radius, belt or kernel settings differ
 from the planner's is not used (and is replaced). Writes are
 atomic. ``Catalog.rebuild`` lists these files under ``refinements``, apart
 from the map shards.
+
+A read-only catalog (shared on a cluster, a colleague's) is never written:
+its refinements are kept in a user cache folder instead, one per catalog
+(:func:`cache_root`: ``$PINFEED_CACHE``, default the platform's cache folder,
+e.g. ``~/.cache/pinfeed``), said once on stderr, and read back with the
+catalog's own on the next run.
 """
 from __future__ import annotations
 
+import hashlib
+import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -26,12 +35,40 @@ import xarray as xr
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
 
 from pipeline.maps.catalog import REFINE_FOLDER
+from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_atomic
 from pipeline.parts.part import Part
 from pipeline.planning.propagate import UNITS, OutcomeLattice
 from pipeline.provenance import provenance_attrs
 
 FOLDER = REFINE_FOLDER
+CACHE_ENV = "PINFEED_CACHE"
+_announced = set()  # catalogs whose cache folder was named once already
+
+
+def cache_root(root) -> Path:
+    """The user cache folder standing in for catalog ``root``'s refinements:
+    ``$PINFEED_CACHE`` (else the platform's cache folder ``/pinfeed``), then
+    ``catalogs/NAME-HASH`` of the catalog's absolute path (one per catalog)."""
+    base = os.environ.get(CACHE_ENV)
+    if not base:
+        if sys.platform == "win32":
+            base = Path(os.environ.get("LOCALAPPDATA", Path.home() / "AppData" / "Local")) / "pinfeed"
+        elif sys.platform == "darwin":
+            base = Path.home() / "Library" / "Caches" / "pinfeed"
+        else:
+            base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "pinfeed"
+    resolved = Path(root).resolve()
+    key = hashlib.sha256(str(resolved).encode()).hexdigest()[:12]
+    return Path(base) / "catalogs" / f"{resolved.name}-{key}"
+
+
+def _writable(path: Path) -> bool:
+    """Whether ``path`` could be created: its nearest existing folder is writable."""
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    return folder.is_dir() and os.access(folder, os.W_OK | os.X_OK)
 
 
 def lattice_path(root, part: Part, model: str, v_pin: float, belt_speed: float | None = None,
@@ -66,29 +103,38 @@ def load_lattice(root, part: Part, model: str, v_pin: float, pin_radius: float,
     kernel = kernel or {}
     lattice = OutcomeLattice(part, model, pin_radius, v_pin, kernel.get("ds_max"), kernel.get("tol"),
                              belt_speed=belt_speed, mu_s=mu_s)
-    path = lattice_path(root, part, model, v_pin, belt_speed, mu_s)
+    # the catalog's own, then what a run against it read-only kept in the cache
+    for where in (root, cache_root(root)):
+        _read_into(lattice, lattice_path(where, part, model, v_pin, belt_speed, mu_s))
+    lattice.n_stored = len(lattice.known)
+    return lattice
+
+
+def _read_into(lattice: OutcomeLattice, path: Path) -> None:
+    """Add the outcomes stored at ``path`` to ``lattice``, when the file is
+    there, readable, and made with the lattice's part and settings."""
     if not path.is_file():
-        return lattice
+        return
     try:
         with xr.open_dataset(path, engine="h5netcdf") as ds:
             ds.load()
     except Exception:  # a corrupt file is replaced on the next save
-        return lattice
+        return
     want = _settings(lattice)
-    if ds.attrs.get("part_id") != part.id or ds.attrs.get("model") != lattice.model or any(
+    if ds.attrs.get("part_id") != lattice.part.id or ds.attrs.get("model") != lattice.model or any(
             # relative only: tolerances of 1e-9 and 2e-9 must differ (a default atol of 1e-8 hid them)
             not np.isclose(float(ds.attrs.get(k, 0.0 if k in ("belt_speed", "mu_s") else np.nan)), v,
                            rtol=1e-9, atol=0.0)
             for k, v in want.items()):
-        return lattice
+        return
     keys = np.stack([ds["key_theta_i"].values, ds["key_d"].values, ds["key_mu_c"].values], axis=1)
     lattice.add(keys, ds["status"].values, ds["theta_f"].values, ds["dy"].values)
-    lattice.n_stored = len(keys)
-    return lattice
 
 
 def save_lattice(root, lattice: OutcomeLattice) -> Path | None:
-    """Write the lattice atomically (nothing if it holds no outcome)."""
+    """Write the lattice atomically (nothing if it holds no outcome) into the
+    catalog ``root``, or into :func:`cache_root` when the catalog cannot be
+    written (saying so once on stderr). Returns the file written."""
     if not lattice.known:
         return None
     keys = sorted(lattice.known)
@@ -114,6 +160,16 @@ def save_lattice(root, lattice: OutcomeLattice) -> Path | None:
                "part_vertices": np.asarray(lattice.part.vertices).ravel(), "model": lattice.model,
                "v_pin": float(lattice.v_pin), **_settings(lattice), **provenance_attrs()},
     )
-    path = lattice_path(root, lattice.part, lattice.model, lattice.v_pin, lattice.belt_speed,
-                        lattice.mu_s)
-    return write_atomic(ds, path)
+    where = (lattice.part, lattice.model, lattice.v_pin, lattice.belt_speed, lattice.mu_s)
+    path = lattice_path(root, *where)
+    if _writable(path):
+        try:
+            return write_atomic(ds, path)
+        except PinfeedError:  # writable by its mode, yet refused (ACLs, a read-only mount...)
+            pass
+    cached = write_atomic(ds, lattice_path(cache_root(root), *where))
+    if str(root) not in _announced:
+        _announced.add(str(root))
+        print(f"pinfeed: catalog {root} cannot be written: the planner's rollouts are kept in "
+              f"{cache_root(root)} (set {CACHE_ENV} to move it) and reused on the next run", file=sys.stderr)
+    return cached

@@ -40,7 +40,7 @@ from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import arc_within, in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
 from pipeline.planning.bands import band_lookup, extract_bands
-from pipeline.planning.settings import nominal_friction, parse_friction, pins_from_config
+from pipeline.planning.settings import candidate_pins, nominal_friction, parse_friction
 
 
 @dataclass(frozen=True)
@@ -366,7 +366,7 @@ def build_planner(cat: Catalog, name: str, config: dict, dynamic: bool = True):
     selection = ds.attrs["selection"]
     mu_used = float(ds["mu_c"][0])
     maps = load_maps(ds.isel(mu_c=0).load(), bc["threshold_T"], bc["factor_c"])
-    static = pins_from_config(pc["pins"])
+    static = candidate_pins(part, pc)
     speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if dynamic else []
     dynamic_maps = {}
     for v in speeds:

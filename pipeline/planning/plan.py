@@ -20,15 +20,20 @@ replays with the dynamic model at the same speed.
 """
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import format_arcs
+from pipeline.planning.certify import carried_plan
+from pipeline.planning.complete import FixedPinSearch, FixedSearch, orientation_rank
 from pipeline.planning.lattice_store import load_lattice, save_lattice
+from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required,
+                                      check_tolerance, judge)
 from pipeline.planning.propagate import Tolerances, Uncertainty
 from pipeline.planning.search import TightPlanner
-from pipeline.planning.settings import friction_label, parse_friction, pins_from_config
+from pipeline.planning.settings import candidate_pins, friction_label, parse_friction
 from pipeline.planning.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import verify_plan
@@ -66,7 +71,7 @@ def planner_for(part: Part, config: dict, mu_c, lattices=None, moving: bool = Fa
     when it is set (:func:`planner_belt`)."""
     pc, sweep = config["planner"], config["sweep"]
     belt_speed, mu_s = planner_belt(config, part)
-    static = pins_from_config(pc["pins"])
+    static = candidate_pins(part, pc)
     speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if moving else []
     moving_pins = {f"{k}v{v:+g}": (y, v) for k, y in static.items() for v in speeds}
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
@@ -82,87 +87,158 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
                keep: int = 5, progress=None) -> dict:
     """Search, verify and rank plans for ``part`` at friction ``mu_c`` (a value
     or a range); returns a JSON-ready dict (``plans`` best first, each with
-    its ``verification``; ``recommended``; ``warning``; search statistics)."""
+    its ``verification`` and orientation verdict; ``recommended``; ``warning``;
+    ``fixed_pin_search``: what the complete search found, or its evidence that
+    no fixed-pin plan orients the part; search statistics).
+
+    Fixed pins first, by the complete search (``complete.FixedPinSearch``);
+    only when no fixed-pin sequence of up to ``depth`` pins orients the part
+    within ``planner.tolerance_deg`` do moving pins follow the best fixed-pin
+    prefixes (``planner.dynamic``)."""
     depth = int(depth if depth is not None else config["planner"]["depth"])
-    planner, candidates = _search_candidates(part, config, mu_c, lattices, depth, progress)
+    planner = planner_for(part, config, mu_c, lattices)
+    fixed = _fixed_search(part, config, mu_c, planner, depth, keep, progress)
+    verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
+    chosen = fixed.plans or fixed.best_effort
+    candidates = [carried_plan(planner, p.labels, p.margin, verify_cfg) for p in chosen]
+    moving = None if fixed.orients else _moving_planner(part, config, mu_c, planner)
+    if moving is not None:
+        candidates += _moving_candidates(moving, config, mu_c, chosen, progress)
+        planner = moving
     states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
     _verify_candidates(part, config, mu_c, planner, candidates, states, progress)
-    candidates.sort(key=lambda p: p.rank_key())
-    good = [p for p in candidates if p.verification["failures"] <= MAX_FAILURE * p.verification["trials"]]
-    return _tight_result(config, mu_c, depth, keep, planner, candidates, good, states)
+    candidates.sort(key=_rank)
+    good = [p for p in candidates if _acceptable(p)]
+    return _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed)
 
 
-def _search_candidates(part: Part, config: dict, mu_c, lattices, depth: int, progress):
-    """``(planner, candidate plans)``: fixed pins first; moving pins follow them
-    when fixed pins leave more than one set and the config allows moving pins."""
-    pc = config["planner"]
-    planner = planner_for(part, config, mu_c, lattices)
-    search = dict(keep=int(pc.get("candidates", 12)), complete_depth=int(pc.get("complete_depth", 2)),
-                  static_beam=int(pc.get("beam", 30)), progress=progress)
-    candidates = planner.search(depth, **search)
-    dyn = pc.get("dynamic", {})
-    if candidates and candidates[0].n_sets > 1 and dyn.get("depth", 0) and dyn.get("speeds"):
-        # Passive pins are not enough: let moving pins follow the static ones.
-        if progress:
-            progress(f"fixed pins leave {candidates[0].n_sets} sets: adding moving pins")
-        planner = planner_for(part, config, mu_c, planner.lattices, moving=True)
-        candidates = planner.search(depth, dynamic_depth=int(dyn["depth"]),
-                                    beam=int(dyn.get("beam", 30)), **search)
-    return planner, candidates
+def planner_tolerance(config: dict) -> float:
+    """``planner.tolerance_deg`` (default 10), checked: the full width a final set may have."""
+    return check_tolerance(config["planner"].get("tolerance_deg", DEFAULT_TOLERANCE))
+
+
+def verify_required(config: dict) -> float:
+    """``verify.required`` (default 0.995): the share of trials that must end in the set."""
+    return check_required(config.get("verify", {}).get("required", DEFAULT_REQUIRED))
+
+
+def _fixed_search(part, config, mu_c, planner, depth, keep, progress) -> FixedSearch:
+    """The complete fixed-pin search with the planner's pins and the config's settings."""
+    pc, sweep = config["planner"], config["sweep"]
+    search = FixedPinSearch(part, {k: p.y for k, p in planner.pins.items() if p.v_pin == 0.0}, mu_c,
+                            planner_tolerance(config), verify_required(config),
+                            config.get("verify", {}), sweep["pin_radius"], pc["model"],
+                            sweep.get("kernel"), pc["d_min"], pc["d_max"],
+                            belt_speed=planner.belt_speed, mu_s=planner.mu_s)
+    return search.run(depth, candidates=int(pc.get("candidates", 12)), keep=keep, progress=progress)
+
+
+def _moving_planner(part, config, mu_c, planner):
+    """The planner with moving pins, if the config allows them (else ``None``)."""
+    dyn = config["planner"].get("dynamic", {})
+    if not (dyn.get("depth", 0) and dyn.get("speeds")):
+        return None
+    return planner_for(part, config, mu_c, planner.lattices, moving=True)
+
+
+def _moving_candidates(moving, config, mu_c, chosen, progress) -> list:
+    """Plans where moving pins follow the best fixed-pin prefixes (and the empty one)."""
+    dyn = config["planner"]["dynamic"]
+    if progress:
+        progress(f"mu_c {friction_label(mu_c)}: fixed pins do not orient the part: adding moving pins")
+    prefixes = [()] + [p.labels for p in chosen]
+    return moving.extend_moving(prefixes, int(dyn["depth"]), int(dyn.get("beam", 30)),
+                                keep=int(config["planner"].get("candidates", 12)))
+
+
+def _rank(plan) -> tuple:
+    v = plan.verification or {}
+    return orientation_rank(v.get("orientation"), len(plan.pins), plan.margin)
+
+
+def _acceptable(plan) -> bool:
+    """May ``plan`` be recommended? It orients the part, or it ends in several
+    sets within the tolerance (for a sensor or moving pins to finish) and its
+    claimed sets hold all but ``MAX_FAILURE`` of the trials."""
+    v = plan.verification
+    verdict = v["orientation"]
+    return verdict["orients"] or v["failures"] <= MAX_FAILURE * v["trials"]
 
 
 def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, states, progress) -> None:
     """Replay each candidate by perturbed full rollouts (``verify_plan``) and
-    attach the summary as ``plan.verification``."""
+    attach the summary as ``plan.verification``, with the orientation verdict
+    (``orient.judge``: one set within the tolerance?) as ``orientation``."""
     pc = config["planner"]
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
+    tolerance, required = planner_tolerance(config), verify_required(config)
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
     for plan in candidates:
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
                           config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
                           kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
                           mu_s=planner.mu_s)
+        finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
+        verdict = judge(finals, res["trials"], tolerance, planner.order, required)
+        verdict["trials"], verdict["jammed"] = res["trials"], res["trials"] - len(finals)
         plan.verification = {"trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
                              **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}
-                                if "belt_speed" in res else {})}
+                                if "belt_speed" in res else {}),
+                             "orientation": verdict}
         if progress:
-            progress(f"verified {' '.join(plan.pins)}: {res['successes']}/{res['trials']} trials")
+            width = verdict["width_deg"]
+            progress(f"mu_c {friction_label(mu_c)}: verified {' '.join(plan.pins)}: "
+                     f"{verdict['in_tolerance']}/{res['trials']} trials in one set of {tolerance:g} deg"
+                     + (f", verified width {width:.1f} deg" if width is not None else ""))
 
 
-def _no_plan_warning(depth: int, candidates, good):
-    """Why nothing is recommended (None when a verified plan exists)."""
+def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance: float):
+    """Why the recommended plan does not orient the part, or why nothing is
+    recommended (None when a plan orients it)."""
+    if good and good[0].verification["orientation"]["orients"]:
+        return None
     if not candidates:
-        return f"no allowed pin sequence within depth {depth}"
+        return f"{fixed.evidence()}; no allowed pin sequence within depth {depth}"
     if not good:
         best = candidates[0]
-        return (f"no plan passed verification: the best prediction, {' '.join(best.pins)} "
+        return (f"{fixed.evidence()}; no plan passed verification: the best, {' '.join(best.pins)} "
                 f"({format_arcs(best.final_sets)}), failed {best.verification['failures']} of "
                 f"{best.verification['trials']} trials")
-    return None
+    verdict = good[0].verification["orientation"]
+    return (f"{fixed.evidence()}; the recommended plan ends in {verdict['sets_within_tolerance']} "
+            f"sets of at most {tolerance:g} deg: a sensor or moving pins must tell them apart")
 
 
-def _tight_result(config: dict, mu_c, depth: int, keep: int, planner, candidates, good, states) -> dict:
+def _tight_result(config: dict, mu_c, depth: int, keep: int, planner, candidates, good, states,
+                  fixed: FixedSearch) -> dict:
     """The JSON-ready tight-planner entry at one friction (the stored format)."""
     pc = config["planner"]
     recommended = good[0] if good else None
+    tolerance = planner_tolerance(config)
     return {
         "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c,
         "friction": friction_label(mu_c),
         "belt_speed": planner.belt_speed, "mu_s": planner.mu_s if planner.belt_speed else None,
         "mechanics": mechanics_label(pc["model"], planner.belt_speed, planner.mu_s),
         "symmetry_order": planner.order,
-        "depth": depth, "complete_depth": int(pc.get("complete_depth", 2)),
-        "beam": int(pc.get("beam", 30)),
+        "depth": depth, "complete_depth": depth,
+        "beam": int(pc.get("dynamic", {}).get("beam", 30)),
+        "tolerance_deg": tolerance, "required": verify_required(config),
+        "orients": bool(recommended and recommended.verification["orientation"]["orients"]),
         "plans": [p.to_dict() for p in good[:keep]],
         "rejected": [p.to_dict() for p in candidates if p not in good][:keep],
         "recommended": recommended.to_dict() if recommended else None,
-        "warning": _no_plan_warning(depth, candidates, good),
-        "stats": {"transitions": planner.stats.transitions, "rollouts": planner.stats.rollouts,
-                  "joint_states": planner.stats.nodes, "seconds": round(planner.stats.seconds, 2),
+        "warning": _no_plan_warning(depth, candidates, good, fixed, tolerance),
+        "fixed_pin_search": fixed.to_dict(),
+        "pins_used": {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0},
+        "stats": {"transitions": planner.stats.transitions,
+                  "rollouts": planner.stats.rollouts + fixed.rollouts,
+                  "nominal_rollouts": fixed.rollouts,
+                  "joint_states": planner.stats.nodes, "seconds": round(fixed.seconds + planner.stats.seconds, 2),
                   "pruned_branching": planner.stats.pruned_branching,
                   "unresolved": planner.stats.unresolved,
-                  "per_level": planner.stats.per_level},
+                  "per_level": [lv["sequences"] for lv in fixed.levels]},
         "initial_states": {k: {"theta": t, "y_c": y} for k, (t, y) in states.items()},
         "lattices": planner.lattices,
     }
@@ -250,8 +326,10 @@ def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progre
     out = []
     try:
         for mu_c in plan_frictions(config):
+            t0 = time.perf_counter()
             res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep,
                              progress=_labelled(progress, f"mu_c {friction_label(mu_c)}"))
+            res["stats"]["wall_seconds"] = round(time.perf_counter() - t0, 2)  # search, verification and all
             res.pop("lattices")
             out.append(res)
     finally:  # also on Ctrl-C: the rollouts done so far are reused by the next run
@@ -261,7 +339,8 @@ def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progre
 
 
 def _labelled(progress, label: str):
-    """``progress`` with each message prefixed by ``label`` (which friction it is for)."""
+    """``progress`` with each message prefixed by ``label`` (which friction it is
+    for), unless the message already starts with it."""
     if progress is None:
         return None
-    return lambda message: progress(f"{label}: {message}")
+    return lambda message: progress(message if message.startswith(label) else f"{label}: {message}")

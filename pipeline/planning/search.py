@@ -77,6 +77,7 @@ class TightPlan:
     initial: dict  # initial-state label -> StateSet
     sets_after: tuple = ()
     verification: dict | None = None  # filled in by verify
+    claim: str = "propagated"  # how the carried sets were found: "propagated" or "sampled"
 
     @property
     def n_dynamic(self) -> int:
@@ -114,6 +115,7 @@ class TightPlan:
             "initial_sets": {k: v.to_dict() for k, v in self.initial.items()},
             "initial_states": {label: [[st.to_dict() for st in br] for br in brs]
                                for label, brs in self.branches.items()},
+            "claim": self.claim,
             "verification": self.verification,
         }
 
@@ -252,7 +254,7 @@ class TightPlanner:
         t0 = time.perf_counter()
         starts = self.initial_states()
         self.labels = list(starts)
-        root = ((), tuple(((st, ()),) for st in starts.values()), math.inf, 0, ())
+        root = self._root(starts)
         seen = {self._joint_key(root[1])}
         nodes, frontier = [], [root]
         for level in range(depth):
@@ -276,21 +278,67 @@ class TightPlanner:
         self.stats.seconds = time.perf_counter() - t0
         return plans[:keep]
 
+    def follow(self, seq) -> TightPlan | None:
+        """The tight plan of one given pin sequence (its carried sets, no search),
+        or ``None`` if the propagation forbids one of its pins for some branch
+        (a reachable jam, a pin passing a centroid on both sides, too many
+        branches or jumps)."""
+        starts = self.initial_states()
+        self.labels = list(starts)
+        node = self._root(starts)
+        for label in seq:
+            node = self._step(node, label)
+            if node is None:
+                return None
+        return self._plan(node, starts)
+
+    def extend_moving(self, prefixes, dynamic_depth: int, beam: int = 30, keep: int = 10) -> list[TightPlan]:
+        """Plans that follow one of the fixed-pin ``prefixes`` (label tuples, the
+        empty one included) by up to ``dynamic_depth`` moving pins: a beam of
+        ``beam`` joint states per level, ranked by fewest sets, then fewest pins."""
+        t0 = time.perf_counter()
+        starts = self.initial_states()
+        self.labels = list(starts)
+        nodes, seen = [], set()
+        for seq in prefixes:
+            node = self._root(starts)
+            for label in seq:
+                node = node and self._step(node, label)
+            if node is not None and self._joint_key(node[1]) not in seen:
+                seen.add(self._joint_key(node[1]))
+                nodes.append(node)
+        grown, out = list(nodes), []
+        for _ in range(dynamic_depth):
+            grown.sort(key=self._node_rank)
+            grown = self._expand(grown[:beam], self.moving_labels, seen)
+            out.extend(grown)
+        self.stats.nodes += len(out)
+        plans = sorted((self._plan(node, starts) for node in out), key=TightPlan.rank_key)
+        self.stats.seconds += time.perf_counter() - t0
+        return plans[:keep]
+
+    def _root(self, starts):
+        return ((), tuple(((st, ()),) for st in starts.values()), math.inf, 0, ())
+
+    def _step(self, node, label):
+        """``node`` followed by pin ``label`` (``None`` if forbidden)."""
+        seq, joint, margin, jumps, sets_after = node
+        child = self._apply(joint, label)
+        if child is None:
+            return None
+        new_joint, step_margin, step_jumps = child
+        return (seq + (label,), new_joint, min(margin, step_margin), jumps + step_jumps,
+                sets_after + (self._count_sets(new_joint),))
+
     def _expand(self, frontier, labels, seen):
         out = []
-        for seq, joint, margin, jumps, sets_after in frontier:
+        for node in frontier:
             for label in labels:
-                child = self._apply(joint, label)
-                if child is None:
+                child = self._step(node, label)
+                if child is None or self._joint_key(child[1]) in seen:
                     continue
-                new_joint, step_margin, step_jumps = child
-                key = self._joint_key(new_joint)
-                if key in seen:
-                    continue
-                seen.add(key)
-                n_sets = self._count_sets(new_joint)
-                out.append((seq + (label,), new_joint, min(margin, step_margin),
-                            jumps + step_jumps, sets_after + (n_sets,)))
+                seen.add(self._joint_key(child[1]))
+                out.append(child)
         return out
 
     def _apply(self, joint, label):

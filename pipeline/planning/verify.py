@@ -79,6 +79,26 @@ def corner_inputs(theta, y_c, mu_c, n_pins, cfg):
             arr[:, 2], offs)
 
 
+def trial_inputs(initial_states: dict, mu_c, n_pins: int, settings: dict) -> list:
+    """The trials :func:`verify_plan` replays for a plan of ``n_pins`` pins: per
+    initial state (in order), arrays ``(theta, y_c, mu, offsets (n, n_pins))``
+    of ``settings["trials"]`` random trials followed by every corner of the
+    perturbation box (``settings["corners"]``). The same settings give the same
+    trials, so a subset of them can be replayed first to reject a plan early."""
+    cfg = dict(DEFAULTS, **(settings or {}))
+    rng = np.random.default_rng(cfg["seed"])
+    out = []
+    for state in initial_states.values():
+        theta0, yc0 = _start(state)
+        th, yc, mu, offs = perturbed_batch(theta0, yc0, mu_c, n_pins, cfg, rng, int(cfg["trials"]))
+        if cfg.get("corners", True):
+            corners = corner_inputs(theta0, yc0, mu_c, n_pins, cfg)
+            th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), corners[:3]))
+            offs = np.concatenate([offs, corners[3]])
+        out.append((th, yc, mu, offs))
+    return out
+
+
 def _arc(step):
     return (step["band"]["start"], step["band"]["width"])
 
@@ -111,21 +131,23 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
 
     ``belt_speed`` (mm/s) replays with the dynamic model at that speed and
     belt friction ``mu_s`` (``model`` is then unused); ``None`` is
-    quasi-static ``model``.
+    quasi-static ``model``. ``pin_heights`` is one height per pin (mm), or an
+    array ``(n_trials, n_pins)`` to replay several plans of one length at once.
 
     Returns ``(theta_f, y_c, jam_reason_or_empty, missed)``: arrays over trials,
     ``missed`` a boolean array ``(n_trials, n_pins)``. If ``path`` is a list,
     ``(theta, y_c)`` arrays after each pin are appended to it."""
     theta, y_c = np.array(theta, float), np.array(y_c, float)
     n = theta.size
+    heights = np.broadcast_to(np.asarray(pin_heights, dtype=float), (n, len(pin_speeds)))
     jam = np.full(n, "", dtype=object)
-    missed = np.zeros((n, len(pin_heights)), bool)
+    missed = np.zeros((n, len(pin_speeds)), bool)
     alive = np.ones(n, bool)
-    for k, (y_pin, v) in enumerate(zip(pin_heights, pin_speeds)):
+    for k, v in enumerate(pin_speeds):
         idx = np.flatnonzero(alive)
         if idx.size == 0:
             break
-        d = contact_parameter(y_pin + offsets[idx, k], y_c[idx], part.a)
+        d = contact_parameter(heights[idx, k] + offsets[idx, k], y_c[idx], part.a)
         if belt_speed is None:
             res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, model,
                                           v_pin=float(v), ds_max=ds_max, tol=tol)
@@ -164,18 +186,13 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     speeds = speeds or {}
     cfg = dict(DEFAULTS, **(settings or {}))
     kernel = kernel or {}
-    rng = np.random.default_rng(cfg["seed"])
     labels = list(plan["pins"])
     heights = [float(pins[p]) for p in labels]
     vs = [float(speeds.get(p, 0.0)) for p in labels]
     rows, trials = [], []
-    for label, state in initial_states.items():
+    inputs = trial_inputs(initial_states, mu_c, len(labels), cfg)
+    for (label, state), (th, yc, mu, offs) in zip(initial_states.items(), inputs):
         theta0, yc0 = _start(state)
-        th, yc, mu, offs = perturbed_batch(theta0, yc0, mu_c, len(labels), cfg, rng, int(cfg["trials"]))
-        if cfg.get("corners", True):
-            corners = corner_inputs(theta0, yc0, mu_c, len(labels), cfg)
-            th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), corners[:3]))
-            offs = np.concatenate([offs, corners[3]])
         tf, yf, jam, missed = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
                                      kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL),
                                      belt_speed=belt_speed, mu_s=mu_s)

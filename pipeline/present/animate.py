@@ -284,7 +284,8 @@ def plan_inputs(result, plan_index, config: dict) -> dict:
             h = float(plan.pin_heights_mm[k])
         elif label in table:
             h = float(table[label])
-        elif m and int(m.group(1)) <= len(config["planner"]["pins"]):
+        elif m and isinstance(config["planner"].get("pins"), list) \
+                and int(m.group(1)) <= len(config["planner"]["pins"]):
             h = float(config["planner"]["pins"][int(m.group(1)) - 1])
         else:
             raise PinfeedError(f"pin {label!r} of the {what} has no height in the plan or the config")

@@ -15,6 +15,7 @@ from pipeline import __version__
 from pipeline.config import config_hash
 from pipeline.maps.io import write_text_atomic
 from pipeline.planning.arcs import format_arcs
+from pipeline.present.atlas_section import atlas_section
 from pipeline.present.figures.tables import HEADER, verification_rows
 from pipeline.present.layout import speed_limit_text
 from pipeline.provenance import creation_time, git_commit
@@ -55,10 +56,12 @@ def config_title(config: dict) -> str:
     return "the default config" if name in ("config", "default") else f"config {name}"
 
 
-def write_report(config, parts: dict, out, overview: dict | None = None, catalog=None) -> Path:
+def write_report(config, parts: dict, out, overview: dict | None = None, catalog=None,
+                 atlas: dict | None = None) -> Path:
     """``parts``: name -> {"plan", "verify", optional "sensing" (results), "files"
     (kind -> path), "shards" (catalog entries)}; ``overview``: text -> path of the
-    all-parts files; ``catalog``: the catalog folder (shard links). Writes ``out``."""
+    all-parts files; ``catalog``: the catalog folder (shard links); ``atlas``: the
+    feedability atlas (``workflow.atlas``), shown first. Writes ``out``."""
     out = Path(out)
     base = out.parent
     pc, bc = config["planner"], config["bands"]
@@ -71,6 +74,9 @@ def write_report(config, parts: dict, out, overview: dict | None = None, catalog
          f"{html.escape(pc['model'])}, mu_c {html.escape(str(pc['mu_c']))}, depth "
          f"{pc['depth']}, d in [{pc['d_min']:g}, {pc['d_max']:g}], T = {bc['threshold_T']:g} deg, "
          f"c = {bc['factor_c']:g}.</p>"]
+    if atlas:
+        thumbs = {n: v["files"]["outline"] for n, v in parts.items() if "outline" in v["files"]}
+        p += atlas_section(atlas, thumbs, base, _anchor)
     p += _warnings({n: v["plan"] for n, v in parts.items()}, {n: v["verify"] for n, v in parts.items()})
     p += _toc(parts)
     if overview:

@@ -13,13 +13,15 @@ from pipeline.errors import PinfeedError
 from pipeline.maps.catalog import Catalog
 from pipeline.parts.families import family_parts
 from pipeline.parts.part import Part
+from pipeline.planning.orient import check_tolerance
 from pipeline.planning.plan import plan_tight_all, planner_belt
 from pipeline.planning.settings import parse_friction
 from pipeline.provenance import provenance_attrs
 
 
 def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model=None, coverage=None,
-                     speeds=None, dynamic_depth=None, pins=None, belt_speed=None, mu_s=None) -> dict:
+                     speeds=None, dynamic_depth=None, pins=None, belt_speed=None, mu_s=None,
+                     tolerance=None) -> dict:
     """A copy of ``config`` with ``pinfeed plan``'s overrides applied, each checked.
 
     ``None`` leaves the config's value. ``catalog``: the catalog folder;
@@ -28,7 +30,8 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
     ``speeds``: the moving pins' speed ratios (no 0; ``[]`` none);
     ``dynamic_depth`` (>= 0; 0 plans fixed pins only, dropping the speeds);
     ``pins``: candidate pin heights (mm); ``belt_speed`` (mm/s) and ``mu_s``
-    (only with a belt speed). Raises :class:`PinfeedError` on a bad value
+    (only with a belt speed); ``tolerance``: the full width (deg) a final set
+    may have, in (0, 360). Raises :class:`PinfeedError` on a bad value
     before any work."""
     config = copy.deepcopy(config)
     if catalog:
@@ -46,6 +49,8 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
     _dynamic_settings(pc["dynamic"], speeds, dynamic_depth)
     if pins is not None:
         pc["pins"] = [float(x) for x in pins]
+    if tolerance is not None:
+        pc["tolerance_deg"] = check_tolerance(tolerance)
     if belt_speed is not None:
         pc["belt_speed"] = belt_speed
     if mu_s is not None:

@@ -210,9 +210,10 @@ def part_files(results, name: str) -> dict:
     return out
 
 
-def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_paths=()):
-    """The HTML page (``out``, in the results folder) of the planned parts: their
-    results, every figure found beside them, and the catalog shards they use."""
+def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_paths=(), atlas_path=None):
+    """The HTML page (``out``, in the results folder) of the planned parts: the
+    feedability atlas (``atlas_path``) first, their results, every figure found
+    beside them, and the catalog shards they use."""
     results = Path(out).parent
     cat = Catalog.open(config["catalog_dir"])
     parts = {}
@@ -239,7 +240,8 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_p
     overview = {k: results / f for k, f in (("verification figure", "figures/verification.png"),
                                             ("verification table", "verification.md"))
                 if (results / f).is_file()}
-    return write_report(config, parts, out, overview=overview, catalog=cat.root)
+    return write_report(config, parts, out, overview=overview, catalog=cat.root,
+                        atlas=read_json(atlas_path) if atlas_path else None)
 
 
 # ---------------------------------------------------------------------- rules reading a plan file

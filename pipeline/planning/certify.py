@@ -1,0 +1,67 @@
+"""The carried sets of a chosen pin sequence, for the stored plan.
+
+A sequence the complete search picked (``complete.py``) is first followed by
+the tight propagation (``search.TightPlanner.follow``): its carried sets are
+then a sound claim (``"claim": "propagated"``), checked again by the
+verification. When the propagation forbids one of its pins (the uncertainty
+box reaches a jam or a centroid on both sides, or holds too many jumps),
+the sets are *sampled* instead (``"claim": "sampled"``): the hull of a
+separate replay of the perturbation box (the verification's settings with
+the next seed) after each pin. A sampled claim is weaker: the
+verification, with its own seed, is what then checks it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.parts.contact import contact_parameter
+from pipeline.planning.arcs import merge_arcs, merge_modulo
+from pipeline.planning.orient import narrowest_arc
+from pipeline.planning.propagate import friction_interval, snapped_state
+from pipeline.planning.search import Step, TightPlan, TightPlanner
+from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
+from pipeline.planning.verify import replay, trial_inputs
+
+
+def carried_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> TightPlan:
+    """The :class:`TightPlan` of the sequence ``labels``: propagated if the
+    tight propagation allows every pin, else sampled (see the module notes)."""
+    plan = planner.follow(labels)
+    if plan is not None:
+        plan.claim = "propagated"
+        return plan
+    return sampled_plan(planner, labels, margin, verify)
+
+
+def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> TightPlan:
+    """A :class:`TightPlan` whose carried sets are the hulls of a replay of the
+    perturbation box (seed ``verify.seed + 1``) after each pin."""
+    cfg = dict(VERIFY_DEFAULTS, **(verify or {}))
+    cfg["seed"] = int(cfg["seed"]) + 1
+    part, unc = planner.part, planner.unc
+    pins = [planner.pins[p] for p in labels]
+    starts = planner.initial_states()
+    resting = {k: (float(t), float(y)) for k, (t, y) in zip(starts, part.stable_states())}
+    mu_lo, mu_hi = friction_interval(planner.mu_c, unc)
+    branches, finals = {}, []
+    for label, (th, yc, mu, offs) in zip(starts, trial_inputs(resting, planner.mu_c, len(pins), cfg)):
+        path = []
+        replay(part, [p.y for p in pins], [p.v_pin for p in pins], th, yc, mu, offs,
+               planner.pin_radius, planner.model, path=path, belt_speed=planner.belt_speed,
+               mu_s=planner.mu_s)
+        steps, y_before = [], yc
+        for k, (pin, (theta_k, y_k)) in enumerate(zip(pins, path)):
+            ok = np.isfinite(theta_k)
+            d = contact_parameter(pin.y + offs[:, k], y_before, part.a)
+            arc = narrowest_arc(theta_k[ok], int(ok.sum())) or (0.0, 360.0)
+            after = snapped_state(arc[0], arc[1], float(np.min(y_k[ok], initial=np.inf)),
+                                  float(np.max(y_k[ok], initial=-np.inf)), mu_lo, mu_hi)
+            steps.append(Step(pin.label, pin.y, pin.v_pin, float(d.min()), float(d.max()), after))
+            y_before = y_k
+        branches[label] = [steps]
+        finals.append(steps[-1].after.arc)
+    plan = TightPlan(tuple(labels), tuple(p.y for p in pins), tuple(p.v_pin for p in pins),
+                     merge_arcs(finals), len(merge_modulo(finals, planner.order)), float(margin), 0,
+                     branches, dict(starts), ())
+    plan.claim = "sampled"
+    return plan

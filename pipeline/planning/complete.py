@@ -1,0 +1,300 @@
+"""The complete search for fixed-pin plans that orient a part within a tolerance.
+
+What "complete" means here. Take the candidate pins, the depth ``N``, the
+tolerance ``T`` and the verification's trials (``verify.trial_inputs``: the
+configured random trials per resting state plus every corner of the
+perturbation box). A sequence *orients* the part when at least
+``verify.required`` of those trials end in one arc no wider than ``T``
+(``orient.judge``; jams count as failures). The search returns a plan of
+``n`` pins whenever some sequence of ``n <= N`` pins orients the part and
+its nominal paths (``enumerate.NominalTree``: every resting state unperturbed,
+at the middle friction) neither jam nor pass a centroid within the pins'
+placement tolerance, and end within ``T + SLACK_DEG`` of each other; and it
+never returns a plan with more pins than such a sequence. It does so by
+trying every sequence, level by level:
+
+1. enumerate all sequences of the level by nominal rollouts;
+2. keep those whose nominal finals span at most ``T + SLACK_DEG`` (modulo the
+   part's symmetry), narrowest first;
+3. replay a fixed subset of the verification trials (``SCREEN_RANDOM`` random
+   trials per state and ``SCREEN_CORNERS`` corners) for all of them at once;
+   a sequence whose subset already has more failures than the whole
+   verification allows is rejected (exact: more trials cannot mend it);
+4. replay all the verification trials for the survivors and judge them;
+5. stop at the first level where some sequence orients.
+
+Among the orienting sequences of that level the narrowest verified width
+wins, then the larger margin in d; at least ``candidates`` survivors of step
+3 are judged (all of them if fewer), so the width ranking is over those.
+
+When no sequence of up to ``N`` pins orients, the result says so with the
+evidence: per level, how many sequences were enumerated, kept, screened out
+and judged, and the best fixed-pin results found (the most trials in one set,
+and the fewest sets within ``T``).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
+
+from pipeline.parts.part import Part
+from pipeline.planning import orient
+from pipeline.planning.enumerate import NominalTree
+from pipeline.planning.settings import nominal_friction
+from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
+from pipeline.planning.verify import replay, trial_inputs
+
+SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
+SCREEN_RANDOM = 12  # random trials per resting state in the screen
+SCREEN_CORNERS = 8  # corners per resting state in the screen
+MAX_ROWS = 150_000  # trials replayed in one batch
+
+
+def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None) -> tuple:
+    """The ranking of plans (best first): plans that orient the part, by fewest
+    pins, narrowest verified width, largest margin in d; then plans ending in
+    several sets within the tolerance (those that jam too often last), by
+    fewest sets, fewest pins, most trials in one set."""
+    v = verdict or {}
+    width = v.get("width_deg")
+    margin = -margin if margin is not None and np.isfinite(margin) else 0.0
+    if v.get("orients"):
+        return (0, 0, 0, n_pins, width, margin)
+    trials = v.get("trials", 1)
+    jams_decide = trials - v.get("jammed", 0) < v.get("needed", trials)  # too many jams for any set
+    share = v.get("in_tolerance", 0) / max(1, trials)
+    return (1, int(jams_decide), v.get("sets_within_tolerance", 10 ** 6), n_pins, -share, margin)
+
+
+@dataclass
+class FixedPlan:
+    """A fixed-pin sequence and its verdict on the verification trials."""
+    labels: tuple
+    heights: tuple
+    nominal_span: float
+    margin: float
+    verdict: dict | None = None
+
+    def rank_key(self):
+        """Orienting first, then fewer pins, narrower verified width, larger margin."""
+        return orientation_rank(self.verdict, len(self.labels), self.margin)
+
+
+@dataclass
+class FixedSearch:
+    """What the complete search found: ``plans`` orient the part (best first);
+    ``best_effort`` are the best fixed-pin results when none does."""
+    plans: list
+    best_effort: list
+    depth: int
+    tolerance: float
+    required: float
+    levels: list = field(default_factory=list)
+    rollouts: int = 0
+    seconds: float = 0.0
+
+    @property
+    def orients(self) -> bool:
+        """True if some fixed-pin sequence orients the part."""
+        return bool(self.plans)
+
+    def evidence(self) -> str:
+        """One sentence: what was found, or why fixed pins are not enough."""
+        if self.plans:
+            best = self.plans[0]
+            return (f"{len(best.labels)} fixed pins orient this part within {self.tolerance:g} deg "
+                    f"(verified width {best.verdict['width_deg']:.1f} deg); no sequence of fewer does")
+        text = f"no fixed-pin sequence of up to {self.depth} pins orients this part within {self.tolerance:g} deg"
+        if self.best_effort:
+            b = self.best_effort[0]
+            v = b.verdict
+            text += (f"; best fixed-pin result: {' '.join(b.labels)} ends in {v['sets_within_tolerance']} "
+                     f"set(s) of at most {self.tolerance:g} deg, at most {v['in_tolerance']} of "
+                     f"{v['trials']} trials in one")
+        return text
+
+    def to_dict(self) -> dict:
+        """The search's record for the plan file (``fixed_pin_search``)."""
+        return {"orients": self.orients, "depth": self.depth, "tolerance_deg": self.tolerance,
+                "required": self.required, "evidence": self.evidence(), "levels": self.levels,
+                "nominal_rollouts": self.rollouts, "seconds": round(self.seconds, 2),
+                "best_effort": [{"pins": list(b.labels), "pin_heights_mm": list(b.heights),
+                                 **b.verdict} for b in self.best_effort]}
+
+
+class FixedPinSearch:
+    """The complete search over ``pins`` (label -> height, mm) for one part and friction.
+
+    Parameters
+    ----------
+    part : the part.
+    pins : candidate fixed pins ``{label: height_mm}``.
+    mu_c : a friction value or a range ``(lo, hi)`` (the nominal paths use its
+        middle; the trials sample it as verification does).
+    tolerance : the full width (deg) a final set may have.
+    required : share of trials that must end in the set.
+    verify : the verification settings (trials, perturbation sizes, seed).
+    pin_radius, model, kernel : rollout settings.
+    d_min, d_max : the margin's limits on ``|d|``.
+    belt_speed, mu_s : plan with the dynamic model at this belt speed (mm/s)
+        and belt friction instead of the quasi-static ``model``.
+    """
+
+    def __init__(self, part: Part, pins: dict, mu_c, tolerance: float, required: float,
+                 verify: dict, pin_radius: float, model: str = "minpower", kernel: dict | None = None,
+                 d_min: float = 0.1, d_max: float = 0.9, belt_speed: float | None = None,
+                 mu_s: float = 0.5):
+        self.part, self.mu_c, self.model = part, mu_c, model
+        self.belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
+        self.labels = list(pins)
+        self.heights = np.array([float(pins[k]) for k in self.labels])
+        self.tolerance = orient.check_tolerance(tolerance)
+        self.required = orient.check_required(required)
+        self.cfg = dict(VERIFY_DEFAULTS, **(verify or {}))
+        self.pin_radius = float(pin_radius)
+        self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **(kernel or {})}
+        self.order = part.symmetry_order()
+        self.states = {f"state {k}": (float(t), float(y))
+                       for k, (t, y) in enumerate(part.stable_states(), start=1)}
+        self.tree = NominalTree(part, self.heights, nominal_friction(mu_c), self.pin_radius, model,
+                                self.kernel, float(self.cfg["pin_halfwidth"]), d_min, d_max,
+                                belt=self.belt)
+
+    def run(self, depth: int, candidates: int = 12, keep: int = 5, progress=None) -> FixedSearch:
+        """Search levels 1 to ``depth``; stop at the first level with an orienting plan."""
+        t0 = time.perf_counter()
+        result = FixedSearch([], [], int(depth), self.tolerance, self.required)
+        runners_up = []
+        for level in self.tree.levels(int(depth)):
+            n_pins = level.seq.shape[1] if level.size else len(result.levels) + 1
+            found, judged, record = self._level(level, candidates)
+            result.levels.append({"pins": n_pins, **record})
+            if progress:
+                progress(f"{n_pins} fixed pin(s): {record['sequences']} sequences, "
+                         f"{record['nominal_within']} within {self.tolerance:g} deg nominally, "
+                         f"{record['judged']} replayed in full, {record['orienting']} orient the part")
+            runners_up.extend(judged)
+            if found:
+                result.plans = sorted(found, key=FixedPlan.rank_key)[:keep]
+                break
+            runners_up.extend(self._several_sets(level, candidates))
+        if not result.plans:
+            result.best_effort = sorted(runners_up, key=FixedPlan.rank_key)[:keep]
+        result.rollouts = self.tree.rollouts
+        result.seconds = time.perf_counter() - t0
+        return result
+
+    # ------------------------------------------------------------------ one level
+
+    def _level(self, level, candidates):
+        """``(orienting plans, every judged plan, the level's counts)``."""
+        record = {"sequences": level.size, "nominal_within": 0, "screened_out": 0, "judged": 0,
+                  "orienting": 0}
+        if level.size == 0:
+            return [], [], record
+        span = orient.row_spans(level.theta, self.order)
+        within = np.flatnonzero(span <= self.tolerance + SLACK_DEG)
+        within = within[np.lexsort((-level.margin[within], span[within]))]
+        record["nominal_within"] = int(within.size)
+        if within.size == 0:
+            return [], [], record
+        n_pins = level.seq.shape[1]
+        inputs = trial_inputs(self.states, self.mu_c, n_pins, self.cfg)
+        n_total = sum(x[0].size for x in inputs)
+        allowed = n_total - orient.needed(n_total, self.required)
+        screen = self._screen_rows(inputs)
+        fails = self._failures(level, within, screen)
+        alive = within[fails <= allowed]
+        alive = alive[np.argsort(fails[fails <= allowed], kind="stable")]
+        record["screened_out"] = int(within.size - alive.size)
+        found, judged = [], []
+        full = self._all_rows(inputs)
+        step = max(1, min(candidates, MAX_ROWS // full[0].size))
+        for start in range(0, alive.size, step):
+            chunk = alive[start:start + step]
+            for idx, verdict in zip(chunk, self._judge(level, chunk, full)):
+                plan = self._plan(level, idx, span[idx], verdict)
+                judged.append(plan)
+                if verdict["orients"]:
+                    found.append(plan)
+            if found and len(judged) >= candidates:
+                break
+        record["judged"], record["orienting"] = len(judged), len(found)
+        return found, judged, record
+
+    def _plan(self, level, idx, span, verdict) -> FixedPlan:
+        seq = level.seq[idx]
+        return FixedPlan(tuple(self.labels[i] for i in seq), tuple(float(self.heights[i]) for i in seq),
+                         float(span), float(level.margin[idx]), verdict)
+
+    def _screen_rows(self, inputs):
+        """The screen's trials: the first random trials and evenly spread corners of each state."""
+        n_random = int(self.cfg["trials"])
+        rows = []
+        for th, yc, mu, offs in inputs:
+            n_corners = th.size - n_random
+            pick = list(range(min(SCREEN_RANDOM, n_random)))
+            if n_corners:
+                step = max(1, n_corners // SCREEN_CORNERS)
+                pick += list(range(n_random, th.size, step))[:SCREEN_CORNERS]
+            rows.append((th[pick], yc[pick], mu[pick], offs[pick]))
+        return self._stack(rows)
+
+    def _all_rows(self, inputs):
+        return self._stack(inputs)
+
+    @staticmethod
+    def _stack(rows):
+        return tuple(np.concatenate([r[k] for r in rows]) for k in range(4))
+
+    def _replay(self, level, idx, rows):
+        """Final orientations ``(len(idx), trials)`` and jam flags of plans ``idx`` on ``rows``."""
+        th, yc, mu, offs = rows
+        n_trials, n_plans = th.size, idx.size
+        heights = self.heights[level.seq[idx]]  # (plans, pins)
+        tf, _, jam, _ = replay(self.part, np.repeat(heights, n_trials, axis=0),
+                               [0.0] * heights.shape[1], np.tile(th, n_plans), np.tile(yc, n_plans),
+                               np.tile(mu, n_plans), np.tile(offs, (n_plans, 1)), self.pin_radius,
+                               self.model, self.kernel["ds_max"], self.kernel["tol"], **self.belt)
+        return tf.reshape(n_plans, n_trials), (jam != "").reshape(n_plans, n_trials)
+
+    def _failures(self, level, idx, rows):
+        """Trials of ``rows`` that no one arc of the tolerance can hold, per plan."""
+        out = np.empty(idx.size, dtype=int)
+        step = max(1, MAX_ROWS // rows[0].size)
+        for start in range(0, idx.size, step):
+            chunk = idx[start:start + step]
+            tf, jam = self._replay(level, chunk, rows)
+            for k in range(chunk.size):
+                held, _ = orient.best_arc(tf[k][~jam[k]], self.tolerance, self.order)
+                out[start + k] = rows[0].size - held
+        return out
+
+    def _judge(self, level, idx, rows):
+        tf, jam = self._replay(level, idx, rows)
+        for k in range(idx.size):
+            verdict = orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order,
+                                   self.required)
+            verdict["trials"], verdict["jammed"] = int(rows[0].size), int(jam[k].sum())
+            yield verdict
+
+    # ------------------------------------------------------------------ when nothing orients
+
+    def _several_sets(self, level, candidates):
+        """The level's sequences whose nominal finals fall into the fewest
+        clusters (gaps over the tolerance), judged in full."""
+        if level.size == 0:
+            return []
+        period = 360.0 / self.order
+        x = np.sort(np.mod(level.theta, period), axis=1)
+        gaps = np.diff(np.concatenate([x, x[:, :1] + period], axis=1), axis=1)
+        clusters = np.maximum(1, (gaps > self.tolerance).sum(axis=1))
+        spread = period - gaps.max(axis=1)
+        best = np.lexsort((-level.margin, spread, clusters))[:candidates]
+        inputs = trial_inputs(self.states, self.mu_c, level.seq.shape[1], self.cfg)
+        verdicts = self._judge(level, best, self._all_rows(inputs))
+        return [self._plan(level, i, spread[i], v) for i, v in zip(best, verdicts)]

@@ -1,0 +1,137 @@
+"""Every fixed-pin sequence, by nominal rollouts, level by level.
+
+The nominal path of a sequence starts each resting state exactly as it lies
+on the fence (no perturbation) and rolls it past each pin in turn at one
+friction. All sequences of one length are one level: the level's states are
+arrays ``(sequences, resting states)``, and going one pin deeper repeats
+each sequence once per candidate pin and rolls out every (state, pin) pair
+in one parallel batch. Pairs that start from the same pose (to within
+``QUANTUM`` degrees and millimetres) share one rollout: different
+sequences often bring a state to the same pose (a pin that misses leaves it
+as it was; a vertex pushed to rest ends where the vertex sits behind the
+centroid whatever the offset was).
+
+A sequence is dropped (with all its extensions) when, on its nominal path:
+
+- a rollout jams (or runs out of steps): a jam stops the feeder;
+- its last pin touches no resting state: it adds nothing to the shorter
+  sequence, which is enumerated too;
+- a pin that touches a state passes within ``pin_halfwidth`` of that state's
+  centroid: the pin's own placement error decides on which side it passes,
+  so the part may turn either way (metastable).
+
+Nothing else is pruned: every other sequence of up to ``depth`` pins is
+enumerated (``NominalTree.levels``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from kernels.rollout import JAMMED, MISS, TRUNCATED
+
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
+
+QUANTUM = 0.01  # deg and mm: poses closer than this share one nominal rollout
+
+
+@dataclass
+class Level:
+    """All surviving sequences of one length.
+
+    ``seq``: pin indices ``(n, length)``; ``theta``, ``y``: each resting
+    state's nominal orientation (deg) and centroid height (mm) after the
+    sequence ``(n, states)``; ``margin``: the smallest distance of any
+    touching nominal ``|d|`` from ``[d_min, d_max]`` (negative outside;
+    ``inf`` if nothing was touched)."""
+    seq: np.ndarray
+    theta: np.ndarray
+    y: np.ndarray
+    margin: np.ndarray
+
+    @property
+    def size(self) -> int:
+        """Number of sequences in the level."""
+        return int(self.seq.shape[0])
+
+
+class NominalTree:
+    """Nominal paths of every fixed-pin sequence over ``heights`` (mm).
+
+    Parameters
+    ----------
+    part : the part.
+    heights : candidate pin heights above the fence, mm (one per pin index).
+    mu_c : the friction of the nominal paths.
+    pin_radius, model, kernel : as for every rollout (``kernel``: optional
+        ``ds_max`` and ``tol``).
+    pin_halfwidth : the pins' placement tolerance (mm), for the metastable rule.
+    d_min, d_max : the margin's limits on ``|d|`` (not a rule here).
+    belt : ``{"belt_speed": mm/s, "mu_s": ...}`` for the dynamic model, or None.
+    """
+
+    def __init__(self, part: Part, heights, mu_c: float, pin_radius: float, model: str = "minpower",
+                 kernel: dict | None = None, pin_halfwidth: float = 0.3, d_min: float = 0.1,
+                 d_max: float = 0.9, belt: dict | None = None):
+        self.part, self.mu_c, self.pin_radius, self.model = part, float(mu_c), float(pin_radius), model
+        self.heights = np.asarray(heights, dtype=float)
+        self.kernel = {k: v for k, v in (kernel or {}).items() if k in ("ds_max", "tol")}
+        if belt:  # the dynamic model at a belt speed: its own step control
+            self.model, self.kernel = "dynamic", dict(belt)
+        self.pin_halfwidth, self.d_min, self.d_max = float(pin_halfwidth), float(d_min), float(d_max)
+        self.rollouts = 0
+
+    def root(self) -> Level:
+        """The empty sequence: every resting state as it lies on the fence."""
+        states = self.part.stable_states()
+        return Level(np.zeros((1, 0), dtype=np.int16), states[None, :, 0].copy(),
+                     states[None, :, 1].copy(), np.full(1, np.inf))
+
+    def levels(self, depth: int):
+        """Yield the levels of lengths 1 to ``depth`` in turn (lazily, so a search
+        may stop early)."""
+        level = self.root()
+        for _ in range(depth):
+            level = self.extend(level)
+            yield level
+            if level.size == 0:
+                return
+
+    def extend(self, level: Level) -> Level:
+        """Every surviving sequence of ``level`` followed by every candidate pin."""
+        n_pins, n = self.heights.size, level.size
+        theta = np.repeat(level.theta, n_pins, axis=0)
+        y_c = np.repeat(level.y, n_pins, axis=0)
+        y_pin = np.tile(self.heights, n)[:, None]
+        status, theta_f, dy = self._rollouts(theta, y_pin - y_c)
+        touched = status != MISS
+        d_abs = np.abs(y_pin - y_c) / self.part.a
+        bad = ((status == JAMMED) | (status == TRUNCATED)).any(axis=1)
+        bad |= (touched & (np.abs(y_pin - y_c) < self.pin_halfwidth)).any(axis=1)
+        bad |= ~touched.any(axis=1)
+        step_margin = np.where(touched, np.minimum(d_abs - self.d_min, self.d_max - d_abs), np.inf).min(axis=1)
+        keep = ~bad
+        seq = np.concatenate([np.repeat(level.seq, n_pins, axis=0),
+                              np.tile(np.arange(n_pins, dtype=np.int16), n)[:, None]], axis=1)
+        margin = np.minimum(np.repeat(level.margin, n_pins), step_margin)
+        return Level(seq[keep], theta_f[keep], (y_c + dy)[keep], margin[keep])
+
+    def _rollouts(self, theta, dy_pin):
+        """``(status, theta_f, dy)`` arrays shaped like ``theta`` for the pin offsets
+        ``dy_pin`` (mm), one rollout per distinct quantised pose."""
+        a = self.part.a
+        keys = np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM)],
+                        axis=-1).reshape(-1, 2).astype(np.int64)
+        if keys.shape[0] == 0:
+            empty = np.zeros(theta.shape)
+            return empty.astype(np.int8), empty, empty
+        uniq, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.ravel()
+        res = simulate.rollout_points(self.part, theta.ravel()[first], dy_pin.ravel()[first] / a,
+                                      self.mu_c, self.pin_radius, self.model, **self.kernel)
+        self.rollouts += uniq.shape[0]
+        shape = theta.shape
+        return (res["status"][inverse].reshape(shape), res["theta_f"][inverse].reshape(shape),
+                res["dy"][inverse].reshape(shape))

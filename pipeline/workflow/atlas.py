@@ -1,0 +1,121 @@
+"""The feedability atlas: which of a family's parts pins can orient, with how
+many pins, how precisely and how fast (``RESULTS/atlas.json`` and
+``RESULTS/atlas.csv``, one row per planned part).
+
+Every row is read from files the workflow already wrote for that part: the
+plan (``plans/NAME.json``: the recommended tight plan at ``planner.mu_c``,
+its verification and orientation verdict, the planning time), the speed
+limit (``speed/NAME.json``) and the layout (``layout_NAME.json``:
+throughput at the layout's belt speed). Nothing is recomputed, so the atlas
+always agrees with the files it summarises.
+
+Outcome of a part: ``fixed pins`` (fixed pins orient it within the
+tolerance), ``moving pins`` (it takes moving pins), ``sensor`` (no plan of
+up to the depth orients it: a sensor or a person must finish), ``no plan``
+(nothing passed verification).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import tempfile
+from pathlib import Path
+
+from pipeline.maps.io import read_json, write_json
+from pipeline.planning.types import validate_plan_file
+from pipeline.provenance import provenance_attrs
+
+COLUMNS = ("part", "part_id", "outcome", "orients", "tolerance_deg", "fixed_pins", "moving_pins",
+           "sensor_needed", "verified_width_deg", "trials", "in_set", "plan", "mu_c",
+           "speed_limit_mm_s", "belt_speed_mm_s", "throughput_per_min", "planning_seconds", "evidence")
+
+
+def _outcome(orients: bool, plan: dict | None) -> str:
+    if plan is None:
+        return "no plan"
+    if not orients:
+        return "sensor"
+    return "moving pins" if plan.get("n_dynamic_pins") else "fixed pins"
+
+
+def atlas_row(plan_result: dict, speed: dict | None = None, layout: dict | None = None) -> dict:
+    """One atlas row from a stored plan file (a dict) and, if there, the part's
+    speed and layout results."""
+    entry = (plan_result.get("tight") or [None])[0] or {}
+    plan = entry.get("recommended")
+    verdict = ((plan or {}).get("verification") or {}).get("orientation") or {}
+    orients = bool(verdict.get("orients"))
+    n_moving = int((plan or {}).get("n_dynamic_pins") or 0)
+    search = entry.get("fixed_pin_search") or {}
+    return {
+        "part": plan_result["part"]["name"], "part_id": plan_result["part"]["id"],
+        "outcome": _outcome(orients, plan), "orients": orients,
+        "tolerance_deg": entry.get("tolerance_deg"),
+        "fixed_pins": None if plan is None else len(plan["pins"]) - n_moving,
+        "moving_pins": None if plan is None else n_moving,
+        "sensor_needed": not orients,
+        "verified_width_deg": verdict.get("width_deg"),
+        "trials": verdict.get("trials"), "in_set": verdict.get("in_tolerance"),
+        "plan": None if plan is None else " ".join(plan["pins"]),
+        "mu_c": entry.get("friction"),
+        "speed_limit_mm_s": (speed or {}).get("speed_limit_mm_s"),
+        "belt_speed_mm_s": (layout or {}).get("belt_speed_mm_s"),
+        "throughput_per_min": (layout or {}).get("throughput_per_min"),
+        "planning_seconds": (entry.get("stats") or {}).get("wall_seconds"),
+        "evidence": search.get("evidence") or entry.get("warning"),
+    }
+
+
+def build_atlas(config: dict, plan_paths, speed_paths=(), layout_paths=()) -> dict:
+    """The atlas of the planned parts (one row per plan file, in order); speed
+    and layout files are matched to a part by name and may be missing."""
+    speeds = {read_json(p)["part"]: read_json(p) for p in speed_paths if Path(p).is_file()}
+    layouts = {}
+    for p in layout_paths:
+        if Path(p).is_file():
+            lay = read_json(p)
+            layouts[lay.get("part", Path(p).stem.removeprefix("layout_"))] = lay
+    rows = []
+    for path in plan_paths:
+        res = validate_plan_file(path)
+        name = res["part"]["name"]
+        rows.append(atlas_row(res, speeds.get(name), layouts.get(name)))
+    return {"config": config.get("name"), "tolerance_deg": config["planner"].get("tolerance_deg"),
+            "required": config.get("verify", {}).get("required"), "depth": config["planner"]["depth"],
+            "columns": list(COLUMNS), "rows": rows, **provenance_attrs()}
+
+
+def atlas_csv(atlas: dict) -> str:
+    """The atlas rows as CSV text (header = :data:`COLUMNS`)."""
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    for row in atlas["rows"]:
+        writer.writerow({k: "" if row.get(k) is None else row[k] for k in COLUMNS})
+    return buf.getvalue()
+
+
+def write_atlas(atlas: dict, json_out, csv_out) -> None:
+    """Write the atlas as JSON and CSV, each atomically (a temporary file renamed)."""
+    write_json(atlas, json_out)
+    csv_out = Path(csv_out)
+    csv_out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=csv_out.parent, prefix=f".{csv_out.name}.", suffix=".tmp")
+    with os.fdopen(fd, "w", newline="") as fh:
+        fh.write(atlas_csv(atlas))
+    os.replace(tmp, csv_out)
+
+
+def atlas(config: dict, plan_paths, speed_paths, layout_paths, json_out, csv_out) -> dict:
+    """Rule ``atlas``: :func:`build_atlas`, written to ``json_out`` and ``csv_out``."""
+    result = build_atlas(config, plan_paths, speed_paths, layout_paths)
+    write_atlas(result, json_out, csv_out)
+    return result
+
+
+def read_atlas(path) -> dict:
+    """A stored atlas (``RESULTS/atlas.json``)."""
+    with open(path) as fh:
+        return json.load(fh)

@@ -1,0 +1,132 @@
+"""The complete fixed-pin search (issue 23) against a brute-force oracle that
+shares none of its arithmetic (tests/oracle.py: its own trials, replay and
+judgement), on hypothesis-drawn triangles and quadrilaterals and on fixed
+parts beyond the default triangles; the orientation verdict against brute
+force; the evidence when no fixed-pin plan exists."""
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from oracle import box_trials, most_in_arc, orienting_sequences, replay_box
+from strategies import convex_polygons, triangles
+
+from pipeline.parts.part import Part
+from pipeline.planning import orient
+from pipeline.planning.complete import FixedPinSearch
+
+MU = (0.1, 0.2)
+VERIFY = {"trials": 20, "seed": 3}
+RADIUS = 3.0
+
+
+def _search(part, pins, tolerance, depth):
+    search = FixedPinSearch(part, pins, MU, tolerance, 0.995, VERIFY, RADIUS)
+    return search.run(depth, candidates=4, keep=5)
+
+
+def _grid(part, n):
+    """``n`` pins evenly across the resting states' heights (labels Q1..Qn)."""
+    top = max(y for _, y in part.stable_states()) * 1.8
+    return {f"Q{k}": float(y) for k, y in enumerate(np.linspace(-0.1 * part.a, top, n), start=1)}
+
+
+def _check(part, pins, tolerance, depth):
+    """Completeness: whenever the oracle finds a sequence whose every trial ends
+    within half the tolerance, the planner returns a plan with no more pins.
+    Soundness: every returned plan keeps 95 % of the oracle's own trials within
+    the tolerance (+1 deg: the two sample the box differently)."""
+    order = part.symmetry_order()
+    oracle = orienting_sequences(part, pins, depth, tolerance / 2,
+                                 lambda n: box_trials(part, n, 12, 7, MU), order)
+    result = _search(part, pins, tolerance, depth)
+    if oracle:
+        assert result.plans, f"oracle found {oracle[0]}, the planner none: {result.evidence()}"
+        assert len(result.plans[0].labels) <= min(len(s) for s in oracle)
+    for plan in result.plans:
+        finals = replay_box(part, plan.heights, box_trials(part, len(plan.heights), 40, 11, MU),
+                            strict=False)
+        assert most_in_arc(finals, tolerance + 1.0, order) >= 0.95 * finals.size, plan.labels
+    return oracle, result
+
+
+@settings(max_examples=3, deadline=None)
+@given(triangles(), st.floats(30.0, 60.0))
+def test_complete_and_sound_on_random_triangles(tri, size):
+    part = Part.from_vertices(tri * size)
+    _check(part, _grid(part, 5), 12.0, 2)
+
+
+@settings(max_examples=2, deadline=None)
+@given(convex_polygons(min_n=4, max_n=4), st.floats(30.0, 60.0))
+def test_complete_and_sound_on_random_quadrilaterals(quad, size):
+    part = Part.from_vertices(quad * size)
+    _check(part, _grid(part, 5), 12.0, 2)
+
+
+@pytest.mark.parametrize("vertices, pins, tolerance", [
+    ([[0, 0], [50, 0], [0, 30]], {"A": -7.5, "B": 7.5, "C": 15.0, "D": 27.5}, 12.0),  # right triangle
+    ([[0, 0], [60, 0], [15, 35]], {"A": -10.0, "B": 10.0, "C": 27.5}, 16.0),  # the default asym triangle
+])
+def test_three_pin_plans_found_where_the_oracle_finds_them(vertices, pins, tolerance):
+    """The oracle finds 3-pin sequences whose every trial ends within half the
+    tolerance on these grids (checked here, so the completeness check is not
+    vacuous); the planner's plan has at most 3 pins and is sound."""
+    part = Part.from_vertices(vertices)
+    oracle, result = _check(part, pins, tolerance, 3)
+    assert oracle and min(len(s) for s in oracle) == 3
+    assert len(result.plans[0].labels) <= 3
+
+
+def test_no_fixed_plan_evidence_on_a_part_the_oracle_cannot_orient():
+    """Two pins far above a flat bar touch nothing useful: the oracle finds no
+    sequence, the planner returns none and says so with its evidence."""
+    part = Part.from_vertices([[0, 0], [60, 0], [60, 12], [0, 12]])
+    pins = {"A": 3.0, "B": 9.0}
+    order = part.symmetry_order()
+    assert not orienting_sequences(part, pins, 2, 10.0, lambda n: box_trials(part, n, 8, 5, MU), order)
+    result = _search(part, pins, 10.0, 2)
+    assert not result.plans
+    assert result.evidence().startswith("no fixed-pin sequence of up to 2 pins orients this part within 10 deg")
+    assert [lv["pins"] for lv in result.levels] == [1, 2]
+    assert sum(lv["sequences"] for lv in result.levels) > 0
+
+
+@given(st.lists(st.floats(0.0, 359.99), min_size=1, max_size=40), st.floats(0.5, 90.0),
+       st.sampled_from([1, 2, 3]))
+def test_best_arc_matches_brute_force(thetas, width, order):
+    count, _ = orient.best_arc(thetas, width, order)
+    assert count == most_in_arc(thetas, width, order)
+
+
+@given(st.lists(st.floats(0.0, 359.99), min_size=2, max_size=30), st.integers(1, 30))
+def test_narrowest_arc_holds_k_and_none_narrower(thetas, k):
+    arc = orient.narrowest_arc(thetas, k)
+    if k > len(thetas):
+        assert arc is None
+        return
+    start, width = arc
+    assert most_in_arc(thetas, width) >= k
+    assert most_in_arc(thetas, max(0.0, width - 1e-6)) < k or width < 1e-6
+
+
+def test_judge_counts_jams_as_failures():
+    finals = [10.0] * 990  # 1000 trials, 10 jammed: 99.0 % < 99.5 %
+    verdict = orient.judge(finals, 1000, 5.0)
+    assert not verdict["orients"] and verdict["in_tolerance"] == 990 and verdict["width_deg"] is None
+    assert orient.judge(finals + [12.0] * 5, 995, 5.0)["orients"]
+
+
+def test_judge_works_modulo_symmetry():
+    """Two sets 180 deg apart are one orientation of a 2-fold symmetric part."""
+    finals = [10.0] * 50 + [190.5] * 50
+    assert not orient.judge(finals, 100, 5.0, order=1)["orients"]
+    verdict = orient.judge(finals, 100, 5.0, order=2)
+    assert verdict["orients"] and verdict["width_deg"] == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("bad", [0, -3, 360, 400, float("nan"), "ten"])
+def test_bad_tolerance_is_one_line(bad):
+    with pytest.raises(Exception) as exc:
+        orient.check_tolerance(bad)
+    assert "\n" not in str(exc.value) and "tolerance" in str(exc.value)
