@@ -321,14 +321,15 @@ def cmd_sweep(args):
         config["catalog_dir"] = args.catalog
     written = run_sweep(config, scheduler=args.scheduler, threads=args.threads,
                         progress=not args.quiet, backend=args.backend)
-    print(f"computed {len(written)} shards; catalog index at {config['catalog_dir']}/index.json")
+    index = Path(config["catalog_dir"]).resolve() / "index.json"
+    print(f"computed {len(written)} shards; catalog index at {index}")
 
 
 
 def cmd_plan(args):
     """Plan a part (see :func:`pipeline.workflow.commands.plan_command`)."""
     from pipeline.config import load_config
-    from pipeline.workflow.commands import plan_command, planner_settings
+    from pipeline.workflow.commands import plan_command, plan_store_path, planner_settings
     speeds = None if args.speeds is None else (parse_values(args.speeds, "--speeds") if args.speeds else [])
     pins = parse_values(args.pins, "--pins") if args.pins else None
     config = planner_settings(load_config(args.config), catalog=args.catalog, mu_c=args.mu_c,
@@ -336,14 +337,33 @@ def cmd_plan(args):
                               dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
                               mu_s=args.mu_s, tolerance=args.tolerance)
     part = _plan_part_arg(args, config)
+    out = plan_store_path(config, part.name, args.out)  # checked before any work
     result = plan_command(part, config, args.mode, progress=None if args.json else _progress)
-    if args.out:
+    if out is not None:
         from pipeline.maps.io import write_json
-        write_json(result, args.out)
+        write_json(result, out)
     if args.json:
         _print_json(_plan_json(result, args.mode), default=float)
+    else:
+        _print_plan_result(result, part, config, args.mode)
+    _print_stored(result, out, config, args.config, sys.stderr if args.json else sys.stdout)
+
+
+def _print_stored(result, out, config, config_path, stream):
+    """Where the plan went and the commands that use it (``stream``: stderr with
+    ``--json``, which keeps stdout one JSON document)."""
+    from pipeline.workflow.commands import next_step_hints
+    if out is None:
+        print(f"not stored: the workflow stores {result['part']['name']}'s plan; give --out FILE.json "
+              f"to keep this one", file=stream)
         return
-    _print_plan_result(result, part, config, args.mode)
+    print(f"stored the plan at {out}", file=stream)
+    hints = next_step_hints(result, out, config, config_path)
+    if hints:
+        print("next: " + "\n      ".join(hints), file=stream)
+    else:
+        print("(speed, layout and animate read RESULTS/plans/NAME.json: store it there to use them)",
+              file=stream)
 
 
 def _progress(message):
@@ -395,6 +415,7 @@ def _plan_json(result, mode) -> dict:
         out.update(mu_c=first["mu_c"], warning=first["warning"], tolerance_deg=first.get("tolerance_deg"),
                    orients=first.get("orients"), pins_used=first.get("pins_used"),
                    evidence=(first.get("fixed_pin_search") or {}).get("evidence"),
+                   recommended=_plan_summary(first["recommended"]) if first["recommended"] else None,
                    plans=[_plan_summary(p) for p in first["plans"]],
                    rejected=[_plan_summary(p) for p in first["rejected"]],
                    frictions=[{"mu_c": t["mu_c"], "warning": t["warning"],
@@ -430,7 +451,8 @@ def _print_plan_result(result, part, config, mode):
         for k, plan in enumerate(t.plans, start=1):
             v = plan.verification
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))
-            print(f"  #{k}: {heights} -> claimed {plan.n_final_sets} set(s) "
+            mark = " (recommended)" if t.recommended is not None and plan == t.recommended else ""
+            print(f"  #{k}{mark}: {heights} -> claimed {plan.n_final_sets} set(s) "
                   f"({plan.extra.get('claim', 'propagated')}): {format_arcs(plan.final_arcs)}; "
                   f"{_orientation_text(v)}; margin in d "
                   + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
@@ -468,44 +490,43 @@ def _results_arg(args, config) -> Path:
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from pipeline.config import load_config
-    from pipeline.planning.speed_limit import stored_plan_speed
-    from pipeline.planning.types import validate_plan_file
+    from pipeline.planning.speed_limit import speed_label
+    from pipeline.workflow.commands import speed_command, stored_plan
     config = load_config(args.config)
-    path = _results_arg(args, config) / "plans" / f"{args.part}.json"
-    if not path.is_file():
-        raise PinfeedError(f"no stored plan for {args.part} at {path}; run 'pinfeed plan --part "
-                           f"{args.part} --mode both --out {path}' or the workflow ('make run') first")
-    if not (args.mu_s > 0):
-        raise PinfeedError(f"--mu-s must be > 0, got {args.mu_s}")
-    if args.trials < 1:
-        raise PinfeedError(f"--trials must be at least 1, got {args.trials}")
-    out = stored_plan_speed(validate_plan_file(path), config, plan=args.plan, mu_text=args.mu_c,
-                            mu_s=args.mu_s, trials=args.trials)
+    result, _ = stored_plan(config, _results_arg(args, config), args.part, args.config)
+    out, stored = speed_command(result, config, args.plan, args.mu_c, args.mu_s, args.trials)
     if args.json:
         _print_json(out, default=float)
         return
+    same = out["source"] == "stored with the plan"
+    other = "" if same or not stored else f"; the plan file stores {speed_label(stored)}"
     print(f"{out['part']}, plan {' '.join(out['pin_labels'])} (mu_c {out['friction']}, mu_s "
-          f"{args.mu_s:g}): speed limit {out['speed_limit_mm_s']:g} mm/s "
-          f"({out['trials_per_speed']} trials per speed, {out['seconds']:.0f} s)")
+          f"{out['mu_s']:g}): speed limit {speed_label(out)}"
+          + (", stored with the plan" if same else f", {out['seconds']:.0f} s") + other)
     for speed, frac in out["curve"]:
         print(f"  {speed:7.1f} mm/s: {100 * frac:5.1f} % of trials in the final set")
 
 
 def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
+    from pipeline.checks import check_out_path
     from pipeline.config import load_config
     from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
     from pipeline.workflow.commands import layout_settings, stored_plan
     config = load_config(args.config)
-    if args.out:
-        check_drawing_path(args.out)  # before minutes of trials
+    as_json = args.out is not None and Path(args.out).suffix.lower() == ".json"
+    if args.out:  # before minutes of trials
+        check_out_path(args.out, (".json",)) if as_json else check_drawing_path(args.out)
     settings = layout_settings(args.margin, args.trials)
-    result, _ = stored_plan(config, _results_arg(args, config), args.part)
+    result, _ = stored_plan(config, _results_arg(args, config), args.part, args.config)
     out = layout_stored(result, config, args.plan, args.mu_c, belt_speed=args.belt_speed,
                         mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
     for warning in out["warnings"]:
         print(f"pinfeed: warning: {warning}", file=sys.stderr)
-    if args.out:
+    if as_json:
+        from pipeline.maps.io import write_json
+        write_json(out, args.out)
+    elif args.out:
         write_drawing(out, args.out)
     if args.json:
         _print_json(out, default=float)
@@ -517,6 +538,7 @@ def cmd_layout(args):
 
 def _print_layout(out: dict):
     """The stations, belt, pitch and throughput of a layout, for people."""
+    from pipeline.present.layout import speed_limit_text
     m = out["method"]
     print(f"{out['part']}, plan {out['plan']['number']}: {' '.join(out['plan']['pins'])} "
           f"(mu_c {out['plan']['friction']}); model {m['model']}, {m['trials']['replayed']} trials "
@@ -526,7 +548,7 @@ def _print_layout(out: dict):
               f"radius {s['radius_mm']:g} mm")
     speed = out["belt_speed_mm_s"]
     print(f"belt speed {'n/a' if speed is None else f'{speed:.1f} mm/s'} ({m['belt_speed']}); "
-          f"speed limit {out['speed_limit_mm_s']:g} mm/s")
+          f"speed limit {speed_limit_text(out)}")
     print(f"pitch {out['pitch_mm']:.1f} mm; belt width {out['belt_width_mm']:.1f} mm "
           f"(y {out['belt_y_mm'][0]:.1f} to {out['belt_y_mm'][1]:.1f}); fence at y = 0 up to "
           f"x = {out['fence_end_x_mm']:.1f} mm")
@@ -540,9 +562,10 @@ def cmd_animate(args):
     from pipeline.present.animate import animate_stored
     from pipeline.workflow.commands import animation_inputs, stored_plan
     config = load_config(args.config)
-    result, path = stored_plan(config, _results_arg(args, config), args.part)
+    result, path = stored_plan(config, _results_arg(args, config), args.part, args.config)
     stored_layout = path.parent.parent / f"layout_{args.part}.json"
-    inputs, layout = animation_inputs(result, config, args.part, args.plan, args.layout, stored_layout)
+    inputs, layout = animation_inputs(result, config, args.part, args.plan, args.layout, stored_layout,
+                                      dict(config_path=args.config, results=args.results))
     if layout is not None:
         pins = " -> ".join(f"{r['label']} at x {r['x_mm']:.1f}, y {r['y_mm']:g} mm" for r in layout["stations"])
         print(f"animating the laid-out {inputs['what']} of {args.part}: {pins}; pitch "
@@ -720,7 +743,9 @@ def _add_sweep_plan_commands(sub) -> None:
                    help="friction the plan must work for: a value X or a range LO:HI (default: the config's)")
     p.add_argument("--mode", default="tight", choices=["tight", "paper", "both"],
                    help="tight propagation (default), the paper's adjusted bands, or both side by side")
-    p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"])
+    p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"],
+                   help="quasi-static contact model the plans are computed and verified with "
+                        "(default: the config's planner.model, minpower)")
     p.add_argument("--depth", type=int, default=None, help="largest number of pins (>= 1)")
     p.add_argument("--pins", default=None, help="candidate pin heights, mm: 'a,b,c' or 'start:stop:step' "
                    "(default: the config's planner.pins; 'auto' there fits them to the part)")
@@ -728,7 +753,11 @@ def _add_sweep_plan_commands(sub) -> None:
                    help="full width (deg) the final orientation set may have (default: planner.tolerance_deg, "
                    "10): a plan orients the part when verify.required (99.5%%) of its trials end in one "
                    "set this narrow")
-    p.add_argument("--coverage", default=None, choices=["bracket", "nearest"])
+    p.add_argument("--coverage", default=None, choices=["bracket", "nearest"],
+                   help="paper mode only: which stored maps stand for an uncertain state; bracket "
+                        "(the d maps around its d range and one theta_i step either side; "
+                        "conservative) or nearest (the nearest d map, the grid points inside the "
+                        "arc); default: the config's planner.coverage, bracket")
     p.add_argument("--speeds", default=None,
                    help="dynamic pin speeds v_pin/v_b after the static pins: 'a,b' ('' for none)")
     p.add_argument("--dynamic-depth", dest="dynamic_depth", type=int, default=None,
@@ -738,7 +767,9 @@ def _add_sweep_plan_commands(sub) -> None:
                         "(default: the config's planner.belt_speed; none = quasi-static)")
     p.add_argument("--mu-s", dest="mu_s", type=float, default=None,
                    help="belt friction with --belt-speed (default: planner.mu_s, 0.5)")
-    p.add_argument("--out", default=None, help="also write the result JSON here")
+    p.add_argument("--out", default=None, help="store the plan JSON here (default: RESULTS/plans/NAME.json, "
+                   "where speed, layout and animate look; a part the workflow plans is stored only "
+                   "with --out)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_plan)
 
@@ -867,8 +898,12 @@ def _add_stored_plan_commands(sub) -> None:
     p.add_argument("--part", required=True, help="part name (its plan is RESULTS/plans/NAME.json)")
     p.add_argument("--plan", type=int, default=1, help="which tight plan, 1 = the recommended one")
     p.add_argument("--mu-c", dest="mu_c", default=None, help="which planned friction: X or LO:HI")
-    p.add_argument("--mu-s", dest="mu_s", type=float, default=0.5, help="belt friction (default 0.5)")
-    p.add_argument("--trials", type=int, default=300, help="random trials per initial state (default 300)")
+    p.add_argument("--mu-s", dest="mu_s", type=float, default=None,
+                   help="belt friction (default: the plan's stored speed limit's, else the config's "
+                        "speed.mu_s, 0.5)")
+    p.add_argument("--trials", type=int, default=None,
+                   help="random trials per initial state (default: those of the speed limit stored "
+                        "with the plan, else the config's speed.trials); other settings recompute it")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--results", default=None, help="results folder holding plans/ "
                    "(default: the config's, RESULTS_DIR/NAME)")
@@ -894,7 +929,8 @@ def _add_layout_commands(sub) -> None:
                    help="station margin, mm (default: the config's layout.station_margin_mm, 5)")
     p.add_argument("--trials", type=int, default=None,
                    help="random trials per initial state (default: the config's layout.trials)")
-    p.add_argument("--out", default=None, help="also draw the feeder: .dxf, .svg or .png")
+    p.add_argument("--out", default=None, help="also draw the feeder (.dxf, .svg or .png) or write "
+                   "the layout JSON (.json; 'pinfeed animate --layout' reads RESULTS/layout_NAME.json)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--results", default=None, help="results folder holding plans/ "
                    "(default: the config's, RESULTS_DIR/NAME)")
@@ -924,7 +960,31 @@ def main(argv=None) -> int:
         return 2
     except BrokenPipeError:  # e.g. piped into head
         return 0
+    except KeyboardInterrupt:  # Ctrl-C: one line; writes are atomic, finished work is kept
+        return _interrupted()
+    except SystemError as exc:  # Ctrl-C inside a Numba kernel call arrives wrapped
+        if not _caused_by_interrupt(exc):
+            raise
+        return _interrupted()
     return 0
+
+
+def _interrupted() -> int:
+    """Ctrl-C: one line on stderr and the shell's status 130 (128 + SIGINT)."""
+    print("pinfeed: interrupted; finished files and the rollouts computed so far are kept "
+          "(the next run reuses them)", file=sys.stderr)
+    return 130
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """Whether ``exc`` was raised because of a KeyboardInterrupt (its cause chain)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 if __name__ == "__main__":

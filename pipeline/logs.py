@@ -2,17 +2,29 @@
 from __future__ import annotations
 
 import contextlib
+import sys
 import traceback
 from pathlib import Path
+
+from pipeline.errors import PinfeedError
 
 
 @contextlib.contextmanager
 def log_to(path):
-    """Redirect stdout and stderr to the log file ``path`` (tracebacks included) for the block."""
+    """Redirect stdout and stderr to the log file ``path`` for the block. A known
+    error (:class:`PinfeedError`) is one line ``pinfeed: error: ...`` in the log
+    and on the console, and the job exits with status 1; anything else is
+    logged with its traceback and raised."""
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w") as fh, contextlib.redirect_stdout(fh), contextlib.redirect_stderr(fh):
+    console = sys.stderr
+    with open(path, "w") as fh:
         try:
-            yield fh
+            with contextlib.redirect_stdout(fh), contextlib.redirect_stderr(fh):
+                yield fh
+        except PinfeedError as exc:
+            for stream in (fh, console):
+                print(f"pinfeed: error: {exc}", file=stream, flush=True)
+            raise SystemExit(1) from None
         except BaseException:
             traceback.print_exc(file=fh)
             raise

@@ -12,6 +12,11 @@ wildcard_constraints:
     tag="mu_c=[0-9.eE+-]+(_v_pin=[0-9.eE+-]+)?(_belt=[0-9.eE+-]+_mu_s=[0-9.eE+-]+)?",
 
 
+def part_shards(wildcards):
+    """The shard files of the part named ``wildcards.name`` (what its plan reads)."""
+    return [path for path, job in JOBS.items() if job.part.name == wildcards.name]
+
+
 def shard_params(wildcards):
     """Everything a shard's content depends on: changing any of it reruns the shard."""
     path = f"{CATALOG}/{wildcards.family}/{wildcards.part}/{wildcards.model}/{wildcards.tag}.h5"

@@ -18,11 +18,14 @@ rule bands:
 
 rule plan:
     input:
-        index=rules.catalog_index.output.index,
+        # The part's own shards: a re-index ('pinfeed catalog index') or another
+        # part's new shards do not re-plan it; the index must exist (ancient).
+        shards=part_shards,
+        index=ancient(rules.catalog_index.output.index),
     output:
         plan=f"{RESULTS}/plans/{{name}}.json",
     params:
-        settings={k: config[k] for k in ("planner", "bands", "verify")},
+        settings={k: config[k] for k in ("planner", "bands", "verify", "speed")},
         sweep={k: config["sweep"][k] for k in ("pin_radius", "kernel")},
     log:
         f"{LOGS}/plan/{{name}}.log",

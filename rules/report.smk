@@ -4,7 +4,8 @@
 
 rule figures:
     input:
-        index=rules.catalog_index.output.index,
+        # maps are read from the planned parts' shards, which their plans depend on
+        index=ancient(rules.catalog_index.output.index),
         plans=expand(f"{RESULTS}/plans/{{name}}.json", name=PLANNED),
         verify=expand(f"{RESULTS}/verify/{{name}}.json", name=PLANNED),
     output:
@@ -16,6 +17,8 @@ rule figures:
                         caption="report/sequence.rst", category="Plans"),
         sequence_dynamic=report(expand(f"{RESULTS}/figures/sequence_dynamic_{{name}}.png", name=PLANNED),
                                 caption="report/sequence_dynamic.rst", category="Plans"),
+        sequence_tight=report(expand(f"{RESULTS}/figures/sequence_tight_{{name}}.png", name=PLANNED),
+                              caption="report/sequence_tight.rst", category="Plans"),
         carried=report(expand(f"{RESULTS}/figures/carried_{{name}}.png", name=PLANNED),
                        caption="report/carried.rst", category="Plans"),
         verification_plans=report(expand(f"{RESULTS}/figures/verification_{{name}}.png", name=PLANNED),

@@ -153,6 +153,7 @@ def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
     ``backend="cuda"``, overriding the config's ``sweep.backend``).
     """
     from pipeline.maps.catalog import Catalog
+    config = absolute_folders(config)
     root = Path(config["catalog_dir"])
     todo = [j for j in shard_jobs(config) if not j.path(root).is_file()]
     written = []
@@ -166,8 +167,35 @@ def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
     else:
         for job in _progress(todo, len(todo), progress):
             written.append(write_shard(config, job, threads=threads, backend=backend))
-    Catalog.rebuild(root)
+    catalog = Catalog.rebuild(root)
+    check_landed(catalog, written)
     return written
+
+
+def absolute_folders(config: dict) -> dict:
+    """A copy of ``config`` whose ``catalog_dir`` and ``results_dir`` are absolute
+    paths, resolved here: a dask worker runs in its own working folder, where a
+    relative path would put the shards somewhere else."""
+    out = dict(config)
+    for key in ("catalog_dir", "results_dir"):
+        if out.get(key) is not None:
+            out[key] = str(Path(out[key]).expanduser().resolve())
+    return out
+
+
+def check_landed(catalog, written) -> None:
+    """Raise :class:`PinfeedError` unless every shard a task reported is on disk
+    under the catalog's folder and in its index (a worker that cannot see
+    this folder writes its shards elsewhere)."""
+    from pipeline.errors import PinfeedError
+    root = Path(catalog.root).resolve()
+    indexed = {(root / e["file"]).resolve() for e in catalog.entries}
+    lost = [p for p in written if Path(p).resolve() not in indexed]
+    if lost:
+        raise PinfeedError(f"{len(lost)} of {len(written)} shards computed did not land in the "
+                           f"catalog {root} (e.g. {lost[0]}); the workers must share this folder "
+                           f"(a path they all see, e.g. a network file system): give --catalog "
+                           f"such a path")
 
 
 SCHEDULER_TIMEOUT = 10  # seconds to reach a dask scheduler

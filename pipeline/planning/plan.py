@@ -324,12 +324,23 @@ def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progre
                                 belt_speed=belt_speed, mu_s=mu_s)
                 for v in speeds}
     out = []
-    for mu_c in plan_frictions(config):
-        t0 = time.perf_counter()
-        res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep, progress=progress)
-        res["stats"]["wall_seconds"] = round(time.perf_counter() - t0, 2)  # search, verification and all
-        res.pop("lattices")
-        out.append(res)
-    for lattice in lattices.values():
-        save_lattice(catalog_root, lattice)
+    try:
+        for mu_c in plan_frictions(config):
+            t0 = time.perf_counter()
+            res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep,
+                             progress=_labelled(progress, f"mu_c {friction_label(mu_c)}"))
+            res["stats"]["wall_seconds"] = round(time.perf_counter() - t0, 2)  # search, verification and all
+            res.pop("lattices")
+            out.append(res)
+    finally:  # also on Ctrl-C: the rollouts done so far are reused by the next run
+        for lattice in lattices.values():
+            save_lattice(catalog_root, lattice)
     return out
+
+
+def _labelled(progress, label: str):
+    """``progress`` with each message prefixed by ``label`` (which friction it is
+    for), unless the message already starts with it."""
+    if progress is None:
+        return None
+    return lambda message: progress(message if message.startswith(label) else f"{label}: {message}")

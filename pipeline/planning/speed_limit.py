@@ -230,3 +230,54 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
             "method": f"dynamic model, {trials} perturbed trials per initial state plus corners "
                       f"at each speed; limit = highest speed with >= {100 * required:g} % in the "
                       f"final set, {resolution:g} mm/s bisection"}
+
+
+def speed_settings(config: dict) -> dict:
+    """The keyword arguments of :func:`stored_plan_speed` from a config's ``speed``
+    section (``mu_s``, ``trials`` per state, the speed grid, ``resolution``,
+    the ``required`` fraction and the ``seed``): the settings a plan's stored
+    speed limit is computed with."""
+    sc = config.get("speed", {})
+    return {"mu_s": float(sc.get("mu_s", 0.5)), "trials": int(sc.get("trials", 30)),
+            "speeds": [float(v) for v in sc.get("speeds", DEFAULT_SPEEDS)],
+            "resolution": float(sc.get("resolution", 5.0)),
+            "required": float(sc.get("required", 0.99)), "seed": int(sc.get("seed", 0))}
+
+
+def stored_speed_limit(plan) -> dict | None:
+    """The speed limit stored with a tight plan (a :class:`~pipeline.planning.types.Plan`
+    or its dict; see :func:`attach_speed_limits`), or None."""
+    extra = plan.get("speed_limit") if isinstance(plan, dict) else plan.extra.get("speed_limit")
+    return extra or None
+
+
+def speed_label(record: dict) -> str:
+    """``'250 mm/s (30 trials per state)'``: a speed limit with the trials it comes from."""
+    return f"{record['speed_limit_mm_s']:g} mm/s ({record['trials']} trials per state)"
+
+
+def attach_speed_limits(result: dict, config: dict) -> dict:
+    """Store in the plan dict ``result`` (what ``pinfeed plan`` and the workflow
+    write) the speed limit of the recommended tight plan and of the first tight
+    plan of fixed pins (the one a layout uses) at the first planned friction:
+    each such plan gets ``speed_limit``, the :func:`stored_plan_speed` result
+    with the config's :func:`speed_settings` (kept under ``settings``), so
+    that the report, ``pinfeed speed`` and ``pinfeed layout`` show one figure
+    per plan. A plan whose speed limit cannot be computed (a part any grid
+    speed would throw) gets none: the speed stage then says why. Returns
+    ``result`` (changed in place)."""
+    tight = result.get("tight") or []
+    if not tight or not tight[0]["plans"]:
+        return result
+    entry, settings = tight[0], speed_settings(config)
+    plans = entry["plans"]
+    fixed = [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.get("pin_speeds") or ())]
+    for number in sorted({1, *fixed[:1]}):
+        try:
+            record = stored_plan_speed(result, config, plan=number, **settings)
+        except PinfeedError:
+            continue
+        plans[number - 1]["speed_limit"] = dict(record, settings=settings)
+    if entry.get("recommended") is not None and "speed_limit" in plans[0]:
+        entry["recommended"]["speed_limit"] = plans[0]["speed_limit"]
+    return result

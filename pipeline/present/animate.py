@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import re
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,6 +26,7 @@ import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
+from pipeline.present.figures import LABEL_ROW_PT, label_above, stagger_labels
 from pipeline.present.lanes import build_lane, pin_height, pin_reach, rotated
 
 
@@ -137,16 +139,18 @@ def _still_figure(part, lanes, stations, heights, speeds, labels, pin_radius, b_
         ax.text(x_lo + 0.1 * a, 0.0, "fence", fontsize=7, va="bottom")
         ax.set_ylabel(f"{lane.label}\n$y$ (mm)", fontsize=8)
         ax.tick_params(labelsize=7)
+        pin_labels = []
         for k, (h, v, x) in enumerate(zip(heights, speeds, stations)):
             colour = "tab:purple" if v else "tab:red"
             if not v:  # moving pins are drawn frame by frame
                 ax.add_patch(Circle((x, h), pin_radius, color=colour, zorder=3))
             ax.axvline(x, color=colour, lw=0.4, ls=":", zorder=0)
-            ax.text(x, 1.02, f"{labels[k]}: {h:g} mm" + (f", $v_{{pin}}$ = {v:+g} $v_b$" if v else ""),
-                    transform=ax.get_xaxis_transform(), ha="center", va="bottom", fontsize=7, color=colour)
+            pin_labels.append(label_above(ax, x, f"{labels[k]}: {h:g} mm" + (
+                f", $v_{{pin}}$ = {v:+g} $v_b$" if v else ""), fontsize=7, color=colour))
+        stagger_labels(fig, pin_labels)
         panes.append((lane, ax, lo))
     axes[-1, 0].set_xlabel("along the belt $x$ (mm), belt moving to the right", fontsize=8)
-    fig.suptitle(title, fontsize=9)
+    fig.suptitle(textwrap.fill(title, 110), fontsize=9)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     fig.canvas.draw()
     return fig, panes
@@ -322,6 +326,17 @@ def layout_inputs(result, layout: dict) -> dict:
             "what": f"tight plan {number} at mu_c {entry.friction}"}
 
 
+def animation_subject(result, config: dict, layout: dict | None = None) -> str:
+    """What the workflow's animation of a stored plan result shows, in words, from
+    the records it is drawn from (the caption of that animation): the laid-out
+    plan of ``layout`` when it has stations, else the recommended plan
+    (:func:`recommended_index`); ``'no plan'`` without one."""
+    if layout is not None and layout.get("stations"):
+        return f"the laid-out {layout_inputs(result, layout)['what']}"
+    which = recommended_index(result)
+    return "no plan" if which is None else f"the {plan_inputs(result, which, config)['what']}"
+
+
 def animate_stored(result, config: dict, out, plan_index=None, frames: int = 120,
                    fps: int = 20, layout: dict | None = None) -> dict:
     """Animate a plan of a stored plan result (``plan_index`` as in :func:`plan_inputs`;
@@ -461,13 +476,13 @@ def station_figure(scene: StationScene, title: str) -> dict:
                            fc="0.93", ec="0.5", lw=0.8, zorder=0))
     ax.plot([x_lo, scene.fence_end], [scene.fence_y] * 2, color="k", lw=2.5, zorder=1)
     ax.text(x_lo + 0.1 * a, scene.fence_y, "fence", fontsize=7, va="bottom")
-    pins = []
+    pins, labels = [], []
     for row in scene.stations:
         x, y, r = float(row["x_mm"]), float(row["y_mm"]), float(row["radius_mm"])
         pins.append(ax.add_patch(Circle((x, y), r, color="tab:red", zorder=3, gid=f"pin {row['label']}")))
         ax.axvline(x, color="tab:red", lw=0.4, ls=":", zorder=0)
-        ax.text(x, 1.02, f"{row['label']}: x {x:.0f}, y {y:g} mm", transform=ax.get_xaxis_transform(),
-                ha="center", va="bottom", fontsize=7, color="tab:red")
+        labels.append(label_above(ax, x, f"{row['label']}: x {x:.0f}, y {y:g} mm", fontsize=7,
+                                  color="tab:red"))
     parts = [ax.add_patch(Polygon(np.zeros((3, 2)), closed=True, fc=f"C{k % len(scene.lanes)}", ec="k",
                                   alpha=0.75, zorder=2)) for k in range(scene.n_parts)]
     marks, = ax.plot([], [], "|", color="0.6", ms=5, zorder=1)
@@ -476,7 +491,8 @@ def station_figure(scene: StationScene, title: str) -> dict:
     ax.set_xlabel("along the belt $x$ (mm), belt moving to the right", fontsize=8)
     ax.set_ylabel("across the belt $y$ (mm)", fontsize=8)
     ax.tick_params(labelsize=7)
-    ax.set_title(title, fontsize=9, pad=18)
+    rows = stagger_labels(fig, labels)  # close stations: their labels in rows
+    ax.set_title(textwrap.fill(title, 110), fontsize=9, pad=6.0 + LABEL_ROW_PT * rows)
     fig.tight_layout()
 
     def draw(b):

@@ -352,9 +352,12 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     (``RESULTS/plans/NAME.json``; a :class:`~pipeline.planning.types.PlanFile`
     or its dict), as ``pinfeed layout`` and the workflow make it.
 
-    The plan's speed limit is computed (``speed_limit.speed_curve`` with
-    ``speed_trials`` trials per state); without ``belt_speed`` the belt runs at
-    ``speed_fraction`` (80 %) of it. A belt speed above the limit is kept and
+    The plan's speed limit is the one stored with the plan (at the same belt
+    friction; ``speed_limit.attach_speed_limits``), else computed
+    (``speed_limit.speed_curve`` with ``speed_trials`` trials per state);
+    ``speed_limit_trials`` says which trials it comes from and
+    ``stored_speed_limit`` the plan file's figure. Without ``belt_speed`` the
+    belt runs at ``speed_fraction`` (80 %) of it. A belt speed above the limit is kept and
     named in ``warnings``. Trials use the dynamic model at that speed, or the
     plan's quasi-static model with ``quasi_static`` (or when no belt speed
     passes the speed grid at all: then there is no belt speed and no
@@ -362,7 +365,7 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     """
     from pipeline.maps import simulate
     from pipeline.planning.settings import friction_label
-    from pipeline.planning.speed_limit import DEFAULT_SPEEDS, perturbation_from_verify, speed_curve
+    from pipeline.planning.speed_limit import DEFAULT_SPEEDS
     from pipeline.planning.types import as_plan_file
     from pipeline.provenance import provenance_attrs
     cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})
@@ -372,12 +375,10 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     pin_radius = float(result.extra.get("pin_radius", config["sweep"]["pin_radius"]))
     mu_s = float(cfg["mu_s"] if mu_s is None else mu_s)
     heights = [float(h) for h in plan.pin_heights_mm]
-    arcs = plan.final_arcs
     # A bad belt speed or mu_s is refused before any work.
     simulate.check_belt(part, min(DEFAULT_SPEEDS) if belt_speed is None else belt_speed, mu_s)
-    curve = speed_curve(part, heights, [0.0] * len(heights), list(states.values()), arcs, mu_c,
-                        mu_s=mu_s, perturb=perturbation_from_verify(config.get("verify", {})),
-                        trials=cfg["speed_trials"], r_pin=pin_radius, seed=cfg["seed"])
+    curve, trials, stored = _speed_limit(plan, part, list(states.values()), mu_c, mu_s, pin_radius,
+                                         config, cfg)
     limit = curve["speed_limit_mm_s"]
     belt_speed, source, quasi_static, warnings = _belt_speed_choice(belt_speed, limit, cfg,
                                                                     quasi_static)
@@ -391,16 +392,44 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     out["mu_c"] = list(mu_c) if isinstance(mu_c, tuple) else mu_c
     out["plan"] = {"number": int(plan_number), "friction": friction_label(mu_c),
                    "pins": list(plan.pins), "pin_heights_mm": heights,
-                   "final_sets": [s.to_dict() for s in plan.final_sets]}
-    out["warnings"] = warnings
+                   "final_sets": [s.to_dict() for s in plan.final_sets],
+                   "n_final_sets": plan.n_final_sets}
+    out["warnings"] = warnings + final_sets_warning(out["plan"])
     out["method"]["belt_speed"] = source
     out["method"]["throughput"] = "60 x belt speed / pitch" if belt_speed else "none: no belt speed"
-    out["method"]["speed_limit"] = {
-        "model": "dynamic", "trials_per_state": cfg["speed_trials"], "corners_per_state": 4,
-        "required_fraction": 0.99, "speeds_mm_s": list(DEFAULT_SPEEDS), "bisection_mm_s": 5.0,
-        "curve": curve["curve"]}
+    _record_speed_limit(out, curve, trials, stored)
     out.update(provenance_attrs())
     return out
+
+
+def _record_speed_limit(out: dict, curve: dict, trials: int, stored: dict | None) -> None:
+    """Write into the layout ``out`` where its speed limit comes from: the trials per
+    state (``speed_limit_trials``), the plan file's figure (``stored_speed_limit``)
+    and ``method.speed_limit``."""
+    from pipeline.planning.speed_limit import DEFAULT_SPEEDS
+    out["speed_limit_trials"] = int(trials)
+    out["stored_speed_limit"] = None if stored is None else {
+        k: stored[k] for k in ("speed_limit_mm_s", "trials", "mu_s")}
+    out["method"]["speed_limit"] = {
+        "model": "dynamic", "trials_per_state": int(trials), "corners_per_state": 4,
+        "source": "stored with the plan" if curve is stored else "computed for this layout",
+        "required_fraction": 0.99, "speeds_mm_s": list(DEFAULT_SPEEDS), "bisection_mm_s": 5.0,
+        "curve": curve["curve"]}
+
+
+def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, config, cfg) -> tuple:
+    """``(curve, trials, stored)``: the speed limit stored with ``plan`` when it was
+    computed at belt friction ``mu_s`` (one speed limit per plan), else one computed
+    here with ``speed_trials`` trials per state; ``stored``: the plan's record or None."""
+    from pipeline.planning.speed_limit import perturbation_from_verify, speed_curve, stored_speed_limit
+    stored = stored_speed_limit(plan)
+    if stored and stored["settings"]["mu_s"] == mu_s:
+        return stored, stored["trials"], stored
+    heights = [float(h) for h in plan.pin_heights_mm]
+    curve = speed_curve(part, heights, [0.0] * len(heights), states, plan.final_arcs, mu_c, mu_s=mu_s,
+                        perturb=perturbation_from_verify(config.get("verify", {})),
+                        trials=cfg["speed_trials"], r_pin=pin_radius, seed=cfg["seed"])
+    return curve, cfg["speed_trials"], stored
 
 
 def _fixed_pin_plan(result, plan_number, mu_text):
@@ -412,8 +441,12 @@ def _fixed_pin_plan(result, plan_number, mu_text):
     from pipeline.planning.plan import pick_tight_plan
     plan, mu_c, entry = pick_tight_plan(result, int(plan_number), mu_text)
     if any(float(v) for v in plan.pin_speeds or ()):
+        fixed = [f"--plan {k} ({' '.join(p.pins)})" for k, p in enumerate(entry.plans, start=1)
+                 if not any(float(v) for v in p.pin_speeds or ())]
+        usable = (f"plans of fixed pins: {', '.join(fixed)}" if fixed else
+                  "no stored plan at this friction has fixed pins only; re-plan with --dynamic-depth 0")
         raise PinfeedError(f"plan {plan_number} ({' '.join(plan.pins)}) has moving pins; a layout "
-                           f"places fixed pins only: choose a plan of fixed pins with --plan N")
+                           f"places fixed pins only; {usable}")
     stored_states = entry.initial_states or result.initial_states or {}
     return plan, mu_c, {k: (float(s.theta), float(s.y_c)) for k, s in stored_states.items()}
 
@@ -442,6 +475,29 @@ def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
             warnings.append(f"belt speed {belt_speed:g} mm/s is above the plan's speed limit "
                             f"{limit:g} mm/s (fewer than 99 % of its trials end in the final set)")
     return belt_speed, source, quasi_static, warnings
+
+
+def final_sets_warning(plan: dict) -> list[str]:
+    """A warning (a list of none or one line) when a laid-out plan leaves the parts in
+    several final orientation sets: such a feeder does not orient them fully."""
+    from pipeline.planning.arcs import format_arcs
+    n = plan.get("n_final_sets") or len(plan.get("final_sets") or ())
+    if n <= 1:
+        return []
+    return [f"plan {plan['number']} leaves {n} final orientation sets ({format_arcs(plan['final_sets'])}): "
+            f"parts leave this feeder in more than one orientation"]
+
+
+def speed_limit_text(layout: dict) -> str:
+    """A layout's speed limit with the trials it comes from, and the plan file's
+    figure when that differs: one speed limit per plan, or a labelled other one."""
+    trials = layout.get("speed_limit_trials")
+    text = f"{layout['speed_limit_mm_s']:g} mm/s" + (f" ({trials} trials per state)" if trials else "")
+    stored = layout.get("stored_speed_limit")
+    if stored and (stored["speed_limit_mm_s"], stored["trials"]) != (layout["speed_limit_mm_s"], trials):
+        text += (f"; the plan file stores {stored['speed_limit_mm_s']:g} mm/s ({stored['trials']} trials "
+                 f"per state, mu_s {stored['mu_s']:g})")
+    return text
 
 
 DRAWING_SUFFIXES = (".dxf", ".svg", ".png")

@@ -17,12 +17,13 @@ from pipeline.maps.io import write_text_atomic
 from pipeline.planning.arcs import format_arcs
 from pipeline.present.atlas_section import atlas_section
 from pipeline.present.figures.tables import HEADER, verification_rows
+from pipeline.present.layout import speed_limit_text
 from pipeline.provenance import creation_time, git_commit
 
 SECTIONS = (("outline", "Outline"), ("maps", "Configuration maps"), ("plans", "Plans"),
             ("verification", "Verification"), ("animation", "Animation"), ("layout", "Feeder layout"),
             ("sensing", "Sensing"))
-STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto}img{max-width:100%}"
+STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto}img{max-width:100%}.warn{color:#b00}"
          "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;font-size:90%}"
          "tr.fail td{background:#f8d0d0}.files{font-size:90%}")
 
@@ -48,6 +49,13 @@ def _figure(files: dict, kind: str, base, title: str) -> list[str]:
             f'<a href="{src}"><img src="{src}" alt="{html.escape(title)}"></a>']
 
 
+def config_title(config: dict) -> str:
+    """The config in the page's heading: ``config workstation``, or ``the default
+    config`` for the embedded one (named ``config`` after its file)."""
+    name = config.get("name", "default")
+    return "the default config" if name in ("config", "default") else f"config {name}"
+
+
 def write_report(config, parts: dict, out, overview: dict | None = None, catalog=None,
                  atlas: dict | None = None) -> Path:
     """``parts``: name -> {"plan", "verify", optional "sensing" (results), "files"
@@ -58,9 +66,9 @@ def write_report(config, parts: dict, out, overview: dict | None = None, catalog
     base = out.parent
     pc, bc = config["planner"], config["bands"]
     p = ['<!doctype html><html><head><meta charset="utf-8">'
-         f"<title>pinfeed results: {html.escape(config.get('name', ''))}</title>"
+         f"<title>pinfeed results: {html.escape(config_title(config))}</title>"
          f"<style>{STYLE}</style></head><body>",
-         f"<h1>pinfeed results: config {html.escape(config.get('name', ''))}</h1>",
+         f"<h1>pinfeed results: {html.escape(config_title(config))}</h1>",
          f"<p>pinfeed {html.escape(__version__)} ({html.escape(git_commit())}), config "
          f"{config_hash(config)}, made {creation_time()}. Planner: model "
          f"{html.escape(pc['model'])}, mu_c {html.escape(str(pc['mu_c']))}, depth "
@@ -75,7 +83,7 @@ def write_report(config, parts: dict, out, overview: dict | None = None, catalog
         p.append('<p class="files">All parts: ' + ", ".join(
             _link(path, base, text) for text, path in overview.items()) + "</p>")
     for name, part in parts.items():
-        p += _part_section(name, part, base, catalog)
+        p += _part_section(name, part, base, catalog, config)
     p.append("</body></html>")
     return write_text_atomic("\n".join(p), out)
 
@@ -90,7 +98,7 @@ def _toc(parts: dict) -> list[str]:
     return p + ["</ul></nav>"]
 
 
-def _part_section(name: str, part: dict, base, catalog) -> list[str]:
+def _part_section(name: str, part: dict, base, catalog, config: dict) -> list[str]:
     """One part: its files, then outline, maps, plans, verification, animation, sensing."""
     res, ver, files = part["plan"], part["verify"], part["files"]
     p = [f'<h2 id="{_anchor(name)}">{html.escape(name)}</h2>',
@@ -109,31 +117,29 @@ def _part_section(name: str, part: dict, base, catalog) -> list[str]:
     p += _figure(files, "outline", base, "Outline, centroid and resting states")
     p.append(f'<h3 id="{_anchor(name, "maps")}">Configuration maps</h3>')
     p.append(f"<p>Maps: {html.escape(res['selection'])}.</p>")
-    p += _figure(files, "maps", base, "Configuration maps with bands (rows: models)")
-    p += _figure(files, "speeds", base, "Maps by pin speed (dynamic pins)")
+    captions = part.get("captions", {})  # made from the records each figure is drawn from
+    p += _figure(files, "maps", base, captions.get("maps", "Configuration maps with bands (rows: models)"))
+    p += _figure(files, "speeds", base, captions.get("speeds", "Maps by pin speed (dynamic pins)"))
     p.append(f'<h3 id="{_anchor(name, "plans")}">Plans</h3>')
     p += _side_by_side(res, ver, part.get("speed"))
     p += _paper_plans(res)
-    p += _figure(files, "sequence", base, "Pin sequence: best plan of fixed pins")
-    p += _figure(files, "sequence_dynamic", base, "Pin sequence: best plan with dynamic pins")
-    p += _figure(files, "carried", base, "Carried sets against replayed rollouts (recommended tight plan)")
-    p += _figure(files, "speed_limit", base, "Success against belt speed (recommended tight plan, "
-                 "dynamic model) and its speed limit")
+    for kind in ("sequence_tight", "sequence", "sequence_dynamic", "carried", "speed_limit"):
+        p += _figure(files, kind, base, captions.get(kind, kind.replace("_", " ")))
     p.append(f'<h3 id="{_anchor(name, "verification")}">Verification</h3>')
     p += _verification_table(name, ver)
     p += _figure(files, "verification", base, "Verification by plan (failing states in red)")
     p.append(f'<h3 id="{_anchor(name, "animation")}">Animation</h3>')
-    p += _animation(res, files, base)
+    p += _animation(res, files, base, config, part.get("layout"))
     if part.get("layout"):
         p.append(f'<h3 id="{_anchor(name, "layout")}">Feeder layout</h3>')
-        p += _layout_section(part["layout"], files, base)
+        p += _layout_section(part["layout"], files, base, captions.get("layout_png"))
     if "sensing" in part:
         p.append(f'<h3 id="{_anchor(name, "sensing")}">Sensing</h3>')
         p += _sensing_section(part["sensing"], files, base)
     return p
 
 
-def _layout_section(lay: dict, files: dict, base) -> list[str]:
+def _layout_section(lay: dict, files: dict, base, caption: str | None = None) -> list[str]:
     """The feeder to build: throughput, speed limit, pitch, stations, the drawing."""
     if not lay.get("plan"):
         return [f"<p>{html.escape(lay.get('note', 'no layout'))}</p>"]
@@ -141,7 +147,7 @@ def _layout_section(lay: dict, files: dict, base) -> list[str]:
     p = [f"<p>Plan {lay['plan']['number']} ({html.escape(' '.join(lay['plan']['pins']))}): "
          f"<b>throughput {'n/a' if tp is None else f'{tp:.1f}'} parts/min</b> at belt speed "
          f"{'n/a' if v is None else f'{v:.1f}'} mm/s ({html.escape(lay['method']['belt_speed'])}); "
-         f"<b>speed limit {lay['speed_limit_mm_s']:g} mm/s</b>; pitch {lay['pitch_mm']:.1f} mm; belt "
+         f"<b>speed limit {html.escape(speed_limit_text(lay))}</b>; pitch {lay['pitch_mm']:.1f} mm; belt "
          f"width {lay['belt_width_mm']:.1f} mm; model {html.escape(lay['method']['model'])}, "
          f"{lay['method']['trials']['replayed']} trials. Stations: " + ", ".join(
              f"{html.escape(s['label'])} at x = {s['x_mm']:.1f} mm, y = {s['y_mm']:g} mm"
@@ -150,7 +156,7 @@ def _layout_section(lay: dict, files: dict, base) -> list[str]:
     p.append('<p class="files">Drawing: ' + ", ".join(
         _link(files[k], base, k.replace("layout_", "").upper()) for k in
         ("layout_json", "layout_dxf", "layout_svg") if k in files) + "</p>")
-    return p + _figure(files, "layout_png", base, "Feeder drawing (top view)")
+    return p + _figure(files, "layout_png", base, caption or "Feeder drawing (top view)")
 
 
 def _paper_plans(res: dict) -> list[str]:
@@ -185,16 +191,15 @@ def _verification_table(name: str, ver: dict) -> list[str]:
     return p + ["</table>"]
 
 
-def _animation(res: dict, files: dict, base) -> list[str]:
-    """The recommended plan's animation (the tight planner's, else paper mode's best)."""
-    from pipeline.present.animate import recommended_index
-    which = recommended_index(res)
+def _animation(res: dict, files: dict, base, config: dict, layout: dict | None) -> list[str]:
+    """The part's animation, captioned from the records it was drawn from: the
+    layout's plan, else the recommended plan (``animate.animation_subject``)."""
+    from pipeline.present.animate import animation_subject
     if "animation" not in files:
         return ["<p>No animation.</p>"]
-    what = {"tight": f"the tight planner's recommended plan (mu_c {(res.get('tight') or [{}])[0].get('friction')})",
-            1: "paper mode's best plan", None: "no plan"}[which]
+    what = animation_subject(res, config, layout)
     src = _rel(files["animation"], base)
-    return [f"<p>Every initial state past the pins of {html.escape(what)}; "
+    return [f"<p class=\"caption\">Every initial state past the pins of {html.escape(what)}; "
             f"'pinfeed animate --part {html.escape(res['part']['name'])}' makes a smoother one.</p>",
             f'<a href="{src}"><img src="{src}" alt="animation"></a>']
 
@@ -233,7 +238,7 @@ def _speed_cell(speed: dict | None, friction: str, pins) -> str:
         return "<td>n/a</td>"
     if speed.get("friction") != friction or list(speed.get("pin_labels", [])) != list(pins):
         return "<td>n/a</td>"
-    return f"<td>{speed['speed_limit_mm_s']:g}</td>"
+    return f"<td>{speed['speed_limit_mm_s']:g} ({speed['trials']} trials per state)</td>"
 
 
 def _width_cell(plan: dict) -> str:

@@ -99,14 +99,16 @@ def plan_tight_only(part: Part, config: dict, progress=None) -> dict:
 
 def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     """What ``pinfeed plan`` stores: plans of ``part`` with the planner(s) of
-    ``mode`` (``tight``, ``paper`` or ``both``), each verified. A belt speed
+    ``mode`` (``tight``, ``paper`` or ``both``), each verified, the tight ones
+    with their speed limit (``speed_limit.attach_speed_limits``). A belt speed
     plans with the tight planner only (a one-line error otherwise)."""
     belt_speed, _ = planner_belt(config, part)  # a bad belt: a one-line error before any work
     if belt_speed is not None and mode != "tight":
         raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
                            "the paper-mode planner uses the quasi-static map shards: use --mode tight")
+    from pipeline.planning.speed_limit import attach_speed_limits
     if mode == "tight":
-        return plan_tight_only(part, config, progress=progress)
+        return attach_speed_limits(plan_tight_only(part, config, progress=progress), config)
     from pipeline.workflow.plan import ensure_maps, plan_part
     cat = ensure_maps(config, part)
     if mode == "paper":
@@ -115,7 +117,7 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     result = plan_part(cat, part.id, config, progress=progress, tight=mode == "both")
     if mode == "paper":
         result.pop("tight")
-    return result
+    return attach_speed_limits(result, config)
 
 
 def layout_settings(margin=None, trials=None) -> dict:
@@ -177,25 +179,114 @@ def rollout_rows(part: Part, thetas, d: float, mu_c: float, pin_radius: float, m
     return rows
 
 
-def stored_plan(config: dict, root, part_name: str) -> tuple:
-    """``(plan result, path)`` of the plan file stored for ``part_name`` under the
-    results folder ``root``; a missing file is a one-line error saying how to make it."""
+def pinfeed_command(*words, config_path=None, results=None) -> str:
+    """The text of a ``pinfeed`` command line (words quoted for a POSIX shell),
+    with ``--config`` and ``--results`` when they are given: the hints the CLI
+    prints, so that each one works as printed."""
+    import shlex
+    words = [str(w) for w in words]
+    if config_path:
+        words += ["--config", str(config_path)]
+    if results:
+        words += ["--results", str(results)]
+    return " ".join(["pinfeed", *map(shlex.quote, words)])
+
+
+def plan_store_path(config: dict, name: str, out=None, results=None):
+    """Where ``pinfeed plan`` stores the plan of part ``name``: ``out`` if given,
+    else ``RESULTS/plans/NAME.json`` (``results``, default the config's results
+    folder), where ``speed``, ``layout`` and ``animate`` look; ``None`` for a
+    part the workflow plans (``planner.parts``), whose file the workflow owns.
+    The path is checked before any work."""
     from pathlib import Path
 
-    from pipeline.planning.plan import plan_hint
+    from pipeline.checks import check_out_path
+    from pipeline.config import results_folder
+    if out is None and name in config["planner"]["parts"] and results is None:
+        return None
+    path = Path(out) if out else Path(results or results_folder(config)) / "plans" / f"{name}.json"
+    return check_out_path(path, (".json",))
+
+
+def next_step_hints(result: dict, path, config: dict, config_path=None) -> list[str]:
+    """The commands that use a plan stored at ``path``: ``speed``, ``layout`` (of
+    the first tight plan of fixed pins, if any; its JSON beside the plans) and
+    ``animate``; none if the file is not ``RESULTS/plans/NAME.json``, where
+    those commands look. ``--results`` appears where ``RESULTS`` is not the
+    config's folder, ``--config`` where one was given."""
+    from pathlib import Path
+
+    from pipeline.config import results_folder
+    path = Path(path)
+    name = result["part"]["name"]
+    if path.name != f"{name}.json" or path.parent.name != "plans":
+        return []
+    root = path.parent.parent
+    opts = dict(config_path=config_path, results=None if root == results_folder(config) else root)
+    hints = []
+    if result.get("tight") and result["tight"][0]["plans"]:
+        hints.append(pinfeed_command("speed", "--part", name, **opts))
+        fixed = fixed_pin_plans(result)
+        if fixed:
+            plan = [] if fixed[0] == 1 else ["--plan", fixed[0]]
+            layout = root / f"layout_{name}.json"
+            hints.append(pinfeed_command("layout", "--part", name, *plan, "--out", layout, **opts))
+    layout = ["--layout"] if len(hints) == 2 else []  # the layout just hinted at
+    hints.append(pinfeed_command("animate", "--part", name, *layout, "--out",
+                                 root / "animations" / f"{name}.gif", **opts))
+    return hints
+
+
+def fixed_pin_plans(result) -> list[int]:
+    """Numbers (1 = recommended) of the tight plans of fixed pins only at the first
+    planned friction of a stored plan (a :class:`PlanFile` or its dict)."""
+    from pipeline.planning.types import as_plan_file
+    tight = as_plan_file(result).tight
+    plans = tight[0].plans if tight else ()
+    return [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.pin_speeds or ())]
+
+
+def plan_hint(config: dict, name: str, root, config_path=None) -> str:
+    """How to make the stored plan of ``name`` under results folder ``root``: the
+    workflow for the parts it plans; ``pinfeed plan --part NAME`` for a part the
+    config or the catalog knows; else ``pinfeed plan`` with its outline."""
+    from pathlib import Path
+
+    from pipeline.config import results_folder
+    root = Path(root)
+    default_root = root == results_folder(config)
+    if name in config["planner"]["parts"] and default_root:
+        return "run the workflow ('make run')"
+    out = [] if default_root else ["--out", root / "plans" / f"{name}.json"]
+    try:
+        named_part(config, name)
+    except PinfeedError:
+        return (f"plan it from its outline: {pinfeed_command('plan', '--outline', 'FILE', '--name', name, *out, config_path=config_path)} "
+                f"(or --vertices \"x0,y0 x1,y1 ...\")")
+    return f"run '{pinfeed_command('plan', '--part', name, *out, config_path=config_path)}'"
+
+
+def stored_plan(config: dict, root, part_name: str, config_path=None) -> tuple:
+    """``(plan result, path)`` of the plan file stored for ``part_name`` under the
+    results folder ``root``; a missing file is a one-line error saying how to make it
+    (``config_path``: the ``--config`` the hint repeats)."""
+    from pathlib import Path
+
     from pipeline.planning.types import validate_plan_file
     path = Path(root) / "plans" / f"{part_name}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {part_name} at {path}; "
-                           f"{plan_hint(config, part_name, path.parent.parent)} first")
+                           f"{plan_hint(config, part_name, path.parent.parent, config_path)} first")
     return validate_plan_file(path), path  # checked against the plan schema
 
 
-def animation_inputs(result: dict, config: dict, part_name: str, plan, layout, stored_layout) -> tuple:
+def animation_inputs(result: dict, config: dict, part_name: str, plan, layout, stored_layout,
+                     hint_opts=None) -> tuple:
     """``(inputs, layout)`` for ``pinfeed animate``: with ``layout`` (a path, or
     ``"auto"`` for ``stored_layout``) the laid-out plan and that layout (a dict);
     else plan ``plan`` of the stored ``result`` and ``None``. Fails early on a
-    bad ``--plan``, a missing layout or a layout of another part or plan."""
+    bad ``--plan``, a missing layout (saying how to make it, with the
+    ``config_path``/``results`` of ``hint_opts``) or a layout of another part or plan."""
     from pathlib import Path
 
     from pipeline.maps.io import read_json
@@ -206,7 +297,42 @@ def animation_inputs(result: dict, config: dict, part_name: str, plan, layout, s
         raise PinfeedError("--layout animates the layout's own plan; leave out --plan")
     layout_path = stored_layout if layout == "auto" else Path(layout)
     if not layout_path.is_file():
-        raise PinfeedError(f"no layout at {layout_path}; run 'pinfeed layout --part {part_name}' "
-                           f"or the workflow first")
+        raise PinfeedError(f"no layout at {layout_path}; {layout_hint(result, part_name, layout_path, hint_opts)}")
     stored = read_json(layout_path)
     return layout_inputs(result, stored), stored
+
+
+def layout_hint(result, part_name: str, layout_path, hint_opts=None) -> str:
+    """How to make the layout JSON at ``layout_path``: ``pinfeed layout`` of the
+    first tight plan of fixed pins; or why no layout can be made."""
+    fixed = fixed_pin_plans(result)
+    if not fixed:
+        return ("no stored tight plan of fixed pins to lay out (a layout places fixed pins only); "
+                "re-plan with --dynamic-depth 0")
+    plan = [] if fixed[0] == 1 else ["--plan", fixed[0]]
+    return (f"run '{pinfeed_command('layout', '--part', part_name, *plan, '--out', layout_path, **(hint_opts or {}))}' "
+            f"first")
+
+
+def speed_command(result, config: dict, plan: int = 1, mu_text=None, mu_s=None, trials=None) -> tuple:
+    """``pinfeed speed``: ``(speed result, stored record or None)``. The settings
+    default to those of the speed limit stored with the plan (else the config's
+    ``speed`` section); with the same settings the stored figure is returned
+    (``source``: ``stored with the plan``), else it is computed (``computed``)."""
+    from pipeline.planning.plan import pick_tight_plan
+    from pipeline.planning.speed_limit import speed_settings, stored_plan_speed, stored_speed_limit
+    chosen, _, _ = pick_tight_plan(result, plan, mu_text)
+    stored = stored_speed_limit(chosen)
+    settings = dict(stored["settings"]) if stored else speed_settings(config)
+    if mu_s is not None:
+        if not mu_s > 0:
+            raise PinfeedError(f"--mu-s must be > 0, got {mu_s}")
+        settings["mu_s"] = float(mu_s)
+    if trials is not None:
+        if trials < 1:
+            raise PinfeedError(f"--trials must be at least 1, got {trials}")
+        settings["trials"] = int(trials)
+    if stored and stored["settings"] == settings:
+        return dict({k: v for k, v in stored.items() if k != "settings"}, source="stored with the plan"), stored
+    out = stored_plan_speed(result, config, plan=plan, mu_text=mu_text, **settings)
+    return dict(out, source="computed"), stored

@@ -17,6 +17,7 @@ from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
 from pipeline.planning.paper import build_planner, load_maps, paper_depth
 from pipeline.planning.plan import plan_tight_all
+from pipeline.planning.speed_limit import attach_speed_limits
 from pipeline.planning.settings import nominal_friction, parse_friction
 from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.planning.verify import verify_plan
@@ -151,8 +152,9 @@ def bands(shard, settings: dict, out) -> dict:
 
 def plan(config: dict, name: str, out) -> dict:
     """Rule ``plan``: the plans of the config's part ``name`` from the catalog
-    (:func:`plan_part`), written to ``out``."""
-    result = plan_part(Catalog.open(config["catalog_dir"]), name, config)
+    (:func:`plan_part`) with their speed limits (``attach_speed_limits``),
+    written to ``out``."""
+    result = attach_speed_limits(plan_part(Catalog.open(config["catalog_dir"]), name, config), config)
     write_json(result, out)
     return result
 

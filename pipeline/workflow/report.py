@@ -12,6 +12,7 @@ from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_source
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
+from pipeline.planning.settings import nominal_friction, parse_friction
 from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.present.animate import animate_stored, recommended_index
 from pipeline.present.figures import placeholder, placeholder_gif
@@ -24,18 +25,22 @@ from pipeline.present.report import write_report
 from pipeline.workflow.plan import plans_to_check
 
 
-def nominal_paths(plan_result: dict, config: dict, plan: dict | None = None) -> dict:
-    """Unperturbed rollouts of a plan (default: the best): (theta, y_c) before and after each pin."""
+def nominal_paths(plan_result: dict, config: dict, plan: dict | None = None, pins: dict | None = None,
+                  speeds: dict | None = None, mu_c: float | None = None) -> dict:
+    """Unperturbed rollouts of a plan (default: the best): (theta, y_c) before and after each pin;
+    ``pins`` (label -> mm), ``speeds`` (label -> v_pin / v_b) and ``mu_c`` default to the
+    file's tables and paper mode's friction."""
     part = Part.from_vertices(plan_result["part"]["vertices"], name=plan_result["part"]["name"])
     best = plan or plan_result["plans"][0]
-    speeds = plan_result.get("pin_speeds", {})
+    pins = plan_result["pins"] if pins is None else pins
+    speeds = plan_result.get("pin_speeds", {}) if speeds is None else speeds
     paths = {}
     for label, s in plan_result["initial_states"].items():
         theta, y = s["theta"], s["y_c"]
         path = [(theta, y)]
         for pin in best["pins"]:
-            r = simulate.rollout(part, theta, contact_parameter(plan_result["pins"][pin], y, part.a),
-                                 plan_result["mu_c"], config["sweep"]["pin_radius"],
+            r = simulate.rollout(part, theta, contact_parameter(pins[pin], y, part.a),
+                                 plan_result["mu_c"] if mu_c is None else mu_c, config["sweep"]["pin_radius"],
                                  model=plan_result["model"], v_pin=speeds.get(pin, 0.0))
             theta, y = float(r.theta_f), y + float(r.dy)
             path.append((theta, y))
@@ -47,7 +52,9 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
     """Every figure of the planned parts. ``out`` holds lists (one path per
     part, in plan order) under ``maps`` (models side by side), ``speeds``
     (the planner's model at each pin speed), ``sequence`` (best fixed-pin
-    plan), ``sequence_dynamic`` (best plan with dynamic pins), and single
+    plan), ``sequence_dynamic`` (best plan with dynamic pins), optionally
+    ``sequence_tight`` (the recommended tight plan; see
+    :func:`sequence_subjects`), and single
     paths ``verification`` (PNG) and ``table`` (Markdown)."""
     cat = Catalog.open(config["catalog_dir"])
     bc, fc = config["bands"], config["figures"]
@@ -64,10 +71,9 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
         plot_band_maps(speeds, fc["d"], bc["threshold_T"], bc["factor_c"],
                        f"{name}: {res['model']} maps by pin speed, $\\mu_c$ = {res['mu_c']:g} "
                        f"(d at the centroid's station)", out["speeds"][k])
-        to_draw = plans_to_check(res)
-        _sequence_figure(config, res, to_draw.get("fixed pins"), "best fixed-pin plan", out["sequence"][k])
-        _sequence_figure(config, res, to_draw.get("with dynamic pins"), "best plan with dynamic pins",
-                         out["sequence_dynamic"][k])
+        for kind, (what, plan) in sequence_subjects(res).items():
+            if kind in out:
+                _sequence_figure(config, res, plan, what, out[kind][k])
         if "carried" in out:
             _carried_figure(config, res, out["carried"][k])
         verifications[name] = read_json(verify_path)
@@ -86,10 +92,48 @@ def _verification_figure(result: dict, path):
     plot_verification(result["checks"], f"{result['part']}: verification by perturbed rollouts", path)
 
 
+def sequence_subjects(res: dict) -> dict:
+    """What each pin-sequence figure of a plan file draws, ``kind -> (what, plan
+    dict or None)``: ``sequence`` (paper mode's best plan of fixed pins),
+    ``sequence_dynamic`` (its best plan with dynamic pins) and ``sequence_tight``
+    (the tight planner's recommended plan at the first friction). The figures'
+    titles and the report's captions both come from here."""
+    to_draw = plans_to_check(res)
+    tight = (res.get("tight") or [None])[0]
+    return {"sequence": ("best fixed-pin plan (paper mode)", to_draw.get("fixed pins")),
+            "sequence_dynamic": ("best plan with dynamic pins (paper mode)", to_draw.get("with dynamic pins")),
+            "sequence_tight": ("recommended tight plan" + (f" at mu_c {tight['friction']}" if tight else ""),
+                               tight.get("recommended") if tight else None)}
+
+
+def figure_captions(res: dict, speed: dict | None = None, layout: dict | None = None) -> dict:
+    """The report's caption of each figure of a part, kind -> text, from the records
+    the figure is drawn from: the plan file (maps, sequences, carried sets), the
+    speed JSON and the layout JSON."""
+    out = {"maps": f"Configuration maps with bands at mu_c {res['mu_c']:g} (rows: models)",
+           "speeds": f"Maps by pin speed (dynamic pins), {res['model']} at mu_c {res['mu_c']:g}"}
+    for kind, (what, plan) in sequence_subjects(res).items():
+        out[kind] = f"Pin sequence: {what}: " + (" → ".join(plan["pins"]) if plan else "none")
+    _, rec = sequence_subjects(res)["sequence_tight"]
+    if rec:
+        out["carried"] = (f"Carried sets against replayed rollouts: {out['sequence_tight'].split(': ', 1)[1]}")
+    if speed and speed.get("speed_limit_mm_s") is not None:
+        out["speed_limit"] = (f"Success against belt speed (dynamic model) of tight plan "
+                              f"{' → '.join(speed['pin_labels'])} at mu_c {speed['friction']}: speed limit "
+                              f"{speed['speed_limit_mm_s']:g} mm/s ({speed['trials']} trials per state)")
+    if layout and layout.get("plan"):
+        out["layout_png"] = (f"Feeder drawing (top view) of tight plan {layout['plan']['number']}: "
+                             f"{' → '.join(layout['plan']['pins'])}")
+    return out
+
+
 def _sequence_figure(config, res, plan, what, path):
     name = res["part"]["name"]
     if plan is None:
-        if not res["plans"]:
+        if "tight" in what:
+            tight = (res.get("tight") or [None])[0]
+            why = (tight or {}).get("warning") or "no tight plan"
+        elif not res["plans"]:
             why = f"no allowed plan within depth {res['depth']}"
         elif "fixed" in what:
             why = "no allowed plan of fixed pins only"
@@ -98,9 +142,13 @@ def _sequence_figure(config, res, plan, what, path):
         placeholder(path, f"{name}, {what}: {why}")
         return
     part = Part.from_vertices(res["part"]["vertices"], name=name)
-    plot_sequence(part, plan, res["pins"], nominal_paths(res, config, plan),
-                  config["sweep"]["pin_radius"], f"{name}: {what}", path,
-                  speeds=res.get("pin_speeds", {}))
+    pins, speeds, mu_c = res["pins"], res.get("pin_speeds", {}), None
+    if plan.get("pin_heights_mm") is not None:  # a tight plan: its own heights, speeds and friction
+        pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
+        speeds = {q: v for q, v in zip(plan["pins"], plan.get("pin_speeds") or ()) if v}
+        mu_c = nominal_friction(parse_friction(res["tight"][0]["mu_c"]))
+    plot_sequence(part, plan, pins, nominal_paths(res, config, plan, pins, speeds, mu_c),
+                  config["sweep"]["pin_radius"], f"{name}: {what}", path, speeds=speeds)
 
 
 def _carried_figure(config, res, path):
@@ -144,8 +192,8 @@ def animate_part(plan_result: dict, config: dict, out, frames: int, fps: int,
     return animate_stored(plan_result, config, out, which, frames=frames, fps=fps)
 
 
-PART_FIGURES = ("outline", "maps", "speeds", "sequence", "sequence_dynamic", "carried", "verification",
-                "profiles", "scores", "speed_limit")
+PART_FIGURES = ("outline", "maps", "speeds", "sequence", "sequence_dynamic", "sequence_tight", "carried",
+                "verification", "profiles", "scores", "speed_limit")
 
 
 def part_files(results, name: str) -> dict:
@@ -187,6 +235,8 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_p
         res = read_json(path)
         parts[res["part"]]["speed"] = res
         parts[res["part"]]["files"]["speed"] = Path(path)
+    for part in parts.values():
+        part["captions"] = figure_captions(part["plan"], part.get("speed"), part.get("layout"))
     overview = {k: results / f for k, f in (("verification figure", "figures/verification.png"),
                                             ("verification table", "verification.md"))
                 if (results / f).is_file()}

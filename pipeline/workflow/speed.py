@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from pipeline.maps.io import write_json
-from pipeline.planning.speed_limit import stored_plan_speed
+from pipeline.planning.speed_limit import speed_settings, stored_plan_speed, stored_speed_limit
 from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.present.figures import placeholder
 from pipeline.present.figures.speed import plot_speed_curve
@@ -15,9 +15,9 @@ def speed_part(plan_result: dict, config: dict) -> dict:
     """The speed curve and speed limit of a part's recommended tight plan (first
     friction), with the settings of ``config["speed"]`` (trials per state,
     ``mu_s``, speed grid, resolution, required fraction, seed): the JSON of
-    ``speed_limit.stored_plan_speed`` plus provenance. A part without a
+    ``speed_limit.stored_plan_speed`` plus provenance; the speed limit stored
+    with the plan when it was made with these settings. A part without a
     recommended plan gets ``speed_limit_mm_s: None`` and a ``note``."""
-    sc = config.get("speed", {})
     stored = PlanFile.from_dict(plan_result)
     name = stored.name
     tight = (stored.tight or [None])[0]
@@ -25,11 +25,12 @@ def speed_part(plan_result: dict, config: dict) -> dict:
         why = tight.warning if tight else "no tight plan"
         return {"part": name, "speed_limit_mm_s": None, "curve": [], "note": why,
                 **provenance_attrs()}
-    res = stored_plan_speed(plan_result, config, plan=1, mu_s=float(sc.get("mu_s", 0.5)),
-                            trials=int(sc.get("trials", 30)),
-                            speeds=[float(v) for v in sc.get("speeds", (10, 50, 100, 150, 200, 300, 400, 500))],
-                            resolution=float(sc.get("resolution", 5.0)),
-                            required=float(sc.get("required", 0.99)), seed=int(sc.get("seed", 0)))
+    settings = speed_settings(config)
+    stored_limit = stored_speed_limit(tight.plans[0])
+    if stored_limit and stored_limit.get("settings") == settings:  # the plan file's own figure
+        res = {k: v for k, v in stored_limit.items() if k != "settings"}
+    else:
+        res = stored_plan_speed(plan_result, config, plan=1, **settings)
     return {**res, **provenance_attrs()}
 
 

@@ -6,5 +6,6 @@ with log_to(snakemake.log[0]):  # noqa: F821
     out = snakemake.output  # noqa: F821
     make_figures(snakemake.config, snakemake.input.plans, snakemake.input.verify,  # noqa: F821
                  {key: getattr(out, key) for key in
-                  ("maps", "speeds", "sequence", "sequence_dynamic", "carried", "verification_plans",
+                  ("maps", "speeds", "sequence", "sequence_dynamic", "sequence_tight", "carried",
+                   "verification_plans",
                    "verification", "table")})

@@ -197,8 +197,9 @@ def test_refinement_shard_round_trip_and_reuse(tmp_path):
     assert not load_lattice(tmp_path, ASYM, "minpower", 0.0, 2.0).known
 
 
-def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys):
+def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys, monkeypatch):
     from pipeline.cli import main
+    monkeypatch.chdir(tmp_path)  # the plan is stored under ./results (the embedded config's)
     args = ["plan", "--vertices", "0,0 60,0 15,35", "--name", "tri", "--catalog", str(tmp_path / "cat"),
             "--depth", "2", "--pins=7.5,15,27.5,42.5", "--mu-c", "0"]
     assert main(args + ["--json"]) == 0
@@ -214,7 +215,7 @@ def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys):
     assert (tmp_path / "cat" / "refine").is_dir()
     assert main(args) == 0
     text = capsys.readouterr().out
-    assert "0 new rollouts" in text and " deg" in text and "#1:" in text
+    assert "0 new rollouts" in text and " deg" in text and "#1 (recommended):" in text
     assert main(args[:-2] + ["--mu-c", "0.3:0.1"]) == 2
     assert main(args + ["--depth", "0"]) == 2
     # The speed limit of the stored plan (dynamic model), issue 18's keys.

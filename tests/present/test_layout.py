@@ -273,6 +273,6 @@ def test_belt_speed_above_limit_warns_naming_the_limit(stored, capsys):
                  str(fast), "--quasi-static", "--trials", "2", "--json"])
     captured = capsys.readouterr()
     assert code == 0
-    warning = [ln for ln in captured.err.splitlines() if ln.startswith("pinfeed: warning:")]
+    warning = [ln for ln in captured.err.splitlines() if ln.startswith("pinfeed: warning: belt speed")]
     assert len(warning) == 1 and f"{limit:g} mm/s" in warning[0]
-    assert json.loads(captured.out)["warnings"] == [warning[0].removeprefix("pinfeed: warning: ")]
+    assert json.loads(captured.out)["warnings"][0] == warning[0].removeprefix("pinfeed: warning: ")

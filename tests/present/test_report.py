@@ -119,7 +119,7 @@ def test_report_numbers_match_the_verify_json(workflow):
         speed = json.loads((results / "speed" / f"{name}.json").read_text())
         if plan["tight"][0]["recommended"]:  # the speed stage replays the first friction's plan
             assert speed["pin_labels"] == plan["tight"][0]["recommended"]["pins"]
-            limits.append(f"{speed['speed_limit_mm_s']:g}")
+            limits.append(f"{speed['speed_limit_mm_s']:g} ({speed['trials']} trials per state)")
         else:
             assert speed["speed_limit_mm_s"] is None
         checks = {c["kind"]: c for c in json.loads((results / "verify" / f"{name}.json").read_text())["checks"]}
@@ -169,3 +169,50 @@ def _planned_outputs(workdir, stem) -> set:
     assert run.returncode == 0, run.stderr[-2000:]
     rows = [line.split("\t")[0] for line in run.stdout.splitlines()]
     return {r for r in rows if "/" in r and not r.startswith("cat/")}
+
+
+def test_captions_come_from_the_records_their_figures_draw(workflow):
+    """Each caption names the plan its figure draws, read here from the JSON the
+    figure rules read: the plan file, the layout and the speed stage's result."""
+    results = workflow / "res" / "tiny"
+    page = (results / "report.html").read_text()
+    assert "<h1>pinfeed results: config tiny</h1>" in page
+    for name in ("tri", "rect"):
+        plan = json.loads((results / "plans" / f"{name}.json").read_text())
+        tight = plan["tight"][0]
+        rec, static = tight["recommended"], plan["best_static"]
+        if rec:
+            assert (f"Pin sequence: recommended tight plan at mu_c {tight['friction']}: "
+                    f"{' → '.join(rec['pins'])}") in page
+            assert (results / "figures" / f"sequence_tight_{name}.png").is_file()
+            assert f'src="figures/sequence_tight_{name}.png"' in page
+        if static:
+            assert f"Pin sequence: best fixed-pin plan (paper mode): {' → '.join(static['pins'])}" in page
+        layout = json.loads((results / f"layout_{name}.json").read_text())
+        if layout.get("plan"):
+            p = layout["plan"]
+            assert f"the laid-out tight plan {p['number']} at mu_c {p['friction']}" in page
+            assert f"Feeder drawing (top view) of tight plan {p['number']}: {' → '.join(p['pins'])}" in page
+        speed = json.loads((results / "speed" / f"{name}.json").read_text())
+        if speed["speed_limit_mm_s"] is not None:
+            assert (f"of tight plan {' → '.join(speed['pin_labels'])} at mu_c {speed['friction']}: speed "
+                    f"limit {speed['speed_limit_mm_s']:g} mm/s ({speed['trials']} trials per state)") in page
+            stored = plan["tight"][0]["plans"][0]["speed_limit"]  # one speed limit per plan
+            assert (stored["speed_limit_mm_s"], stored["trials"]) == (speed["speed_limit_mm_s"], speed["trials"])
+
+
+def test_default_config_heading_names_it_once():
+    from pipeline.present.report import config_title
+    assert config_title({"name": "config"}) == "the default config"
+    assert config_title({"name": "workstation"}) == "config workstation"
+
+
+def test_catalog_index_then_dry_run_has_nothing_to_do(workflow, capsys):
+    """Re-indexing the catalog rewrites index.json; plans depend on their part's
+    shards (the index only as 'ancient'), so nothing is re-planned. Last in this
+    module: it touches the shared workflow folder."""
+    from pipeline.cli import main
+    assert main(["catalog", "index", "--catalog", str(workflow / "cat")]) == 0
+    again = _snakemake(workflow, "--configfile", str(workflow / "tiny.yaml"), "--dry-run")
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert "Nothing to be done" in again.stdout + again.stderr, (again.stdout + again.stderr)[-3000:]

@@ -46,6 +46,33 @@ def circle_axes(ax):
     ax.tick_params(labelsize=7)
 
 
+LABEL_ROW_PT = 9.0  # one row of 7-point labels above an axes
+
+
+def label_above(ax, x: float, text: str, **kwargs):
+    """A label centred at data ``x`` just above ``ax`` (rows: :func:`stagger_labels`)."""
+    return ax.annotate(text, xy=(x, 1.0), xycoords=ax.get_xaxis_transform(), xytext=(0.0, 2.0),
+                       textcoords="offset points", ha="center", va="bottom", annotation_clip=False,
+                       **kwargs)
+
+
+def stagger_labels(fig, labels) -> int:
+    """Raise each label of :func:`label_above` that would overlap an earlier one by
+    whole rows of :data:`LABEL_ROW_PT` points until it overlaps none (close pins
+    get stacked labels); returns the number of rows used, for a title's pad."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    placed, rows = [], 1
+    for label in labels:
+        row = 0
+        while any(label.get_window_extent(renderer).overlaps(box) for box in placed):
+            row += 1
+            label.xyann = (0.0, 2.0 + LABEL_ROW_PT * row)
+        placed.append(label.get_window_extent(renderer))
+        rows = max(rows, row + 1)
+    return rows
+
+
 def text_problems(fig) -> list[str]:
     """Visible texts of ``fig`` that overlap one another or stick out of the
     figure, measured with the renderer (the figure as it would be saved)."""

@@ -10,6 +10,7 @@ degrees thick so that a band of identical theta_f (zero width) still shows.
 from __future__ import annotations
 
 import math
+import textwrap
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -131,6 +132,9 @@ def band_maps_figure(maps_by_model: dict, d_values, threshold_T, factor_c, title
             if c == 0:
                 ax.set_ylabel(r"$\theta_f$ (deg)", fontsize=8)
     bottom = bottom_legend(fig, legend_handles(factor_c, seen))
+    width, height = fig.get_size_inches()
+    # The title wrapped to the figure's width, and the panels kept below it.
+    title = textwrap.fill(title, int(11 * width), break_on_hyphens=False)
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout(rect=(0, bottom, 1, 1))
+    fig.tight_layout(rect=(0, bottom, 1, 1 - (0.12 + 0.2 * title.count("\n") + 0.2) / height))
     return fig

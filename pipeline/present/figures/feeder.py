@@ -8,6 +8,7 @@ y = 0, the first pin at x = 0.
 """
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +38,8 @@ def title_lines(layout: dict) -> list[str]:
             f"plan {plan.get('number', '-')}: {pins}",
             f"mu_c {mu_c}   mu_s {'n/a' if mu_s is None else f'{mu_s:g}'}",
             f"belt speed {_fmt(layout.get('belt_speed_mm_s'), ' mm/s')}"
-            f" (limit {_fmt(limit, ' mm/s')})",
+            f" (limit {_fmt(limit, ' mm/s')}"
+            + (f", {layout['speed_limit_trials']} trials/state)" if layout.get("speed_limit_trials") else ")"),
             f"pitch {_fmt(layout['pitch_mm'], ' mm')}   belt width {_fmt(layout['belt_width_mm'], ' mm')}",
             f"throughput {_fmt(layout.get('throughput_per_min'), ' parts/min')}",
             f"pinfeed {layout.get('pinfeed_version', __version__)}   "
@@ -57,9 +59,10 @@ def drawing_items(layout: dict) -> dict:
     x_lo, x_hi = float(xs.min()) - 15.0, float(xs.max()) + 15.0
     pin_r = max(s["radius_mm"] for s in stations)
     dims = []
+    row = label_row_mm(x_hi - x_lo)
     # Stations: each pin's x from the first pin, stacked above the belt.
     for k, s in enumerate(stations[1:], start=1):
-        y = y_hi + 8.0 + 7.0 * (k - 1)
+        y = y_hi + 8.0 + row * (k - 1)
         dims.append(((stations[0]["x_mm"], s["y_mm"]), (s["x_mm"], s["y_mm"]), (0.0, y),
                      f"{s['x_mm']:.1f}", 0.0))
     # Heights: each pin's y from the fence line, just left of the pin.
@@ -74,30 +77,55 @@ def drawing_items(layout: dict) -> dict:
     dims.append(((x_lo, y_lo), (x_lo, y_hi), (x_lo - 6.0, 0.0),
                  f"belt {layout['belt_width_mm']:.1f}", 90.0))
     arrow_y = y_hi - 4.0
+    # Pin labels: one row each above the station dimensions, joined to their pin by a
+    # leader, so labels of close pins never cover one another or a dimension.
+    label_y0 = y_hi + 8.0 + row * max(len(stations) - 1, 0)
     return {
         "belt": [((x_lo, y_lo), (x_hi, y_lo)), ((x_lo, y_hi), (x_hi, y_hi))],
         "fence": [((x_lo, layout["fence_y_mm"]), (layout["fence_end_x_mm"], layout["fence_y_mm"]))],
-        # Labels alternate above and below their pins, so close pins stay readable.
         "pins": [((s["x_mm"], s["y_mm"]), s["radius_mm"], f"{s['label']} y={s['y_mm']:g}",
-                  1.0 if k % 2 == 0 else -1.0) for k, s in enumerate(stations)],
+                  (s["x_mm"], label_y0 + row * (k + 1))) for k, s in enumerate(stations)],
         "dims": dims,
         "parts": parts,
         "arrow": ((x_lo + 5.0, arrow_y), (x_lo + 35.0, arrow_y)),
         # The title block's top right corner, under the belt and its dimensions.
         "title": ((x_hi, y_lo - 16.0), title_lines(layout)),
-        "extent": (x_lo - 12.0, x_hi, y_lo - 16.0, y_hi + 8.0 + 7.0 * len(stations)),
+        "extent": (x_lo - 12.0, x_hi, y_lo - 16.0, label_y0 + row * (len(stations) + 1)),
     }
+
+
+DRAWING_WIDTH_IN = 11.0  # the PNG/SVG figure's width, inches
+
+
+def label_row_mm(span_mm: float) -> float:
+    """Height of one pin label's row (mm): 1.6 lines of 7-point text at the
+    drawing's scale (``span_mm`` across about 10 inches), at least 7 mm."""
+    return max(7.0, 1.6 * span_mm / (DRAWING_WIDTH_IN - 1.0) * 7.0 / 72.0)
+
+
+ALERT_COLOUR = "#bb0000"  # warnings (several final sets, a belt above its limit): red
 
 
 def draw_feeder(layout: dict, out) -> Path:
     """The drawing as PNG or SVG (by ``out``'s suffix), written atomically."""
+    import matplotlib.pyplot as plt
+    fig = feeder_figure(layout)
+    out = Path(out)
+    with atomic_target(out) as tmp:
+        fig.savefig(tmp, format=out.suffix.lower().lstrip("."), dpi=110)
+    plt.close(fig)
+    return out
+
+
+def feeder_figure(layout: dict):
+    """The matplotlib figure of the drawing; the layout's warnings above it, in red."""
     import matplotlib.pyplot as plt
     from matplotlib.patches import Circle, Polygon
 
     from pipeline.present.figures import save_figure  # noqa: F401 (selects the Agg backend)
     items = drawing_items(layout)
     x0, x1, y0, y1 = items["extent"]
-    width = 11.0
+    width = DRAWING_WIDTH_IN
     y0 -= 1.2 * (x1 - x0) / (width - 1.0)  # about 1.2 inches for the title block
     fig, ax = plt.subplots(figsize=(width, max(3.0, width * (y1 - y0) / (x1 - x0)) + 0.4))
     for (a, b) in items["belt"]:
@@ -107,10 +135,10 @@ def draw_feeder(layout: dict, out) -> Path:
         ax.text(a[0] + 2, a[1] - 1.0, "fence", fontsize=7, va="top")
     for k, poly in enumerate(items["parts"]):
         ax.add_patch(Polygon(poly, closed=True, fc="tab:blue", ec="k", alpha=0.35, lw=0.8))
-    for centre, r, label, side in items["pins"]:
+    for centre, r, label, at in items["pins"]:
         ax.add_patch(Circle(centre, r, color="tab:red", zorder=3))
-        ax.text(centre[0] + r + 1.0, centre[1] + side * (r + 0.5), label, fontsize=7, color="tab:red",
-                va="bottom" if side > 0 else "top")
+        ax.plot([centre[0], at[0]], [centre[1] + r, at[1]], color="tab:red", lw=0.4, ls=":")
+        ax.text(at[0] + 1.0, at[1], label, fontsize=7, color="tab:red", va="center")
     for p1, p2, at, text, angle in items["dims"]:
         if angle == 0.0:
             a, b = (p1[0], at[1]), (p2[0], at[1])
@@ -134,12 +162,11 @@ def draw_feeder(layout: dict, out) -> Path:
     ax.set_xlabel("x along the belt (mm)", fontsize=8)
     ax.set_ylabel("y across the belt (mm)", fontsize=8)
     ax.tick_params(labelsize=7)
+    if layout.get("warnings"):
+        ax.set_title("\n".join(textwrap.fill(w, 150) for w in layout["warnings"]), color=ALERT_COLOUR,
+                     fontsize=7, loc="left")
     fig.tight_layout()
-    out = Path(out)
-    with atomic_target(out) as tmp:
-        fig.savefig(tmp, format=out.suffix.lower().lstrip("."), dpi=110)
-    plt.close(fig)
-    return out
+    return fig
 
 
 def write_dxf(layout: dict, out) -> Path:
@@ -156,10 +183,11 @@ def write_dxf(layout: dict, out) -> Path:
         msp.add_line(a, b, dxfattribs={"layer": "BELT"})
     for a, b in items["fence"]:
         msp.add_line(a, b, dxfattribs={"layer": "FENCE"})
-    for centre, r, label, side in items["pins"]:
+    for centre, r, label, at in items["pins"]:
         msp.add_circle(centre, r, dxfattribs={"layer": "PINS"})
+        msp.add_line((centre[0], centre[1] + r), at, dxfattribs={"layer": "PINS"})
         msp.add_text(label, height=TEXT_MM * 0.7, dxfattribs={"layer": "PINS"}).set_placement(
-            (centre[0] + r + 1.0, centre[1] + side * (r + 0.5) - (TEXT_MM if side < 0 else 0.0)))
+            (at[0] + 1.0, at[1] - 0.5 * TEXT_MM * 0.7))
     for p1, p2, at, text, angle in items["dims"]:
         base = (p1[0], at[1]) if angle == 0.0 else (at[0], p1[1])
         dim = msp.add_linear_dim(base=base, p1=p1, p2=p2, angle=angle, text=text,
@@ -184,6 +212,10 @@ def write_dxf(layout: dict, out) -> Path:
     for k, line in enumerate(lines):
         msp.add_text(line, height=TEXT_MM * 0.8, dxfattribs={"layer": "TITLE"}).set_placement(
             (origin[0] + 2.0, origin[1] - step * (k + 1)))
+    x_lo, _, _, y_top = items["extent"]
+    for k, warning in enumerate(layout.get("warnings") or ()):  # red (ACI 1), above the drawing
+        msp.add_text(warning, height=TEXT_MM * 0.8, dxfattribs={"layer": "TITLE", "color": 1}).set_placement(
+            (x_lo, y_top + step * (len(layout["warnings"]) - k)))
     out = Path(out)
     with atomic_target(out) as tmp:
         doc.saveas(tmp)
