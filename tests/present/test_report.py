@@ -112,7 +112,7 @@ def test_report_numbers_match_the_verify_json(workflow):
             want += [[" ".join(check["plan"]), check["kind"], r["state"], str(r["trials"]),
                       str(r["successes"]), str(r["failures"])] for r in check["rows"]]
     assert [r[:6] for r in table] == want and want
-    side = [r for r in page.rows["side-by-side"] if r[0] != "planner" and len(r) == 7]  # tri's rows, then rect's
+    side = [r for r in page.rows["side-by-side"] if r[0] != "planner" and len(r) == 8]  # tri's rows, then rect's
     want, limits = [], []
     for name in ("tri", "rect"):
         plan = json.loads((results / "plans" / f"{name}.json").read_text())
@@ -129,7 +129,15 @@ def test_report_numbers_match_the_verify_json(workflow):
             ok = sum(r["successes"] for r in checks[kind]["rows"])
             want.append([str(best["n_final_sets"]), f"{ok}/{sum(r['trials'] for r in checks[kind]['rows'])}"])
     assert [[r[3], r[5]] for r in side] == want
-    assert [r[6] for r in side if r[0].startswith("tight") and r[6] != "n/a"] == limits
+    assert [r[7] for r in side if r[0].startswith("tight") and r[7] != "n/a"] == limits
+    widths = []  # the verified width beside the claim, from the plan file's orientation verdict
+    for name in ("tri", "rect"):
+        for t in json.loads((results / "plans" / f"{name}.json").read_text())["tight"]:
+            o = (t["recommended"] or {}).get("verification", {}).get("orientation")
+            if o:
+                widths.append((f"{o['width_deg']:.1f}" if o["width_deg"] is not None else "n/a")
+                              + f": {o['in_tolerance']}/{o['trials']} in {o['tolerance_deg']:g} deg")
+    assert [r[6].split(" (")[0] for r in side if r[0].startswith("tight")] == widths
     assert all(int(r[3]) == 3 + 2 ** (3 + len(r[0].split())) for r in table)  # verify.trials 3 + corners
 
 

@@ -301,23 +301,22 @@ TRI_PLAN = ["--depth", "2", "--pins=7.5,27.5", "--mu-c", "0", "--dynamic-depth",
 @pytest.fixture(scope="module")
 def stored_tri(tmp_path_factory):
     """Tight plans of the asymmetric triangle on a two-pin grid, stored by
-    ``pinfeed plan --out`` (as a user or the plan stage stores them), and a copy
-    of that file without the plans that end in one set (a feeder whose fixed
-    pins cannot orient the part)."""
+    ``pinfeed plan --out`` (as a user or the plan stage stores them): two pins
+    orient it ("full"); one pin cannot (depth 1, "partial": a feeder whose
+    fixed pins leave several sets, each within the tolerance)."""
     from pipeline.cli import main
     tmp = tmp_path_factory.mktemp("sense")
     cat, full, partial = tmp / "cat", tmp / "full", tmp / "partial"
-    path = full / "plans" / "tri.json"
-    assert main(["plan", "--vertices", TRI, "--name", "tri", "--catalog", str(cat), *TRI_PLAN,
-                 "--out", str(path), "--json"]) == 0
+    for folder, depth in ((full, "2"), (partial, "1")):
+        path = folder / "plans" / "tri.json"
+        plan_args = [a if a != "2" else depth for a in TRI_PLAN]
+        assert main(["plan", "--vertices", TRI, "--name", "tri", "--catalog", str(cat), *plan_args,
+                     "--out", str(path), "--json"]) == 0
     assert main(["catalog", "index", "--catalog", str(cat)]) == 0  # refinement shards only
-    stored = json.loads(path.read_text())
-    entry = stored["tight"][0]
-    assert entry["plans"][0]["n_final_sets"] == 1 and any(p["n_final_sets"] > 1 for p in entry["plans"])
-    entry["plans"] = [p for p in entry["plans"] if p["n_final_sets"] > 1]
-    entry["recommended"] = entry["plans"][0]
-    (partial / "plans").mkdir(parents=True)
-    (partial / "plans" / "tri.json").write_text(json.dumps(stored))
+    full_entry = json.loads((full / "plans" / "tri.json").read_text())["tight"][0]
+    partial_entry = json.loads((partial / "plans" / "tri.json").read_text())["tight"][0]
+    assert full_entry["orients"] and full_entry["recommended"]["n_final_sets"] == 1
+    assert not partial_entry["orients"] and partial_entry["recommended"]["n_final_sets"] > 1
     return {"catalog": cat, "full": full, "partial": partial}
 
 
