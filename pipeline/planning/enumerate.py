@@ -5,8 +5,10 @@ on the fence (no perturbation) and rolls it past each pin in turn at one
 friction. All sequences of one length are one level: the level's states are
 arrays ``(sequences, resting states)``, and going one pin deeper repeats
 each sequence once per candidate pin and rolls out every (state, pin) pair
-in one parallel batch. Pairs whose start poses round to the same multiple
-of ``QUANTUM`` (degrees and millimetres) share one rollout: different
+in one parallel batch. Each (state, pin) pair starts from its pose rounded
+to a multiple of ``QUANTUM`` (the orientation in degrees, the pin's offset
+from the centroid in millimetres), and pairs that round alike share one
+rollout (so an outcome depends on the rounded pose only): different
 sequences often bring a state to the same pose (a pin that misses leaves it
 as it was; a vertex pushed to rest ends where the vertex sits behind the
 centroid whatever the offset was).
@@ -35,6 +37,7 @@ from pipeline.maps import simulate
 from pipeline.parts.part import Part
 
 QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout
+MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
 
 
 @dataclass
@@ -100,7 +103,18 @@ class NominalTree:
                 return
 
     def extend(self, level: Level) -> Level:
-        """Every surviving sequence of ``level`` followed by every candidate pin."""
+        """Every surviving sequence of ``level`` followed by every candidate pin
+        (in chunks of parents, so memory stays bounded on long levels)."""
+        per_parent = max(1, self.heights.size * level.theta.shape[1])
+        step = max(1, MAX_PAIRS // per_parent)
+        if level.size <= step:
+            return self._extend(level)
+        parts = [self._extend(Level(level.seq[i:i + step], level.theta[i:i + step], level.y[i:i + step],
+                                    level.margin[i:i + step])) for i in range(0, level.size, step)]
+        return Level(*(np.concatenate([getattr(p, k) for p in parts])
+                       for k in ("seq", "theta", "y", "margin")))
+
+    def _extend(self, level: Level) -> Level:
         n_pins, n = self.heights.size, level.size
         theta = np.repeat(level.theta, n_pins, axis=0)
         y_c = np.repeat(level.y, n_pins, axis=0)
@@ -127,9 +141,10 @@ class NominalTree:
         if keys.shape[0] == 0:
             empty = np.zeros(theta.shape)
             return empty.astype(np.int8), empty, empty
-        uniq, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
         inverse = inverse.ravel()
-        res = simulate.rollout_points(self.part, theta.ravel()[first], dy_pin.ravel()[first] / a,
+        # Roll out from the rounded pose itself, so an outcome depends on its key only.
+        res = simulate.rollout_points(self.part, uniq[:, 0] * QUANTUM, uniq[:, 1] * QUANTUM / a,
                                       self.mu_c, self.pin_radius, self.model, **self.kernel)
         self.rollouts += uniq.shape[0]
         shape = theta.shape
