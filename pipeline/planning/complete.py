@@ -8,7 +8,7 @@ perturbation box). A sequence *orients* the part when at least
 (``orient.judge``; jams count as failures). The search returns a plan of
 ``n`` pins whenever some sequence of ``n <= N`` pins orients the part and
 its nominal paths (``enumerate.NominalTree``: every resting state unperturbed,
-at the middle friction) neither jam nor pass a centroid within the pins'
+at the middle friction, each pose rounded to 0.05 deg and mm) neither jam nor pass a centroid within the pins'
 placement tolerance, and end within ``T + SLACK_DEG`` of each other; and it
 never returns a plan with more pins than such a sequence. It does so by
 trying every sequence, level by level:
