@@ -122,6 +122,7 @@ def _part_section(name: str, part: dict, base, catalog, config: dict) -> list[st
     p += _figure(files, "speeds", base, captions.get("speeds", "Maps by pin speed (dynamic pins)"))
     p.append(f'<h3 id="{_anchor(name, "plans")}">Plans</h3>')
     p += _side_by_side(res, ver, part.get("speed"))
+    p += _search_evidence(res)
     p += _paper_plans(res)
     for kind in ("sequence_tight", "sequence", "sequence_dynamic", "carried", "speed_limit"):
         p += _figure(files, kind, base, captions.get(kind, kind.replace("_", " ")))
@@ -239,6 +240,19 @@ def _speed_cell(speed: dict | None, friction: str, pins) -> str:
     if speed.get("friction") != friction or list(speed.get("pin_labels", [])) != list(pins):
         return "<td>n/a</td>"
     return f"<td>{speed['speed_limit_mm_s']:g} ({speed['trials']} trials per state)</td>"
+
+
+def _search_evidence(res: dict) -> list[str]:
+    """What the complete fixed-pin search found at each friction (red where
+    fixed pins cannot orient the part, and why)."""
+    items = []
+    for t in res.get("tight", []):
+        search = t.get("fixed_pin_search")
+        if search:
+            style = "" if search["orients"] else ' style="color:#b00"'
+            items.append(f"<li{style}>mu_c {html.escape(t['friction'])}: {html.escape(search['evidence'])}</li>")
+    return ['<p>Fixed-pin search (complete to the depth, see the README):</p><ul class="evidence">',
+            *items, "</ul>"] if items else []
 
 
 def _width_cell(plan: dict) -> str:
