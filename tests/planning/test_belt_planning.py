@@ -8,8 +8,8 @@ import json
 import numpy as np
 import pytest
 import xarray as xr
-import yaml
 
+from cli_runs import TRI_PLAN_ARGS, small_config_file
 from images import assert_png_figure
 from pipeline.cli import main
 from pipeline.config import load_config
@@ -22,27 +22,14 @@ from pipeline.planning.verify import replay
 
 TRI = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 BELT = 150.0
-ARGS = ["--vertices", "0,0 60,0 15,35", "--name", "tri", "--depth", "1", "--pins=7.5,27.5,42.5",
-        "--mu-c", "0", "--dynamic-depth", "0"]
-
-
-def _small_config(tmp_path):
-    """The default config with few verification trials and candidates (fast)."""
-    cfg = load_config(None)
-    cfg["verify"]["trials"] = 20
-    cfg["planner"]["candidates"] = 3
-    cfg["speed"].update(trials=5, speeds=[50.0, 300.0], resolution=25.0)
-    cfg.pop("name", None)
-    path = tmp_path / "small.yaml"
-    path.write_text(yaml.safe_dump(cfg))
-    return path
+ARGS = TRI_PLAN_ARGS
 
 
 @pytest.fixture(scope="module")
 def planned(tmp_path_factory):
     """One quasi-static and one belt-speed plan of the triangle in one catalog."""
     tmp = tmp_path_factory.mktemp("belt")
-    cfg = _small_config(tmp)
+    cfg = small_config_file(tmp)
     common = ARGS + ["--config", str(cfg), "--catalog", str(tmp / "cat")]
     assert main(["plan", *common, "--out", str(tmp / "res" / "plans" / "tri.json")]) == 0
     assert main(["plan", *common, "--belt-speed", f"{BELT:g}",

@@ -8,26 +8,11 @@ import os
 from pathlib import Path
 
 import pytest
-import yaml
 
-from cli_runs import run_cli
-from pipeline.config import load_config
+from cli_runs import TRI_PLAN_ARGS, run_cli, small_config_file
 from pipeline.planning import lattice_store
 
-ARGS = ["--vertices", "0,0 60,0 15,35", "--name", "tri", "--depth", "1", "--pins=7.5,27.5,42.5",
-        "--mu-c", "0", "--dynamic-depth", "0"]
-
-
-def _small_config(tmp_path):
-    """The default config with few verification trials and candidates (fast)."""
-    cfg = load_config(None)
-    cfg["verify"]["trials"] = 20
-    cfg["planner"]["candidates"] = 3
-    cfg["speed"].update(trials=5, speeds=[50.0, 300.0], resolution=25.0)
-    cfg.pop("name", None)
-    path = tmp_path / "small.yaml"
-    path.write_text(yaml.safe_dump(cfg))
-    return path
+ARGS = TRI_PLAN_ARGS
 
 
 def _snapshot(root: Path) -> dict:
@@ -77,7 +62,7 @@ def read_only(tmp_path, monkeypatch):
 
 def test_plan_twice_on_a_read_only_catalog(tmp_path, capsys, read_only, computed):
     before = _snapshot(read_only)
-    common = ARGS + ["--config", str(_small_config(tmp_path)), "--catalog", str(read_only)]
+    common = ARGS + ["--config", str(small_config_file(tmp_path)), "--catalog", str(read_only)]
     code, _, err = run_cli(capsys, ["plan", *common, "--out", str(tmp_path / "one.json")])
     said = [line for line in err.splitlines() if "cannot be written" in line]
     assert code == 0 and len(said) == 1 and str(tmp_path / "cache") in said[0], err
