@@ -277,6 +277,7 @@ def attach_speed_limits(result: dict, config: dict) -> dict:
             record = stored_plan_speed(result, config, plan=number, **settings)
         except PinfeedError:
             continue
+        record.pop("seconds", None)  # a timing would make the same plan differ between runs
         plans[number - 1]["speed_limit"] = dict(record, settings=settings)
     if entry.get("recommended") is not None and "speed_limit" in plans[0]:
         entry["recommended"]["speed_limit"] = plans[0]["speed_limit"]
