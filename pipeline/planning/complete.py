@@ -217,7 +217,7 @@ class FixedPinSearch:
         probe_fails = self._failures(level, within, self._screen_rows(inputs, *PROBE))
         order = within[probe_fails <= allowed][np.argsort(probe_fails[probe_fails <= allowed], kind="stable")]
         record["screened_out"] = int(within.size - order.size)
-        screen, full = self._screen_rows(inputs, *SCREEN), self._all_rows(inputs)
+        screen, full = self._screen_rows(inputs, *SCREEN), self._stack(inputs)
         found, judged = [], []
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
         done = 0
@@ -259,9 +259,6 @@ class FixedPinSearch:
             rows.append((th[pick], yc[pick], mu[pick], offs[pick]))
         return self._stack(rows)
 
-    def _all_rows(self, inputs):
-        return self._stack(inputs)
-
     @staticmethod
     def _stack(rows):
         return tuple(np.concatenate([r[k] for r in rows]) for k in range(4))
@@ -292,10 +289,7 @@ class FixedPinSearch:
     def _judge(self, level, idx, rows):
         tf, jam = self._replay(level, idx, rows)
         for k in range(idx.size):
-            verdict = orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order,
-                                   self.required)
-            verdict["trials"], verdict["jammed"] = int(rows[0].size), int(jam[k].sum())
-            yield verdict
+            yield orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order, self.required)
 
     # ------------------------------------------------------------------ when nothing orients
 
@@ -311,5 +305,5 @@ class FixedPinSearch:
         spread = period - gaps.max(axis=1)
         best = np.lexsort((-level.margin, spread, clusters))[:candidates]
         inputs = trial_inputs(self.states, self.mu_c, level.seq.shape[1], self.cfg)
-        verdicts = self._judge(level, best, self._all_rows(inputs))
+        verdicts = self._judge(level, best, self._stack(inputs))
         return [self._plan(level, i, spread[i], v) for i, v in zip(best, verdicts)]

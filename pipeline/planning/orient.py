@@ -121,7 +121,8 @@ def judge(finals, n_trials: int, tolerance: float, order: int = 1,
     """The orientation verdict on trials: ``finals`` are the final orientations
     of the trials that did not jam, ``n_trials`` all trials.
 
-    Returns ``orients``, ``in_tolerance`` (the most trials one arc of the
+    Returns ``orients``, ``trials``, ``jammed`` (trials that are not in
+    ``finals``), ``in_tolerance`` (the most trials one arc of the
     tolerance holds), ``needed``, ``width_deg`` (the verified width: the
     narrowest arc holding the needed trials; ``None`` if too many jammed),
     ``set`` (that arc, ``{"start", "width"}``), ``spread_deg`` (the narrowest arc
@@ -132,7 +133,8 @@ def judge(finals, n_trials: int, tolerance: float, order: int = 1,
     count, _ = best_arc(finals, tolerance, order)
     arc = narrowest_arc(finals, need, order)
     spread = narrowest_arc(finals, finals.size, order)
-    return {"orients": bool(count >= need and n_trials > 0), "tolerance_deg": float(tolerance),
+    return {"orients": bool(count >= need and n_trials > 0), "trials": int(n_trials),
+            "jammed": int(n_trials - finals.size), "tolerance_deg": float(tolerance),
             "required": float(required), "in_tolerance": int(count), "needed": need,
             "width_deg": None if arc is None else round(arc[1], 4),
             "set": None if arc is None else {"start": round(arc[0], 4), "width": round(arc[1], 4)},

@@ -180,7 +180,6 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
                           mu_s=planner.mu_s)
         finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
         verdict = judge(finals, res["trials"], tolerance, planner.order, required)
-        verdict["trials"], verdict["jammed"] = res["trials"], res["trials"] - len(finals)
         plan.verification = {"trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
                              **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}
