@@ -143,3 +143,15 @@ def orienting_sequences(part, pins: dict, depth, width, trials_for, order=1):
             if finals is not None and most_in_arc(finals, width, order) == finals.size:
                 found.append(seq)
     return found
+
+
+def all_tight_plans(planner, depth):
+    """Every sequence of up to ``depth`` of the planner's pins, followed by the
+    tight propagation (``TightPlanner.follow``), best first by ``rank_key``."""
+    plans = []
+    for n in range(1, depth + 1):
+        for seq in itertools.product(list(planner.pins), repeat=n):
+            plan = planner.follow(seq)
+            if plan is not None:
+                plans.append(plan)
+    return sorted(plans, key=lambda p: p.rank_key())

@@ -1,32 +1,32 @@
-"""Search over pin sequences with tight state propagation (``propagate.py``).
+"""Tight plans of given pin sequences, and moving pins after fixed ones, by
+tight state propagation (``propagate.py``).
 
 Every initial resting state starts as its uncertainty box. A pin is allowed
 for a state only if the whole d range of the box stays on one side of the
 centroid (the pin never passes it on either side) and no jam is reachable;
 ``d_min <= |d| <= d_max`` (for a moving pin: the offset of the pin's path,
 ``|d| / sqrt(1 + v^2)``) sets the safety margin, and is a hard rule only with
-``hard_limits``; a pin that the
-state misses leaves it as it is (that is part of the propagation). A pin
-sequence is the same for every initial state.
+``hard_limits``; a pin that the state misses leaves it as it is (that is
+part of the propagation). A pin sequence is the same for every initial state.
 
-The search is complete up to ``depth`` over the static candidate pins:
-every sequence is tried, and sequences that reach a joint state (the carried
-sets of all initial states) already reached are merged, so a pin that changes
-nothing is never kept. Moving pins, if any, are appended after the static
-ones by a beam search (complete for one moving pin after the beam's plans).
+``TightPlanner.follow`` carries the sets of one given sequence (the complete
+fixed-pin search, ``complete.py``, chooses the sequences);
+``TightPlanner.extend_moving`` lets moving pins follow given fixed-pin
+prefixes by a beam search over joint states (the carried sets of all initial
+states): sequences that reach a joint state already reached are merged, so a
+pin that changes nothing is never kept.
 
-Plans are ranked by (1) the number of final orientation sets, counted modulo
-the part's rotational symmetry; then, once verified by full rollouts
-(``verify.py``), (2) the fraction of successful trials; (3) fewest pins;
-(4) fewest steps whose box straddles a jump; (5) the safety margin in d (the smallest distance of any d range that a pin
-touches from ``d_min`` and ``d_max``; negative inside them);
-(6) the total width of the final sets.
+Before verification, plans are ranked by (1) the number of final orientation
+sets, counted modulo the part's rotational symmetry; (2) the fraction of
+successful trials once verified; (3) fewest pins; (4) fewest steps whose box
+straddles a jump; (5) the safety margin in d; (6) the total width of the
+final sets. ``plan.py`` ranks verified plans by the orientation verdict.
 """
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
@@ -122,14 +122,13 @@ class TightPlan:
 
 @dataclass
 class SearchStats:
-    """Counters of one search: transitions, rollouts, nodes, time (s), pruning, per level."""
+    """Counters of the propagation: transitions, rollouts, nodes, time (s), pruning."""
     transitions: int = 0
     rollouts: int = 0
     nodes: int = 0
     seconds: float = 0.0
     pruned_branching: int = 0
     unresolved: int = 0
-    per_level: list = field(default_factory=list)
 
 
 class TightPlanner:
@@ -241,43 +240,6 @@ class TightPlanner:
 
     # ------------------------------------------------------------------ search
 
-    def search(self, depth: int, keep: int = 10, dynamic_depth: int = 0, beam: int = 30,
-               complete_depth: int = 2, static_beam: int = 60, progress=None) -> list[TightPlan]:
-        """The ``keep`` best plans by predicted rank (before verification).
-
-        Levels up to ``complete_depth`` expand every joint state; deeper levels
-        expand the ``static_beam`` best (fewest sets, then fewest branches,
-        then narrowest sets), so the search is complete up to
-        ``complete_depth`` and a beam search beyond it."""
-        if depth < 1:
-            raise PinfeedError(f"depth must be >= 1, got {depth}")
-        t0 = time.perf_counter()
-        starts = self.initial_states()
-        self.labels = list(starts)
-        root = self._root(starts)
-        seen = {self._joint_key(root[1])}
-        nodes, frontier = [], [root]
-        for level in range(depth):
-            if level >= complete_depth:
-                frontier = sorted(frontier, key=self._beam_rank)[:static_beam]
-            frontier = self._expand(frontier, self.static_labels, seen)
-            nodes.extend(frontier)
-            self.stats.per_level.append(len(frontier))
-            if progress:
-                progress(f"level {level + 1}: {len(frontier)} new joint states, "
-                         f"{self.stats.rollouts} rollouts so far")
-        if dynamic_depth and self.moving_labels:
-            grown = [root] + nodes
-            for _ in range(dynamic_depth):
-                grown.sort(key=self._node_rank)
-                grown = self._expand(grown[:beam], self.moving_labels, seen)
-                nodes.extend(grown)
-        self.stats.nodes = len(nodes)
-        plans = [self._plan(node, starts) for node in nodes]
-        plans.sort(key=TightPlan.rank_key)
-        self.stats.seconds = time.perf_counter() - t0
-        return plans[:keep]
-
     def follow(self, seq) -> TightPlan | None:
         """The tight plan of one given pin sequence (its carried sets, no search),
         or ``None`` if the propagation forbids one of its pins for some branch
@@ -368,14 +330,6 @@ class TightPlanner:
     @staticmethod
     def _joint_key(joint):
         return tuple(tuple(st for st, _ in branches) for branches in joint)
-
-    @staticmethod
-    def _beam_rank(node):
-        seq, joint, margin, jumps, sets_after = node
-        branches = sum(len(b) for b in joint)
-        width = sum(st.width for b in joint for st, _ in b)
-        return (sets_after[-1] if sets_after else len(joint), branches, width,
-                -margin if math.isfinite(margin) else 0.0)
 
     @staticmethod
     def _node_rank(node):

@@ -16,8 +16,8 @@ plan), in the order the plan stage ranked them. Each stored plan holds, per
 initial state, the branches of sets carried by the tight propagation
 (:mod:`pipeline.planning.propagate`) ending in that state's final arcs, and those arcs
 have passed the verify stage's full rollouts; rejected plans are never
-candidates. We chose the stored plans over a new
-:meth:`pipeline.planning.search.TightPlanner.search` so that the sensor plan is one of
+candidates. We chose the stored plans over a new search
+(:mod:`pipeline.planning.complete`) so that the sensor plan is one of
 the plans the user was shown and verified. The price: a plan the plan stage
 ranked below its stored ``keep`` best (for instance one pin that leaves each
 state in its own set while a two-set plan exists) is not seen; a wider search

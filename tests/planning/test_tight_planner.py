@@ -12,7 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from conftest import fewer_examples
-from oracle import n_clusters, one_set_sequences, replay_sequence, trial_inputs
+from oracle import all_tight_plans, n_clusters, one_set_sequences, replay_sequence, trial_inputs
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
@@ -121,7 +121,7 @@ def test_oracle_completeness_and_soundness_on_the_default_triangle():
     pins = {"P8": 7.5, "P11": 15.0, "P16": 27.5, "P22": 42.5}
     oracle = one_set_sequences(ASYM, pins, 2, lambda n: trial_inputs(ASYM, n, 4, seed=11))
     planner = TightPlanner(ASYM, pins, 0.1, 0.9, 0.0, 3.0)
-    plans = planner.search(2, keep=50)
+    plans = all_tight_plans(planner, 2)
     one_set = [p for p in plans if p.n_sets == 1]
     assert bool(oracle) == bool(one_set), (oracle, [p.pins for p in one_set])
     for plan in plans[:8]:
@@ -141,7 +141,7 @@ def test_oracle_completeness_on_random_triangles(part):
     ys = [p[1] for p in part.stable_states()]
     pins = {f"P{k}": float(y) for k, y in enumerate(np.round(np.linspace(min(ys) - 12, max(ys) + 20, 4), 1))}
     oracle = one_set_sequences(part, pins, 2, lambda n: trial_inputs(part, n, 3, seed=5))
-    plans = TightPlanner(part, pins, 0.1, 0.9, 0.0, 3.0).search(2, keep=100)
+    plans = all_tight_plans(TightPlanner(part, pins, 0.1, 0.9, 0.0, 3.0), 2)
     if oracle:
         assert any(p.n_sets == 1 for p in plans), oracle
 
@@ -150,7 +150,7 @@ def test_one_set_plan_for_the_default_asymmetric_triangle_holds_in_replay():
     """The paper's headline (Fig. 2): one orientation set with fixed pins. Found by the
     planner on part of the config's pin grid, checked by the oracle's replay only."""
     pins = {"P6": 2.5, "P8": 7.5, "P11": 15.0, "P16": 27.5, "P22": 42.5}
-    plans = TightPlanner(ASYM, pins, 0.1, 0.9, 0.0, 3.0).search(2, keep=5)
+    plans = all_tight_plans(TightPlanner(ASYM, pins, 0.1, 0.9, 0.0, 3.0), 2)
     best = plans[0]
     assert best.n_sets == 1 and len(best.pins) == 2
     trials = trial_inputs(ASYM, 2, 30, seed=2024)
