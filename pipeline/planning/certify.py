@@ -7,8 +7,9 @@ verification. When the propagation forbids one of its pins (the uncertainty
 box reaches a jam or a centroid on both sides, or holds too many jumps),
 the sets are *sampled* instead (``"claim": "sampled"``): the hull of a
 separate replay of the perturbation box (the verification's settings with
-the next seed) after each pin. A sampled claim is weaker: the
-verification, with its own seed, is what then checks it.
+the next seed) after each pin, one branch per cluster of final
+orientations. A sampled claim is weaker: the verification, with its own
+seed, is what then checks it.
 """
 from __future__ import annotations
 
@@ -22,6 +23,8 @@ from pipeline.planning.search import Step, TightPlan, TightPlanner
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import replay, trial_inputs
 
+CLUSTER_GAP_DEG = 3.0  # sampled final orientations further apart than this are separate sets
+
 
 def carried_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> TightPlan:
     """The :class:`TightPlan` of the sequence ``labels``: propagated if the
@@ -34,8 +37,11 @@ def carried_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> 
 
 
 def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> TightPlan:
-    """A :class:`TightPlan` whose carried sets are the hulls of a replay of the
-    perturbation box (seed ``verify.seed + 1``) after each pin."""
+    """A :class:`TightPlan` whose carried sets are sampled: a replay of the
+    perturbation box (seed ``verify.seed + 1``); per initial state, the trials
+    whose final orientations form one cluster (gaps of more than
+    ``CLUSTER_GAP_DEG`` split clusters) are one branch, and each step of a
+    branch carries the hull of its trials after that pin."""
     cfg = dict(VERIFY_DEFAULTS, **(verify or {}))
     cfg["seed"] = int(cfg["seed"]) + 1
     part, unc = planner.part, planner.unc
@@ -49,19 +55,39 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> 
         replay(part, [p.y for p in pins], [p.v_pin for p in pins], th, yc, mu, offs,
                planner.pin_radius, planner.model, path=path, belt_speed=planner.belt_speed,
                mu_s=planner.mu_s)
-        steps, y_before = [], yc
-        for k, (pin, (theta_k, y_k)) in enumerate(zip(pins, path)):
-            ok = np.isfinite(theta_k)
-            d = contact_parameter(pin.y + offs[:, k], y_before, part.a)
-            arc = narrowest_arc(theta_k[ok], int(ok.sum())) or (0.0, 360.0)
-            after = snapped_state(arc[0], arc[1], float(np.min(y_k[ok], initial=np.inf)),
-                                  float(np.max(y_k[ok], initial=-np.inf)), mu_lo, mu_hi)
-            steps.append(Step(pin.label, pin.y, pin.v_pin, float(d.min()), float(d.max()), after))
-            y_before = y_k
-        branches[label] = [steps]
-        finals.append(steps[-1].after.arc)
+        before = [yc] + [y for _, y in path[:-1]]
+        alive = np.isfinite(path[-1][0])  # jammed trials end nowhere
+        branches[label] = []
+        for members in _clusters(path[-1][0], alive):
+            steps = []
+            for pin, k, (theta_k, y_k) in zip(pins, range(len(pins)), path):
+                d = contact_parameter(pin.y + offs[members, k], before[k][members], part.a)
+                arc = narrowest_arc(theta_k[members], members.size) or (0.0, 360.0)
+                after = snapped_state(arc[0], arc[1], float(y_k[members].min()), float(y_k[members].max()),
+                                      mu_lo, mu_hi)
+                steps.append(Step(pin.label, pin.y, pin.v_pin, float(d.min()), float(d.max()), after))
+            branches[label].append(steps)
+            finals.append(steps[-1].after.arc)
     plan = TightPlan(tuple(labels), tuple(p.y for p in pins), tuple(p.v_pin for p in pins),
                      merge_arcs(finals), len(merge_modulo(finals, planner.order)), float(margin), 0,
                      branches, dict(starts), ())
     plan.claim = "sampled"
     return plan
+
+
+def _clusters(theta, alive) -> list:
+    """Index arrays of the trials in ``alive`` whose orientations ``theta`` form
+    one cluster on the circle (sorted; a gap over ``CLUSTER_GAP_DEG`` splits)."""
+    idx = np.flatnonzero(alive)
+    if idx.size == 0:
+        return []
+    order = idx[np.argsort(np.mod(theta[idx], 360.0))]
+    x = np.mod(theta[order], 360.0)
+    gaps = np.diff(np.concatenate([x, [x[0] + 360.0]]))
+    cut = np.flatnonzero(gaps > CLUSTER_GAP_DEG)
+    if cut.size == 0:
+        return [order]
+    order = np.roll(order, -(cut[-1] + 1))  # start after the widest-wrapping gap
+    x = np.mod(theta[order], 360.0)
+    breaks = np.flatnonzero(np.mod(np.diff(x), 360.0) > CLUSTER_GAP_DEG) + 1
+    return np.split(order, breaks)

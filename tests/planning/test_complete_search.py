@@ -130,3 +130,29 @@ def test_bad_tolerance_is_one_line(bad):
     with pytest.raises(Exception) as exc:
         orient.check_tolerance(bad)
     assert "\n" not in str(exc.value) and "tolerance" in str(exc.value)
+
+
+def test_sampled_claim_splits_outliers_and_holds_in_an_independent_replay():
+    """A sequence the propagation cannot follow gets sampled carried sets: one
+    branch per cluster of final orientations (outliers are their own branch,
+    not a 160-degree hull), and the verification's own trials (another seed)
+    end in the claimed sets."""
+    from pipeline.config import load_config
+    from pipeline.planning.certify import CLUSTER_GAP_DEG, sampled_plan
+    from pipeline.planning.plan import planner_for
+    from pipeline.planning.verify import verify_plan
+    part = Part.from_vertices([[0, 0], [60, 0], [15, 35]])
+    config = load_config()
+    planner = planner_for(part, config, 0.3)
+    labels = [k for k, p in planner.pins.items() if p.y in (10.0, 27.5, 47.5)]
+    labels = sorted(labels, key=lambda k: [10.0, 27.5, 47.5].index(planner.pins[k].y))
+    plan = sampled_plan(planner, labels, 0.0, {"trials": 100})
+    assert plan.claim == "sampled"
+    for label, branches in plan.branches.items():
+        finals = sorted(br[-1].after.start for br in branches)
+        assert all(br[-1].after.width < 20.0 for br in branches), (label, finals)
+        assert len(branches) == 1 or min(np.diff(finals)) > CLUSTER_GAP_DEG - 1.0
+    states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
+    res = verify_plan(part, plan.to_dict(), {k: p.y for k, p in planner.pins.items()}, states, 0.3, 3.0,
+                      settings={"trials": 100})
+    assert res["successes"] >= 0.98 * res["trials"]
