@@ -16,7 +16,7 @@ trying every sequence, level by level:
 1. enumerate all sequences of the level by nominal rollouts;
 2. keep those whose nominal finals span at most ``T + SLACK_DEG`` (modulo the
    part's symmetry), narrowest first;
-3. replay a small subset of the verification trials (``PROBE``: two random
+3. replay a small subset of the verification trials (``PROBE``: six random
    trials and two corners per state) for all of them at once, and order them
    by its failures; then, in blocks of ``SCREEN_BLOCK`` in that order, a larger
    subset (``SCREEN``: 12 and 8). A sequence whose subset already has more
@@ -33,7 +33,9 @@ blocks after that are not screened (``not_screened`` in the level's counts).
 When no sequence of up to ``N`` pins orients, the result says so with the
 evidence: per level, how many sequences were enumerated, kept, screened out
 and judged, and the best fixed-pin results found (the most trials in one set,
-and the fewest sets within ``T``).
+and the fewest sets within ``T``) among the judged sequences and the
+``EVIDENCE_PER_LEVEL`` sequences of each level whose nominal finals fall
+into the fewest clusters.
 """
 from __future__ import annotations
 
@@ -52,26 +54,30 @@ from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import replay, trial_inputs
 
 SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
-PROBE = (2, 2)  # random trials and corners per resting state that order the candidates
+PROBE = (6, 2)  # random trials and corners per resting state that order the candidates
 SCREEN = (12, 8)  # random trials and corners per resting state in the screen
 SCREEN_BLOCK = 96  # candidates screened at once
 MAX_ROWS = 150_000  # trials replayed in one batch
+EVIDENCE_PER_LEVEL = 4  # several-set sequences judged per level when nothing orients
 
 
-def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None) -> tuple:
+def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None, n_moving: int = 0) -> tuple:
     """The ranking of plans (best first): plans that orient the part, by fewest
     pins, narrowest verified width, largest margin in d; then plans ending in
-    several sets within the tolerance (those that jam too often last), by
-    fewest sets, fewest pins, most trials in one set."""
+    several sets within the tolerance (those that jam too often last, then
+    those with moving pins: a moving pin is there to orient the part, and a
+    sensor finishes fixed pins' sets as well), by fewest sets, fewest pins,
+    most trials in one set."""
     v = verdict or {}
     width = v.get("width_deg")
     margin = -margin if margin is not None and np.isfinite(margin) else 0.0
     if v.get("orients"):
-        return (0, 0, 0, n_pins, width, margin)
+        return (0, 0, 0, 0, n_pins, width, margin)
     trials = v.get("trials", 1)
     jams_decide = trials - v.get("jammed", 0) < v.get("needed", trials)  # too many jams for any set
     share = v.get("in_tolerance", 0) / max(1, trials)
-    return (1, int(jams_decide), v.get("sets_within_tolerance", 10 ** 6), n_pins, -share, margin)
+    return (1, int(jams_decide), int(n_moving > 0), v.get("sets_within_tolerance", 10 ** 6), n_pins,
+            -share, margin)
 
 
 @dataclass
@@ -188,7 +194,7 @@ class FixedPinSearch:
             levels.append(level)
         if not result.plans:  # the evidence: the best several-set results of every level
             for level in levels:
-                runners_up.extend(self._several_sets(level, candidates))
+                runners_up.extend(self._several_sets(level, min(candidates, EVIDENCE_PER_LEVEL)))
             result.best_effort = sorted(runners_up, key=FixedPlan.rank_key)[:keep]
         result.rollouts = self.tree.rollouts
         result.seconds = time.perf_counter() - t0

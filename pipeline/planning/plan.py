@@ -153,7 +153,7 @@ def _moving_candidates(moving, config, mu_c, chosen, progress) -> list:
 
 def _rank(plan) -> tuple:
     v = plan.verification or {}
-    return orientation_rank(v.get("orientation"), len(plan.pins), plan.margin)
+    return orientation_rank(v.get("orientation"), len(plan.pins), plan.margin, plan.n_dynamic)
 
 
 def _acceptable(plan) -> bool:

@@ -131,29 +131,29 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
 
     ``belt_speed`` (mm/s) replays with the dynamic model at that speed and
     belt friction ``mu_s`` (``model`` is then unused); ``None`` is
-    quasi-static ``model``. ``pin_heights`` is one height per pin (mm), or an
-    array ``(n_trials, n_pins)`` to replay several plans of one length at once.
+    quasi-static ``model``. ``pin_heights`` (mm) and ``pin_speeds`` (v_pin /
+    v_b) are one value per pin, or arrays ``(n_trials, n_pins)`` to replay
+    several plans of one length at once.
 
     Returns ``(theta_f, y_c, jam_reason_or_empty, missed)``: arrays over trials,
     ``missed`` a boolean array ``(n_trials, n_pins)``. If ``path`` is a list,
     ``(theta, y_c)`` arrays after each pin are appended to it."""
     theta, y_c = np.array(theta, float), np.array(y_c, float)
     n = theta.size
-    heights = np.broadcast_to(np.asarray(pin_heights, dtype=float), (n, len(pin_speeds)))
+    n_pins = np.shape(pin_speeds)[-1] if np.ndim(pin_speeds) else 0
+    heights = np.broadcast_to(np.asarray(pin_heights, dtype=float), (n, n_pins))
+    speeds = np.broadcast_to(np.asarray(pin_speeds, dtype=float), (n, n_pins))
     jam = np.full(n, "", dtype=object)
-    missed = np.zeros((n, len(pin_speeds)), bool)
+    missed = np.zeros((n, n_pins), bool)
     alive = np.ones(n, bool)
-    for k, v in enumerate(pin_speeds):
+    kw = {"ds_max": ds_max, "tol": tol} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
+    for k in range(n_pins):
         idx = np.flatnonzero(alive)
         if idx.size == 0:
             break
         d = contact_parameter(heights[idx, k] + offsets[idx, k], y_c[idx], part.a)
-        if belt_speed is None:
-            res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, model,
-                                          v_pin=float(v), ds_max=ds_max, tol=tol)
-        else:
-            res = simulate.rollout_points(part, theta[idx], d, mu[idx], pin_radius, "dynamic",
-                                          v_pin=float(v), belt_speed=belt_speed, mu_s=mu_s)
+        res = _rollouts_by_speed(part, theta[idx], d, mu[idx], speeds[idx, k], pin_radius,
+                                 model if belt_speed is None else "dynamic", kw)
         st = res["status"]
         stuck = (st == JAMMED) | (st == TRUNCATED)
         for j in np.flatnonzero(stuck):
@@ -165,6 +165,24 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
         if path is not None:
             path.append((np.where(alive, theta % 360.0, np.nan), np.where(alive, y_c, np.nan)))
     return theta % 360.0, y_c, jam, missed
+
+
+def _rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw) -> dict:
+    """``simulate.rollout_points`` for rows whose pins may move at different
+    speeds ``v_pin`` (one batch per speed), results in row order."""
+    speeds = np.unique(v_pin)
+    if speeds.size == 1:
+        return simulate.rollout_points(part, theta, d, mu, pin_radius, model, v_pin=float(speeds[0]), **kw)
+    out = None
+    for v in speeds:
+        rows = np.flatnonzero(v_pin == v)
+        res = simulate.rollout_points(part, theta[rows], d[rows], mu[rows], pin_radius, model,
+                                      v_pin=float(v), **kw)
+        if out is None:
+            out = {key: np.empty(theta.size, dtype=arr.dtype) for key, arr in res.items()}
+        for key, arr in res.items():
+            out[key][rows] = arr
+    return out
 
 
 def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, pin_radius: float,
