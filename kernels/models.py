@@ -232,6 +232,9 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, 
 
 # A kink is optimal when its subgradient multiplier s has |s|^2 <= 1 + this.
 _KINK_SLACK = 1e-10
+# An iterate whose slip at a point, over its weight, is below this fraction
+# of the twist is at that point's kink (``_minimise_points``).
+_KINK_NEAR = 1e-6
 
 
 @jit
@@ -269,7 +272,7 @@ def _kink(pts, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j):
 @jit
 def _kink_optimal(pts, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j, y1, y2):
     """Whether the kink of point ``j`` at ``y`` (from ``_kink``) minimises P
-    over the family: ``(optimal, P, g, H)``.
+    over the family: ``(optimal, P, g, H, d1, d2, slope)``.
 
     Notes
     -----
@@ -287,6 +290,11 @@ def _kink_optimal(pts, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j, y1, y2):
     friction at the pivot. ``g = g_r + w_j J_j^T s`` is P's subgradient
     there: its force part is the pin's force. ``H`` is the Hessian of the
     other points' terms (the kink's own is unbounded).
+
+    Where the kink is not optimal, ``d`` is the steepest way out of it: the
+    directional derivative ``g_r . d + w_j |M d|`` (``M = [ub, uc]``) is
+    smallest, ``slope = w_j (1 - |s|) < 0``, for ``M d = s / |s|`` (one
+    unknown: ``d = -sign(g_r . b) / |ub|``).
     """
     vx = x0 + y1 * b0 + y2 * c0
     vy = x1 + y1 * b1 + y2 * c1
@@ -296,17 +304,26 @@ def _kink_optimal(pts, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j, y1, y2):
     px, py, w = pts[j, 0], pts[j, 1], pts[j, 2]
     ubx, uby = b0 - b2 * py, b1 + b2 * px
     if k == 1:
-        f = -gb / (w * (ubx * ubx + uby * uby))
+        bb = ubx * ubx + uby * uby
+        f = -gb / (w * bb)
         sx, sy = f * ubx, f * uby
+        d1 = (-1.0 if gb > 0.0 else 1.0) / math.sqrt(bb)
+        d2 = 0.0
     else:
         gc = r[1] * c0 + r[2] * c1 + r[3] * c2
         ucx, ucy = c0 - c2 * py, c1 + c2 * px
-        wdet = w * (ubx * ucy - uby * ucx)
-        sx = (-gb * ucy + gc * uby) / wdet
-        sy = (-ubx * gc + ucx * gb) / wdet
-    ok = sx * sx + sy * sy <= 1.0 + _KINK_SLACK
+        det = ubx * ucy - uby * ucx
+        sx = (-gb * ucy + gc * uby) / (w * det)
+        sy = (-ubx * gc + ucx * gb) / (w * det)
+        ns = math.sqrt(sx * sx + sy * sy)
+        zx, zy = (sx / ns, sy / ns) if ns > 0.0 else (0.0, 0.0)
+        d1 = (ucy * zx - ucx * zy) / det
+        d2 = (-uby * zx + ubx * zy) / det
+    ns2 = sx * sx + sy * sy
+    ok = ns2 <= 1.0 + _KINK_SLACK
     g = (r[1] + w * sx, r[2] + w * sy, r[3] + w * (px * sy - py * sx))
-    return ok, r[0], g, (r[4], r[5], r[6], r[7], r[8], r[9])
+    return (ok, r[0], g, (r[4], r[5], r[6], r[7], r[8], r[9]), d1, d2,
+            w * (1.0 - math.sqrt(ns2)))
 
 
 @jit
@@ -351,17 +368,40 @@ def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2,
     p, g0, g1, g2 = r[0], r[1], r[2], r[3]
     h00, h01, h02, h11, h12, h22 = r[4], r[5], r[6], r[7], r[8], r[9]
     jmin = r[10]
-    tested_a = tested_b = -1
+    tested_a = tested_b = escaped = -1
     converged = False
     for _ in range(_NEWTON_MAX_IT):
         if jmin >= 0 and jmin != tested_a and jmin != tested_b:
             tested_b, tested_a = tested_a, jmin
             found, ky1, ky2 = _kink(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin)
             if found:
-                ok, kp, kg, kh = _kink_optimal(quad, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k,
-                                               jmin, ky1, ky2)
+                ok, kp, kg, kh, e1, e2, slope = _kink_optimal(
+                    quad, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin, ky1, ky2)
                 if ok:
                     return kp, ky1, ky2, kg, kh, True
+        elif jmin >= 0 and jmin != escaped and r[11] <= _KINK_NEAR * (abs(vx) + abs(vy) + abs(om)):
+            # Stuck at the apex of a kink that is not optimal, where Newton's
+            # steps shrink with the distance to it: leave along the steepest
+            # way out (``_kink_optimal``), if that does better than here.
+            escaped = jmin
+            found, ky1, ky2 = _kink(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin)
+            if found:
+                ok, kp, kg, kh, e1, e2, slope = _kink_optimal(
+                    quad, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin, ky1, ky2)
+                t = 0.1 * (1.0 + abs(ky1) + abs(ky2)) / (abs(e1) + abs(e2) + 1e-300)
+                while t * (abs(e1) + abs(e2)) > 1e-14 * (1.0 + abs(ky1) + abs(ky2)):
+                    ty1, ty2 = ky1 + t * e1, ky2 + t * e2
+                    vx = x0 + ty1 * b0 + ty2 * c0
+                    vy = x1 + ty1 * b1 + ty2 * c1
+                    om = x2 + ty1 * b2 + ty2 * c2
+                    res = _point_power(quad, m, vx, vy, om, -1)
+                    if res[0] <= kp + 0.5 * t * slope and res[0] < p:
+                        y1, y2, r = ty1, ty2, res
+                        p, g0, g1, g2 = r[0], r[1], r[2], r[3]
+                        h00, h01, h02, h11, h12, h22 = r[4], r[5], r[6], r[7], r[8], r[9]
+                        jmin = r[10]
+                        break
+                    t *= 0.5
         d1, d2, dec = _newton_direction(g0, g1, g2, h00, h01, h02, h11, h12, h22, b0, b1, b2,
                                         c0, c1, c2, k)
         if dec <= 1e-28 * (p + 1e-300):
@@ -375,15 +415,15 @@ def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2,
             vx = x0 + ty1 * b0 + ty2 * c0
             vy = x1 + ty1 * b1 + ty2 * c1
             om = x2 + ty1 * b2 + ty2 * c2
-            r = _point_power(quad, m, vx, vy, om, -1)
-            if r[0] <= p - 1e-4 * t * dec + 1e-12 * p:
+            res = _point_power(quad, m, vx, vy, om, -1)
+            if res[0] <= p - 1e-4 * t * dec + 1e-12 * p:
                 accepted = True
                 break
             t *= 0.5
         if not accepted:
             converged = dec <= 1e-20 * (p + 1e-300)
             break
-        y1, y2 = ty1, ty2
+        y1, y2, r = ty1, ty2, res
         p, g0, g1, g2 = r[0], r[1], r[2], r[3]
         h00, h01, h02, h11, h12, h22 = r[4], r[5], r[6], r[7], r[8], r[9]
         jmin = r[10]
@@ -395,8 +435,8 @@ def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2,
         for j in range(m):
             found, ky1, ky2 = _kink(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j)
             if found:
-                ok, kp, kg, kh = _kink_optimal(quad, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k,
-                                               j, ky1, ky2)
+                ok, kp, kg, kh, _, _, _ = _kink_optimal(quad, m, x0, x1, x2, b0, b1, b2, c0, c1,
+                                                        c2, k, j, ky1, ky2)
                 if ok:
                     return kp, ky1, ky2, kg, kh, True
     return p, y1, y2, (g0, g1, g2), (h00, h01, h02, h11, h12, h22), converged

@@ -157,7 +157,7 @@ def point_support(part, points, weights=None, kind: str = "points",
     if np.any(out):
         k = int(np.argmax(out))
         gap = float(_boundary_distance(verts, xy[k:k + 1])[0])
-        raise PinfeedError(f"support point {k} ({xy[k, 0]:g}, {xy[k, 1]:g}) lies {gap:.3g} outside "
+        raise PinfeedError(f"support point {k} ({xy[k, 0]:g}, {xy[k, 1]:g}) lies {gap:.3g} mm outside "
                            f"the outline; support points are in the part frame (centroid at the "
                            f"origin, drawing axes): move it inside")
     keep = w > 0
