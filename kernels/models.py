@@ -235,6 +235,10 @@ _KINK_SLACK = 1e-10
 # An iterate whose slip at a point, over its weight, is below this fraction
 # of the twist is at that point's kink (``_minimise_points``).
 _KINK_NEAR = 1e-6
+# ... and is near enough to it to check the kink (a check costs an
+# evaluation of P; iterates that head for a kink get there: see
+# ``_minimise_points``).
+_KINK_TEST = 0.05
 
 
 @jit
@@ -351,12 +355,15 @@ def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2,
     with zero gradient. The solve is damped Newton with an Armijo line search
     (as ``_minimise``) on the smooth part, and at every iterate it checks
     the kink of the point nearest to turning (smallest ``|u_j| / w_j``), once
-    per point and solve: Newton iterates that head for a kink make that
-    point the nearest, and the check then returns the kink exactly (the
-    centre of rotation on the point to rounding). A smooth minimum ends on
-    the Newton decrement, as in ``_minimise``, after a full step taken once
-    the decrement is below ``take * P`` (checked by its evaluation, since a
-    kink may lie within the step). If Newton stalls, every kink is checked.
+    per point and solve, when the iterate is near it (``_KINK_TEST``):
+    Newton iterates that head for a kink make that point the nearest, and
+    the check then returns the kink exactly (the centre of rotation on the
+    point to rounding). An iterate stuck at the apex of a kink that is not
+    optimal leaves it along its steepest way out (``_KINK_NEAR``). A smooth
+    minimum ends on the Newton decrement, as in ``_minimise``: the last step,
+    once the decrement is below ``take * P``, is taken unchecked when no
+    point's slip can reach zero within it, else checked by an evaluation. If
+    Newton stalls, every kink is checked.
     The family's parameters are exact at a kink; no smoothing of ``|u|`` is
     used anywhere.
     """
@@ -371,7 +378,8 @@ def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2,
     tested_a = tested_b = escaped = -1
     converged = False
     for _ in range(_NEWTON_MAX_IT):
-        if jmin >= 0 and jmin != tested_a and jmin != tested_b:
+        if jmin >= 0 and jmin != tested_a and jmin != tested_b and \
+                r[11] <= _KINK_TEST * (abs(vx) + abs(vy) + abs(om)):
             tested_b, tested_a = tested_a, jmin
             found, ky1, ky2 = _kink(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin)
             if found:
@@ -405,6 +413,20 @@ def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2,
         d1, d2, dec = _newton_direction(g0, g1, g2, h00, h01, h02, h11, h12, h22, b0, b1, b2,
                                         c0, c1, c2, k)
         if dec <= 1e-28 * (p + 1e-300):
+            converged = True
+            break
+        s0 = d1 * b0 + d2 * c0
+        s1 = d1 * b1 + d2 * c1
+        s2 = d1 * b2 + d2 * c2
+        if dec <= take * p and 4.0 * (abs(s0) + abs(s1) + 2.0 * abs(s2)) < r[12]:
+            # As ``_minimise``: the last Newton step unchecked, when no
+            # point's slip can reach zero within it (|p_j| <= 1 in units of
+            # a), so P is smooth there and the quadratic model holds.
+            y1 += d1
+            y2 += d2
+            g0 += h00 * s0 + h01 * s1 + h02 * s2
+            g1 += h01 * s0 + h11 * s1 + h12 * s2
+            g2 += h02 * s0 + h12 * s1 + h22 * s2
             converged = True
             break
         t = 1.0

@@ -272,10 +272,11 @@ def _point_power(pts, m, vx, vy, om, skip):
 
     Returns
     -------
-    (P, g0, g1, g2, H00, H01, H02, H11, H12, H22, jmin, rmin)
+    (P, g0, g1, g2, H00, H01, H02, H11, H12, H22, jmin, rmin, umin)
         P and its gradient and Hessian over the points whose slip speed is
         not zero, the point ``jmin`` with the smallest ``|u_j| / w_j`` (the
-        kink the twist is nearest, -1 if none) and that ratio.
+        kink the twist is nearest, -1 if none), that ratio, and the
+        smallest slip speed ``|u_j|``.
 
     Notes
     -----
@@ -297,6 +298,7 @@ def _point_power(pts, m, vx, vy, om, skip):
     tiny = 1e-15 * (abs(vx) + abs(vy) + abs(om))
     jmin = -1
     rmin = math.inf
+    umin = math.inf
     for i in range(m):
         wx, wy, wt = pts[i, 0], pts[i, 1], pts[i, 2]
         ux = vx - om * wy
@@ -305,6 +307,7 @@ def _point_power(pts, m, vx, vy, om, skip):
         if nu < rmin * wt:
             rmin = nu / wt
             jmin = i
+        umin = min(umin, nu)
         if i == skip or nu <= tiny:
             continue
         p_val += wt * nu
@@ -321,4 +324,4 @@ def _point_power(pts, m, vx, vy, om, skip):
         h11 += c * ay * ay
         h12 += c * ay * aw
         h22 += c * aw * aw
-    return p_val, g0, g1, g2, h00, h01, h02, h11, h12, h22, jmin, rmin
+    return p_val, g0, g1, g2, h00, h01, h02, h11, h12, h22, jmin, rmin, umin
