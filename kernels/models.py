@@ -631,6 +631,16 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
             _scaled_hessian(hess, scale))
 
 
+@jit
+def _minpower_twist_points(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
+                           model, take):
+    """``_minpower_twist`` over the point support in ``quad``: the same code,
+    compiled as a function of its own so that the uniform model's callers,
+    which inline ``_minpower_twist``, keep their code (and speed) as before."""
+    return _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
+                           model, take, True)
+
+
 # --------------------------------------------------------------------------- tip
 
 
@@ -760,9 +770,12 @@ def _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, 
     scales like ``h^2`` and makes the step control reject step after step.
     """
     ex, ey = _cone_edge(nx, ny, mu, side)
-    if model == MINPOWER or model == MINPOWER_POINTS:
+    if model == MINPOWER:
         vx, vy, om, _, _, _ = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
-                                           p_model, take, model == MINPOWER_POINTS)
+                                           p_model, take)
+    elif model == MINPOWER_POINTS:
+        vx, vy, om, _, _, _ = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
+                                           p_model, take, True)
     elif model == TIP:
         vx, vy, om = _tip_twist_for_line(cx, cy, ex, ey)
     else:
@@ -787,9 +800,13 @@ def _contact_twist(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu
     """
     if vpx * nx + vpy * ny <= 0.0:
         return TWIST_OK, 0.0, 0.0, 0.0, 0.0, 0.0, SEPARATE
-    if model == MINPOWER or model == MINPOWER_POINTS:
+    if model == MINPOWER:
         res = _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom,
-                              hint, NO_MODEL, _DEC_TAKE, model == MINPOWER_POINTS)
+                              hint, NO_MODEL, _DEC_TAKE)
+        return res[0], res[1], res[2], res[3], res[4], res[5], res[6]
+    if model == MINPOWER_POINTS:
+        res = _minpower_twist_points(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy,
+                                     wom, hint, NO_MODEL, _DEC_TAKE)
         return res[0], res[1], res[2], res[3], res[4], res[5], res[6]
     if model == TIP:
         return _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu)

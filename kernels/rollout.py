@@ -52,7 +52,8 @@ from ._numba import jit, jit_inline
 from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
                        _ray_first_contact)
 from .models import (_DEC_TAKE, MINPOWER, MINPOWER_POINTS, NO_MODEL, SEPARATE, SLIDE_NEG,
-                     SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide, _minpower_twist)
+                     SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide, _minpower_twist,
+                     _minpower_twist_points)
 from .support import _fan_quadrature, _max_moment
 
 OK = 0
@@ -304,9 +305,14 @@ def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
                                           vpy, mu, wvx, wvy, wom, hint, p_model, take)
     elif model == MINPOWER or model == MINPOWER_POINTS:
         wvx, wvy, wom, p_model = _warm_start(warm, sp)
-        st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist(
-            verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model, take,
-            model == MINPOWER_POINTS)
+        if model == MINPOWER:
+            st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist(
+                verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model,
+                take)
+        else:
+            st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist_points(
+                verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model,
+                take)
         if st == TWIST_OK:
             _remember(warm, sp, vx, vy, om, mode, g, hess)
     else:
