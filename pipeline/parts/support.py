@@ -123,7 +123,8 @@ def point_support(part, points, weights=None, kind: str = "points",
         the part's length unit), inside the outline or on it.
     weights : ``(K,)`` pressures >= 0, not all zero (default: all equal).
         They are normalised to sum 1; zero-weight points are dropped and
-        points at the same place merged.
+        points at the same place merged (the result lists the points sorted
+        by x, then y).
     kind, label : recorded on the result.
 
     Raises

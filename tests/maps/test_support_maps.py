@@ -16,8 +16,11 @@ import json
 import numpy as np
 import pytest
 
+import strategies as sts
 from cli_runs import run_cli as run
-from conftest import TRIANGLE, V_NOTCH, circular_diff
+from conftest import TRIANGLE, V_NOTCH, circular_diff, fewer_examples
+from hypothesis import given
+from hypothesis import strategies as st
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
@@ -194,3 +197,32 @@ def test_rollout_pivots_about_a_heavy_support_point(weights, theta_i):
     turned = np.abs(np.diff(th))
     pivot = (moved < 1e-6) & (turned > 1e-4)
     assert np.degrees(turned[pivot].sum()) > 40.0
+
+
+def test_cli_map_with_a_support_stores_it(capsys, tmp_path):
+    import xarray as xr
+    out = tmp_path / "m.h5"
+    code, _, err = run(capsys, ["map", "--vertices", "0,0 60,0 15,35", "--mu-c", "0.2",
+                                "--pin-radius", "3", "--d", "0.3", "--theta-step", "90",
+                                "--support", "rim:8", "--out", str(out)])
+    assert code == 0, err
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["support"] == "rim:8"
+        assert ds.attrs["support_points"].shape == (16,)
+        np.testing.assert_allclose(ds.attrs["support_weights"], np.full(8, 0.125))
+
+
+@fewer_examples(0.3)
+@given(sts.star_polygons(), st.floats(1.05, 3.0), st.floats(0.0, 2 * np.pi))
+def test_points_inside_any_outline_are_taken_and_outside_refused(xy, far, ang):
+    """Random (mostly non-convex) outlines: the centroids of the triangles of
+    the outline's triangulation (``filled_support(part, 1)``) are inside and
+    taken; a point beyond every vertex is refused in one line that names it."""
+    part = Part.from_vertices(np.asarray(xy) * 40.0, name="p")
+    inside = filled_support(part, 1).points
+    sup = point_support(part, inside, np.arange(1.0, len(inside) + 1.0))
+    assert sup.n_points == len(inside) and abs(sup.weights.sum() - 1.0) < 1e-12
+    outside = far * part.a * np.array([np.cos(ang), np.sin(ang)])
+    with pytest.raises(PinfeedError) as exc:
+        point_support(part, np.vstack([inside, outside]))
+    assert f"point {len(inside)} " in str(exc.value) and "\n" not in str(exc.value)
