@@ -232,6 +232,11 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, 
 
 # A kink is optimal when its subgradient multiplier s has |s|^2 <= 1 + this.
 _KINK_SLACK = 1e-10
+# In the one-unknown (sticking) family a point is a kink when the family's
+# closest approach to turning about it is below this, relative: closer than
+# that, P's curvature there is beyond what Newton resolves in floating point,
+# and the kink (off by at most this, relative) is the answer.
+_KINK_LINE = 1e-10
 # An iterate whose slip at a point, over its weight, is below this fraction
 # of the twist is at that point's kink (``_minimise_points``).
 _KINK_NEAR = 1e-6
@@ -253,7 +258,8 @@ def _kink(pts, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j):
     unknowns the kink is the solution of that 2 x 2 system (none if it is
     singular: then no twist of the family turns about the point). With one
     unknown, ``u_j`` vanishes only where ``u0`` and ``ub`` are parallel: the
-    least-squares ``y1`` counts when its residual is at rounding level.
+    least-squares ``y1`` counts when its residual is below ``_KINK_LINE``
+    (relative).
     """
     px, py = pts[j, 0], pts[j, 1]
     u0x, u0y = x0 - x2 * py, x1 + x2 * px
@@ -265,7 +271,7 @@ def _kink(pts, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j):
         y1 = -(u0x * ubx + u0y * uby) / bb
         rx, ry = u0x + y1 * ubx, u0y + y1 * uby
         scale = math.sqrt(u0x * u0x + u0y * u0y) + abs(y1) * math.sqrt(bb)
-        return math.sqrt(rx * rx + ry * ry) <= 1e-13 * scale, y1, 0.0
+        return math.sqrt(rx * rx + ry * ry) <= _KINK_LINE * scale, y1, 0.0
     ucx, ucy = c0 - c2 * py, c1 + c2 * px
     det = ubx * ucy - uby * ucx
     if abs(det) <= 1e-13 * math.sqrt((ubx * ubx + uby * uby) * (ucx * ucx + ucy * ucy)):
