@@ -397,3 +397,27 @@ def test_every_sampled_support_turns_within_the_cor_locus_bound():
     assert checked > 2000
     assert worst <= 1.0 + 1e-9, f"a COR lies {worst:.6f} times the bound from the centroid"
     assert worst >= 0.999, "no sample reached the bound: the test lost its edge"
+
+
+def test_stick_solve_near_a_kink_converges_to_the_minimum():
+    """Sticking with a heavy point at 1e-15 to 1e-6 (relative) from the line
+    of centres of rotation through the contact: P(omega) is smooth there but
+    its curvature is up to 1e15; the solve converges (no stall) and is not
+    above brute force (150 seeded cases)."""
+    verts = unit_triangle()
+    rng = np.random.default_rng(11)
+    for _ in range(150):
+        c, nrm = edge_contact(verts, int(rng.integers(3)), rng.uniform(0.05, 0.95))
+        t = np.array([-nrm[1], nrm[0]])
+        al = rng.uniform(-1.2, 1.2)
+        vp = math.cos(al) * nrm + math.sin(al) * t
+        tv = np.array([-vp[1], vp[0]])
+        k = int(rng.integers(2, 6))
+        pts = rng.uniform(-0.6, 0.6, (k, 2))
+        pts[0] = c + rng.uniform(-0.8, 0.8) * tv + 10 ** rng.uniform(-15, -6) * vp
+        w = rng.uniform(0.05, 1.0, k)
+        w[0] *= rng.uniform(1.0, 6.0)
+        xi, g, conv = k_stick(verts, support_quad(verts, pts, w), c, vp, rng.normal())
+        assert conv
+        _, p_ref = brute_stick(pts, w, c, vp)
+        assert power_ref(pts, w, xi) <= p_ref + 1e-12 * (1 + p_ref)
