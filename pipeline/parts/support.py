@@ -47,7 +47,7 @@ _SYNTAX = ('give "uniform", "points:x0,y0,w0 x1,y1,w1 ..." (part frame: centroid
            'origin; w defaults to 1), "rim", "rim:N" or "tripod"')
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Support:
     """A support distribution of one part.
 
@@ -58,6 +58,9 @@ class Support:
         unit); empty for ``uniform``.
     weights : ``(K,)`` positive weights summing to 1; empty for ``uniform``.
     label : the text it was given as (``"rim:64"``, ...), for outputs.
+
+    Two supports are equal (and hash alike) when their kind, points and
+    weights are; the label is for display only.
     """
 
     kind: str
@@ -81,6 +84,14 @@ class Support:
         if self.is_uniform:
             return 0.0
         return float(np.hypot(*(self.weights @ self.points)))
+
+    def __eq__(self, other) -> bool:
+        return (isinstance(other, Support) and self.kind == other.kind
+                and np.array_equal(self.points, other.points)
+                and np.array_equal(self.weights, other.weights))
+
+    def __hash__(self) -> int:
+        return hash((self.kind, self.points.tobytes(), self.weights.tobytes()))
 
     def to_dict(self) -> dict:
         """Kind, label, points and weights as a JSON-ready dict."""

@@ -226,3 +226,10 @@ def test_points_inside_any_outline_are_taken_and_outside_refused(xy, far, ang):
     with pytest.raises(PinfeedError) as exc:
         point_support(part, np.vstack([inside, outside]))
     assert f"point {len(inside)} " in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_supports_compare_by_value():
+    a = parse_support("points:0,0,1 5,2,3", PART)
+    b = point_support(PART, [[5.0, 2.0], [0.0, 0.0]], [3.0, 1.0])
+    assert a == b and hash(a) == hash(b) and len({a, b, UNIFORM}) == 2
+    assert a != parse_support("points:0,0,1 5,2,2", PART)
