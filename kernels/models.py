@@ -22,6 +22,15 @@ Models (spec section 3):
     Ellipsoidal limit surface ``H = |f|^2 + m^2 / m_max^2``; the twist is
     ``grad H``.
 
+Support (issue 25): ``MINPOWER`` presses the part evenly over its area (the
+spec's uniform pressure, closed forms of ``support.py``); ``MINPOWER_POINTS``
+presses it on K weighted points, ``P = sum_k w_k |u(p_k)|``, with the points
+in the first K rows of ``quad`` (``(x, y, w)``, weights summing to 1) and the
+edge directions in the last n rows as usual. The sticking and sliding logic
+is the same code for both; only the minimisation differs
+(``_minimise_points``: P has kinks at the points, and a centre of rotation
+exactly at a support point is a real outcome).
+
 Every model returns ``(status, vx, vy, om, fx, fy, mode)``: ``status`` is
 ``TWIST_OK`` or ``TWIST_NO_PUSH`` (the pin moves into the part but no pushing
 solution exists, i.e. the part is jammed), the twist, the force ``f`` of the
@@ -34,12 +43,17 @@ slow): all quantities are in units of a, far from overflow and underflow.
 import math
 
 from ._numba import jit, jit_inline
-from .support import _power
+from .support import _point_power, _power
 
 MINPOWER = 0
 TIP = 1
 ELLIPSOID = 2
 MODEL_NAMES = ("minpower", "tip", "ellipsoid")
+# Kernel code of the minpower model over a point support (issue 25): the
+# rollout's ``quad`` then holds the support points (see ``_minimise_points``)
+# instead of the fan quadrature. Not a public model name: the public API
+# selects it with ``model="minpower"`` and a ``support``.
+MINPOWER_POINTS = 3
 
 STICK = 0
 SLIDE_POS = 1
@@ -214,6 +228,248 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, 
     return p, y1, y2, (g0, g1, g2), (h00, h01, h02, h11, h12, h22), converged
 
 
+# --------------------------------------------------------------------------- point supports
+
+# A kink is optimal when its subgradient multiplier s has |s|^2 <= 1 + this.
+_KINK_SLACK = 1e-10
+# In the one-unknown (sticking) family a point is a kink when the family's
+# closest approach to turning about it is below this, relative: closer than
+# that, P's curvature there is beyond what Newton resolves in floating point,
+# and the kink (off by at most this, relative) is the answer.
+_KINK_LINE = 1e-10
+# An iterate whose slip at a point, over its weight, is below this fraction
+# of the twist is at that point's kink (``_minimise_points``).
+_KINK_NEAR = 1e-6
+# ... and is near enough to it to check the kink (a check costs an
+# evaluation of P; iterates that head for a kink get there: see
+# ``_minimise_points``).
+_KINK_TEST = 0.05
+
+
+@jit
+def _kink(pts, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j):
+    """The parameters ``y`` at which the twist ``x + y1 b + y2 c`` turns about
+    support point ``j`` (``u_j = 0``): ``(found, y1, y2)``.
+
+    Notes
+    -----
+    ``u_j`` is affine in ``y``: ``u_j(y) = u0 + y1 ub + y2 uc`` with
+    ``u0, ub, uc`` the velocities of point j under ``x, b, c``. With two
+    unknowns the kink is the solution of that 2 x 2 system (none if it is
+    singular: then no twist of the family turns about the point). With one
+    unknown, ``u_j`` vanishes only where ``u0`` and ``ub`` are parallel: the
+    least-squares ``y1`` counts when its residual is below ``_KINK_LINE``
+    (relative).
+    """
+    px, py = pts[j, 0], pts[j, 1]
+    u0x, u0y = x0 - x2 * py, x1 + x2 * px
+    ubx, uby = b0 - b2 * py, b1 + b2 * px
+    if k == 1:
+        bb = ubx * ubx + uby * uby
+        if bb == 0.0:
+            return False, 0.0, 0.0
+        y1 = -(u0x * ubx + u0y * uby) / bb
+        rx, ry = u0x + y1 * ubx, u0y + y1 * uby
+        scale = math.sqrt(u0x * u0x + u0y * u0y) + abs(y1) * math.sqrt(bb)
+        return math.sqrt(rx * rx + ry * ry) <= _KINK_LINE * scale, y1, 0.0
+    ucx, ucy = c0 - c2 * py, c1 + c2 * px
+    det = ubx * ucy - uby * ucx
+    if abs(det) <= 1e-13 * math.sqrt((ubx * ubx + uby * uby) * (ucx * ucx + ucy * ucy)):
+        return False, 0.0, 0.0
+    return True, (-u0x * ucy + u0y * ucx) / det, (-ubx * u0y + uby * u0x) / det
+
+
+@jit
+def _kink_optimal(pts, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j, y1, y2):
+    """Whether the kink of point ``j`` at ``y`` (from ``_kink``) minimises P
+    over the family: ``(optimal, P, g, H, d1, d2, slope)``.
+
+    Notes
+    -----
+    P is convex, so ``y`` is a minimiser iff 0 lies in the subdifferential of
+    P restricted to the family (the Clarke condition at a kink)::
+
+        g_r . b + w_j s . ub = 0,   g_r . c + w_j s . uc = 0,   |s| <= 1
+
+    with ``g_r`` the gradient of the other points' terms at ``y`` and ``s``
+    the friction direction of point j (``w_j s`` its friction force, static:
+    any magnitude up to ``w_j``). Two unknowns: ``s`` is the solution of the
+    2 x 2 system. One unknown (sticking): ``s`` is the least-norm solution of
+    the one equation; the pin force is then not unique (a sticking contact
+    and a pivot share the load), and this choice is the one of least
+    friction at the pivot. ``g = g_r + w_j J_j^T s`` is P's subgradient
+    there: its force part is the pin's force. ``H`` is the Hessian of the
+    other points' terms (the kink's own is unbounded).
+
+    Where the kink is not optimal, ``d`` is the steepest way out of it: the
+    directional derivative ``g_r . d + w_j |M d|`` (``M = [ub, uc]``) is
+    smallest, ``slope = w_j (1 - |s|) < 0``, for ``M d = s / |s|`` (one
+    unknown: ``d = -sign(g_r . b) / |ub|``).
+    """
+    vx = x0 + y1 * b0 + y2 * c0
+    vy = x1 + y1 * b1 + y2 * c1
+    om = x2 + y1 * b2 + y2 * c2
+    r = _point_power(pts, m, vx, vy, om, j)
+    gb = r[1] * b0 + r[2] * b1 + r[3] * b2
+    px, py, w = pts[j, 0], pts[j, 1], pts[j, 2]
+    ubx, uby = b0 - b2 * py, b1 + b2 * px
+    if k == 1:
+        bb = ubx * ubx + uby * uby
+        f = -gb / (w * bb)
+        sx, sy = f * ubx, f * uby
+        d1 = (-1.0 if gb > 0.0 else 1.0) / math.sqrt(bb)
+        d2 = 0.0
+    else:
+        gc = r[1] * c0 + r[2] * c1 + r[3] * c2
+        ucx, ucy = c0 - c2 * py, c1 + c2 * px
+        det = ubx * ucy - uby * ucx
+        sx = (-gb * ucy + gc * uby) / (w * det)
+        sy = (-ubx * gc + ucx * gb) / (w * det)
+        ns = math.sqrt(sx * sx + sy * sy)
+        zx, zy = (sx / ns, sy / ns) if ns > 0.0 else (0.0, 0.0)
+        d1 = (ucy * zx - ucx * zy) / det
+        d2 = (-uby * zx + ubx * zy) / det
+    ns2 = sx * sx + sy * sy
+    ok = ns2 <= 1.0 + _KINK_SLACK
+    g = (r[1] + w * sx, r[2] + w * sy, r[3] + w * (px * sy - py * sx))
+    return (ok, r[0], g, (r[4], r[5], r[6], r[7], r[8], r[9]), d1, d2,
+            w * (1.0 - math.sqrt(ns2)))
+
+
+@jit
+def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
+    """``_minimise`` for a point support: minimise ``P = sum_j w_j |u_j|``
+    over ``y`` on the family ``x + y1 b + y2 c``, exactly, kinks included.
+
+    Parameters
+    ----------
+    verts, quad : the polygon and the support: the first
+        ``len(quad) - len(verts)`` rows of ``quad`` are the points
+        ``(x, y, w)`` (``support._point_power``).
+    x0..x2, b0..b2, c0..c2, k, y1, y2, take : as for ``_minimise``.
+
+    Returns
+    -------
+    (P, y1, y2, g, H, converged) as ``_minimise``; at a kink ``g`` is the
+    subgradient that satisfies the optimality condition (``_kink_optimal``).
+
+    Notes
+    -----
+    P is convex and smooth except at the kinks, one per point: the twist of
+    the family that turns about that point (``_kink``). Its minimiser is
+    either a kink at which 0 lies in the subdifferential, or a smooth point
+    with zero gradient. The solve is damped Newton with an Armijo line search
+    (as ``_minimise``) on the smooth part, and at every iterate it checks
+    the kink of the point nearest to turning (smallest ``|u_j| / w_j``), once
+    per point and solve, when the iterate is near it (``_KINK_TEST``):
+    Newton iterates that head for a kink make that point the nearest, and
+    the check then returns the kink exactly (the centre of rotation on the
+    point to rounding). An iterate stuck at the apex of a kink that is not
+    optimal leaves it along its steepest way out (``_KINK_NEAR``). A smooth
+    minimum ends on the Newton decrement, as in ``_minimise``: the last step,
+    once the decrement is below ``take * P``, is taken unchecked when no
+    point's slip can reach zero within it, else checked by an evaluation. If
+    Newton stalls, every kink is checked.
+    The family's parameters are exact at a kink; no smoothing of ``|u|`` is
+    used anywhere.
+    """
+    m = quad.shape[0] - verts.shape[0]
+    vx = x0 + y1 * b0 + y2 * c0
+    vy = x1 + y1 * b1 + y2 * c1
+    om = x2 + y1 * b2 + y2 * c2
+    r = _point_power(quad, m, vx, vy, om, -1)
+    p, g0, g1, g2 = r[0], r[1], r[2], r[3]
+    h00, h01, h02, h11, h12, h22 = r[4], r[5], r[6], r[7], r[8], r[9]
+    jmin = r[10]
+    tested_a = tested_b = escaped = -1
+    converged = False
+    for _ in range(_NEWTON_MAX_IT):
+        if jmin >= 0 and jmin != tested_a and jmin != tested_b and \
+                r[11] <= _KINK_TEST * (abs(vx) + abs(vy) + abs(om)):
+            tested_b, tested_a = tested_a, jmin
+            found, ky1, ky2 = _kink(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin)
+            if found:
+                ok, kp, kg, kh, e1, e2, slope = _kink_optimal(
+                    quad, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin, ky1, ky2)
+                if ok:
+                    return kp, ky1, ky2, kg, kh, True
+        elif jmin >= 0 and jmin != escaped and r[11] <= _KINK_NEAR * (abs(vx) + abs(vy) + abs(om)):
+            # Stuck at the apex of a kink that is not optimal, where Newton's
+            # steps shrink with the distance to it: leave along the steepest
+            # way out (``_kink_optimal``), if that does better than here.
+            escaped = jmin
+            found, ky1, ky2 = _kink(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin)
+            if found:
+                ok, kp, kg, kh, e1, e2, slope = _kink_optimal(
+                    quad, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, jmin, ky1, ky2)
+                t = 0.1 * (1.0 + abs(ky1) + abs(ky2)) / (abs(e1) + abs(e2) + 1e-300)
+                while t * (abs(e1) + abs(e2)) > 1e-14 * (1.0 + abs(ky1) + abs(ky2)):
+                    ty1, ty2 = ky1 + t * e1, ky2 + t * e2
+                    vx = x0 + ty1 * b0 + ty2 * c0
+                    vy = x1 + ty1 * b1 + ty2 * c1
+                    om = x2 + ty1 * b2 + ty2 * c2
+                    res = _point_power(quad, m, vx, vy, om, -1)
+                    if res[0] <= kp + 0.5 * t * slope and res[0] < p:
+                        y1, y2, r = ty1, ty2, res
+                        p, g0, g1, g2 = r[0], r[1], r[2], r[3]
+                        h00, h01, h02, h11, h12, h22 = r[4], r[5], r[6], r[7], r[8], r[9]
+                        jmin = r[10]
+                        break
+                    t *= 0.5
+        d1, d2, dec = _newton_direction(g0, g1, g2, h00, h01, h02, h11, h12, h22, b0, b1, b2,
+                                        c0, c1, c2, k)
+        if dec <= 1e-28 * (p + 1e-300):
+            converged = True
+            break
+        s0 = d1 * b0 + d2 * c0
+        s1 = d1 * b1 + d2 * c1
+        s2 = d1 * b2 + d2 * c2
+        if dec <= take * p and 4.0 * (abs(s0) + abs(s1) + 2.0 * abs(s2)) < r[12]:
+            # As ``_minimise``: the last Newton step unchecked, when no
+            # point's slip can reach zero within it (|p_j| <= 1 in units of
+            # a), so P is smooth there and the quadratic model holds.
+            y1 += d1
+            y2 += d2
+            g0 += h00 * s0 + h01 * s1 + h02 * s2
+            g1 += h01 * s0 + h11 * s1 + h12 * s2
+            g2 += h02 * s0 + h12 * s1 + h22 * s2
+            converged = True
+            break
+        t = 1.0
+        accepted = False
+        while t > 1e-12:
+            ty1 = y1 + t * d1
+            ty2 = y2 + t * d2
+            vx = x0 + ty1 * b0 + ty2 * c0
+            vy = x1 + ty1 * b1 + ty2 * c1
+            om = x2 + ty1 * b2 + ty2 * c2
+            res = _point_power(quad, m, vx, vy, om, -1)
+            if res[0] <= p - 1e-4 * t * dec + 1e-12 * p:
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted:
+            converged = dec <= 1e-20 * (p + 1e-300)
+            break
+        y1, y2, r = ty1, ty2, res
+        p, g0, g1, g2 = r[0], r[1], r[2], r[3]
+        h00, h01, h02, h11, h12, h22 = r[4], r[5], r[6], r[7], r[8], r[9]
+        jmin = r[10]
+        if (t == 1.0 and dec <= take * p) or \
+                t * (abs(d1) + abs(d2)) <= 1e-15 * (1.0 + abs(y1) + abs(y2)):
+            converged = True
+            break
+    if not converged:
+        for j in range(m):
+            found, ky1, ky2 = _kink(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j)
+            if found:
+                ok, kp, kg, kh, _, _, _ = _kink_optimal(quad, m, x0, x1, x2, b0, b1, b2, c0, c1,
+                                                        c2, k, j, ky1, ky2)
+                if ok:
+                    return kp, ky1, ky2, kg, kh, True
+    return p, y1, y2, (g0, g1, g2), (h00, h01, h02, h11, h12, h22), converged
+
+
 @jit
 def _cone_side(fx, fy, nx, ny, mu):
     """Contact mode of a sticking force: ``STICK`` if ``f`` lies in the friction
@@ -248,10 +504,20 @@ def _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy):
 
 
 @jit_inline
-def _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm, model, take):
+def _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm, model, take, points=False):
     """Sticking: minimise P over twists with ``u(c) = v_p`` (1 unknown, omega).
 
-    Returns ``(vx, vy, om, g, H, converged)`` (``g``, ``H``: see ``_minimise``)."""
+    ``points``: the part rests on the point support in ``quad``
+    (``_minimise_points``; no local model step, whose quadratic model does
+    not hold across a kink). Returns ``(vx, vy, om, g, H, converged)``
+    (``g``, ``H``: see ``_minimise``)."""
+    if points:
+        _, om, _, g, hess, conv = _minimise_points(verts, quad, vpx, vpy, 0.0, cy, -cx, 1.0,
+                                                   0.0, 0.0, 0.0, 1, om_warm, 0.0, take)
+        if not conv and om_warm != 0.0:
+            _, om, _, g, hess, conv = _minimise_points(verts, quad, vpx, vpy, 0.0, cy, -cx,
+                                                       1.0, 0.0, 0.0, 0.0, 1, 0.0, 0.0, take)
+        return vpx + om * cy, vpy - om * cx, om, g, hess, conv
     om_warm, _ = _model_step(model, vpx, vpy, 0.0, cy, -cx, 1.0, 0.0, 0.0, 0.0, 1, om_warm,
                              0.0)
     _, om, _, g, hess, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
@@ -263,11 +529,12 @@ def _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm, model, take):
 
 
 @jit_inline
-def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take):
+def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take, points=False):
     """Sliding: minimise P over twists with ``e . u(c) = 1`` (2 unknowns).
 
     ``(wvx, wvy, wom)`` is a warm-start twist of any scale, and ``model`` a
     local model of P at that twist (or ``NO_MODEL``; see ``_model_step``).
+    ``points``: the point support in ``quad`` (see ``_stick_solve``).
     Returns ``(vx, vy, om, g, H, converged)`` on the family's scale."""
     ke = cx * ey - cy * ex  # e . (z x c)
     uwx, uwy = wvx - wom * cy, wvy + wom * cx
@@ -280,7 +547,7 @@ def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take):
         iu = 1.0 / ue
         y1 = (-wvx * ey + wvy * ex) * iu
         y2 = wom * iu
-        if model[0] != 0.0:
+        if model[0] != 0.0 and not points:
             # The start is the warm twist / ue: move the model with it (P's
             # gradient is odd and homogeneous of degree 0, its Hessian even
             # and of degree -1).
@@ -293,11 +560,19 @@ def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take):
     else:
         y1 = 0.0
         y2 = 0.0
-    _, y1, y2, g, hess, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
-                                         -ke * ex, -ke * ey, 1.0, 2, y1, y2, take)
-    if not conv and (y1 != 0.0 or y2 != 0.0):
+    if points:
+        _, y1, y2, g, hess, conv = _minimise_points(verts, quad, ex, ey, 0.0, -ey, ex, 0.0,
+                                                    -ke * ex, -ke * ey, 1.0, 2, y1, y2, take)
+        if not conv and (y1 != 0.0 or y2 != 0.0):
+            _, y1, y2, g, hess, conv = _minimise_points(verts, quad, ex, ey, 0.0, -ey, ex, 0.0,
+                                                        -ke * ex, -ke * ey, 1.0, 2, 0.0, 0.0,
+                                                        take)
+    else:
         _, y1, y2, g, hess, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
-                                             -ke * ex, -ke * ey, 1.0, 2, 0.0, 0.0, take)
+                                             -ke * ex, -ke * ey, 1.0, 2, y1, y2, take)
+        if not conv and (y1 != 0.0 or y2 != 0.0):
+            _, y1, y2, g, hess, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
+                                                 -ke * ex, -ke * ey, 1.0, 2, 0.0, 0.0, take)
     vx = ex - y1 * ey - y2 * ke * ex
     vy = ey + y1 * ex - y2 * ke * ey
     return vx, vy, y2, g, hess, conv
@@ -320,10 +595,11 @@ def _scaled_hessian(hess, scale):
 
 @jit_inline
 def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
-                    model, take):
+                    model, take, points=False):
     """Minpower twist, force and mode (see ``_contact_twist``), plus P's
     gradient and Hessian at the twist returned, for the next warm start;
-    ``model`` and ``take`` as for ``_slide_solve`` and ``_minimise``."""
+    ``model`` and ``take`` as for ``_slide_solve`` and ``_minimise``;
+    ``points`` for the point support in ``quad`` (``_minimise_points``)."""
     if mu > 0.0 and (hint == SLIDE_POS or hint == SLIDE_NEG):
         # Shortcut while sliding: the spec's rule (solve sticking, slide on the
         # side its force leaves the cone) has a unique consistent answer, so a
@@ -331,7 +607,7 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
         # that answer. Otherwise fall through to the full rule.
         ex, ey = _cone_edge(nx, ny, mu, hint)
         vx, vy, om, g, hess, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx,
-                                                 wvy, wom, model, take)
+                                                 wvy, wom, model, take, points)
         scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
         if scale > 0.0:
             vx, vy, om = scale * vx, scale * vy, scale * om
@@ -340,7 +616,7 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
                         _scaled_hessian(hess, scale))
     if mu > 0.0:
         vx, vy, om, g, hess, conv = _stick_solve(verts, quad, area, cx, cy, vpx, vpy, wom,
-                                                 model, take)
+                                                 model, take, points)
         side = _cone_side(g[0], g[1], nx, ny, mu)
         if side == STICK:
             return TWIST_OK, vx, vy, om, g[0], g[1], STICK, g, hess
@@ -353,12 +629,22 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
         vx, vy, om = wvx, wvy, wom
     ex, ey = _cone_edge(nx, ny, mu, side)
     vx, vy, om, g, hess, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, vx, vy, om,
-                                             model, take)
+                                             model, take, points)
     scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
     if scale <= 0.0:
         return TWIST_NO_PUSH, 0.0, 0.0, 0.0, g[0], g[1], side, g, hess
     return (TWIST_OK, scale * vx, scale * vy, scale * om, g[0], g[1], side, g,
             _scaled_hessian(hess, scale))
+
+
+@jit
+def _minpower_twist_points(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
+                           model, take):
+    """``_minpower_twist`` over the point support in ``quad``: the same code,
+    compiled as a function of its own so that the uniform model's callers,
+    which inline ``_minpower_twist``, keep their code (and speed) as before."""
+    return _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
+                           model, take, True)
 
 
 # --------------------------------------------------------------------------- tip
@@ -493,6 +779,9 @@ def _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, 
     if model == MINPOWER:
         vx, vy, om, _, _, _ = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
                                            p_model, take)
+    elif model == MINPOWER_POINTS:
+        vx, vy, om, _, _, _ = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
+                                           p_model, take, True)
     elif model == TIP:
         vx, vy, om = _tip_twist_for_line(cx, cy, ex, ey)
     else:
@@ -520,6 +809,10 @@ def _contact_twist(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu
     if model == MINPOWER:
         res = _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom,
                               hint, NO_MODEL, _DEC_TAKE)
+        return res[0], res[1], res[2], res[3], res[4], res[5], res[6]
+    if model == MINPOWER_POINTS:
+        res = _minpower_twist_points(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy,
+                                     wom, hint, NO_MODEL, _DEC_TAKE)
         return res[0], res[1], res[2], res[3], res[4], res[5], res[6]
     if model == TIP:
         return _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu)

@@ -51,8 +51,9 @@ import numpy as np
 from ._numba import jit, jit_inline
 from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
                        _ray_first_contact)
-from .models import (_DEC_TAKE, MINPOWER, NO_MODEL, SEPARATE, SLIDE_NEG, SLIDE_POS, TWIST_OK,
-                     _contact_twist, _continued_slide, _minpower_twist)
+from .models import (_DEC_TAKE, MINPOWER, MINPOWER_POINTS, NO_MODEL, SEPARATE, SLIDE_NEG,
+                     SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide, _minpower_twist,
+                     _minpower_twist_points)
 from .support import _fan_quadrature, _max_moment
 
 OK = 0
@@ -302,10 +303,16 @@ def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
             wvx, wvy, wom, p_model = _warm_start(warm, sp)
             vx, vy, om = _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx,
                                           vpy, mu, wvx, wvy, wom, hint, p_model, take)
-    elif model == MINPOWER:
+    elif model == MINPOWER or model == MINPOWER_POINTS:
         wvx, wvy, wom, p_model = _warm_start(warm, sp)
-        st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist(
-            verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model, take)
+        if model == MINPOWER:
+            st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist(
+                verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model,
+                take)
+        else:
+            st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist_points(
+                verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model,
+                take)
         if st == TWIST_OK:
             _remember(warm, sp, vx, vy, om, mode, g, hess)
     else:
@@ -595,7 +602,9 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
     Parameters
     ----------
     verts, area, a, quad, m_max, convex : output of ``_prepare``.
-    model : ``models.MINPOWER``, ``TIP`` or ``ELLIPSOID``.
+    model : ``models.MINPOWER``, ``TIP``, ``ELLIPSOID`` or ``MINPOWER_POINTS``
+        (minpower over the point support that ``quad`` then holds; see
+        ``models``).
     mu_c : contact friction coefficient (>= 0).
     r_pin : pin radius (same length unit as the part).
     theta_i : initial orientation (radians).
@@ -742,7 +751,7 @@ def _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h, tol, y_new, ks, tmp
     """
     rejected = False
     attempts = 0
-    keep = prm[0] == MINPOWER
+    keep = prm[0] == MINPOWER or prm[0] == MINPOWER_POINTS
     if keep:
         for i in range(_WARM_SIZE):
             warm_saved[i] = warm[i]

@@ -30,6 +30,11 @@ The belt's power for a twist ``xi = (v_x, v_y, omega)`` (spec section 3) is
 translation) the closed forms lose digits to cancellation, and a collapsed
 Gauss rule on the centroid fan is exact to rounding because the integrand is
 smooth there.
+
+A point support (issue 25) replaces the area integral by a weighted sum over
+K points, ``P = sum_k w_k |u(p_k)|``: ``_point_power`` at the end of this
+module (the same sums as the quadrature branch, with the kinks of P at the
+points left to ``models._minimise_points``).
 """
 import math
 
@@ -251,3 +256,77 @@ def _max_moment(verts, area):
     """m_max = E(0) / A: the belt's friction moment on a part spinning about its
     centroid, in units of mu_s m g times length (2R/3 for a disc of radius R)."""
     return _support(verts, 0.0, 0.0)[0] / area
+
+
+# --------------------------------------------------------------------------- point supports
+
+
+@jit
+def _point_power(pts, m, vx, vy, om, skip):
+    """Belt power of a point support, its gradient and Hessian in the twist.
+
+    Parameters
+    ----------
+    pts : array whose first ``m`` rows are ``(x, y, w)``: support points in
+        the part frame (units of a) and weights that sum to 1 (the rows after
+        them are ignored; ``models.MINPOWER_POINTS`` passes the rollout's
+        ``quad`` built that way).
+    m : number of support points.
+    vx, vy, om : the twist.
+    skip : index of a point left out of the sums (-1: none).
+
+    Returns
+    -------
+    (P, g0, g1, g2, H00, H01, H02, H11, H12, H22, jmin, rmin, umin)
+        P and its gradient and Hessian over the points whose slip speed is
+        not zero, the point ``jmin`` with the smallest ``|u_j| / w_j`` (the
+        kink the twist is nearest, -1 if none), that ratio, and the
+        smallest slip speed ``|u_j|``.
+
+    Notes
+    -----
+    With ``u_j = (vx - om y_j, vy + om x_j)`` the velocity of point j::
+
+        P = sum_j w_j |u_j|
+        grad P = sum_j w_j J_j^T u_j / |u_j|,     J_j = [[1, 0, -y_j], [0, 1, x_j]]
+        Hess P = sum_j (w_j / |u_j|) a_j a_j^T,   a_j = J_j^T (z x u_j / |u_j|)
+
+    (the same sums as ``_power``'s quadrature branch, with the points as the
+    rule). A point with ``u_j = 0`` (the centre of rotation on it) is a kink
+    of P: it adds nothing to P, and the zero vector of its subdifferential
+    ``w_j J_j^T B`` (B the unit disc) to the gradient; it is left out of the
+    Hessian, where its term is unbounded. ``models._minimise_points`` picks
+    the element of B that the optimality condition needs.
+    """
+    p_val = g0 = g1 = g2 = 0.0
+    h00 = h01 = h02 = h11 = h12 = h22 = 0.0
+    tiny = 1e-15 * (abs(vx) + abs(vy) + abs(om))
+    jmin = -1
+    rmin = math.inf
+    umin = math.inf
+    for i in range(m):
+        wx, wy, wt = pts[i, 0], pts[i, 1], pts[i, 2]
+        ux = vx - om * wy
+        uy = vy + om * wx
+        nu = math.sqrt(ux * ux + uy * uy)
+        if nu < rmin * wt:
+            rmin = nu / wt
+            jmin = i
+        umin = min(umin, nu)
+        if i == skip or nu <= tiny:
+            continue
+        p_val += wt * nu
+        hx, hy = ux / nu, uy / nu
+        g0 += wt * hx
+        g1 += wt * hy
+        g2 += wt * (wx * hy - wy * hx)
+        ax, ay = -hy, hx
+        aw = wx * ay - wy * ax
+        c = wt / nu
+        h00 += c * ax * ax
+        h01 += c * ax * ay
+        h02 += c * ax * aw
+        h11 += c * ay * ay
+        h12 += c * ay * aw
+        h22 += c * aw * aw
+    return p_val, g0, g1, g2, h00, h01, h02, h11, h12, h22, jmin, rmin, umin

@@ -107,6 +107,11 @@ def _add_physics(p, d_required=True, belt=False):
                        help="contact model (default minpower)")
     p.add_argument("--v-pin", type=float, default=0.0,
                    help="pin speed across the belt / belt speed (default 0: static pin)")
+    p.add_argument("--support", default=None, metavar="SPEC",
+                   help="where the part presses on the belt (model minpower): uniform (default), "
+                   "points:\"x0,y0,w0 x1,y1,w1 ...\" (mm, part frame: centroid at the origin, "
+                   "drawing axes; w defaults to 1), rim or rim:N (N points on the outline), "
+                   "tripod (three hull vertices holding the centroid)")
 
 
 def cmd_rollout(args):
@@ -116,13 +121,14 @@ def cmd_rollout(args):
     belt = rollout_belt(part, args.model, args.belt_speed, args.mu_s)
     rows = rollout_rows(part, parse_values(args.theta_i, "--theta-i"), args.d, args.mu_c, args.pin_radius,
                         args.model, v_pin=args.v_pin, max_travel=args.max_travel,
-                        trajectory=args.trajectory, belt=belt)
+                        trajectory=args.trajectory, belt=belt, support=args.support)
     if args.json:
         _print_json(rows)
         return
     speed = f"  belt {args.belt_speed:g} mm/s  mu_s = {args.mu_s:g}" if belt else ""
+    support = f"  support {args.support}" if args.support else ""
     print(f"part {part.id}  a = {part.a:.3f} mm  model {args.model}  mu_c = {args.mu_c:g}  "
-          f"pin radius {args.pin_radius:g} mm  d = {args.d:+g}{speed}")
+          f"pin radius {args.pin_radius:g} mm  d = {args.d:+g}{speed}{support}")
     print(f"{'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9} {'travel':>8} "
           f"{'changes':>7} {'peak F':>7}")
     for r in rows:
@@ -164,7 +170,8 @@ def cmd_map(args):
     check_out_path(args.out, MAP_SUFFIXES)
     theta = np.arange(0.0, 360.0 - 1e-9, args.theta_step)
     ds = simulate.compute_map(part, theta, d, args.mu_c, args.pin_radius, model=args.model,
-                              v_pin=args.v_pin, threads=args.threads, backend=args.backend)
+                              v_pin=args.v_pin, threads=args.threads, backend=args.backend,
+                              support=args.support)
     ds.attrs.update(provenance_attrs())
     write_atomic(ds, args.out)
     counts = {name: int((ds.status.values == k).sum()) for k, name in enumerate(simulate.STATUSES)}

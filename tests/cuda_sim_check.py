@@ -23,4 +23,17 @@ for xy, model, mu in ((V_NOTCH, 0, 0.3), (TRIANGLE, 0, 0.2), (V_NOTCH, 2, 0.6)):
                         blocks_for(2, th.size * d.size))
     out.append({"gpu": [np.asarray(x).tolist() for x in gpu],
                 "cpu": [np.asarray(x).tolist() for x in cpu]})
+# A point support (issue 25): the kernel code MINPOWER_POINTS with the support
+# points in ``quad`` (as ``simulate._kernel_part`` builds it).
+prep = _prepare(np.array(TRIANGLE, float))
+pts = np.array([[-0.6, -0.3, 0.3], [0.8, -0.3, 0.3], [-0.2, 0.5, 0.4]])
+quad = np.ascontiguousarray(np.vstack([pts, prep[3][-3:]]))
+prep = prep[:3] + (quad,) + prep[4:]
+th = np.radians(np.arange(0.0, 360.0, 30.0) + 0.37)
+d = np.array([-0.9, -0.3, 0.2, 0.6, 1.3])
+gpu = kcuda.rollout_grid(*prep, 3, 0.2, 3.0, th, d, 0.0, np.inf, 0.1, 1e-7, max_steps_for(3))
+cpu = _rollout_grid(*prep, 3, 0.2, 3.0, th, d, 0.0, np.inf, 0.1, 1e-7,
+                    blocks_for(2, th.size * d.size))
+out.append({"gpu": [np.asarray(x).tolist() for x in gpu],
+            "cpu": [np.asarray(x).tolist() for x in cpu]})
 json.dump(out, sys.stdout)

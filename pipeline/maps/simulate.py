@@ -18,7 +18,7 @@ import xarray as xr
 
 from kernels.batch import _rollout_grid, blocks_for
 from kernels.points import _rollout_points
-from kernels.models import MODEL_NAMES
+from kernels.models import MINPOWER_POINTS, MODEL_NAMES
 from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
                              _rollout, max_steps_for)
 
@@ -26,6 +26,7 @@ from pipeline import __version__
 from pipeline.checks import check_belt, check_kernel_settings, check_pin_ratio
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
+from pipeline.parts.support import Support, parse_support, point_support
 
 MODELS = MODEL_NAMES
 STATUSES = STATUS_NAMES
@@ -56,6 +57,59 @@ def check_parameters(mu_c, pin_radius, model="minpower", v_pin=0.0, max_travel=N
         raise PinfeedError(f"pin speed ratio v_pin must be finite, got {v_pin!r}")
     if max_travel is not None and not (max_travel > 0):
         raise PinfeedError(f"max travel must be > 0, got {max_travel!r}")
+
+
+def resolve_support(part: Part, support, model: str = "minpower") -> Support | None:
+    """The checked point support of ``part`` that ``support`` names, or
+    ``None`` for the spec's uniform pressure.
+
+    ``support`` is ``None``, a :class:`~pipeline.parts.support.Support` or
+    the CLI's text (``"uniform"``, ``"points:x,y,w ..."``, ``"rim:N"``,
+    ``"tripod"``; see :func:`~pipeline.parts.support.parse_support`). A point
+    support needs the quasi-static ``minpower`` model (``tip`` and
+    ``ellipsoid`` are built on uniform pressure; the belt-speed models do not
+    take supports yet): anything else is a one-line :class:`PinfeedError`.
+    """
+    if support is None:
+        return None
+    if isinstance(support, str):
+        support = parse_support(support, part)
+    elif isinstance(support, Support):
+        if not support.is_uniform:  # checked again against this part's outline
+            support = point_support(part, support.points, support.weights, support.kind,
+                                    support.label)
+    else:
+        raise PinfeedError(f"support must be a Support or its text, got {type(support).__name__}")
+    if support.is_uniform:
+        return None
+    if model != "minpower":
+        raise PinfeedError(f"support {support.label!r} needs model minpower (model {model} "
+                           f"assumes uniform pressure); use model minpower or support uniform")
+    return support
+
+
+def _kernel_part(part: Part, model: str, support: Support | None):
+    """The arrays a rollout kernel takes for ``part`` (``Part.prepared``) and
+    the kernel's model code; for a point support the ``quad`` array holds
+    the points in units of a, weights summing to 1, before the edge
+    directions (see ``kernels.models``), and the code is ``MINPOWER_POINTS``."""
+    prep = part.prepared()
+    if support is None:
+        return prep, MODELS.index(model)
+    verts, area, a, quad, m_max, convex = prep
+    # The kernel centres the outline again (to rounding): move the points with it.
+    shift = np.asarray(part.vertices).mean(axis=0) - (verts * a).mean(axis=0)
+    rows = np.column_stack([(support.points - shift) / a, support.weights])
+    pts = np.ascontiguousarray(np.vstack([rows, quad[-verts.shape[0]:]]))
+    return (verts, area, a, pts, m_max, convex), MINPOWER_POINTS
+
+
+def _support_attrs(support: Support | None) -> dict:
+    """Map attributes naming a point support (none for uniform: outputs unchanged)."""
+    if support is None:
+        return {}
+    return {"support": support.label, "support_kind": support.kind,
+            "support_points": support.points.ravel(), "support_weights": support.weights}
 
 
 def _angles(values, what) -> np.ndarray:
@@ -99,7 +153,7 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
             model: str = "minpower", v_pin: float = 0.0, max_travel: float | None = None,
             trajectory: bool = False, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
             length_unit: str = "mm", belt_speed: float | None = None,
-            mu_s: float = 0.5) -> xr.Dataset:
+            mu_s: float = 0.5, support=None) -> xr.Dataset:
     """One passage of ``part`` past one pin (spec section 4).
 
     Parameters
@@ -116,6 +170,8 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
         ``truncated``); ``None`` runs to the end.
     trajectory : also return the trajectory (dim ``step``: ``s``, ``x``,
         ``y``, ``theta``) and the force on the pin (dim ``sample``).
+    support : ``None`` (uniform pressure, the default) or a point support
+        (see :func:`resolve_support`); model minpower only.
 
     Returns
     -------
@@ -127,23 +183,26 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
     if model in BELT_MODELS:
         if belt_speed is None:
             raise PinfeedError(f"model {model!r} needs a belt speed (mm/s)")
+        resolve_support(part, support, model)
         return dynamic_rollout(part, theta_i, d, mu_c, pin_radius, belt_speed, mu_s, model=model,
                                v_pin=v_pin, max_travel=max_travel, trajectory=trajectory)
     check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
     check_pin_ratio(part, pin_radius)
     check_kernel_settings(ds_max, tol)
+    sup = resolve_support(part, support, model)
     theta = float(_angles(theta_i, "theta_i")[0])
     dd = float(_angles(d, "d")[0])
     cap = np.inf if max_travel is None else float(max_travel)
-    res = _rollout(*part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
+    prep, code = _kernel_part(part, model, sup)
+    res = _rollout(*prep, code, float(mu_c), float(pin_radius),
                    math.radians(theta), dd, float(v_pin), cap, float(ds_max), float(tol),
                    bool(trajectory))
     status, reason, theta_f, dy, travel, changes, peak, traj, force = res
     ds = _passage_dataset(STATUS_NAMES[status], JAM_REASONS[reason] or "none",
                           "why jammed (or truncated by the step budget)",
                           theta_f, dy, travel, changes, peak, theta, dd, length_unit,
-                          _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol,
-                                        length_unit))
+                          dict(_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol,
+                                             length_unit), **_support_attrs(sup)))
     if trajectory:
         _add_trajectory(ds, traj, force, length_unit, "centroid displacement along the belt")
     return ds
@@ -215,7 +274,7 @@ def compute_map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: s
                 v_pin: float = 0.0, max_travel: float | None = None, threads: int | None = None,
                 ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
                 length_unit: str = "mm", belt_speed: float | None = None,
-                mu_s: float = 0.5, backend: str = "cpu") -> xr.Dataset:
+                mu_s: float = 0.5, backend: str = "cpu", support=None) -> xr.Dataset:
     """Configuration map set: rollouts over ``d x theta_i`` (paper eq. 2).
 
     ``model="dynamic"`` needs ``belt_speed`` (mm/s; the part in mm) and takes
@@ -226,28 +285,34 @@ def compute_map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: s
     kernel code; ``threads`` is then ignored; quasi-static models only).
     Returns a Dataset with dims ``(d, theta_i)`` and variables ``theta_f``,
     ``dy``, ``status`` (int8 flags, see its ``flag_meanings``), ``jam_reason``,
-    ``contact_travel``, ``feature_changes`` and ``peak_force``.
+    ``contact_travel``, ``feature_changes`` and ``peak_force``. ``support``:
+    ``None`` (uniform pressure, the default) or a point support (see
+    :func:`resolve_support`; model minpower, either backend), named in the
+    attributes ``support*``.
     """
     dynamic = model == "dynamic"
     fr = _check_map_inputs(part, mu_c, pin_radius, model, v_pin, max_travel, ds_max, tol,
                            belt_speed, mu_s, backend)
+    sup = resolve_support(part, support, model)
     th = _angles(theta_i, "theta_i")
     dd = _angles(d, "d")
     cap = np.inf if max_travel is None else float(max_travel)
     if backend == "cuda":
-        prep = part.prepared()
+        prep, code = _kernel_part(part, model, sup)
         out = cuda_grid()(
-            *prep, MODELS.index(model), float(mu_c), float(pin_radius), np.radians(th), dd,
+            *prep, code, float(mu_c), float(pin_radius), np.radians(th), dd,
             float(v_pin), cap, float(ds_max), float(tol), max_steps_for(prep[0].shape[0]))
     elif dynamic:
         out = _dynamic_grid(part, mu_c, pin_radius, th, dd, v_pin, fr, belt_speed, cap, threads)
     else:
+        prep, code = _kernel_part(part, model, sup)
         with _threads(threads) as n:
             out = _rollout_grid(
-                *part.prepared(), MODELS.index(model), float(mu_c), float(pin_radius),
+                *prep, code, float(mu_c), float(pin_radius),
                 np.radians(th), dd, float(v_pin), cap, float(ds_max), float(tol),
                 blocks_for(n, th.size * dd.size))
-    attrs = _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, length_unit)
+    attrs = dict(_common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, length_unit),
+                 **_support_attrs(sup))
     jam_attrs = dict(JAM_ATTRS)
     if dynamic:
         jam_attrs = _dynamic_jam_attrs()
@@ -320,7 +385,7 @@ def _map_dataset(out, th, dd, unit, jam_attrs, attrs) -> xr.Dataset:
 def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str = "minpower",
                    v_pin: float = 0.0, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
                    threads: int | None = None, belt_speed: float | None = None,
-                   mu_s: float = 0.5) -> dict:
+                   mu_s: float = 0.5, support=None) -> dict:
     """Final states of independent rollouts at scattered points.
 
     ``theta_i`` (degrees), ``d`` and ``mu_c`` are equal-length 1-D arrays (or
@@ -331,7 +396,8 @@ def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str =
     Returns a dict of NumPy arrays: ``status`` (int8 codes, see
     :data:`STATUSES`), ``jam_reason`` (int8, an index into
     ``kernels.rollout.JAM_REASONS``, which the dynamic model shares),
-    ``theta_f`` (degrees, [0, 360)) and ``dy`` (the part's unit).
+    ``theta_f`` (degrees, [0, 360)) and ``dy`` (the part's unit). ``support``
+    as for :func:`compute_map` (model minpower).
     """
     dynamic = model == "dynamic"
     if dynamic:
@@ -341,6 +407,7 @@ def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str =
     elif belt_speed is not None:
         raise PinfeedError(f"a belt speed needs model 'dynamic' (the {model} model is quasi-static)")
     check_parameters(0.0, pin_radius, "minpower" if dynamic else model, v_pin)
+    sup = resolve_support(part, support, model)
     th, dd, mu = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=np.float64))
                                        for x in (theta_i, d, mu_c)))
     for arr, what in ((th, "theta_i"), (dd, "d"), (mu, "mu_c")):
@@ -358,8 +425,9 @@ def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str =
                 np.radians(th), np.ascontiguousarray(dd), float(v_pin), fr, 0.0,
                 DEFAULT_V_REG / float(belt_speed), DEFAULT_H, np.inf, DEFAULT_MAX_STEPS, n)
         else:
+            prep, code = _kernel_part(part, model, sup)
             status, reason, theta_f, dy = _rollout_points(
-                *part.prepared(), MODELS.index(model), np.ascontiguousarray(mu), float(pin_radius),
+                *prep, code, np.ascontiguousarray(mu), float(pin_radius),
                 np.radians(th), np.ascontiguousarray(dd), float(v_pin), np.inf, float(ds_max),
                 float(tol), n)
     return {"status": status, "jam_reason": reason,

@@ -152,20 +152,23 @@ def rollout_belt(part: Part, model: str, belt_speed: float | None, mu_s: float) 
 
 def rollout_rows(part: Part, thetas, d: float, mu_c: float, pin_radius: float, model: str, *,
                  v_pin: float = 0.0, max_travel=None, trajectory: bool = False,
-                 belt: dict | None = None) -> list[dict]:
+                 belt: dict | None = None, support=None) -> list[dict]:
     """``pinfeed rollout``: one rollout of ``part`` per initial orientation in
     ``thetas`` (degrees) at contact parameter ``d``, with the belt settings
-    ``belt`` of :func:`rollout_belt`. Returns a dict per rollout (the keys of
+    ``belt`` of :func:`rollout_belt` and the ``support`` (``None``: uniform;
+    see ``simulate.resolve_support``). Returns a dict per rollout (the keys of
     ``--json``; with ``trajectory`` also the samples ``[s, x, y, theta]`` and
     the forces ``[s, F_x, F_y]``)."""
     import numpy as np
 
     from pipeline.maps import simulate
     belt = belt or {}
+    support = simulate.resolve_support(part, support, model)
     rows = []
     for theta in thetas:
         ds = simulate.rollout(part, theta, d, mu_c, pin_radius, model=model, v_pin=v_pin,
-                              max_travel=max_travel, trajectory=trajectory, **belt)
+                              max_travel=max_travel, trajectory=trajectory, support=support,
+                              **belt)
         row = {"theta_i": float(theta), "status": str(ds.status.item()),
                "theta_f": float(ds.theta_f), "dy": float(ds.dy),
                "contact_travel": float(ds.contact_travel),
