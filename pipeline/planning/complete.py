@@ -48,7 +48,7 @@ from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
 
 from pipeline.parts.part import Part
 from pipeline.planning import orient
-from pipeline.planning.enumerate import NominalTree
+from pipeline.planning.enumerate import Level, NominalTree
 from pipeline.planning.settings import nominal_friction
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import replay, trial_inputs
@@ -88,10 +88,12 @@ class FixedPlan:
     nominal_span: float
     margin: float
     verdict: dict | None = None
+    speeds: tuple = ()  # v_pin / v_b of each pin (empty: all fixed)
 
     def rank_key(self):
         """Orienting first, then fewer pins, narrower verified width, larger margin."""
-        return orientation_rank(self.verdict, len(self.labels), self.margin)
+        return orientation_rank(self.verdict, len(self.labels), self.margin,
+                                sum(1 for v in self.speeds if v))
 
 
 @dataclass
@@ -152,16 +154,20 @@ class FixedPinSearch:
     d_min, d_max : the margin's limits on ``|d|``.
     belt_speed, mu_s : plan with the dynamic model at this belt speed (mm/s)
         and belt friction instead of the quasi-static ``model``.
+    speeds : ``{label: v_pin / v_b}`` for candidate pins that move (the
+        others are fixed); :meth:`run` with a ``prefix`` lets them follow a
+        fixed-pin sequence.
     """
 
     def __init__(self, part: Part, pins: dict, mu_c, tolerance: float, required: float,
                  verify: dict, pin_radius: float, model: str = "minpower", kernel: dict | None = None,
                  d_min: float = 0.1, d_max: float = 0.9, belt_speed: float | None = None,
-                 mu_s: float = 0.5):
+                 mu_s: float = 0.5, speeds: dict | None = None):
         self.part, self.mu_c, self.model = part, mu_c, model
         self.belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
         self.labels = list(pins)
         self.heights = np.array([float(pins[k]) for k in self.labels])
+        self.speeds = np.array([float((speeds or {}).get(k, 0.0)) for k in self.labels])
         self.tolerance = orient.check_tolerance(tolerance)
         self.required = orient.check_required(required)
         self.cfg = dict(VERIFY_DEFAULTS, **(verify or {}))
@@ -172,15 +178,24 @@ class FixedPinSearch:
                        for k, (t, y) in enumerate(part.stable_states(), start=1)}
         self.tree = NominalTree(part, self.heights, nominal_friction(mu_c), self.pin_radius, model,
                                 self.kernel, float(self.cfg["pin_halfwidth"]), d_min, d_max,
-                                belt=self.belt)
+                                belt=self.belt, speeds=self.speeds)
+        self.prefix = FixedPlan((), (), 0.0, np.inf)  # the pins every sequence starts with (run)
 
-    def run(self, depth: int, candidates: int = 12, keep: int = 5, progress=None) -> FixedSearch:
-        """Search levels 1 to ``depth``; stop at the first level with an orienting plan."""
+    def run(self, depth: int, candidates: int = 12, keep: int = 5, progress=None,
+            prefix: FixedPlan | None = None) -> FixedSearch:
+        """Search levels 1 to ``depth`` (after the pins of ``prefix``, if given:
+        every sequence then starts with them); stop at the first level with an
+        orienting plan."""
         t0 = time.perf_counter()
         result = FixedSearch([], [], int(depth), self.tolerance, self.required)
         runners_up, levels = [], []
-        for level in self.tree.levels(int(depth)):
-            n_pins = level.seq.shape[1] if level.size else len(result.levels) + 1
+        self.prefix, root = prefix or FixedPlan((), (), 0.0, np.inf), None
+        if prefix is not None:
+            root = self._after(prefix)
+            if root is None:  # the prefix jams its own nominal path
+                return result
+        for level in self.tree.levels(int(depth), root):
+            n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
             found, judged, record = self._level(level, candidates)
             result.levels.append({"pins": n_pins, **record})
             if progress:
@@ -200,6 +215,20 @@ class FixedPinSearch:
         result.seconds = time.perf_counter() - t0
         return result
 
+    def _after(self, prefix: FixedPlan):
+        """The nominal level after ``prefix`` (its pins replayed exactly from the
+        resting states at the middle friction), or None if it jams."""
+        states = self.part.stable_states()
+        n = len(prefix.labels)
+        speeds = prefix.speeds or (0.0,) * n
+        theta, y_c, jam, _ = replay(self.part, list(prefix.heights), list(speeds), states[:, 0], states[:, 1],
+                                    np.full(len(states), nominal_friction(self.mu_c)), np.zeros((len(states), n)),
+                                    self.pin_radius, self.model, self.kernel["ds_max"], self.kernel["tol"],
+                                    **self.belt)
+        if (jam != "").any():
+            return None
+        return Level(np.zeros((1, 0), dtype=np.int16), theta[None, :], y_c[None, :], np.array([prefix.margin]))
+
     # ------------------------------------------------------------------ one level
 
     def _level(self, level, candidates):
@@ -214,7 +243,7 @@ class FixedPinSearch:
         record["nominal_within"] = int(within.size)
         if within.size == 0:
             return [], [], record
-        n_pins = level.seq.shape[1]
+        n_pins = len(self.prefix.labels) + level.seq.shape[1]
         inputs = trial_inputs(self.states, self.mu_c, n_pins, self.cfg)
         n_total = sum(x[0].size for x in inputs)
         allowed = n_total - orient.needed(n_total, self.required)
@@ -247,9 +276,11 @@ class FixedPinSearch:
         return found, judged, record
 
     def _plan(self, level, idx, span, verdict) -> FixedPlan:
-        seq = level.seq[idx]
-        return FixedPlan(tuple(self.labels[i] for i in seq), tuple(float(self.heights[i]) for i in seq),
-                         float(span), float(level.margin[idx]), verdict)
+        seq, pre = level.seq[idx], self.prefix
+        return FixedPlan(pre.labels + tuple(self.labels[i] for i in seq),
+                         pre.heights + tuple(float(self.heights[i]) for i in seq),
+                         float(span), float(level.margin[idx]), verdict,
+                         (pre.speeds or (0.0,) * len(pre.labels)) + tuple(float(self.speeds[i]) for i in seq))
 
     def _screen_rows(self, inputs, n_first: int, n_corners_wanted: int):
         """A subset of the verification trials: the first ``n_first`` random trials
@@ -273,9 +304,12 @@ class FixedPinSearch:
         """Final orientations ``(len(idx), trials)`` and jam flags of plans ``idx`` on ``rows``."""
         th, yc, mu, offs = rows
         n_trials, n_plans = th.size, idx.size
-        heights = self.heights[level.seq[idx]]  # (plans, pins)
+        pre = self.prefix
+        pre_speeds = pre.speeds or (0.0,) * len(pre.labels)
+        heights = np.hstack([np.tile(pre.heights, (n_plans, 1)), self.heights[level.seq[idx]]])
+        speeds = np.hstack([np.tile(pre_speeds, (n_plans, 1)), self.speeds[level.seq[idx]]])
         tf, _, jam, _ = replay(self.part, np.repeat(heights, n_trials, axis=0),
-                               [0.0] * heights.shape[1], np.tile(th, n_plans), np.tile(yc, n_plans),
+                               np.repeat(speeds, n_trials, axis=0), np.tile(th, n_plans), np.tile(yc, n_plans),
                                np.tile(mu, n_plans), np.tile(offs, (n_plans, 1)), self.pin_radius,
                                self.model, self.kernel["ds_max"], self.kernel["tol"], **self.belt)
         return tf.reshape(n_plans, n_trials), (jam != "").reshape(n_plans, n_trials)
@@ -310,6 +344,6 @@ class FixedPinSearch:
         clusters = np.maximum(1, (gaps > self.tolerance).sum(axis=1))
         spread = period - gaps.max(axis=1)
         best = np.lexsort((-level.margin, spread, clusters))[:candidates]
-        inputs = trial_inputs(self.states, self.mu_c, level.seq.shape[1], self.cfg)
+        inputs = trial_inputs(self.states, self.mu_c, len(self.prefix.labels) + level.seq.shape[1], self.cfg)
         verdicts = self._judge(level, best, self._stack(inputs))
         return [self._plan(level, i, spread[i], v) for i, v in zip(best, verdicts)]

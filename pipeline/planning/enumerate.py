@@ -33,8 +33,8 @@ import numpy as np
 
 from kernels.rollout import JAMMED, MISS, TRUNCATED
 
-from pipeline.maps import simulate
 from pipeline.parts.part import Part
+from pipeline.planning.verify import rollouts_by_speed
 
 QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout
 MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
@@ -73,13 +73,16 @@ class NominalTree:
     pin_halfwidth : the pins' placement tolerance (mm), for the metastable rule.
     d_min, d_max : the margin's limits on ``|d|`` (not a rule here).
     belt : ``{"belt_speed": mm/s, "mu_s": ...}`` for the dynamic model, or None.
+    speeds : each candidate pin's speed across the belt, v_pin / v_b (default
+        all 0: fixed pins; moving pins follow the same rules).
     """
 
     def __init__(self, part: Part, heights, mu_c: float, pin_radius: float, model: str = "minpower",
                  kernel: dict | None = None, pin_halfwidth: float = 0.3, d_min: float = 0.1,
-                 d_max: float = 0.9, belt: dict | None = None):
+                 d_max: float = 0.9, belt: dict | None = None, speeds=None):
         self.part, self.mu_c, self.pin_radius, self.model = part, float(mu_c), float(pin_radius), model
         self.heights = np.asarray(heights, dtype=float)
+        self.speeds = np.zeros(self.heights.size) if speeds is None else np.asarray(speeds, dtype=float)
         self.kernel = {k: v for k, v in (kernel or {}).items() if k in ("ds_max", "tol")}
         if belt:  # the dynamic model at a belt speed: its own step control
             self.model, self.kernel = "dynamic", dict(belt)
@@ -92,10 +95,10 @@ class NominalTree:
         return Level(np.zeros((1, 0), dtype=np.int16), states[None, :, 0].copy(),
                      states[None, :, 1].copy(), np.full(1, np.inf))
 
-    def levels(self, depth: int):
-        """Yield the levels of lengths 1 to ``depth`` in turn (lazily, so a search
-        may stop early)."""
-        level = self.root()
+    def levels(self, depth: int, root: Level | None = None):
+        """Yield the levels of lengths 1 to ``depth`` after ``root`` (default
+        :meth:`root`) in turn (lazily, so a search may stop early)."""
+        level = self.root() if root is None else root
         for _ in range(depth):
             level = self.extend(level)
             yield level
@@ -119,7 +122,8 @@ class NominalTree:
         theta = np.repeat(level.theta, n_pins, axis=0)
         y_c = np.repeat(level.y, n_pins, axis=0)
         y_pin = np.tile(self.heights, n)[:, None]
-        status, theta_f, dy = self._rollouts(theta, y_pin - y_c)
+        v_pin = np.broadcast_to(np.tile(self.speeds, n)[:, None], theta.shape)
+        status, theta_f, dy = self._rollouts(theta, y_pin - y_c, v_pin)
         touched = status != MISS
         d_abs = np.abs(y_pin - y_c) / self.part.a
         bad = ((status == JAMMED) | (status == TRUNCATED)).any(axis=1)
@@ -132,20 +136,23 @@ class NominalTree:
         margin = np.minimum(np.repeat(level.margin, n_pins), step_margin)
         return Level(seq[keep], theta_f[keep], (y_c + dy)[keep], margin[keep])
 
-    def _rollouts(self, theta, dy_pin):
+    def _rollouts(self, theta, dy_pin, v_pin):
         """``(status, theta_f, dy)`` arrays shaped like ``theta`` for the pin offsets
-        ``dy_pin`` (mm), one rollout per distinct quantised pose."""
+        ``dy_pin`` (mm) and pin speeds ``v_pin``, one rollout per distinct
+        quantised pose and speed."""
         a = self.part.a
-        keys = np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM)],
-                        axis=-1).reshape(-1, 2).astype(np.int64)
+        speed_index = np.searchsorted(np.unique(self.speeds), v_pin)
+        keys = np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM), speed_index],
+                        axis=-1).reshape(-1, 3).astype(np.int64)
         if keys.shape[0] == 0:
             empty = np.zeros(theta.shape)
             return empty.astype(np.int8), empty, empty
         uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
         inverse = inverse.ravel()
         # Roll out from the rounded pose itself, so an outcome depends on its key only.
-        res = simulate.rollout_points(self.part, uniq[:, 0] * QUANTUM, uniq[:, 1] * QUANTUM / a,
-                                      self.mu_c, self.pin_radius, self.model, **self.kernel)
+        res = rollouts_by_speed(self.part, uniq[:, 0] * QUANTUM, uniq[:, 1] * QUANTUM / a,
+                                np.full(uniq.shape[0], self.mu_c), np.unique(self.speeds)[uniq[:, 2]],
+                                self.pin_radius, self.model, self.kernel)
         self.rollouts += uniq.shape[0]
         shape = theta.shape
         return (res["status"][inverse].reshape(shape), res["theta_f"][inverse].reshape(shape),

@@ -27,7 +27,7 @@ from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import format_arcs
 from pipeline.planning.certify import carried_plan
-from pipeline.planning.complete import FixedPinSearch, FixedSearch, orientation_rank
+from pipeline.planning.complete import FixedPinSearch, FixedPlan, FixedSearch, orientation_rank
 from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required,
                                       check_tolerance, judge)
@@ -40,6 +40,7 @@ from pipeline.planning.verify import verify_plan
 
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
+MOVING_PREFIXES = 3  # best fixed-pin results (besides none) that moving pins may follow
 
 
 def planner_belt(config: dict, part: Part | None = None):
@@ -102,14 +103,16 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     chosen = fixed.plans or fixed.best_effort
     candidates = [carried_plan(planner, p.labels, p.margin, verify_cfg) for p in chosen]
     moving = None if fixed.orients else _moving_planner(part, config, mu_c, planner)
+    moving_search = None
     if moving is not None:
-        candidates += _moving_candidates(moving, config, mu_c, chosen, progress)
+        moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress)
+        candidates += [carried_plan(moving, p.labels, p.margin, verify_cfg) for p in moving_search.plans]
         planner = moving
     states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
     _verify_candidates(part, config, mu_c, planner, candidates, states, progress)
     candidates.sort(key=_rank)
     good = [p for p in candidates if _acceptable(p)]
-    return _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed)
+    return _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed, moving_search)
 
 
 def planner_tolerance(config: dict) -> float:
@@ -141,14 +144,30 @@ def _moving_planner(part, config, mu_c, planner):
     return planner_for(part, config, mu_c, planner.lattices, moving=True)
 
 
-def _moving_candidates(moving, config, mu_c, chosen, progress) -> list:
-    """Plans where moving pins follow the best fixed-pin prefixes (and the empty one)."""
-    dyn = config["planner"]["dynamic"]
+def _moving_search(part, config, mu_c, moving, chosen, keep, progress) -> FixedSearch:
+    """Up to ``planner.dynamic.depth`` moving pins after no fixed pin and after
+    each of the ``MOVING_PREFIXES`` best fixed-pin results, by the same
+    enumeration, screen and judgement as the fixed pins (every moving-pin
+    sequence after each prefix is tried); the orienting plans, best first."""
+    pc, sweep, dyn = config["planner"], config["sweep"], config["planner"]["dynamic"]
     if progress:
         progress(f"mu_c {friction_label(mu_c)}: fixed pins do not orient the part: adding moving pins")
-    prefixes = [()] + [p.labels for p in chosen]
-    return moving.extend_moving(prefixes, int(dyn["depth"]), int(dyn.get("beam", 30)),
-                                keep=int(config["planner"].get("candidates", 12)))
+    pins = {k: p for k, p in moving.pins.items() if p.v_pin}
+    search = FixedPinSearch(part, {k: p.y for k, p in pins.items()}, mu_c, planner_tolerance(config),
+                            verify_required(config), config.get("verify", {}), sweep["pin_radius"],
+                            pc["model"], sweep.get("kernel"), pc["d_min"], pc["d_max"],
+                            belt_speed=moving.belt_speed, mu_s=moving.mu_s,
+                            speeds={k: p.v_pin for k, p in pins.items()})
+    depth = int(dyn["depth"])
+    total = FixedSearch([], [], depth, planner_tolerance(config), verify_required(config))
+    for prefix in [None, *chosen[:MOVING_PREFIXES]]:
+        res = search.run(depth, candidates=int(pc.get("candidates", 12)), keep=keep, prefix=prefix)
+        total.plans += res.plans
+        total.levels += [dict(lv, after=list(prefix.labels) if prefix else []) for lv in res.levels]
+        total.rollouts += res.rollouts
+        total.seconds += res.seconds
+    total.plans = sorted(total.plans, key=FixedPlan.rank_key)[:keep]
+    return total
 
 
 def _rank(plan) -> tuple:
@@ -192,25 +211,30 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
                      + (f", verified width {width:.1f} deg" if width is not None else ""))
 
 
-def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance: float):
+def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance: float,
+                     moving: FixedSearch | None = None):
     """Why the recommended plan does not orient the part, or why nothing is
     recommended (None when a plan orients it)."""
     if good and good[0].verification["orientation"]["orients"]:
         return None
+    why = fixed.evidence()
+    if moving is not None:
+        why += (f"; nor do up to {moving.depth} moving pins after no fixed pin or after the "
+                f"{MOVING_PREFIXES} best fixed-pin results")
     if not candidates:
-        return f"{fixed.evidence()}; no allowed pin sequence within depth {depth}"
+        return f"{why}; no allowed pin sequence within depth {depth}"
     if not good:
         best = candidates[0]
-        return (f"{fixed.evidence()}; no plan passed verification: the best, {' '.join(best.pins)} "
+        return (f"{why}; no plan passed verification: the best, {' '.join(best.pins)} "
                 f"({format_arcs(best.final_sets)}), failed {best.verification['failures']} of "
                 f"{best.verification['trials']} trials")
     verdict = good[0].verification["orientation"]
-    return (f"{fixed.evidence()}; the recommended plan ends in {verdict['sets_within_tolerance']} "
-            f"sets of at most {tolerance:g} deg: a sensor or moving pins must tell them apart")
+    return (f"{why}; the recommended plan ends in {verdict['sets_within_tolerance']} "
+            f"sets of at most {tolerance:g} deg: a sensor must tell them apart")
 
 
 def _tight_result(config: dict, mu_c, depth: int, keep: int, planner, candidates, good, states,
-                  fixed: FixedSearch) -> dict:
+                  fixed: FixedSearch, moving: FixedSearch | None = None) -> dict:
     """The JSON-ready tight-planner entry at one friction (the stored format)."""
     pc = config["planner"]
     recommended = good[0] if good else None
@@ -228,12 +252,16 @@ def _tight_result(config: dict, mu_c, depth: int, keep: int, planner, candidates
         "plans": [p.to_dict() for p in good[:keep]],
         "rejected": [p.to_dict() for p in candidates if p not in good][:keep],
         "recommended": recommended.to_dict() if recommended else None,
-        "warning": _no_plan_warning(depth, candidates, good, fixed, tolerance),
+        "warning": _no_plan_warning(depth, candidates, good, fixed, tolerance, moving),
         "fixed_pin_search": fixed.to_dict(),
+        "moving_pin_search": None if moving is None else {
+            "orients": moving.orients, "depth": moving.depth, "levels": moving.levels,
+            "found": [list(p.labels) for p in moving.plans], "nominal_rollouts": moving.rollouts,
+            "seconds": round(moving.seconds, 2)},
         "pins_used": {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0},
         "stats": {"transitions": planner.stats.transitions,
-                  "rollouts": planner.stats.rollouts + fixed.rollouts,
-                  "nominal_rollouts": fixed.rollouts,
+                  "rollouts": planner.stats.rollouts + fixed.rollouts + (moving.rollouts if moving else 0),
+                  "nominal_rollouts": fixed.rollouts + (moving.rollouts if moving else 0),
                   "joint_states": planner.stats.nodes, "seconds": round(fixed.seconds + planner.stats.seconds, 2),
                   "pruned_branching": planner.stats.pruned_branching,
                   "unresolved": planner.stats.unresolved,

@@ -1,5 +1,5 @@
-"""Tight plans of given pin sequences, and moving pins after fixed ones, by
-tight state propagation (``propagate.py``).
+"""Tight plans of given pin sequences: their carried sets by tight state
+propagation (``propagate.py``).
 
 Every initial resting state starts as its uncertainty box. A pin is allowed
 for a state only if the whole d range of the box stays on one side of the
@@ -9,23 +9,20 @@ centroid (the pin never passes it on either side) and no jam is reachable;
 ``hard_limits``; a pin that the state misses leaves it as it is (that is
 part of the propagation). A pin sequence is the same for every initial state.
 
-``TightPlanner.follow`` carries the sets of one given sequence (the complete
-fixed-pin search, ``complete.py``, chooses the sequences);
-``TightPlanner.extend_moving`` lets moving pins follow given fixed-pin
-prefixes by a beam search over joint states (the carried sets of all initial
-states): sequences that reach a joint state already reached are merged, so a
-pin that changes nothing is never kept.
+``TightPlanner.follow`` carries the sets of one given sequence of fixed
+or moving pins; the complete search (``complete.py``) chooses the
+sequences.
 
-Before verification, plans are ranked by (1) the number of final orientation
-sets, counted modulo the part's rotational symmetry; (2) the fraction of
-successful trials once verified; (3) fewest pins; (4) fewest steps whose box
-straddles a jump; (5) the safety margin in d; (6) the total width of the
-final sets. ``plan.py`` ranks verified plans by the orientation verdict.
+``TightPlan.rank_key`` orders propagated plans by (1) the number of final
+orientation sets, counted modulo the part's rotational symmetry; (2) the
+fraction of successful trials once verified; (3) fewest pins; (4) fewest
+steps whose box straddles a jump; (5) the safety margin in d; (6) the total
+width of the final sets. ``plan.py`` ranks verified plans by the
+orientation verdict instead.
 """
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 
 from pipeline.errors import PinfeedError
@@ -193,16 +190,6 @@ class TightPlanner:
         self.stats = SearchStats()
         self._cache: dict = {}
 
-    @property
-    def static_labels(self) -> list[str]:
-        """Labels of the static pins."""
-        return [k for k, p in self.pins.items() if p.v_pin == 0.0]
-
-    @property
-    def moving_labels(self) -> list[str]:
-        """Labels of the moving pins."""
-        return [k for k, p in self.pins.items() if p.v_pin != 0.0]
-
     def initial_states(self) -> dict[str, StateSet]:
         """Initial state label -> the part's resting state set, with the planner's uncertainties."""
         return initial_state_sets(self.part, self.mu_c, self.unc)
@@ -254,31 +241,6 @@ class TightPlanner:
                 return None
         return self._plan(node, starts)
 
-    def extend_moving(self, prefixes, dynamic_depth: int, beam: int = 30, keep: int = 10) -> list[TightPlan]:
-        """Plans that follow one of the fixed-pin ``prefixes`` (label tuples, the
-        empty one included) by up to ``dynamic_depth`` moving pins: a beam of
-        ``beam`` joint states per level, ranked by fewest sets, then fewest pins."""
-        t0 = time.perf_counter()
-        starts = self.initial_states()
-        self.labels = list(starts)
-        nodes, seen = [], set()
-        for seq in prefixes:
-            node = self._root(starts)
-            for label in seq:
-                node = node and self._step(node, label)
-            if node is not None and self._joint_key(node[1]) not in seen:
-                seen.add(self._joint_key(node[1]))
-                nodes.append(node)
-        grown, out = list(nodes), []
-        for _ in range(dynamic_depth):
-            grown.sort(key=self._node_rank)
-            grown = self._expand(grown[:beam], self.moving_labels, seen)
-            out.extend(grown)
-        self.stats.nodes += len(out)
-        plans = sorted((self._plan(node, starts) for node in out), key=TightPlan.rank_key)
-        self.stats.seconds += time.perf_counter() - t0
-        return plans[:keep]
-
     def _root(self, starts):
         return ((), tuple(((st, ()),) for st in starts.values()), math.inf, 0, ())
 
@@ -291,17 +253,6 @@ class TightPlanner:
         new_joint, step_margin, step_jumps = child
         return (seq + (label,), new_joint, min(margin, step_margin), jumps + step_jumps,
                 sets_after + (self._count_sets(new_joint),))
-
-    def _expand(self, frontier, labels, seen):
-        out = []
-        for node in frontier:
-            for label in labels:
-                child = self._step(node, label)
-                if child is None or self._joint_key(child[1]) in seen:
-                    continue
-                seen.add(self._joint_key(child[1]))
-                out.append(child)
-        return out
 
     def _apply(self, joint, label):
         """The joint state after pin ``label``, or None if forbidden for a branch."""
@@ -326,16 +277,6 @@ class TightPlanner:
 
     def _count_sets(self, joint) -> int:
         return len(merge_modulo([st.arc for branches in joint for st, _ in branches], self.order))
-
-    @staticmethod
-    def _joint_key(joint):
-        return tuple(tuple(st for st, _ in branches) for branches in joint)
-
-    @staticmethod
-    def _node_rank(node):
-        seq, joint, margin, jumps, sets_after = node
-        n_sets = sets_after[-1] if sets_after else len(joint)
-        return (n_sets, len(seq), jumps, -margin if math.isfinite(margin) else 0.0)
 
     def _plan(self, node, starts) -> TightPlan:
         seq, joint, margin, jumps, sets_after = node

@@ -152,7 +152,7 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
         if idx.size == 0:
             break
         d = contact_parameter(heights[idx, k] + offsets[idx, k], y_c[idx], part.a)
-        res = _rollouts_by_speed(part, theta[idx], d, mu[idx], speeds[idx, k], pin_radius,
+        res = rollouts_by_speed(part, theta[idx], d, mu[idx], speeds[idx, k], pin_radius,
                                  model if belt_speed is None else "dynamic", kw)
         st = res["status"]
         stuck = (st == JAMMED) | (st == TRUNCATED)
@@ -167,7 +167,7 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     return theta % 360.0, y_c, jam, missed
 
 
-def _rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw) -> dict:
+def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw) -> dict:
     """``simulate.rollout_points`` for rows whose pins may move at different
     speeds ``v_pin`` (one batch per speed), results in row order."""
     speeds = np.unique(v_pin)
