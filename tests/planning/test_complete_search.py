@@ -156,3 +156,40 @@ def test_sampled_claim_splits_outliers_and_holds_in_an_independent_replay():
     res = verify_plan(part, plan.to_dict(), {k: p.y for k, p in planner.pins.items()}, states, 0.3, 3.0,
                       settings={"trials": 100})
     assert res["successes"] >= 0.98 * res["trials"]
+
+
+def test_moving_pins_only_when_fixed_pins_cannot_and_their_plan_holds():
+    """A trapezoid that one fixed pin cannot orient: the plan entry says so,
+    moving pins after it (same enumeration) do orient it, and the recommended
+    moving-pin plan holds in the oracle's own replay with the pins moving."""
+    from pipeline.config import load_config
+    from pipeline.planning.plan import plan_tight
+    config = load_config()
+    config["planner"].update(pins="auto", depth=1, tolerance_deg=10.0)
+    config["verify"]["trials"] = 30
+    part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]], name="trapezoid")
+    entry = plan_tight(part, config, (0.1, 0.3))
+    assert not entry["fixed_pin_search"]["orients"]
+    assert entry["fixed_pin_search"]["evidence"].startswith("no fixed-pin sequence of up to 1 pins")
+    assert entry["moving_pin_search"]["orients"] and entry["orients"]
+    rec = entry["recommended"]
+    assert rec["n_dynamic_pins"] >= 1 and rec["verification"]["orientation"]["orients"]
+    finals = replay_box(part, rec["pin_heights_mm"], box_trials(part, len(rec["pins"]), 40, 13, (0.1, 0.3)),
+                        strict=False, speeds=rec["pin_speeds"])
+    assert most_in_arc(finals, 11.0) >= 0.95 * finals.size
+
+
+def test_no_plan_recommends_fixed_pins_for_a_sensor():
+    """When neither fixed nor moving pins orient the part, the recommended plan
+    is a several-set plan of fixed pins and the warning names the sensor."""
+    from pipeline.config import load_config
+    from pipeline.planning.plan import plan_tight
+    config = load_config()
+    config["planner"].update(pins=[0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0], depth=1, tolerance_deg=12.0)
+    config["planner"]["dynamic"].update(speeds=[-2.0, 2.0], depth=1)
+    config["verify"]["trials"] = 30
+    part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]], name="trapezoid")
+    entry = plan_tight(part, config, 0.15)
+    assert not entry["orients"] and not entry["moving_pin_search"]["orients"]
+    assert entry["recommended"]["n_dynamic_pins"] == 0
+    assert "nor do up to 1 moving pins" in entry["warning"] and "a sensor must tell them apart" in entry["warning"]
