@@ -15,10 +15,15 @@ LEGEND = {"fixed pins": "fixed pins orient it", "moving pins": "needs moving pin
 def _label(row: dict) -> str:
     if row["plan"] is None:
         return "no verified plan"
+    n = row["fixed_pins"] + row["moving_pins"]
     pins = f"{row['fixed_pins']} fixed" + (f" + {row['moving_pins']} moving" if row["moving_pins"] else "")
-    width = "" if row["verified_width_deg"] is None else f", {row['verified_width_deg']:.1f} deg"
+    pins += " pin" if n == 1 else " pins"
+    if row["orients"]:
+        how = "" if row["verified_width_deg"] is None else f", {row['verified_width_deg']:.1f} deg"
+    else:
+        how = f": {row.get('sets')} sets of at most {row['tolerance_deg']:g} deg (sensor)"
     rate = "" if row.get("throughput_per_min") is None else f", {row['throughput_per_min']:.0f}/min"
-    return f"{pins} pins{width}{rate}"
+    return f"{pins}{how}{rate}"
 
 
 def atlas_section(atlas: dict, thumbnails: dict, base, anchor) -> list[str]:

@@ -28,7 +28,7 @@ from pipeline.planning.types import validate_plan_file
 from pipeline.provenance import provenance_attrs
 
 COLUMNS = ("part", "part_id", "outcome", "orients", "tolerance_deg", "fixed_pins", "moving_pins",
-           "sensor_needed", "verified_width_deg", "trials", "in_set", "plan", "mu_c",
+           "sensor_needed", "verified_width_deg", "sets", "trials", "in_set", "plan", "mu_c",
            "speed_limit_mm_s", "belt_speed_mm_s", "throughput_per_min", "planning_seconds", "evidence")
 
 
@@ -57,6 +57,7 @@ def atlas_row(plan_result: dict, speed: dict | None = None, layout: dict | None 
         "moving_pins": None if plan is None else n_moving,
         "sensor_needed": not orients,
         "verified_width_deg": verdict.get("width_deg"),
+        "sets": 1 if orients else verdict.get("sets_within_tolerance"),
         "trials": verdict.get("trials"), "in_set": verdict.get("in_tolerance"),
         "plan": None if plan is None else " ".join(plan["pins"]),
         "mu_c": entry.get("friction"),

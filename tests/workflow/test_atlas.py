@@ -58,6 +58,7 @@ def test_atlas_rows_match_the_plan_files(planned):
         if rec:
             assert row["fixed_pins"] + row["moving_pins"] == len(rec["pins"])
         assert row["sensor_needed"] == (not row["orients"])
+        assert row["sets"] == (1 if row["orients"] else verdict.get("sets_within_tolerance"))
         assert row["evidence"] == entry["fixed_pin_search"]["evidence"]
     tri = atlas["rows"][0]
     assert (tri["speed_limit_mm_s"], tri["throughput_per_min"]) == (210.0, 55.5)
@@ -120,3 +121,31 @@ def test_planner_parts_bad_names_are_one_line(parts, families, words):
 def test_plan_tolerance_out_of_range_is_one_line(bad, capsys):
     code, out, err = run_cli(capsys, ["plan", "--vertices", "0,0 50,0 0,30", f"--tolerance={bad}"])
     assert code != 0 and "tolerance" in err and len(err.strip().splitlines()) == 1
+
+
+def test_report_atlas_grid_links_colours_and_labels(planned):
+    """The report's atlas grid: one tile per part, linking to its section,
+    framed by outcome, labelled from the same atlas row."""
+    from html.parser import HTMLParser
+
+    from pipeline.present.atlas_section import COLOURS, atlas_section
+    config, root, paths, speeds, layouts = planned
+    atlas = build_atlas(config, paths, speeds, layouts)
+    html_text = "\n".join(atlas_section(atlas, {}, root, lambda name: f"part-{name}"))
+
+    class Tiles(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.tiles = []
+
+        def handle_starttag(self, tag, attrs):
+            if tag == "a":
+                self.tiles.append(dict(attrs))
+
+    parser = Tiles()
+    parser.feed(html_text)
+    assert [t["href"] for t in parser.tiles] == [f"#part-{name}" for name in PARTS]
+    for tile, row in zip(parser.tiles, atlas["rows"]):
+        assert COLOURS[row["outcome"]] in tile["style"]
+        words = f"{row['verified_width_deg']:.1f} deg" if row["orients"] else f"{row['sets']} sets"
+        assert words in html_text
