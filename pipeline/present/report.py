@@ -72,7 +72,8 @@ def write_report(config, parts: dict, out, overview: dict | None = None, catalog
          f"<p>pinfeed {html.escape(__version__)} ({html.escape(git_commit())}), config "
          f"{config_hash(config)}, made {creation_time()}. Planner: model "
          f"{html.escape(pc['model'])}, mu_c {html.escape(str(pc['mu_c']))}, depth "
-         f"{pc['depth']}, d in [{pc['d_min']:g}, {pc['d_max']:g}], T = {bc['threshold_T']:g} deg, "
+         f"{pc['depth']}, orientation tolerance {pc.get('tolerance_deg', 10):g} deg, d in "
+         f"[{pc['d_min']:g}, {pc['d_max']:g}], bands T = {bc['threshold_T']:g} deg, "
          f"c = {bc['factor_c']:g}.</p>"]
     if atlas:
         thumbs = {n: v["files"]["outline"] for n, v in parts.items() if "outline" in v["files"]}
