@@ -121,7 +121,10 @@ def test_a_workflow_part_is_not_stored_over_the_workflows_file(fresh, capsys, mo
 def test_ctrl_c_is_one_line_exit_130_and_the_rollouts_are_kept(fresh):
     import xarray as xr
     config = tiny_config(pins=(0, 7.5, 15, 22.5, 30))
-    config["planner"]["frictions"] = [0.3]  # a second friction: still planning when interrupted
+    # Five more frictions with more trials: still planning when interrupted
+    # (one more friction alone finished before the signal arrived on a fast run).
+    config["planner"]["frictions"] = [0.3, 0.05, 0.1, 0.2, 0.25]
+    config["verify"]["trials"] = 60
     (fresh / "slow.yaml").write_text(yaml.safe_dump(config))
     cmd = [sys.executable, "-m", "pipeline.cli", "plan", "--config", "slow.yaml", "--vertices", "0,0 60,0 15,35",
            "--name", "tri"]
