@@ -129,7 +129,11 @@ def test_ctrl_c_is_one_line_exit_130_and_the_rollouts_are_kept(fresh):
     cmd = [sys.executable, "-m", "pipeline.cli", "plan", "--config", "slow.yaml", "--vertices", "0,0 60,0 15,35",
            "--name", "tri"]
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    # A job started in the background of a non-interactive shell (as CI may
+    # run the suite) inherits SIGINT ignored, and Python keeps it ignored: give
+    # the child the default disposition, so that it gets its KeyboardInterrupt.
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     for line in proc.stdout:
         if "mu_c 0: verified" in line:  # the first friction's plans are carried (rollouts done)
             proc.send_signal(signal.SIGINT)
