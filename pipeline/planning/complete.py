@@ -108,14 +108,27 @@ class FixedSearch:
     levels: list = field(default_factory=list)
     rollouts: int = 0
     seconds: float = 0.0
+    resting: dict | None = None  # the verdict on the resting states themselves (no pin)
 
     @property
     def orients(self) -> bool:
         """True if some fixed-pin sequence orients the part."""
         return bool(self.plans)
 
+    @property
+    def needs_no_pin(self) -> bool:
+        """True if the resting states alone end in one set within the tolerance
+        (a part whose symmetry makes its resting states one orientation)."""
+        return bool(self.resting and self.resting["orients"])
+
     def evidence(self) -> str:
         """One sentence: what was found, or why fixed pins are not enough."""
+        if self.needs_no_pin:
+            best = self.plans[0] if self.plans else None
+            return (f"no pin is needed: the resting states alone orient this part within "
+                    f"{self.tolerance:g} deg (verified width {self.resting['width_deg']:.1f} deg)"
+                    + (f"; with pins, {' '.join(best.labels)} would end within "
+                       f"{best.verdict['width_deg']:.1f} deg" if best else ""))
         if self.plans:
             best = self.plans[0]
             return (f"{len(best.labels)} fixed pins orient this part within {self.tolerance:g} deg "
@@ -131,7 +144,8 @@ class FixedSearch:
 
     def to_dict(self) -> dict:
         """The search's record for the plan file (``fixed_pin_search``)."""
-        return {"orients": self.orients, "depth": self.depth, "tolerance_deg": self.tolerance,
+        return {"orients": self.orients, "needs_no_pin": self.needs_no_pin, "resting": self.resting,
+                "depth": self.depth, "tolerance_deg": self.tolerance,
                 "required": self.required, "evidence": self.evidence(), "levels": self.levels,
                 "nominal_rollouts": self.rollouts, "seconds": round(self.seconds, 2),
                 "best_effort": [{"pins": list(b.labels), "pin_heights_mm": list(b.heights),
@@ -194,6 +208,10 @@ class FixedPinSearch:
             root = self._after(prefix)
             if root is None:  # the prefix jams its own nominal path
                 return result
+        else:  # no pin at all: the resting states' own spread (a symmetric part may need none)
+            empty = self.tree.root()
+            result.resting = next(self._judge(empty, np.array([0]),
+                                              self._stack(trial_inputs(self.states, self.mu_c, 0, self.cfg))))
         for level in self.tree.levels(int(depth), root):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
             found, judged, record = self._level(level, candidates)

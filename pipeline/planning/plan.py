@@ -102,7 +102,7 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
     chosen = fixed.plans or fixed.best_effort
     candidates = [carried_plan(planner, p.labels, p.margin, verify_cfg) for p in chosen]
-    moving = None if fixed.orients else _moving_planner(part, config, mu_c, planner)
+    moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, config, mu_c, planner)
     moving_search = None
     if moving is not None:
         moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress)
@@ -112,6 +112,8 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     _verify_candidates(part, config, mu_c, planner, candidates, states, progress)
     candidates.sort(key=_rank)
     good = [p for p in candidates if _acceptable(p)]
+    if fixed.needs_no_pin:  # no pin is the plan with the fewest pins: nothing to recommend
+        good = []
     return _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed, moving_search)
 
 
@@ -217,6 +219,8 @@ def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance
     recommended (None when a plan orients it)."""
     if good and good[0].verification["orientation"]["orients"]:
         return None
+    if fixed.needs_no_pin:
+        return fixed.evidence()
     why = fixed.evidence()
     if moving is not None:
         why += (f"; nor do up to {moving.depth} moving pins after no fixed pin or after the "
@@ -248,7 +252,9 @@ def _tight_result(config: dict, mu_c, depth: int, keep: int, planner, candidates
         "depth": depth, "complete_depth": depth,
         "beam": int(pc.get("dynamic", {}).get("beam", 30)),
         "tolerance_deg": tolerance, "required": verify_required(config),
-        "orients": bool(recommended and recommended.verification["orientation"]["orients"]),
+        "orients": bool(recommended and recommended.verification["orientation"]["orients"])
+        or fixed.needs_no_pin,
+        "needs_no_pin": fixed.needs_no_pin,
         "plans": [p.to_dict() for p in good[:keep]],
         "rejected": [p.to_dict() for p in candidates if p not in good][:keep],
         "recommended": recommended.to_dict() if recommended else None,

@@ -7,12 +7,15 @@ from __future__ import annotations
 import html
 import os
 
-COLOURS = {"fixed pins": "#2a7d2a", "moving pins": "#c77c00", "sensor": "#b00", "no plan": "#b00"}
-LEGEND = {"fixed pins": "fixed pins orient it", "moving pins": "needs moving pins",
+COLOURS = {"fixed pins": "#2a7d2a", "no pin needed": "#2a7d2a", "moving pins": "#c77c00",
+           "sensor": "#b00", "no plan": "#b00"}
+LEGEND = {"fixed pins": "fixed pins orient it", "no pin needed": "", "moving pins": "needs moving pins",
           "sensor": "no pin plan orients it (sensor)", "no plan": "no verified plan"}
 
 
 def _label(row: dict) -> str:
+    if row["outcome"] == "no pin needed":
+        return f"no pin needed, {row['verified_width_deg']:.1f} deg"
     if row["plan"] is None:
         return "no verified plan"
     n = row["fixed_pins"] + row["moving_pins"]
@@ -35,7 +38,7 @@ def atlas_section(atlas: dict, thumbnails: dict, base, anchor) -> list[str]:
          f"of the verified trials in one set; depth {atlas.get('depth')}), with how many pins, how "
          "precisely (verified width) and how fast (throughput at the layout's belt speed). "
          "Frame colour: " + ", ".join(f'<span style="color:{c}">{html.escape(LEGEND[k])}</span>'
-                                      for k, c in COLOURS.items() if k != "no plan") + ".</p>",
+                                      for k, c in COLOURS.items() if LEGEND[k] and k != "no plan") + ".</p>",
          '<div style="display:grid;grid-template-columns:repeat(auto-fill,minmax(150px,1fr));gap:8px">']
     for row in atlas["rows"]:
         name = row["part"]

@@ -10,8 +10,10 @@ throughput at the layout's belt speed). Nothing is recomputed, so the atlas
 always agrees with the files it summarises.
 
 Outcome of a part: ``fixed pins`` (fixed pins orient it within the
-tolerance), ``moving pins`` (it takes moving pins), ``sensor`` (no plan of
-up to the depth orients it: a sensor or a person must finish), ``no plan``
+tolerance), ``moving pins`` (it takes moving pins), ``no pin needed`` (its
+resting states are already one orientation within the tolerance, as for a
+regular polygon, and no pin plan does better), ``sensor`` (no plan of up to
+the depth orients it: a sensor or a person must finish), ``no plan``
 (nothing passed verification).
 """
 from __future__ import annotations
@@ -32,9 +34,9 @@ COLUMNS = ("part", "part_id", "outcome", "orients", "tolerance_deg", "fixed_pins
            "speed_limit_mm_s", "belt_speed_mm_s", "throughput_per_min", "planning_seconds", "evidence")
 
 
-def _outcome(orients: bool, plan: dict | None) -> str:
+def _outcome(orients: bool, plan: dict | None, needs_no_pin: bool = False) -> str:
     if plan is None:
-        return "no plan"
+        return "no pin needed" if needs_no_pin else "no plan"
     if not orients:
         return "sensor"
     return "moving pins" if plan.get("n_dynamic_pins") else "fixed pins"
@@ -45,16 +47,18 @@ def atlas_row(plan_result: dict, speed: dict | None = None, layout: dict | None 
     speed and layout results."""
     entry = (plan_result.get("tight") or [None])[0] or {}
     plan = entry.get("recommended")
-    verdict = ((plan or {}).get("verification") or {}).get("orientation") or {}
+    search = entry.get("fixed_pin_search") or {}
+    no_pin = bool(search.get("needs_no_pin")) and plan is None
+    verdict = (search.get("resting") if no_pin else
+               ((plan or {}).get("verification") or {}).get("orientation")) or {}
     orients = bool(verdict.get("orients"))
     n_moving = int((plan or {}).get("n_dynamic_pins") or 0)
-    search = entry.get("fixed_pin_search") or {}
     return {
         "part": plan_result["part"]["name"], "part_id": plan_result["part"]["id"],
-        "outcome": _outcome(orients, plan), "orients": orients,
+        "outcome": _outcome(orients, plan, no_pin), "orients": orients,
         "tolerance_deg": entry.get("tolerance_deg"),
-        "fixed_pins": None if plan is None else len(plan["pins"]) - n_moving,
-        "moving_pins": None if plan is None else n_moving,
+        "fixed_pins": 0 if no_pin else None if plan is None else len(plan["pins"]) - n_moving,
+        "moving_pins": 0 if no_pin else None if plan is None else n_moving,
         "sensor_needed": not orients,
         "verified_width_deg": verdict.get("width_deg"),
         "sets": 1 if orients else verdict.get("sets_within_tolerance"),
