@@ -193,3 +193,16 @@ def test_no_plan_recommends_fixed_pins_for_a_sensor():
     assert not entry["orients"] and not entry["moving_pin_search"]["orients"]
     assert entry["recommended"]["n_dynamic_pins"] == 0
     assert "nor do up to 1 moving pins" in entry["warning"] and "a sensor must tell them apart" in entry["warning"]
+
+
+def test_a_square_needs_no_pin_and_the_oracle_agrees():
+    """A square's four resting states are one orientation (4-fold symmetry): with
+    no pin at all, the oracle's own trials already end within the tolerance, and
+    the search says that no pin is needed."""
+    part = Part.from_vertices([[0, 0], [40, 0], [40, 40], [0, 40]])
+    finals = np.concatenate([t[0] for t in box_trials(part, 0, 30, 3, MU)])
+    assert most_in_arc(finals, 8.0, part.symmetry_order()) == finals.size  # the oracle: oriented already
+    result = _search(part, {"A": 10.0, "B": 30.0}, 8.0, 1)
+    assert result.needs_no_pin and result.evidence().startswith("no pin is needed")
+    triangle = _search(Part.from_vertices([[0, 0], [60, 0], [15, 35]]), {"A": 10.0}, 8.0, 1)
+    assert not triangle.needs_no_pin
