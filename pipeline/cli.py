@@ -870,13 +870,13 @@ def cmd_atlas(args):
         return
     print(f"feedability atlas of config {atlas['config']}: tolerance {atlas['tolerance_deg']:g} deg, "
           f"depth {atlas['depth']} ({path})")
-    print(f"{'part':<18} {'outcome':<12} {'fixed':>5} {'moving':>6} {'sets':>4} {'width':>7} {'in set':>11} "
+    print(f"{'part':<18} {'outcome':<14} {'fixed':>5} {'moving':>6} {'sets':>4} {'width':>7} {'in set':>11} "
           f"{'limit':>7} {'parts/min':>9} {'plan s':>7}  plan")
     for r in atlas["rows"]:
         def num(key, fmt):
             return "-" if r.get(key) is None else format(r[key], fmt)
         inset = "-" if r.get("in_set") is None else f"{r['in_set']}/{r['trials']}"
-        print(f"{r['part']:<18} {r['outcome']:<12} {num('fixed_pins', 'd'):>5} {num('moving_pins', 'd'):>6} "
+        print(f"{r['part']:<18} {r['outcome']:<14} {num('fixed_pins', 'd'):>5} {num('moving_pins', 'd'):>6} "
               f"{num('sets', 'd'):>4} "
               f"{num('verified_width_deg', '.1f'):>7} {inset:>11} {num('speed_limit_mm_s', '.0f'):>7} "
               f"{num('throughput_per_min', '.0f'):>9} {num('planning_seconds', '.0f'):>7}  {r['plan'] or '-'}")
