@@ -15,6 +15,7 @@ from cli_runs import run_cli  # noqa: E402
 from pipeline.maps.simulate import rollout  # noqa: E402
 from pipeline.parts.outlines import read_outline  # noqa: E402
 from pipeline.parts.part import Part  # noqa: E402
+from cad_files import dxf_file
 
 L_XY = [(0, 0), (60, 0), (60, 10), (10, 10), (10, 40), (0, 40)]  # L-bracket, mm
 SL, R = 40.0, 10.0  # slot: centre distance and end radius, mm
@@ -46,14 +47,6 @@ def _fine_slot(sagitta=1e-3):
 @functools.lru_cache(maxsize=1)
 def _fine():
     return _fine_slot()
-
-
-def _dxf(path, build, insunits=4):
-    doc = ezdxf.new()
-    doc.header["$INSUNITS"] = insunits
-    build(doc.modelspace())
-    doc.saveas(path)
-    return path
 
 
 def _shuffled_lines(msp, xy=L_XY, seed=3, scale=1.0):
@@ -90,7 +83,7 @@ def _l_two_open_lwpolylines(msp):
 
 @pytest.mark.parametrize("build", [_l_lines, _l_lines_duplicated, _l_polyline2d, _l_two_open_lwpolylines])
 def test_exact_polygon_from_dxf_is_the_vertices_part(tmp_path, build):
-    out = read_outline(_dxf(tmp_path / "l.dxf", build))
+    out = read_outline(dxf_file(tmp_path / "l.dxf", build))
     part = Part.from_vertices(out.vertices, name="l")
     reference = Part.from_vertices(L_XY, name="l")
     assert part.id == reference.id and out.n_vertices == 6 and not out.left_out
@@ -100,7 +93,7 @@ def test_exact_polygon_from_dxf_is_the_vertices_part(tmp_path, build):
 def test_issue_l_bracket_of_six_shuffled_lines_reads(tmp_path):
     # The issue's crash: six LINEs out of order (list.remove compared numpy arrays).
     for seed in range(5):
-        out = read_outline(_dxf(tmp_path / f"l{seed}.dxf", lambda m, s=seed: _shuffled_lines(m, seed=s)))
+        out = read_outline(dxf_file(tmp_path / f"l{seed}.dxf", lambda m, s=seed: _shuffled_lines(m, seed=s)))
         assert Part.from_vertices(out.vertices, name="l").id == Part.from_vertices(L_XY, name="l").id
 
 
@@ -112,7 +105,7 @@ def test_svg_polygon_with_transform_has_the_dxf_part_id(tmp_path):
                     f'viewBox="0 0 200 100"><g transform="translate(17,5)"><polygon points="{flipped}"/>'
                     '</g></svg>')
     svg_part = Part.from_vertices(read_outline(path).vertices, name="l")
-    dxf_part = Part.from_vertices(read_outline(_dxf(tmp_path / "l.dxf", _l_lines)).vertices, name="l")
+    dxf_part = Part.from_vertices(read_outline(dxf_file(tmp_path / "l.dxf", _l_lines)).vertices, name="l")
     assert svg_part.id == dxf_part.id == Part.from_vertices(L_XY, name="l").id
     _assert_same_rollouts(svg_part, dxf_part, 1e-6)
 
@@ -159,7 +152,7 @@ def _slot_closed_bulges(msp):
                                    _slot_gaps_and_duplicates, _slot_bulged_open_lwpolylines,
                                    _slot_closed_bulges])
 def test_slot_with_arcs_rolls_like_the_fine_slot(tmp_path, build):
-    out = read_outline(_dxf(tmp_path / "slot.dxf", build), flatten_tol=0.05)
+    out = read_outline(dxf_file(tmp_path / "slot.dxf", build), flatten_tol=0.05)
     assert not out.left_out
     part = Part.from_vertices(out.vertices, name="slot")
     assert part.a == pytest.approx(SL / 2 + R, abs=0.05)
@@ -186,7 +179,7 @@ def test_centre_line_longer_than_the_part_is_left_out(tmp_path):
     def build(msp):
         _slot_issue(msp)
         msp.add_line((-20, 0), (SL + 20, 0), dxfattribs={"layer": "CENTER"})  # 80 mm, across the slot
-    out = read_outline(_dxf(tmp_path / "c.dxf", build))
+    out = read_outline(dxf_file(tmp_path / "c.dxf", build))
     assert "chain of 4 pieces" in out.name
     assert len(out.left_out) == 1 and "open chain LINE" in out.left_out[0] and "80 mm apart" in out.left_out[0]
 
@@ -198,7 +191,7 @@ def test_ellipse_and_spline_pieces_join(tmp_path):
         msp.add_ellipse((0, 0), major_axis=(20, 0), ratio=0.5, start_param=-math.pi / 2,
                         end_param=math.pi / 2)
         msp.add_spline([(0, 10), (-5, 5), (-6, 0), (-5, -5), (0, -10)])
-    out = read_outline(_dxf(tmp_path / "d.dxf", build), flatten_tol=0.01)
+    out = read_outline(dxf_file(tmp_path / "d.dxf", build), flatten_tol=0.01)
     w, h, _ = out.size_mm
     assert "2 pieces" in out.name and w == pytest.approx(26, abs=0.5) and h == pytest.approx(20, abs=0.01)
 
@@ -215,7 +208,7 @@ def _l_scaled(factor):
                                                     (0, 1.0, "units mm from the default (unitless DXF"),
                                                     (5, 0.1, "units cm from $INSUNITS=5")])
 def test_declared_units_give_the_same_part(tmp_path, insunits, factor, said):
-    out = read_outline(_dxf(tmp_path / "l.dxf", _l_scaled(factor), insunits=insunits))
+    out = read_outline(dxf_file(tmp_path / "l.dxf", _l_scaled(factor), insunits=insunits))
     assert Part.from_vertices(out.vertices, name="l").id == Part.from_vertices(L_XY, name="l").id
     assert said in out.describe() and "size 60 x 40 mm, a = 40.07 mm" in out.describe()
     assert not out.warnings()
@@ -223,7 +216,7 @@ def test_declared_units_give_the_same_part(tmp_path, insunits, factor, said):
 
 def test_mm_drawing_declared_in_metres_warns_and_units_fixes_it(tmp_path, capsys):
     # ezdxf's new drawings default to metres: a drawing made in mm comes out 1000 times larger.
-    path = _dxf(tmp_path / "l.dxf", _l_lines, insunits=6)
+    path = dxf_file(tmp_path / "l.dxf", _l_lines, insunits=6)
     base = ["rollout", "--outline", str(path), "--mu-c", "0.2", "--pin-radius", "3", "--theta-i", "30",
             "--d", "0.3"]
     code, out, err = run_cli(capsys, base)
@@ -236,7 +229,7 @@ def test_mm_drawing_declared_in_metres_warns_and_units_fixes_it(tmp_path, capsys
 
 
 def test_tiny_part_warns(tmp_path):
-    out = read_outline(_dxf(tmp_path / "l.dxf", _l_scaled(1 / 100), insunits=4))
+    out = read_outline(dxf_file(tmp_path / "l.dxf", _l_scaled(1 / 100), insunits=4))
     assert any("0.6 mm across" in w and "--units" in w for w in out.warnings())
 
 
@@ -271,7 +264,7 @@ def test_bad_outlines_are_one_line_errors(tmp_path, capsys):
     def washer(msp):
         _slot_issue(msp)
         msp.add_circle((SL / 2, 0), 3, dxfattribs={"layer": "HOLES"})
-    path = _dxf(tmp_path / "washer.dxf", washer)
+    path = dxf_file(tmp_path / "washer.dxf", washer)
     _one_line_error(capsys, _rollout_args(path), "1 hole(s)", "CIRCLE", "not supported", "--layer")
     code, _, err = run_cli(capsys, _rollout_args(path, "--layer", "0"))  # the way out works
     assert code == 0 and "chain of 4 pieces" in err
@@ -279,7 +272,7 @@ def test_bad_outlines_are_one_line_errors(tmp_path, capsys):
     def gapped(msp):  # the L in two open polylines, 0.05 mm apart at (0, 0)
         msp.add_lwpolyline(L_XY[:4])
         msp.add_lwpolyline([(0, 0.05)] + L_XY[5:2:-1])
-    gap_path = _dxf(tmp_path / "gap.dxf", gapped)
+    gap_path = dxf_file(tmp_path / "gap.dxf", gapped)
     _one_line_error(capsys, _rollout_args(gap_path), "open outline", "0.050 mm from its start", "--join-tol")
     code, _, err = run_cli(capsys, _rollout_args(gap_path, "--join-tol", "0.1"))
     assert code == 0 and "6 vertices" in err
@@ -292,7 +285,7 @@ def test_zero_length_line_is_ignored(tmp_path):
     def build(msp):
         _shuffled_lines(msp)
         msp.add_line((0, 0), (0, 0))
-    out = read_outline(_dxf(tmp_path / "z.dxf", build))
+    out = read_outline(dxf_file(tmp_path / "z.dxf", build))
     assert out.n_vertices == 6 and not out.left_out
 
 
@@ -313,7 +306,7 @@ def test_config_part_takes_units_and_join_tol(tmp_path):
     def gapped(msp):  # the L drawn in inches, read as mm unless told, 0.002 in apart at (0, 0)
         msp.add_lwpolyline(np.divide(L_XY[:4], 25.4).tolist())
         msp.add_lwpolyline((np.array([(0, 0.05)] + L_XY[5:2:-1]) / 25.4).tolist())
-    path = _dxf(tmp_path / "l.dxf", gapped, insunits=0)
+    path = dxf_file(tmp_path / "l.dxf", gapped, insunits=0)
     cfg = yaml.safe_load(DEFAULT_CONFIG.read_text())
     cfg["planner"]["parts"] = []
     cfg["families"] = {"cad": {"parts": [{"name": "l", "outline": str(path), "units": "in", "join_tol": 0.01}]}}

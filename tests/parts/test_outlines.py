@@ -10,6 +10,7 @@ pytest.importorskip("svgelements")
 
 from pipeline.parts.outlines import OutlineError, read_outline  # noqa: E402
 from pipeline.parts.part import Part  # noqa: E402
+from cad_files import dxf_file
 
 L, R = 40.0, 10.0  # rounded slot: centre distance, end radius
 SLOT_AREA = 2 * R * L + math.pi * R * R
@@ -18,14 +19,6 @@ SLOT_AREA = 2 * R * L + math.pi * R * R
 def _area(xy):
     x, y = xy[:, 0], xy[:, 1]
     return 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
-
-
-def _dxf(path, build, insunits=4):
-    doc = ezdxf.new()
-    doc.header["$INSUNITS"] = insunits
-    build(doc.modelspace())
-    doc.saveas(path)
-    return path
 
 
 def _slot_pieces(msp, dx=0.0, layer="0"):
@@ -51,7 +44,7 @@ SLOT_D = "M 0,-10 L 40,-10 A 10 10 0 0 1 40 10 L 0 10 A 10 10 0 0 1 0 -10 Z"
 
 @pytest.mark.parametrize("tol", [0.05, 0.01])
 def test_dxf_rounded_slot_from_lines_and_arcs(tmp_path, tol):
-    out = read_outline(_dxf(tmp_path / "slot.dxf", _slot_pieces), flatten_tol=tol)
+    out = read_outline(dxf_file(tmp_path / "slot.dxf", _slot_pieces), flatten_tol=tol)
     area = _area(out.vertices)
     # Chords lie inside the arcs: the polygon's area is short of the true one by
     # less than the arcs' length times the tolerance.
@@ -62,7 +55,7 @@ def test_dxf_rounded_slot_from_lines_and_arcs(tmp_path, tol):
 
 
 def test_dxf_units_are_converted_to_mm(tmp_path):
-    out = read_outline(_dxf(tmp_path / "in.dxf", _bracket, insunits=1))  # inches
+    out = read_outline(dxf_file(tmp_path / "in.dxf", _bracket, insunits=1))  # inches
     assert _area(out.vertices) == pytest.approx((60 * 10 + 30 * 10) * 25.4 ** 2)
 
 
@@ -71,12 +64,12 @@ def test_dxf_bulged_polyline_is_flattened(tmp_path):
     def build(msp):
         msp.add_lwpolyline([(0, -R, 0, 0, 0), (L, -R, 0, 0, 1), (L, R, 0, 0, 0), (0, R, 0, 0, 1)],
                            format="xyseb", close=True)
-    out = read_outline(_dxf(tmp_path / "bulge.dxf", build), flatten_tol=0.05)
+    out = read_outline(dxf_file(tmp_path / "bulge.dxf", build), flatten_tol=0.05)
     assert 0 < SLOT_AREA - _area(out.vertices) <= 2 * math.pi * R * 0.05
 
 
 def test_dxf_l_bracket_non_convex(tmp_path):
-    out = read_outline(_dxf(tmp_path / "l.dxf", _bracket))
+    out = read_outline(dxf_file(tmp_path / "l.dxf", _bracket))
     assert out.n_vertices == 6
     part = Part.from_vertices(out.vertices, name="bracket")
     assert not part.is_convex and part.area == pytest.approx(900.0)
@@ -109,14 +102,14 @@ def test_open_outline(tmp_path):
         msp.add_line((0, 0), (10, 0))
         msp.add_line((10, 0), (10, 10))
     with pytest.raises(OutlineError, match=r"open outline.*ends at \(10\.000, 10\.000\)"):
-        read_outline(_dxf(tmp_path / "open.dxf", build))
+        read_outline(dxf_file(tmp_path / "open.dxf", build))
 
 
 def test_disjoint_outlines_largest_by_default_others_reported(tmp_path):
     def build(msp):
         _slot_pieces(msp, dx=100.0, layer="SLOT")  # area 1114 mm^2
         _bracket(msp, layer="BRACKET")  # area 900 mm^2
-    path = _dxf(tmp_path / "two.dxf", build)
+    path = dxf_file(tmp_path / "two.dxf", build)
     out = read_outline(path)
     assert _area(out.vertices) == pytest.approx(SLOT_AREA, rel=1e-2) and "layer SLOT" in out.name
     assert len(out.left_out) == 1 and "layer BRACKET" in out.left_out[0] and "900 mm^2" in out.left_out[0]
@@ -133,7 +126,7 @@ def test_self_intersection(tmp_path):
     def build(msp):
         msp.add_lwpolyline([(0, 0), (10, 10), (10, 0), (0, 10)], close=True)
     with pytest.raises(OutlineError, match="self-intersecting"):
-        read_outline(_dxf(tmp_path / "bow.dxf", build))
+        read_outline(dxf_file(tmp_path / "bow.dxf", build))
 
 
 def test_hole_is_refused(tmp_path):
@@ -141,7 +134,7 @@ def test_hole_is_refused(tmp_path):
         _bracket(msp)
         msp.add_circle((5, 5), 2)
     with pytest.raises(OutlineError, match=r"1 hole\(s\).*not supported.*--layer"):
-        read_outline(_dxf(tmp_path / "hole.dxf", build))
+        read_outline(dxf_file(tmp_path / "hole.dxf", build))
 
 
 def test_bad_inputs(tmp_path):
@@ -151,7 +144,7 @@ def test_bad_inputs(tmp_path):
     with pytest.raises(OutlineError, match="give a .dxf or .svg"):
         read_outline(tmp_path / "x.stl")
     with pytest.raises(OutlineError, match="flatten-tol"):
-        read_outline(_dxf(tmp_path / "l.dxf", _bracket), flatten_tol=0)
+        read_outline(dxf_file(tmp_path / "l.dxf", _bracket), flatten_tol=0)
 
 
 def test_config_family_outline_relative_to_config_file(tmp_path, monkeypatch):
@@ -161,7 +154,7 @@ def test_config_family_outline_relative_to_config_file(tmp_path, monkeypatch):
     from pipeline.errors import PinfeedError
     from pipeline.parts.families import family_parts
     (tmp_path / "cad").mkdir()
-    _dxf(tmp_path / "cad" / "l.dxf", _bracket)
+    dxf_file(tmp_path / "cad" / "l.dxf", _bracket)
     cfg = yaml.safe_load(DEFAULT_CONFIG.read_text())
     cfg["families"] = {"cad": {"parts": [{"name": "bracket", "outline": "cad/l.dxf"}]}}
     cfg["planner"]["parts"] = ["bracket"]
@@ -178,7 +171,7 @@ def test_config_family_outline_relative_to_config_file(tmp_path, monkeypatch):
 
 def test_cli_rollout_from_outline(tmp_path, capsys):
     from pipeline.cli import main
-    path = _dxf(tmp_path / "slot.dxf", _slot_pieces)
+    path = dxf_file(tmp_path / "slot.dxf", _slot_pieces)
     assert main(["rollout", "--outline", str(path), "--mu-c", "0.2", "--pin-radius", "3",
                  "--theta-i", "30", "--d", "0.3", "--json"]) == 0
     cap = capsys.readouterr()
@@ -217,7 +210,7 @@ def test_validated_config_validates_again(tmp_path):
     import yaml
 
     from pipeline.config import DEFAULT_CONFIG, validate_config
-    _dxf(tmp_path / "l.dxf", _bracket)
+    dxf_file(tmp_path / "l.dxf", _bracket)
     cfg = yaml.safe_load(DEFAULT_CONFIG.read_text())
     cfg["families"]["cad"] = {"parts": [{"name": "bracket", "outline": str(tmp_path / "l.dxf")}]}
     once = validate_config(cfg)
@@ -229,7 +222,7 @@ def test_crossing_outlines_and_block_references(tmp_path):
         _bracket(msp)
         msp.add_lwpolyline([(5, 5), (80, 5), (80, 8), (5, 8)], close=True)
     with pytest.raises(OutlineError, match="cross each other"):
-        read_outline(_dxf(tmp_path / "cross.dxf", crossing))
+        read_outline(dxf_file(tmp_path / "cross.dxf", crossing))
     doc = ezdxf.new()
     doc.header["$INSUNITS"] = 4  # mm (ezdxf's new documents default to metres)
     block = doc.blocks.new(name="BRACKET")
