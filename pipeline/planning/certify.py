@@ -18,7 +18,7 @@ import numpy as np
 from pipeline.parts.contact import contact_parameter
 from pipeline.planning.arcs import merge_arcs, merge_modulo
 from pipeline.planning.orient import narrowest_arc
-from pipeline.planning.propagate import friction_interval, snapped_state
+from pipeline.planning.propagate import friction_interval, resting_states, snapped_state
 from pipeline.planning.search import Step, TightPlan, TightPlanner
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import replay, trial_inputs
@@ -47,7 +47,7 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> 
     part, unc = planner.part, planner.unc
     pins = [planner.pins[p] for p in labels]
     starts = planner.initial_states()
-    resting = {k: (float(t), float(y)) for k, (t, y) in zip(starts, part.stable_states())}
+    resting = resting_states(part)
     mu_lo, mu_hi = friction_interval(planner.mu_c, unc)
     branches, finals = {}, []
     for label, (th, yc, mu, offs) in zip(starts, trial_inputs(resting, planner.mu_c, len(pins), cfg)):

@@ -49,6 +49,7 @@ from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
 from pipeline.parts.part import Part
 from pipeline.planning import orient
 from pipeline.planning.enumerate import Level, NominalTree
+from pipeline.planning.propagate import resting_states
 from pipeline.planning.settings import nominal_friction
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import replay, trial_inputs
@@ -188,8 +189,7 @@ class FixedPinSearch:
         self.pin_radius = float(pin_radius)
         self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **(kernel or {})}
         self.order = part.symmetry_order()
-        self.states = {f"state {k}": (float(t), float(y))
-                       for k, (t, y) in enumerate(part.stable_states(), start=1)}
+        self.states = resting_states(part)
         self.tree = NominalTree(part, self.heights, nominal_friction(mu_c), self.pin_radius, model,
                                 self.kernel, float(self.cfg["pin_halfwidth"]), d_min, d_max,
                                 belt=self.belt, speeds=self.speeds)

@@ -31,7 +31,7 @@ from pipeline.planning.complete import FixedPinSearch, FixedPlan, FixedSearch, o
 from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required,
                                       check_tolerance, judge)
-from pipeline.planning.propagate import Tolerances, Uncertainty
+from pipeline.planning.propagate import Tolerances, Uncertainty, resting_states
 from pipeline.planning.search import TightPlanner
 from pipeline.planning.settings import candidate_pins, friction_label, parse_friction
 from pipeline.planning.types import Plan, TightEntry, as_plan_file
@@ -100,7 +100,8 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     planner = planner_for(part, config, mu_c, lattices)
     fixed = _fixed_search(part, config, mu_c, planner, depth, keep, progress)
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
-    chosen = fixed.plans or fixed.best_effort
+    # No pin is the plan with the fewest pins: then nothing is certified or recommended.
+    chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
     candidates = [carried_plan(planner, p.labels, p.margin, verify_cfg) for p in chosen]
     moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, config, mu_c, planner)
     moving_search = None
@@ -108,12 +109,10 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
         moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress)
         candidates += [carried_plan(moving, p.labels, p.margin, verify_cfg) for p in moving_search.plans]
         planner = moving
-    states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
+    states = resting_states(part)
     _verify_candidates(part, config, mu_c, planner, candidates, states, progress)
     candidates.sort(key=_rank)
     good = [p for p in candidates if _acceptable(p)]
-    if fixed.needs_no_pin:  # no pin is the plan with the fewest pins: nothing to recommend
-        good = []
     return _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed, moving_search)
 
 
@@ -127,15 +126,24 @@ def verify_required(config: dict) -> float:
     return check_required(config.get("verify", {}).get("required", DEFAULT_REQUIRED))
 
 
+def _pin_search(part, config, mu_c, planner, moving: bool) -> FixedPinSearch:
+    """The complete search over the planner's fixed pins (``moving`` False) or
+    its moving pins (True), with the config's tolerance, verification and
+    kernel settings and the planner's belt."""
+    pc, sweep = config["planner"], config["sweep"]
+    pins = {k: p for k, p in planner.pins.items() if bool(p.v_pin) == moving}
+    return FixedPinSearch(part, {k: p.y for k, p in pins.items()}, mu_c, planner_tolerance(config),
+                          verify_required(config), config.get("verify", {}), sweep["pin_radius"],
+                          pc["model"], sweep.get("kernel"), pc["d_min"], pc["d_max"],
+                          belt_speed=planner.belt_speed, mu_s=planner.mu_s,
+                          speeds={k: p.v_pin for k, p in pins.items()})
+
+
 def _fixed_search(part, config, mu_c, planner, depth, keep, progress) -> FixedSearch:
     """The complete fixed-pin search with the planner's pins and the config's settings."""
-    pc, sweep = config["planner"], config["sweep"]
-    search = FixedPinSearch(part, {k: p.y for k, p in planner.pins.items() if p.v_pin == 0.0}, mu_c,
-                            planner_tolerance(config), verify_required(config),
-                            config.get("verify", {}), sweep["pin_radius"], pc["model"],
-                            sweep.get("kernel"), pc["d_min"], pc["d_max"],
-                            belt_speed=planner.belt_speed, mu_s=planner.mu_s)
-    return search.run(depth, candidates=int(pc.get("candidates", 12)), keep=keep, progress=progress)
+    search = _pin_search(part, config, mu_c, planner, moving=False)
+    return search.run(depth, candidates=int(config["planner"].get("candidates", 12)), keep=keep,
+                      progress=progress)
 
 
 def _moving_planner(part, config, mu_c, planner):
@@ -151,15 +159,10 @@ def _moving_search(part, config, mu_c, moving, chosen, keep, progress) -> FixedS
     each of the ``MOVING_PREFIXES`` best fixed-pin results, by the same
     enumeration, screen and judgement as the fixed pins (every moving-pin
     sequence after each prefix is tried); the orienting plans, best first."""
-    pc, sweep, dyn = config["planner"], config["sweep"], config["planner"]["dynamic"]
+    pc, dyn = config["planner"], config["planner"]["dynamic"]
     if progress:
         progress(f"mu_c {friction_label(mu_c)}: fixed pins do not orient the part: adding moving pins")
-    pins = {k: p for k, p in moving.pins.items() if p.v_pin}
-    search = FixedPinSearch(part, {k: p.y for k, p in pins.items()}, mu_c, planner_tolerance(config),
-                            verify_required(config), config.get("verify", {}), sweep["pin_radius"],
-                            pc["model"], sweep.get("kernel"), pc["d_min"], pc["d_max"],
-                            belt_speed=moving.belt_speed, mu_s=moving.mu_s,
-                            speeds={k: p.v_pin for k, p in pins.items()})
+    search = _pin_search(part, config, mu_c, moving, moving=True)
     depth = int(dyn["depth"])
     total = FixedSearch([], [], depth, planner_tolerance(config), verify_required(config))
     for prefix in [None, *chosen[:MOVING_PREFIXES]]:

@@ -138,14 +138,19 @@ def friction_interval(mu_c, unc: Uncertainty) -> tuple[float, float]:
     return max(0.0, mu - unc.mu_halfwidth), mu + unc.mu_halfwidth
 
 
+def resting_states(part: Part) -> dict[str, tuple[float, float]]:
+    """The resting states against the fence: label ``state k`` -> ``(theta_deg,
+    y_c_mm)``, the labels every planner and the verification share."""
+    return {f"state {k}": (float(theta), float(y_c))
+            for k, (theta, y_c) in enumerate(part.stable_states(), start=1)}
+
+
 def initial_state_sets(part: Part, mu_c, unc: Uncertainty) -> dict[str, StateSet]:
     """The resting states against the fence, each widened to the uncertainty box."""
     mu_lo, mu_hi = friction_interval(mu_c, unc)
-    out = {}
-    for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
-        out[f"state {k}"] = snapped_state(theta - unc.theta_halfwidth, 2 * unc.theta_halfwidth,
-                                          y_c - unc.y_halfwidth, y_c + unc.y_halfwidth, mu_lo, mu_hi)
-    return out
+    return {label: snapped_state(theta - unc.theta_halfwidth, 2 * unc.theta_halfwidth,
+                                 y_c - unc.y_halfwidth, y_c + unc.y_halfwidth, mu_lo, mu_hi)
+            for label, (theta, y_c) in resting_states(part).items()}
 
 
 class OutcomeLattice:
