@@ -26,19 +26,23 @@ from pipeline.planning.verify import replay, trial_inputs
 CLUSTER_GAP_DEG = 3.0  # sampled final orientations further apart than this are separate sets
 
 
-def carried_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> TightPlan:
+def carried_plan(planner: TightPlanner, labels, margin: float, verify: dict, family=None) -> TightPlan:
     """The :class:`TightPlan` of the sequence ``labels``: propagated if the
-    tight propagation allows every pin, else sampled (see the module notes)."""
-    plan = planner.follow(labels)
+    tight propagation allows every pin, else sampled (see the module notes).
+    With a support ``family`` other than uniform alone the sets are always
+    sampled, over the family's members (the propagation assumes uniform
+    pressure)."""
+    plan = planner.follow(labels) if family is None or family.is_uniform else None
     if plan is not None:
         plan.claim = "propagated"
         return plan
-    return sampled_plan(planner, labels, margin, verify)
+    return sampled_plan(planner, labels, margin, verify, family)
 
 
-def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> TightPlan:
+def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict, family=None) -> TightPlan:
     """A :class:`TightPlan` whose carried sets are sampled: a replay of the
-    perturbation box (seed ``verify.seed + 1``); per initial state, the trials
+    perturbation box (seed ``verify.seed + 1``; supports sampled from
+    ``family`` as the verification does); per initial state, the trials
     whose final orientations form one cluster (gaps of more than
     ``CLUSTER_GAP_DEG`` split clusters) are one branch, and each step of a
     branch carries the hull of its trials after that pin."""
@@ -50,11 +54,12 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict) -> 
     resting = resting_states(part)
     mu_lo, mu_hi = friction_interval(planner.mu_c, unc)
     branches, finals = {}, []
-    for label, (th, yc, mu, offs) in zip(starts, trial_inputs(resting, planner.mu_c, len(pins), cfg)):
+    supports = None if family is None else family.kernel_supports
+    for label, (th, yc, mu, offs, sup) in zip(starts, trial_inputs(resting, planner.mu_c, len(pins), cfg, family)):
         path = []
         replay(part, [p.y for p in pins], [p.v_pin for p in pins], th, yc, mu, offs,
                planner.pin_radius, planner.model, path=path, belt_speed=planner.belt_speed,
-               mu_s=planner.mu_s)
+               mu_s=planner.mu_s, support=sup, supports=supports)
         before = [yc] + [y for _, y in path[:-1]]
         alive = np.isfinite(path[-1][0])  # jammed trials end nowhere
         branches[label] = []

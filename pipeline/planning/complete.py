@@ -172,12 +172,17 @@ class FixedPinSearch:
     speeds : ``{label: v_pin / v_b}`` for candidate pins that move (the
         others are fixed); :meth:`run` with a ``prefix`` lets them follow a
         fixed-pin sequence.
+    family : a :class:`~pipeline.parts.support_family.SupportFamily` the
+        plans must orient the part for (issue 25): the nominal paths run under
+        each of its ``representatives`` (the union over them is what must fit
+        the tolerance) and the trials sample its members as the verification
+        does; ``None``: uniform pressure.
     """
 
     def __init__(self, part: Part, pins: dict, mu_c, tolerance: float, required: float,
                  verify: dict, pin_radius: float, model: str = "minpower", kernel: dict | None = None,
                  d_min: float = 0.1, d_max: float = 0.9, belt_speed: float | None = None,
-                 mu_s: float = 0.5, speeds: dict | None = None):
+                 mu_s: float = 0.5, speeds: dict | None = None, family=None):
         self.part, self.mu_c, self.model = part, mu_c, model
         self.belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
         self.labels = list(pins)
@@ -190,9 +195,12 @@ class FixedPinSearch:
         self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **(kernel or {})}
         self.order = part.symmetry_order()
         self.states = resting_states(part)
+        self.family = None if family is None or family.is_uniform else family
+        self.supports = None if self.family is None else self.family.kernel_supports
+        nominal = None if self.family is None else [self.supports[k] for k in self.family.representatives]
         self.tree = NominalTree(part, self.heights, nominal_friction(mu_c), self.pin_radius, model,
                                 self.kernel, float(self.cfg["pin_halfwidth"]), d_min, d_max,
-                                belt=self.belt, speeds=self.speeds)
+                                belt=self.belt, speeds=self.speeds, supports=nominal)
         self.prefix = FixedPlan((), (), 0.0, np.inf)  # the pins every sequence starts with (run)
 
     def run(self, depth: int, candidates: int = 12, keep: int = 5, progress=None,
@@ -211,7 +219,7 @@ class FixedPinSearch:
         else:  # no pin at all: the resting states' own spread (a symmetric part may need none)
             empty = self.tree.root()
             result.resting = next(self._judge(empty, np.array([0]),
-                                              self._stack(trial_inputs(self.states, self.mu_c, 0, self.cfg))))
+                                              self._stack(self._trials(0))))
         for level in self.tree.levels(int(depth), root):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
             found, judged, record = self._level(level, candidates)
@@ -236,13 +244,13 @@ class FixedPinSearch:
     def _after(self, prefix: FixedPlan):
         """The nominal level after ``prefix`` (its pins replayed exactly from the
         resting states at the middle friction), or None if it jams."""
-        states = self.part.stable_states()
+        states = self.tree.start_poses()
         n = len(prefix.labels)
         speeds = prefix.speeds or (0.0,) * n
         theta, y_c, jam, _ = replay(self.part, list(prefix.heights), list(speeds), states[:, 0], states[:, 1],
                                     np.full(len(states), nominal_friction(self.mu_c)), np.zeros((len(states), n)),
                                     self.pin_radius, self.model, self.kernel["ds_max"], self.kernel["tol"],
-                                    **self.belt)
+                                    **self.belt, support=self.tree.column_support, supports=self.tree.supports)
         if (jam != "").any():
             return None
         return Level(np.zeros((1, 0), dtype=np.int16), theta[None, :], y_c[None, :], np.array([prefix.margin]))
@@ -262,7 +270,7 @@ class FixedPinSearch:
         if within.size == 0:
             return [], [], record
         n_pins = len(self.prefix.labels) + level.seq.shape[1]
-        inputs = trial_inputs(self.states, self.mu_c, n_pins, self.cfg)
+        inputs = self._trials(n_pins)
         n_total = sum(x[0].size for x in inputs)
         allowed = n_total - orient.needed(n_total, self.required)
         # A probe of a few trials per state orders the candidates (most promising
@@ -305,22 +313,26 @@ class FixedPinSearch:
         and ``n_corners_wanted`` evenly spread corners of each state."""
         n_random = int(self.cfg["trials"])
         rows = []
-        for th, yc, mu, offs in inputs:
-            n_corners = th.size - n_random
+        for trials in inputs:
+            n_corners = trials[0].size - n_random
             pick = list(range(min(n_first, n_random)))
             if n_corners:
                 step = max(1, n_corners // n_corners_wanted)
-                pick += list(range(n_random, th.size, step))[:n_corners_wanted]
-            rows.append((th[pick], yc[pick], mu[pick], offs[pick]))
+                pick += list(range(n_random, trials[0].size, step))[:n_corners_wanted]
+            rows.append(tuple(x[pick] for x in trials))
         return self._stack(rows)
+
+    def _trials(self, n_pins: int) -> list:
+        """The verification's trials for plans of ``n_pins`` pins (``verify.trial_inputs``)."""
+        return trial_inputs(self.states, self.mu_c, n_pins, self.cfg, self.family)
 
     @staticmethod
     def _stack(rows):
-        return tuple(np.concatenate([r[k] for r in rows]) for k in range(4))
+        return tuple(np.concatenate([r[k] for r in rows]) for k in range(5))
 
     def _replay(self, level, idx, rows):
         """Final orientations ``(len(idx), trials)`` and jam flags of plans ``idx`` on ``rows``."""
-        th, yc, mu, offs = rows
+        th, yc, mu, offs, sup = rows
         n_trials, n_plans = th.size, idx.size
         pre = self.prefix
         pre_speeds = pre.speeds or (0.0,) * len(pre.labels)
@@ -329,7 +341,8 @@ class FixedPinSearch:
         tf, _, jam, _ = replay(self.part, np.repeat(heights, n_trials, axis=0),
                                np.repeat(speeds, n_trials, axis=0), np.tile(th, n_plans), np.tile(yc, n_plans),
                                np.tile(mu, n_plans), np.tile(offs, (n_plans, 1)), self.pin_radius,
-                               self.model, self.kernel["ds_max"], self.kernel["tol"], **self.belt)
+                               self.model, self.kernel["ds_max"], self.kernel["tol"], **self.belt,
+                               support=np.tile(sup, n_plans), supports=self.supports)
         return tf.reshape(n_plans, n_trials), (jam != "").reshape(n_plans, n_trials)
 
     def _failures(self, level, idx, rows):
@@ -362,6 +375,6 @@ class FixedPinSearch:
         clusters = np.maximum(1, (gaps > self.tolerance).sum(axis=1))
         spread = period - gaps.max(axis=1)
         best = np.lexsort((-level.margin, spread, clusters))[:candidates]
-        inputs = trial_inputs(self.states, self.mu_c, len(self.prefix.labels) + level.seq.shape[1], self.cfg)
+        inputs = self._trials(len(self.prefix.labels) + level.seq.shape[1])
         verdicts = self._judge(level, best, self._stack(inputs))
         return [self._plan(level, i, spread[i], v) for i, v in zip(best, verdicts)]

@@ -24,6 +24,11 @@ A sequence is dropped (with all its extensions) when, on its nominal path:
 
 Nothing else is pruned: every other sequence of up to ``depth`` pins is
 enumerated (``NominalTree.levels``).
+
+With several supports (issue 25: a support family's representatives), every
+resting state is rolled out under each of them: the level's columns are
+(support, resting state) pairs, so the rules above and the planner's span
+of the nominal finals take the union over the supports.
 """
 from __future__ import annotations
 
@@ -75,11 +80,13 @@ class NominalTree:
     belt : ``{"belt_speed": mm/s, "mu_s": ...}`` for the dynamic model, or None.
     speeds : each candidate pin's speed across the belt, v_pin / v_b (default
         all 0: fixed pins; moving pins follow the same rules).
+    supports : supports as ``simulate`` takes them (``None`` for uniform); each
+        resting state is a column once per support (default: uniform only).
     """
 
     def __init__(self, part: Part, heights, mu_c: float, pin_radius: float, model: str = "minpower",
                  kernel: dict | None = None, pin_halfwidth: float = 0.3, d_min: float = 0.1,
-                 d_max: float = 0.9, belt: dict | None = None, speeds=None):
+                 d_max: float = 0.9, belt: dict | None = None, speeds=None, supports=None):
         self.part, self.mu_c, self.pin_radius, self.model = part, float(mu_c), float(pin_radius), model
         self.heights = np.asarray(heights, dtype=float)
         self.speeds = np.zeros(self.heights.size) if speeds is None else np.asarray(speeds, dtype=float)
@@ -87,11 +94,19 @@ class NominalTree:
         if belt:  # the dynamic model at a belt speed: its own step control
             self.model, self.kernel = "dynamic", dict(belt)
         self.pin_halfwidth, self.d_min, self.d_max = float(pin_halfwidth), float(d_min), float(d_max)
+        self.supports = list(supports) if supports else [None]
+        n_states = self.part.stable_states().shape[0]
+        self.column_support = np.repeat(np.arange(len(self.supports)), n_states)
         self.rollouts = 0
+
+    def start_poses(self) -> np.ndarray:
+        """``(columns, 2)``: each column's resting state ``(theta, y_c)``
+        (the resting states, once per support)."""
+        return np.tile(self.part.stable_states(), (len(self.supports), 1))
 
     def root(self) -> Level:
         """The empty sequence: every resting state as it lies on the fence."""
-        states = self.part.stable_states()
+        states = self.start_poses()
         return Level(np.zeros((1, 0), dtype=np.int16), states[None, :, 0].copy(),
                      states[None, :, 1].copy(), np.full(1, np.inf))
 
@@ -142,8 +157,9 @@ class NominalTree:
         quantised pose and speed."""
         a = self.part.a
         speed_index = np.searchsorted(np.unique(self.speeds), v_pin)
-        keys = np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM), speed_index],
-                        axis=-1).reshape(-1, 3).astype(np.int64)
+        support = np.broadcast_to(self.column_support[None, :], theta.shape)
+        keys = np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM), speed_index,
+                         support], axis=-1).reshape(-1, 4).astype(np.int64)
         if keys.shape[0] == 0:
             empty = np.zeros(theta.shape)
             return empty.astype(np.int8), empty, empty
@@ -152,7 +168,7 @@ class NominalTree:
         # Roll out from the rounded pose itself, so an outcome depends on its key only.
         res = rollouts_by_speed(self.part, uniq[:, 0] * QUANTUM, uniq[:, 1] * QUANTUM / a,
                                 np.full(uniq.shape[0], self.mu_c), np.unique(self.speeds)[uniq[:, 2]],
-                                self.pin_radius, self.model, self.kernel)
+                                self.pin_radius, self.model, self.kernel, uniq[:, 3], self.supports)
         self.rollouts += uniq.shape[0]
         shape = theta.shape
         return (res["status"][inverse].reshape(shape), res["theta_f"][inverse].reshape(shape),

@@ -85,7 +85,7 @@ def planner_for(part: Part, config: dict, mu_c, lattices=None, moving: bool = Fa
 
 
 def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None = None,
-               keep: int = 5, progress=None) -> dict:
+               keep: int = 5, progress=None, family=None) -> dict:
     """Search, verify and rank plans for ``part`` at friction ``mu_c`` (a value
     or a range); returns a JSON-ready dict (``plans`` best first, each with
     its ``verification`` and orientation verdict; ``recommended``; ``warning``;
@@ -95,25 +95,36 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     Fixed pins first, by the complete search (``complete.FixedPinSearch``);
     only when no fixed-pin sequence of up to ``depth`` pins orients the part
     within ``planner.tolerance_deg`` do moving pins follow the best fixed-pin
-    prefixes (``planner.dynamic``)."""
+    prefixes (``planner.dynamic``).
+
+    ``family`` (a :class:`~pipeline.parts.support_family.SupportFamily`, see
+    :func:`pipeline.planning.support_plans.planning_family`): the plans must
+    orient the part for every member; the search, the carried sets and the
+    verification sample its members (``support_family`` in the result).
+    ``None``: uniform pressure."""
     depth = int(depth if depth is not None else config["planner"]["depth"])
+    family = None if family is None or family.is_uniform else family
     planner = planner_for(part, config, mu_c, lattices)
-    fixed = _fixed_search(part, config, mu_c, planner, depth, keep, progress)
+    fixed = _fixed_search(part, config, mu_c, planner, depth, keep, progress, family)
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
     # No pin is the plan with the fewest pins: then nothing is certified or recommended.
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
-    candidates = [carried_plan(planner, p.labels, p.margin, verify_cfg) for p in chosen]
+    candidates = [carried_plan(planner, p.labels, p.margin, verify_cfg, family) for p in chosen]
     moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, config, mu_c, planner)
     moving_search = None
     if moving is not None:
-        moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress)
-        candidates += [carried_plan(moving, p.labels, p.margin, verify_cfg) for p in moving_search.plans]
+        moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress, family)
+        candidates += [carried_plan(moving, p.labels, p.margin, verify_cfg, family)
+                       for p in moving_search.plans]
         planner = moving
     states = resting_states(part)
-    _verify_candidates(part, config, mu_c, planner, candidates, states, progress)
+    _verify_candidates(part, config, mu_c, planner, candidates, states, progress, family)
     candidates.sort(key=_rank)
     good = [p for p in candidates if _acceptable(p)]
-    return _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed, moving_search)
+    result = _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed, moving_search)
+    if family is not None:
+        result["support_family"] = family.to_dict()
+    return result
 
 
 def planner_tolerance(config: dict) -> float:
@@ -126,7 +137,7 @@ def verify_required(config: dict) -> float:
     return check_required(config.get("verify", {}).get("required", DEFAULT_REQUIRED))
 
 
-def _pin_search(part, config, mu_c, planner, moving: bool) -> FixedPinSearch:
+def _pin_search(part, config, mu_c, planner, moving: bool, family=None) -> FixedPinSearch:
     """The complete search over the planner's fixed pins (``moving`` False) or
     its moving pins (True), with the config's tolerance, verification and
     kernel settings and the planner's belt."""
@@ -136,12 +147,12 @@ def _pin_search(part, config, mu_c, planner, moving: bool) -> FixedPinSearch:
                           verify_required(config), config.get("verify", {}), sweep["pin_radius"],
                           pc["model"], sweep.get("kernel"), pc["d_min"], pc["d_max"],
                           belt_speed=planner.belt_speed, mu_s=planner.mu_s,
-                          speeds={k: p.v_pin for k, p in pins.items()})
+                          speeds={k: p.v_pin for k, p in pins.items()}, family=family)
 
 
-def _fixed_search(part, config, mu_c, planner, depth, keep, progress) -> FixedSearch:
+def _fixed_search(part, config, mu_c, planner, depth, keep, progress, family=None) -> FixedSearch:
     """The complete fixed-pin search with the planner's pins and the config's settings."""
-    search = _pin_search(part, config, mu_c, planner, moving=False)
+    search = _pin_search(part, config, mu_c, planner, moving=False, family=family)
     return search.run(depth, candidates=int(config["planner"].get("candidates", 12)), keep=keep,
                       progress=progress)
 
@@ -154,7 +165,7 @@ def _moving_planner(part, config, mu_c, planner):
     return planner_for(part, config, mu_c, planner.lattices, moving=True)
 
 
-def _moving_search(part, config, mu_c, moving, chosen, keep, progress) -> FixedSearch:
+def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=None) -> FixedSearch:
     """Up to ``planner.dynamic.depth`` moving pins after no fixed pin and after
     each of the ``MOVING_PREFIXES`` best fixed-pin results, by the same
     enumeration, screen and judgement as the fixed pins (every moving-pin
@@ -162,7 +173,7 @@ def _moving_search(part, config, mu_c, moving, chosen, keep, progress) -> FixedS
     pc, dyn = config["planner"], config["planner"]["dynamic"]
     if progress:
         progress(f"mu_c {friction_label(mu_c)}: fixed pins do not orient the part: adding moving pins")
-    search = _pin_search(part, config, mu_c, moving, moving=True)
+    search = _pin_search(part, config, mu_c, moving, moving=True, family=family)
     depth = int(dyn["depth"])
     total = FixedSearch([], [], depth, planner_tolerance(config), verify_required(config))
     for prefix in [None, *chosen[:MOVING_PREFIXES]]:
@@ -189,7 +200,8 @@ def _acceptable(plan) -> bool:
     return verdict["orients"] or v["failures"] <= MAX_FAILURE * v["trials"]
 
 
-def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, states, progress) -> None:
+def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, states, progress,
+                       family=None) -> None:
     """Replay each candidate by perturbed full rollouts (``verify_plan``) and
     attach the summary as ``plan.verification``, with the orientation verdict
     (``orient.judge``: one set within the tolerance?) as ``orientation``."""
@@ -201,13 +213,15 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
                           config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
                           kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
-                          mu_s=planner.mu_s)
+                          mu_s=planner.mu_s, family=family)
         finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
         verdict = judge(finals, res["trials"], tolerance, planner.order, required)
         plan.verification = {"trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
                              **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}
                                 if "belt_speed" in res else {}),
+                             **({"support_family": res["support_family"]}
+                                if "support_family" in res else {}),
                              "orientation": verdict}
         if progress:
             width = verdict["width_deg"]

@@ -79,23 +79,38 @@ def corner_inputs(theta, y_c, mu_c, n_pins, cfg):
             arr[:, 2], offs)
 
 
-def trial_inputs(initial_states: dict, mu_c, n_pins: int, settings: dict) -> list:
+def trial_inputs(initial_states: dict, mu_c, n_pins: int, settings: dict, family=None) -> list:
     """The trials :func:`verify_plan` replays for a plan of ``n_pins`` pins: per
-    initial state (in order), arrays ``(theta, y_c, mu, offsets (n, n_pins))``
-    of ``settings["trials"]`` random trials followed by every corner of the
-    perturbation box (``settings["corners"]``). The same settings give the same
-    trials, so a subset of them can be replayed first to reject a plan early."""
+    initial state (in order), arrays ``(theta, y_c, mu, offsets (n, n_pins),
+    support)`` of ``settings["trials"]`` random trials followed by every corner
+    of the perturbation box (``settings["corners"]``). The same settings give the
+    same trials, so a subset of them can be replayed first to reject a plan early.
+
+    ``support`` is each trial's member index in ``family`` (a
+    :class:`~pipeline.parts.support_family.SupportFamily`; all 0 without one,
+    and then the trials are exactly those of uniform pressure). With a family,
+    the random trials take its members in turn, in a seeded random order (a
+    stratified sample: each member ``trials / len(family)`` times, give or take
+    one), and the corners are replayed once under each of the family's
+    ``representatives``."""
     cfg = dict(DEFAULTS, **(settings or {}))
     rng = np.random.default_rng(cfg["seed"])
+    members = 1 if family is None else len(family.members)
+    reps = (0,) if family is None else family.representatives
+    pick = np.random.default_rng([int(cfg["seed"]), 25])  # its own stream: uniform trials stay as they were
     out = []
     for state in initial_states.values():
         theta0, yc0 = _start(state)
-        th, yc, mu, offs = perturbed_batch(theta0, yc0, mu_c, n_pins, cfg, rng, int(cfg["trials"]))
+        n = int(cfg["trials"])
+        th, yc, mu, offs = perturbed_batch(theta0, yc0, mu_c, n_pins, cfg, rng, n)
+        sup = pick.permutation(np.resize(np.arange(members), n)) if members > 1 else np.zeros(n, int)
         if cfg.get("corners", True):
             corners = corner_inputs(theta0, yc0, mu_c, n_pins, cfg)
-            th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), corners[:3]))
-            offs = np.concatenate([offs, corners[3]])
-        out.append((th, yc, mu, offs))
+            k = corners[0].size
+            th, yc, mu = (np.concatenate([x, np.tile(c, len(reps))]) for x, c in zip((th, yc, mu), corners[:3]))
+            offs = np.concatenate([offs, np.tile(corners[3], (len(reps), 1))])
+            sup = np.concatenate([sup, np.repeat(np.asarray(reps, int), k)])
+        out.append((th, yc, mu, offs, sup))
     return out
 
 
@@ -126,14 +141,17 @@ def _start(state):
 
 
 def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
-           ds_max=DEFAULT_DS_MAX, tol=DEFAULT_TOL, path=None, belt_speed=None, mu_s=0.5):
+           ds_max=DEFAULT_DS_MAX, tol=DEFAULT_TOL, path=None, belt_speed=None, mu_s=0.5,
+           support=None, supports=None):
     """Roll every trial past every pin in turn (batched per pin).
 
     ``belt_speed`` (mm/s) replays with the dynamic model at that speed and
     belt friction ``mu_s`` (``model`` is then unused); ``None`` is
     quasi-static ``model``. ``pin_heights`` (mm) and ``pin_speeds`` (v_pin /
     v_b) are one value per pin, or arrays ``(n_trials, n_pins)`` to replay
-    several plans of one length at once.
+    several plans of one length at once. ``support`` (an index per trial into
+    ``supports``, a list of supports as ``simulate`` takes them) gives each
+    trial its own support; ``None``: uniform pressure.
 
     Returns ``(theta_f, y_c, jam_reason_or_empty, missed)``: arrays over trials,
     ``missed`` a boolean array ``(n_trials, n_pins)``. If ``path`` is a list,
@@ -143,6 +161,7 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     n_pins = np.shape(pin_speeds)[-1] if np.ndim(pin_speeds) else 0
     heights = np.broadcast_to(np.asarray(pin_heights, dtype=float), (n, n_pins))
     speeds = np.broadcast_to(np.asarray(pin_speeds, dtype=float), (n, n_pins))
+    support = None if support is None else np.broadcast_to(np.asarray(support, dtype=int), (n,))
     jam = np.full(n, "", dtype=object)
     missed = np.zeros((n, n_pins), bool)
     alive = np.ones(n, bool)
@@ -153,7 +172,8 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
             break
         d = contact_parameter(heights[idx, k] + offsets[idx, k], y_c[idx], part.a)
         res = rollouts_by_speed(part, theta[idx], d, mu[idx], speeds[idx, k], pin_radius,
-                                 model if belt_speed is None else "dynamic", kw)
+                                 model if belt_speed is None else "dynamic", kw,
+                                 None if support is None else support[idx], supports)
         st = res["status"]
         stuck = (st == JAMMED) | (st == TRUNCATED)
         for j in np.flatnonzero(stuck):
@@ -167,17 +187,33 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     return theta % 360.0, y_c, jam, missed
 
 
-def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw) -> dict:
+def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw, support=None,
+                      supports=None) -> dict:
     """``simulate.rollout_points`` for rows whose pins may move at different
-    speeds ``v_pin`` (one batch per speed), results in row order."""
-    speeds = np.unique(v_pin)
-    if speeds.size == 1:
-        return simulate.rollout_points(part, theta, d, mu, pin_radius, model, v_pin=float(speeds[0]), **kw)
+    speeds ``v_pin`` and, with ``support`` (an index per row into
+    ``supports``), rest on different supports: one batch per (speed,
+    support), results in row order."""
+    v_pin = np.asarray(v_pin, dtype=float)
+    if support is None or supports is None:
+        groups = [(v, None) for v in np.unique(v_pin)]
+        rows_of = lambda g: np.flatnonzero(v_pin == g[0])  # noqa: E731
+    else:
+        support = np.asarray(support, dtype=int)
+        groups = sorted({(float(v), int(s)) for v, s in zip(v_pin, support)})
+        rows_of = lambda g: np.flatnonzero((v_pin == g[0]) & (support == g[1]))  # noqa: E731
+
+    def batch(rows, group):
+        v, s = group
+        extra = {} if s is None or supports[s] is None else {"support": supports[s]}
+        return simulate.rollout_points(part, theta[rows], d[rows], mu[rows], pin_radius, model,
+                                       v_pin=float(v), **kw, **extra)
+
+    if len(groups) == 1:
+        return batch(np.arange(theta.size), groups[0])
     out = None
-    for v in speeds:
-        rows = np.flatnonzero(v_pin == v)
-        res = simulate.rollout_points(part, theta[rows], d[rows], mu[rows], pin_radius, model,
-                                      v_pin=float(v), **kw)
+    for group in groups:
+        rows = rows_of(group)
+        res = batch(rows, group)
         if out is None:
             out = {key: np.empty(theta.size, dtype=arr.dtype) for key, arr in res.items()}
         for key, arr in res.items():
@@ -188,8 +224,12 @@ def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw) -> dict:
 def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, pin_radius: float,
                 model: str = "minpower", settings: dict | None = None,
                 speeds: dict | None = None, kernel: dict | None = None,
-                belt_speed: float | None = None, mu_s: float = 0.5) -> dict:
+                belt_speed: float | None = None, mu_s: float = 0.5, family=None) -> dict:
     """Run the trials for a stored plan (``to_dict()`` of a plan).
+
+    ``family`` (a :class:`~pipeline.parts.support_family.SupportFamily`)
+    samples each trial's support from it (see :func:`trial_inputs`); each
+    trial then records its ``support`` label. ``None``: uniform pressure.
 
     ``belt_speed`` (mm/s) replays every trial with the dynamic model at that
     belt speed and belt friction ``mu_s``; ``None`` (default) with the
@@ -208,12 +248,13 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     heights = [float(pins[p]) for p in labels]
     vs = [float(speeds.get(p, 0.0)) for p in labels]
     rows, trials = [], []
-    inputs = trial_inputs(initial_states, mu_c, len(labels), cfg)
-    for (label, state), (th, yc, mu, offs) in zip(initial_states.items(), inputs):
+    inputs = trial_inputs(initial_states, mu_c, len(labels), cfg, family)
+    supports = None if family is None else family.kernel_supports
+    for (label, state), (th, yc, mu, offs, sup) in zip(initial_states.items(), inputs):
         theta0, yc0 = _start(state)
         tf, yf, jam, missed = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
                                      kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL),
-                                     belt_speed=belt_speed, mu_s=mu_s)
+                                     belt_speed=belt_speed, mu_s=mu_s, support=sup, supports=supports)
         finals = predicted_sets(plan, label)
         first = plan.get("initial_sets", {}).get(label)
         start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)
@@ -230,11 +271,13 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
                 counts["reasons"][reason] = counts["reasons"].get(reason, 0) + 1
             trials.append({"state": label, "final_theta": float(tf[j]), "final_y_c": float(yf[j]),
                            "ok": reason is None, "reason": reason or "",
-                           "start": [float(th[j]) % 360.0, float(yc[j])], "mu_c": float(mu[j])})
+                           "start": [float(th[j]) % 360.0, float(yc[j])], "mu_c": float(mu[j]),
+                           **({} if family is None else {"support": family.members[sup[j]].label})})
         rows.append(counts)
     total = {k: sum(r[k] for r in rows) for k in ("trials", "successes", "failures")}
     mu_out = list(mu_c) if isinstance(mu_c, (tuple, list)) else mu_c
     belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
     return {"plan": labels, "settings": cfg, "mu_c": mu_out,
             "model": model if belt_speed is None else "dynamic", **belt, "rows": rows,
+            **({} if family is None else {"support_family": family.label}),
             **total, "trials_detail": trials}

@@ -1,0 +1,154 @@
+"""Plans that hold whatever the part rests on (issue 25).
+
+:func:`planning_family` readies a support family for the planner: it checks
+that the planner's mechanics take point supports and finds the family's
+extremes (``support_spread``) on a coarse map grid at the planner's
+friction. :func:`support_study` answers a user's three questions for one
+part (spec section 9): how far the family moves ``theta_f`` from uniform
+pressure over the configured map grid, whether the recommended (uniform)
+plan survives the family, and if it does not, the plan that does.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from pipeline.errors import PinfeedError
+from pipeline.maps.support_spread import extreme_members, family_spread
+from pipeline.parts.part import Part
+from pipeline.parts.support_family import SupportFamily, parse_support_family
+from pipeline.planning.orient import judge
+from pipeline.planning.plan import plan_tight, planner_tolerance, verify_required
+from pipeline.planning.propagate import resting_states
+from pipeline.planning.settings import friction_label, nominal_friction, parse_friction
+from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
+from pipeline.planning.verify import verify_plan
+
+EXTREMES_THETA_STEP = 3.0  # deg: the coarse grid the planner's extremes are found on
+
+
+def check_family_mechanics(config: dict) -> None:
+    """Refuse (one line) a family with mechanics that assume uniform pressure."""
+    pc = config["planner"]
+    if pc.get("model", "minpower") != "minpower" or pc.get("belt_speed") is not None:
+        raise PinfeedError(f"a support family needs the quasi-static minpower model (the planner has "
+                           f"model {pc.get('model')!r}, belt speed {pc.get('belt_speed')}); the other "
+                           f"models assume uniform pressure: use model minpower without a belt speed")
+
+
+def as_family(part: Part, family) -> SupportFamily:
+    """``family`` as a :class:`SupportFamily` of ``part`` (parsing its text)."""
+    return family if isinstance(family, SupportFamily) else parse_support_family(family, part)
+
+
+def planning_family(part: Part, family, config: dict, mu_c=None) -> SupportFamily | None:
+    """The family (text or :class:`SupportFamily`) with its extremes found on
+    the sweep's ``d`` and every ``EXTREMES_THETA_STEP`` degrees of theta_i at
+    the planner's nominal friction (``mu_c``, default ``planner.mu_c``);
+    ``None`` for uniform pressure alone."""
+    family = as_family(part, family)
+    if family.is_uniform:
+        return None
+    check_family_mechanics(config)
+    if family.extremes or len(family) == 1:
+        return family if family.extremes else dataclasses.replace(family, extremes=(0,))
+    mu = nominal_friction(parse_friction(config["planner"]["mu_c"]) if mu_c is None else mu_c)
+    spread = family_spread(part, family, np.arange(0.0, 360.0, EXTREMES_THETA_STEP),
+                           config["sweep"]["d"], mu, config["sweep"]["pin_radius"])
+    return dataclasses.replace(family, extremes=spread.extremes)
+
+
+def map_spread(part: Part, family: SupportFamily, config: dict) -> tuple:
+    """``(summary, spreads)``: the family's shift from uniform over the
+    configured map grid (sweep ``d`` and ``theta_step``) at every swept
+    friction, and the :class:`FamilySpread` per friction. The summary pools
+    the cells of all frictions (see ``FamilySpread.summary``) and names the
+    extremes over all of them."""
+    sweep = config["sweep"]
+    theta = np.arange(0.0, 360.0, float(sweep["theta_step"]))
+    spreads = {float(mu): family_spread(part, family, theta, sweep["d"], float(mu), sweep["pin_radius"])
+               for mu in sweep["mu_c"]}
+    shifts = np.concatenate([s.shift.values.reshape(len(family), -1) for s in spreads.values()], axis=1)
+    worst = np.abs(shifts).max(axis=0)
+    worst = worst[np.isfinite(worst)]
+    changed = np.concatenate([(s.maps["status"] != s.uniform["status"]).any("support").values.ravel()
+                              for s in spreads.values()])
+    extremes = extreme_members(shifts)
+
+    def pct(q):
+        return round(float(np.percentile(worst, q)), 2) if worst.size else None
+
+    summary = {"family": family.label, "members": len(family), "frictions": sorted(spreads),
+               "cells": int(changed.size), "cells_compared": int(worst.size),
+               "shift_median_deg": pct(50), "shift_p90_deg": pct(90), "shift_max_deg": pct(100),
+               "outcome_changed_share": round(float(changed.mean()), 4),
+               "extremes": [family.labels[k] for k in extremes]}
+    return summary, spreads, extremes
+
+
+def verify_under_family(part: Part, config: dict, plan: dict, mu_c, family: SupportFamily) -> dict:
+    """A stored plan (``to_dict()``) replayed with the verification's trials,
+    each on a member of ``family``; the orientation verdict and the counts."""
+    pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
+    speeds = dict(zip(plan["pins"], plan.get("pin_speeds", [0.0] * len(plan["pins"]))))
+    res = verify_plan(part, plan, pins, resting_states(part), mu_c, config["sweep"]["pin_radius"],
+                      config["planner"]["model"], dict(VERIFY_DEFAULTS, **config.get("verify", {})),
+                      speeds={k: v for k, v in speeds.items() if v}, kernel=config["sweep"].get("kernel"),
+                      family=family)
+    finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
+    verdict = judge(finals, res["trials"], planner_tolerance(config), part.symmetry_order(),
+                    verify_required(config))
+    by_member = {}
+    for t in res["trials_detail"]:
+        row = by_member.setdefault(t["support"], {"trials": 0, "failures": 0})
+        row["trials"] += 1
+        row["failures"] += 0 if t["ok"] else 1
+    return {"trials": res["trials"], "failures": res["failures"], "orientation": verdict,
+            "by_member": by_member}
+
+
+def support_study(part: Part, config: dict, family, uniform_entry: dict | None, progress=None) -> dict:
+    """The three numbers of issue 25 for ``part`` (a JSON-ready dict):
+
+    - ``spread``: how far the family moves theta_f from uniform over the
+      configured map grid (:func:`map_spread`);
+    - ``survival``: the recommended plan of ``uniform_entry`` (the stored
+      tight-planner entry at ``planner.mu_c``) replayed with each trial on a
+      member of the family (:func:`verify_under_family`); ``survives`` when it
+      still orients the part within the tolerance (a part that needs no pin
+      survives: the resting states do not depend on the support);
+    - ``family_plan``: when it does not survive, the plan for the family
+      (:func:`~pipeline.planning.plan.plan_tight` with the family).
+
+    The figure's maps come back apart, under ``"_spreads"`` (not JSON)."""
+    family = as_family(part, family)
+    check_family_mechanics(config)
+    summary, spreads, extremes = map_spread(part, family, config)
+    family = dataclasses.replace(family, extremes=extremes)
+    mu_c = parse_friction(config["planner"]["mu_c"])
+    rec = (uniform_entry or {}).get("recommended")
+    out = {"part": part.name, "family": family.to_dict(), "mu_c": friction_label(mu_c),
+           "tolerance_deg": planner_tolerance(config), "required": verify_required(config),
+           "spread": summary, "uniform_plan": rec and list(rec["pins"]), "survival": None,
+           "survives": None, "family_plan": None, "_spreads": spreads}
+    if (uniform_entry or {}).get("needs_no_pin"):
+        out["survives"] = True  # the resting states do not depend on where the part presses
+        return out
+    if rec is not None:
+        if progress:
+            progress(f"replaying the recommended plan {' '.join(rec['pins'])} under {family.label}")
+        out["survival"] = verify_under_family(part, config, rec, mu_c, family)
+        out["survives"] = bool(out["survival"]["orientation"]["orients"])
+    if not out["survives"]:
+        if progress:
+            progress(f"planning for every member of {family.label}")
+        res = plan_tight(part, config, mu_c, family=family, progress=progress)
+        best = res["recommended"]
+        out["family_plan"] = {
+            "orients": res["orients"], "warning": res["warning"],
+            "evidence": res["fixed_pin_search"]["evidence"],
+            "pins": best and list(best["pins"]), "pin_heights_mm": best and best["pin_heights_mm"],
+            "pin_speeds": best and best.get("pin_speeds"),
+            "verification": best and best["verification"], "plans": res["plans"]}
+    return out
