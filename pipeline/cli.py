@@ -342,7 +342,8 @@ def cmd_plan(args):
     config = planner_settings(load_config(args.config), catalog=args.catalog, mu_c=args.mu_c,
                               depth=args.depth, model=args.model, coverage=args.coverage, speeds=speeds,
                               dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
-                              mu_s=args.mu_s, tolerance=args.tolerance)
+                              mu_s=args.mu_s, tolerance=args.tolerance,
+                              support_family=args.support_family)
     part = _plan_part_arg(args, config)
     out = plan_store_path(config, part.name, args.out)  # checked before any work
     result = plan_command(part, config, args.mode, progress=None if args.json else _progress)
@@ -420,6 +421,7 @@ def _plan_json(result, mode) -> dict:
     if tight:
         first = tight[0]
         out.update(mu_c=first["mu_c"], warning=first["warning"], tolerance_deg=first.get("tolerance_deg"),
+                   support_family=(first.get("support_family") or {}).get("label", "uniform"),
                    orients=first.get("orients"), pins_used=first.get("pins_used"),
                    evidence=(first.get("fixed_pin_search") or {}).get("evidence"),
                    recommended=_plan_summary(first["recommended"]) if first["recommended"] else None,
@@ -450,6 +452,10 @@ def _print_plan_result(result, part, config, mode):
         st = t.stats
         print(f"tight planner, friction {t.friction}: {st['rollouts']} new rollouts in "
               f"{st['seconds']:.0f} s, stored under {config['catalog_dir']}/refine/{part.id}/")
+        family = t.extra.get("support_family")
+        if family:
+            print(f"  for every member of the support family {family['label']} ({len(family['members'])} "
+                  f"supports; nominal paths under {', '.join(family['extremes'])})")
         search = t.extra.get("fixed_pin_search")
         if search:
             print(f"  {search['evidence']}")
@@ -760,6 +766,10 @@ def _add_sweep_plan_commands(sub) -> None:
                    help="full width (deg) the final orientation set may have (default: planner.tolerance_deg, "
                    "10): a plan orients the part when verify.required (99.5%%) of its trials end in one "
                    "set this narrow")
+    p.add_argument("--support-family", dest="support_family", default=None, metavar="SPEC",
+                   help="supports the plan must hold for (issue 25): 'tripods:N[:inset=F][:seed=S]', "
+                        "'warp:AMP[:N]', a support ('tripod', 'rim:N', 'points:x,y,w ...') or a list "
+                        "'SPEC; SPEC'; 'uniform' for none (default: planner.support_family)")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"],
                    help="paper mode only: which stored maps stand for an uncertain state; bracket "
                         "(the d maps around its d range and one theta_i step either side; "

@@ -365,8 +365,10 @@ def plan_frictions(config: dict) -> list:
 
 def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progress=None) -> list:
     """Tight plans at every friction of :func:`plan_frictions` (the first is the
-    recommended one), at ``planner.belt_speed`` when it is set; the planner's
-    rollouts are stored in the catalog (keyed by model, pin speed and belt)."""
+    recommended one), at ``planner.belt_speed`` when it is set, for every
+    member of ``planner.support_family`` when it is set (its extremes found
+    at each friction); the planner's rollouts are stored in the catalog
+    (keyed by model, pin speed and belt)."""
     sweep, model = config["sweep"], config["planner"]["model"]
     belt_speed, mu_s = planner_belt(config, part)
     speeds = [0.0] + [float(v) for v in config["planner"].get("dynamic", {}).get("speeds", [])]
@@ -374,11 +376,13 @@ def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progre
                                 belt_speed=belt_speed, mu_s=mu_s)
                 for v in speeds}
     out = []
+    from pipeline.planning.support_plans import planning_family  # it builds on this module
     try:
         for mu_c in plan_frictions(config):
             t0 = time.perf_counter()
+            family = planning_family(part, config["planner"].get("support_family") or "uniform", config, mu_c)
             res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep,
-                             progress=_labelled(progress, f"mu_c {friction_label(mu_c)}"))
+                             progress=_labelled(progress, f"mu_c {friction_label(mu_c)}"), family=family)
             res["stats"]["wall_seconds"] = round(time.perf_counter() - t0, 2)  # search, verification and all
             res.pop("lattices")
             out.append(res)

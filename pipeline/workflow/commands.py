@@ -21,7 +21,7 @@ from pipeline.provenance import provenance_attrs
 
 def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model=None, coverage=None,
                      speeds=None, dynamic_depth=None, pins=None, belt_speed=None, mu_s=None,
-                     tolerance=None) -> dict:
+                     tolerance=None, support_family=None) -> dict:
     """A copy of ``config`` with ``pinfeed plan``'s overrides applied, each checked.
 
     ``None`` leaves the config's value. ``catalog``: the catalog folder;
@@ -31,8 +31,9 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
     ``dynamic_depth`` (>= 0; 0 plans fixed pins only, dropping the speeds);
     ``pins``: candidate pin heights (mm); ``belt_speed`` (mm/s) and ``mu_s``
     (only with a belt speed); ``tolerance``: the full width (deg) a final set
-    may have, in (0, 360). Raises :class:`PinfeedError` on a bad value
-    before any work."""
+    may have, in (0, 360); ``support_family``: the supports plans must hold
+    for (``planner.support_family``; ``"uniform"`` for none). Raises
+    :class:`PinfeedError` on a bad value before any work."""
     config = copy.deepcopy(config)
     if catalog:
         config["catalog_dir"] = catalog
@@ -51,6 +52,8 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
         pc["pins"] = [float(x) for x in pins]
     if tolerance is not None:
         pc["tolerance_deg"] = check_tolerance(tolerance)
+    if support_family is not None:
+        pc["support_family"] = None if support_family.strip() == "uniform" else support_family
     if belt_speed is not None:
         pc["belt_speed"] = belt_speed
     if mu_s is not None:
@@ -106,6 +109,16 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     if belt_speed is not None and mode != "tight":
         raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
                            "the paper-mode planner uses the quasi-static map shards: use --mode tight")
+    family = config["planner"].get("support_family")
+    if family:
+        from pipeline.parts.support_family import parse_support_family
+        from pipeline.planning.support_plans import check_family_mechanics
+        if mode != "tight":
+            raise PinfeedError("--support-family plans with the tight planner (its trials sample the "
+                               "family); the paper-mode planner's map shards assume one support: use "
+                               "--mode tight")
+        check_family_mechanics(config)
+        parse_support_family(family, part)  # a bad family: a one-line error before any work
     from pipeline.planning.speed_limit import attach_speed_limits
     if mode == "tight":
         return attach_speed_limits(plan_tight_only(part, config, progress=progress), config)
