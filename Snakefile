@@ -50,6 +50,7 @@ include: "rules/plan.smk"
 include: "rules/sense.smk"
 include: "rules/layout.smk"
 include: "rules/speed.smk"
+include: "rules/support.smk"
 include: "rules/atlas.smk"
 include: "rules/report.smk"
 

@@ -131,7 +131,26 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
         raise PinfeedError(f"config error at sensing/parts: {', '.join(unplanned)} not in planner/parts "
                            f"(the sensor plans on the planner's maps); planned parts: "
                            f"{', '.join(cfg['planner']['parts']) or 'none'}")
+    _check_support_study(cfg)
     return cfg
+
+
+def _check_support_study(cfg: dict) -> None:
+    """The support study's parts are planned parts, and its family (and the
+    planner's) needs the mechanics that take point supports."""
+    study = cfg.get("support_study") or {}
+    unplanned = [p for p in study.get("parts") or [] if p not in cfg["planner"]["parts"]]
+    if unplanned:
+        raise PinfeedError(f"config error at support_study/parts: {', '.join(unplanned)} not in "
+                           f"planner/parts (the study replays the part's plan); planned parts: "
+                           f"{', '.join(cfg['planner']['parts']) or 'none'}")
+    pc = cfg["planner"]
+    if (study.get("family") or pc.get("support_family")) and (
+            pc["model"] != "minpower" or pc.get("belt_speed") is not None):
+        where = "planner/support_family" if pc.get("support_family") else "support_study/family"
+        raise PinfeedError(f"config error at {where}: support families need planner/model minpower "
+                           f"without planner/belt_speed (the other models assume uniform pressure); "
+                           f"set the family to null or plan with minpower")
 
 
 def _check_planner_belt(cfg: dict) -> None:

@@ -1,5 +1,6 @@
 # Shared helpers: the shard list and per-shard parameters, from the config.
 from pipeline.maps.sweep import shard_jobs
+from pipeline.workflow.supports import studied_parts
 
 CATALOG = config["catalog_dir"]
 JOBS = {str(job.path(CATALOG)): job for job in shard_jobs(config)}
@@ -39,3 +40,5 @@ PLANNED = config["planner"]["parts"]
 BAND_FILES = [
     p.replace(f"{CATALOG}/", f"{RESULTS}/bands/", 1).replace(".h5", ".json") for p in JOBS
 ]
+# Parts whose plans are replayed against the support family (support_study; issue 25).
+STUDIED = studied_parts(config)

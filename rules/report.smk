@@ -86,6 +86,9 @@ rule report:
         # speed limit (rules/speed.smk): JSON and figure of every planned part
         speed=expand(rules.speed.output.speed, name=PLANNED),
         speed_figures=expand(rules.speed.output.figure, name=PLANNED),
+        # plans against the support family (rules/support.smk): JSON and overlaid maps
+        support=expand(rules.support.output.support, name=STUDIED),
+        support_figures=expand(rules.support.output.figure, name=STUDIED),
         # the feedability atlas (rules/atlas.smk), shown first
         atlas=rules.atlas.output.json,
     output:

@@ -103,18 +103,20 @@ def box_trials(part, n_pins, n_random, seed, mu_range, theta_half=2.0, y_half=0.
 
 
 def replay_box(part, heights, trials, pin_radius=3.0, model="minpower", pin_half=0.3, strict=True,
-               speeds=None):
+               speeds=None, support=None):
     """Final orientations of every trial of every state (one array). ``strict``:
     None if a trial jams or the nominal start passes a pin it touches within
     ``pin_half`` of the centroid (the complete search's admissibility rule);
-    otherwise jammed trials are NaN. ``speeds``: each pin's v_pin / v_b (default fixed)."""
+    otherwise jammed trials are NaN. ``speeds``: each pin's v_pin / v_b (default
+    fixed). ``support``: every trial rests on this support (default uniform)."""
     speeds = speeds or [0.0] * len(heights)
     finals = []
     for theta, y_c, mu, offs in trials:
         theta, y_c = theta.copy(), y_c.copy()
         for k, y_pin in enumerate(heights):
             gap = y_pin + offs[:, k] - y_c
-            r = simulate.rollout_points(part, theta, gap / part.a, mu, pin_radius, model, v_pin=speeds[k])
+            r = simulate.rollout_points(part, theta, gap / part.a, mu, pin_radius, model, v_pin=speeds[k],
+                                        support=support)
             stuck = r["status"] >= 2  # jammed or truncated
             if strict and (stuck.any() or (r["status"][0] != 1 and abs(y_pin - y_c[0]) < pin_half)):
                 return None

@@ -22,7 +22,7 @@ from pipeline.provenance import creation_time, git_commit
 
 SECTIONS = (("outline", "Outline"), ("maps", "Configuration maps"), ("plans", "Plans"),
             ("verification", "Verification"), ("animation", "Animation"), ("layout", "Feeder layout"),
-            ("sensing", "Sensing"))
+            ("sensing", "Sensing"), ("support", "Support distributions"))
 STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto}img{max-width:100%}.warn{color:#b00}"
          "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;font-size:90%}"
          "tr.fail td{background:#f8d0d0}.files{font-size:90%}")
@@ -94,7 +94,7 @@ def _toc(parts: dict) -> list[str]:
     p = ['<nav id="toc"><h2>Contents</h2><ul>']
     for name in parts:
         subs = "".join(f'<li><a href="#{_anchor(name, key)}">{title}</a></li>' for key, title in SECTIONS
-                       if key not in ("sensing", "layout") or parts[name].get(key))
+                       if key not in ("sensing", "layout", "support") or parts[name].get(key))
         p.append(f'<li class="toc-part"><a href="#{_anchor(name)}">{html.escape(name)}</a><ul>{subs}</ul></li>')
     return p + ["</ul></nav>"]
 
@@ -104,7 +104,8 @@ def _part_section(name: str, part: dict, base, catalog, config: dict) -> list[st
     res, ver, files = part["plan"], part["verify"], part["files"]
     p = [f'<h2 id="{_anchor(name)}">{html.escape(name)}</h2>',
          '<p class="files">Files: ' + ", ".join(
-             _link(files[k], base, f"{k} JSON") for k in ("plan", "verify", "sensing", "speed") if k in files) + "</p>"]
+             _link(files[k], base, f"{k} JSON") for k in ("plan", "verify", "sensing", "speed", "support")
+             if k in files) + "</p>"]
     if part.get("shards") and catalog is not None:
         p.append('<details class="files"><summary>Catalog shards of this part '
                  f'({len(part["shards"])})</summary><ul>' + "".join(
@@ -138,7 +139,48 @@ def _part_section(name: str, part: dict, base, catalog, config: dict) -> list[st
     if "sensing" in part:
         p.append(f'<h3 id="{_anchor(name, "sensing")}">Sensing</h3>')
         p += _sensing_section(part["sensing"], files, base)
+    if "support" in part:
+        p.append(f'<h3 id="{_anchor(name, "support")}">Support distributions</h3>')
+        p += _support_section(part["support"], files, base)
     return p
+
+
+def _support_section(res: dict, files: dict, base) -> list[str]:
+    """The three numbers of issue 25: theta_f's shift from uniform to the
+    family, whether the recommended plan survives it, the plan that does."""
+    s, fam = res["spread"], res["family"]
+    p = [f"<p>Support family <b>{html.escape(fam['label'])}</b> ({len(fam['members'])} members; "
+         f"extremes {html.escape(', '.join(fam['extremes']))}).</p><ul>",
+         f"<li><b>theta_f moves</b> between uniform pressure and the family by median "
+         f"{s['shift_median_deg']} deg, p90 {s['shift_p90_deg']} deg, max {s['shift_max_deg']} deg "
+         f"(largest shift of any member per map cell, over {s['cells_compared']} of {s['cells']} cells "
+         f"of the sweep's grid at mu_c {', '.join(f'{m:g}' for m in s['frictions'])}; a passage's outcome "
+         f"changes in {100 * s['outcome_changed_share']:.1f} % of the cells).</li>"]
+    rec = " ".join(res.get("uniform_plan") or []) or "none"
+    surv = res.get("survival")
+    if res["survives"] is None:
+        p.append("<li>No recommended plan to replay.</li>")
+    else:
+        o = (surv or {}).get("orientation")
+        detail = (f": {o['in_tolerance']}/{o['trials']} trials in one set of {o['tolerance_deg']:g} deg "
+                  f"(needs {o['needed']})") if o else " (no pin needed: resting states do not depend on support)"
+        word = "survives" if res["survives"] else '<span class="warn">does not survive</span>'
+        p.append(f"<li><b>The recommended plan {html.escape(rec)} {word}</b> the family at mu_c "
+                 f"{html.escape(res['mu_c'])}{detail}.</li>")
+    fp = res.get("family_plan")
+    if fp:
+        if fp.get("orients"):
+            v = fp["verification"]["orientation"]
+            p.append(f"<li><b>The plan that does: {html.escape(' '.join(fp['pins']))}</b> (heights "
+                     f"{', '.join(f'{y:g}' for y in fp['pin_heights_mm'])} mm): {v['in_tolerance']}/"
+                     f"{v['trials']} trials of the family in one set, verified width {v['width_deg']:.1f} deg. "
+                     f"{html.escape(fp['evidence'])}.</li>")
+        else:
+            p.append(f'<li class="warn">No plan orients the part for every member: '
+                     f"{html.escape(fp.get('warning') or fp['evidence'])}</li>")
+    p.append("</ul>")
+    return p + _figure(files, "support_maps", base, "Configuration maps: uniform (black), the family (grey), "
+                       "its extremes (colours)")
 
 
 def _layout_section(lay: dict, files: dict, base, caption: str | None = None) -> list[str]:

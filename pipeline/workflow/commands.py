@@ -53,6 +53,9 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
     if tolerance is not None:
         pc["tolerance_deg"] = check_tolerance(tolerance)
     if support_family is not None:
+        if not support_family.strip():
+            raise PinfeedError("--support-family is empty; give a family such as 'tripods:12' or "
+                               "'warp:0.3', or 'uniform' for none")
         pc["support_family"] = None if support_family.strip() == "uniform" else support_family
     if belt_speed is not None:
         pc["belt_speed"] = belt_speed

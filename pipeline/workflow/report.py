@@ -193,24 +193,25 @@ def animate_part(plan_result: dict, config: dict, out, frames: int, fps: int,
 
 
 PART_FIGURES = ("outline", "maps", "speeds", "sequence", "sequence_dynamic", "sequence_tight", "carried",
-                "verification", "profiles", "scores", "speed_limit")
+                "verification", "profiles", "scores", "speed_limit", "support_maps")
 
 
 def part_files(results, name: str) -> dict:
     """Where the workflow writes a part's files under ``results`` (RESULTS_DIR/NAME):
-    JSON (``plan``, ``verify``, ``sensing``, ``speed``), figures
+    JSON (``plan``, ``verify``, ``sensing``, ``speed``, ``support``), figures
     (:data:`PART_FIGURES`) and the ``animation``; the rules in rules/*.smk use
     the same names."""
     results = Path(results)
     out = {kind: results / kind.replace("plan", "plans") / f"{name}.json"
-           for kind in ("plan", "verify", "sensing", "speed")}
+           for kind in ("plan", "verify", "sensing", "speed", "support")}
     out.update({kind: results / "figures" / f"{kind}_{name}.png" for kind in PART_FIGURES})
     out["animation"] = results / "animations" / f"{name}.gif"
     out.update({f"layout_{ext}": results / f"layout_{name}.{ext}" for ext in ("json", "png", "dxf", "svg")})
     return out
 
 
-def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_paths=(), atlas_path=None):
+def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_paths=(), atlas_path=None,
+                support_paths=()):
     """The HTML page (``out``, in the results folder) of the planned parts: the
     feedability atlas (``atlas_path``) first, their results, every figure found
     beside them, and the catalog shards they use."""
@@ -235,6 +236,10 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_p
         res = read_json(path)
         parts[res["part"]]["speed"] = res
         parts[res["part"]]["files"]["speed"] = Path(path)
+    for path in support_paths:  # plans against the support family (rules/support.smk)
+        res = read_json(path)
+        parts[res["part"]]["support"] = res
+        parts[res["part"]]["files"]["support"] = Path(path)
     for part in parts.values():
         part["captions"] = figure_captions(part["plan"], part.get("speed"), part.get("layout"))
     overview = {k: results / f for k, f in (("verification figure", "figures/verification.png"),

@@ -7,4 +7,5 @@ with log_to(snakemake.log[0]):  # noqa: F821
                 snakemake.output.report,  # noqa: F821
                 sensing_paths=snakemake.input.get("sensing", []),  # noqa: F821
                 speed_paths=snakemake.input.get("speed", []),  # noqa: F821
+                support_paths=snakemake.input.get("support", []),  # noqa: F821
                 atlas_path=snakemake.input.get("atlas"))  # noqa: F821
