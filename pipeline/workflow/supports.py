@@ -1,6 +1,7 @@
 """The function of ``rules/support.smk``: a part's plans against a support family (issue 25)."""
 from __future__ import annotations
 
+from pipeline.config import config_hash
 from pipeline.maps.io import write_json
 from pipeline.parts.part import Part
 from pipeline.planning.settings import nominal_friction, parse_friction
@@ -34,7 +35,7 @@ def support_part(plan_path, config: dict, out, figure, progress=print) -> dict:
     spreads = result.pop("_spreads")
     mu = nominal_friction(parse_friction(config["planner"]["mu_c"]))
     near = min(spreads, key=lambda m: abs(m - mu))
-    write_json({**result, "figure_mu_c": near, **provenance_attrs()}, out)
+    write_json({**result, "figure_mu_c": near, "config_hash": config_hash(config), **provenance_attrs()}, out)
     spread = spreads[near]
     if spread.maps.sizes["support"]:
         plot_support_maps(spread, config["figures"]["d"],
