@@ -735,7 +735,13 @@ def _add_map_commands(sub) -> None:
 
 
 def _add_sweep_plan_commands(sub) -> None:
-    """``sweep`` (catalog shards of a config) and ``plan`` (pin sequences)."""
+    """``sweep`` (catalog shards of a config), ``plan`` (pin sequences) and ``atlas``."""
+    _add_sweep_command(sub)
+    _add_plan_command(sub)
+
+
+def _add_sweep_command(sub) -> None:
+    """``sweep``: the catalog shards of a config."""
     p = sub.add_parser("sweep", help="compute missing catalog shards of a config (locally or on dask)")
     p.add_argument("--config", default=None, help="workflow config YAML (default: the embedded one)")
     p.add_argument("--catalog", default=None, help="catalog folder (default: the config's catalog_dir)")
@@ -747,6 +753,9 @@ def _add_sweep_plan_commands(sub) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_sweep)
 
+
+def _add_plan_command(sub) -> None:
+    """``plan`` (pin sequences for a part) and ``atlas`` (the planned parts)."""
     p = sub.add_parser("plan", help="plan fixed pins for a part (computes missing maps)")
     p.add_argument("--part", default=None, help="part name or id from the config or catalog")
     _add_outline_args(p, required=False)

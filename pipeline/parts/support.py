@@ -102,7 +102,7 @@ class Support:
 UNIFORM = Support("uniform")
 
 
-def _boundary_distance(verts: np.ndarray, xy: np.ndarray) -> np.ndarray:
+def boundary_distance(verts: np.ndarray, xy: np.ndarray) -> np.ndarray:
     """Distance from each point of ``xy`` to the closed polyline ``verts``."""
     p = verts[None, :, :]
     e = np.roll(verts, -1, axis=0)[None, :, :] - p
@@ -112,7 +112,7 @@ def _boundary_distance(verts: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return np.min(np.hypot(gap[..., 0], gap[..., 1]), axis=1)
 
 
-def _inside(verts: np.ndarray, xy: np.ndarray) -> np.ndarray:
+def inside_outline(verts: np.ndarray, xy: np.ndarray) -> np.ndarray:
     """Even-odd rule: whether each point of ``xy`` is inside the polygon ``verts``."""
     x0, y0 = verts[:, 0][None, :], verts[:, 1][None, :]
     x1, y1 = np.roll(verts[:, 0], -1)[None, :], np.roll(verts[:, 1], -1)[None, :]
@@ -165,10 +165,10 @@ def point_support(part, points, weights=None, kind: str = "points",
         raise PinfeedError(f"support {kind!r}: every weight is zero; give at least one "
                            f"positive weight")
     verts = np.asarray(part.vertices, dtype=np.float64)
-    out = ~_inside(verts, xy) & (_boundary_distance(verts, xy) > INSIDE_TOL * part.a)
+    out = ~inside_outline(verts, xy) & (boundary_distance(verts, xy) > INSIDE_TOL * part.a)
     if np.any(out):
         k = int(np.argmax(out))
-        gap = float(_boundary_distance(verts, xy[k:k + 1])[0])
+        gap = float(boundary_distance(verts, xy[k:k + 1])[0])
         raise PinfeedError(f"support point {k} ({xy[k, 0]:g}, {xy[k, 1]:g}) lies {gap:.3g} mm outside "
                            f"the outline; support points are in the part frame (centroid at the "
                            f"origin, drawing axes): move it inside")

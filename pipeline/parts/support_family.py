@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pipeline.errors import PinfeedError
-from pipeline.parts.support import (UNIFORM, Support, _boundary_distance, _inside, filled_support,
+from pipeline.parts.support import (UNIFORM, Support, boundary_distance, filled_support, inside_outline,
                                     parse_support, point_support)
 
 DEFAULT_TRIPODS = 12
@@ -148,7 +148,7 @@ def sample_tripods(part, n: int, inset: float = DEFAULT_INSET, seed: int = 0) ->
     rng = np.random.default_rng([int(seed), 25])
     lo, hi = verts.min(axis=0), verts.max(axis=0)
     xy = rng.uniform(lo, hi, (_DRAWS, 2))
-    ok = _inside(verts, xy) & (_boundary_distance(verts, xy) >= inset * part.a)
+    ok = inside_outline(verts, xy) & (boundary_distance(verts, xy) >= inset * part.a)
     pool = xy[ok]
     if pool.shape[0] < 3:
         raise PinfeedError(f"no point of the outline lies {inset:g} a ({inset * part.a:.3g} mm) from "
