@@ -103,7 +103,7 @@ def test_report_section_and_figure(stage):
 
 def test_config_checks():
     config = load_config()
-    assert studied_parts(config) == ["asym_triangle"]
+    assert studied_parts(config) == ["asym_triangle", "sym_triangle"]  # parts: [] is every planned part
     bad = copy.deepcopy(config)
     bad["support_study"]["parts"] = ["no_such_part"]
     with pytest.raises(PinfeedError, match="support_study/parts: no_such_part not in planner/parts"):
