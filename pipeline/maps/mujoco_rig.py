@@ -161,7 +161,7 @@ def _first_touch(world_xy, start, direction, length, r_pin):
     return lo
 
 
-def _model_xml(pieces, r_pin, mu_c, mass, izz, pin_start, pin_dir):
+def _model_xml(pieces, r_pin, mu_c, mass, izz, pin_start, pin_dir, timestep=TIMESTEP):
     t = THICKNESS_MM / 1000.0
     meshes, geoms = [], []
     for k, tri in enumerate(pieces):
@@ -175,7 +175,7 @@ def _model_xml(pieces, r_pin, mu_c, mass, izz, pin_start, pin_dir):
     return f"""
 <mujoco model="pinfeed-rig">
   <compiler inertiafromgeom="false" angle="radian"/>
-  <option timestep="{TIMESTEP}" gravity="0 0 0" cone="elliptic" impratio="{IMPRATIO}"
+  <option timestep="{timestep:.9g}" gravity="0 0 0" cone="elliptic" impratio="{IMPRATIO}"
           integrator="Euler"/>
   <asset>{''.join(meshes)}</asset>
   <worldbody>
@@ -199,8 +199,11 @@ def _model_xml(pieces, r_pin, mu_c, mass, izz, pin_start, pin_dir):
 
 def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0.5, v_pin=0.0,
                    max_travel=math.inf, trajectory=False, record_every=40,
-                   mass=PART_MASS):
+                   mass=PART_MASS, support=None):
     """One passage in MuJoCo. Lengths in mm, speeds in mm/s, angles in degrees.
+    ``support``: a point support (``Support``, part frame, checked by the
+    caller) whose points carry the belt friction, each its weight's share of
+    the load; ``None`` spreads the load over a grid of the area (uniform).
 
     Returns ``(status, jam_reason, theta_f_rad, dy_mm, contact_travel_mm,
     feature_changes, peak_force, trajectory, force)`` with status codes
@@ -209,7 +212,7 @@ def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0
     on the pin, units of mu_s m g; s = belt travel since first contact, mm).
     """
     mujoco = _mujoco()
-    xy, a, izz, pts, load = _support(part, mass, mu_s)
+    xy, a, izz, pts, load = _support(part, mass, mu_s, support)
     r_pin = r_pin_mm / 1000.0
     vb = belt_speed_mm_s / 1000.0
     eps = V_REG_MM_S / 1000.0
@@ -218,7 +221,8 @@ def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0
     if not math.isfinite(touch):
         return 1, "none", th0 % (2 * math.pi), 0.0, 0.0, 0, 0.0, np.zeros((0, 4)), np.zeros((0, 3))
     pin_start = start + max(touch - 0.02e-3, 0.0) * direction
-    model, data = _build(mujoco, xy, r_pin, mu_c, mass, izz, pin_start, direction, th0)
+    model, data = _build(mujoco, xy, r_pin, mu_c, mass, izz, pin_start, direction, th0,
+                         _timestep(pts, load, izz, mass, mu_s))
     pin_dof = model.jnt_dofadr[model.joint("pin").id]
     pin_geom = model.geom("pin").id
     dt = model.opt.timestep
@@ -257,12 +261,25 @@ def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0
             np.array(st.frc).reshape(-1, 3))
 
 
-def _build(mujoco, xy, r_pin, mu_c, mass, izz, pin_start, direction, th0):
+def _timestep(pts, load, izz, mass, mu_s) -> float:
+    """The step: ``TIMESTEP``, shortened for a support whose friction moment of
+    inertia ``sum load_k r_k^2 / (mu_s g)`` exceeds the part's (``izz / mass``
+    per unit mass). Near rest the regularised belt friction is a viscous
+    damping of rate ``load r^2 / (eps I)``; explicit Euler with that rate
+    times the step above 2 oscillates about rest for ever (points at the
+    vertices of a triangle reach 4). Uniform pressure keeps ``TIMESTEP``."""
+    if np.ndim(load) == 0:
+        return TIMESTEP
+    ratio = float(np.sum(load * np.sum(pts * pts, axis=1)) / (mu_s * mass * G) / (izz / mass))
+    return TIMESTEP / max(1, math.ceil(ratio))
+
+
+def _build(mujoco, xy, r_pin, mu_c, mass, izz, pin_start, direction, th0, timestep=TIMESTEP):
     """The MuJoCo model (a non-convex outline split into triangles) and its data
     with the part at orientation ``th0`` (rad)."""
     pieces = [xy[list(t)] for t in _triangulate(xy)] if not _convex(xy) else [xy]
     model = mujoco.MjModel.from_xml_string(_model_xml(pieces, r_pin, mu_c, mass, izz, pin_start,
-                                                      direction))
+                                                      direction, timestep))
     data = mujoco.MjData(model)
     data.qpos[2] = th0
     return model, data
@@ -287,10 +304,11 @@ class _Passage:
     frc: list = field(default_factory=list)
 
 
-def _support(part, mass, mu_s):
+def _support(part, mass, mu_s, support=None):
     """``(xy, a, izz, pts, load)``: the outline about its centroid (m), its
-    radius a (m), polar inertia (kg m^2), the support grid points inside it
-    (m, body frame) and the normal load on each (N)."""
+    radius a (m), polar inertia (kg m^2), the support points (m, body frame:
+    a grid inside the outline, or the points of ``support``) and the belt's
+    friction load on each (N: ``mu_s m g`` shared evenly, or by weight)."""
     xy_mm = np.asarray(part.vertices, dtype=float)
     if _mass_properties(xy_mm)[0] < 0:
         xy_mm = xy_mm[::-1].copy()
@@ -307,6 +325,9 @@ def _support(part, mass, mu_s):
     pts = np.column_stack([gx.ravel(), gy.ravel()])
     pts = pts[_inside(xy, pts)]
     load = mu_s * mass * G / len(pts)
+    if support is not None:  # the same points as the kernels (part frame, centroid at the origin)
+        pts = (np.asarray(support.points, dtype=float) - com) / 1000.0
+        load = mu_s * mass * G * np.asarray(support.weights, dtype=float)
     return xy, a, izz, pts, load
 
 

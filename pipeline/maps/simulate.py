@@ -66,9 +66,10 @@ def resolve_support(part: Part, support, model: str = "minpower") -> Support | N
     ``support`` is ``None``, a :class:`~pipeline.parts.support.Support` or
     the CLI's text (``"uniform"``, ``"points:x,y,w ..."``, ``"rim:N"``,
     ``"tripod"``; see :func:`~pipeline.parts.support.parse_support`). A point
-    support needs the quasi-static ``minpower`` model (``tip`` and
-    ``ellipsoid`` are built on uniform pressure; the belt-speed models do not
-    take supports yet): anything else is a one-line :class:`PinfeedError`.
+    support needs the quasi-static ``minpower`` model or the MuJoCo rig
+    (``"mujoco"``, which takes the points as its belt contacts); ``tip`` and
+    ``ellipsoid`` are built on uniform pressure and ``dynamic`` integrates
+    the uniform belt force: anything else is a one-line :class:`PinfeedError`.
     """
     if support is None:
         return None
@@ -82,8 +83,8 @@ def resolve_support(part: Part, support, model: str = "minpower") -> Support | N
         raise PinfeedError(f"support must be a Support or its text, got {type(support).__name__}")
     if support.is_uniform:
         return None
-    if model != "minpower":
-        raise PinfeedError(f"support {support.label!r} needs model minpower (model {model} "
+    if model not in ("minpower", "mujoco"):
+        raise PinfeedError(f"support {support.label!r} needs model minpower or mujoco (model {model} "
                            f"assumes uniform pressure); use model minpower or support uniform")
     return support
 
@@ -183,9 +184,9 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
     if model in BELT_MODELS:
         if belt_speed is None:
             raise PinfeedError(f"model {model!r} needs a belt speed (mm/s)")
-        resolve_support(part, support, model)
         return dynamic_rollout(part, theta_i, d, mu_c, pin_radius, belt_speed, mu_s, model=model,
-                               v_pin=v_pin, max_travel=max_travel, trajectory=trajectory)
+                               v_pin=v_pin, max_travel=max_travel, trajectory=trajectory,
+                               support=resolve_support(part, support, model))
     check_parameters(mu_c, pin_radius, model, v_pin, max_travel)
     check_pin_ratio(part, pin_radius)
     check_kernel_settings(ds_max, tol)
@@ -448,7 +449,8 @@ def dynamic_rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radiu
                     belt_speed: float, mu_s: float = 0.5, model: str = "dynamic",
                     v_pin: float = 0.0, restitution: float = 0.0,
                     max_travel: float | None = None, trajectory: bool = False,
-                    h: float | None = None, max_steps: int | None = None) -> xr.Dataset:
+                    h: float | None = None, max_steps: int | None = None,
+                    support: Support | None = None) -> xr.Dataset:
     """One passage at belt speed ``belt_speed`` (mm/s; the part in millimetres).
 
     ``model`` is ``"dynamic"`` (``kernels.dynamic``) or ``"mujoco"`` (the
@@ -456,8 +458,10 @@ def dynamic_rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radiu
     :func:`rollout`; with ``trajectory`` also the force on the pin and, for
     ``dynamic``, the twist history (``twist_*``: belt-frame velocity in units
     of the belt speed, omega in belt speeds per a, the relative normal
-    contact velocity and the normal impulse).
+    contact velocity and the normal impulse). ``support`` (``mujoco`` only; see
+    :func:`resolve_support`): the rig's belt friction acts at its points.
     """
+    sup = resolve_support(part, support, model)
     if model not in BELT_MODELS:
         raise PinfeedError(f"unknown belt-speed model {model!r}; choose one of {', '.join(BELT_MODELS)}")
     check_parameters(mu_c, pin_radius, "minpower", v_pin, max_travel)
@@ -474,13 +478,13 @@ def dynamic_rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radiu
         from pipeline.maps.mujoco_rig import mujoco_rollout
         out = mujoco_rollout(part, theta, dd, float(mu_c), float(pin_radius), float(belt_speed),
                              float(mu_s), v_pin=float(v_pin), max_travel=cap,
-                             trajectory=bool(trajectory)) + (None,)
+                             trajectory=bool(trajectory), support=sup) + (None,)
     status, reason_name, theta_f, dy, travel, changes, peak, traj, force, twist = out
     ds = _passage_dataset(STATUS_NAMES[status], reason_name, "why jammed or truncated",
                           theta_f, dy, travel, changes, peak, theta, dd, "mm",
                           dict(_common_attrs(part, model, mu_c, pin_radius, v_pin, 0.0, 0.0, "mm"),
                                belt_speed=float(belt_speed), mu_s=float(mu_s), froude=fr,
-                               restitution=float(restitution)))
+                               restitution=float(restitution), **_support_attrs(sup)))
     if trajectory:
         _add_trajectory(ds, traj, force, "mm", "centroid displacement along the belt (belt frame)")
         if twist is not None:
