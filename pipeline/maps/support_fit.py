@@ -1,0 +1,262 @@
+"""Fit a point support to measured pushes (issue 25: ``pinfeed support fit``).
+
+A *push* is one passage of a part past one pin: its initial orientation
+``theta_i`` (deg), its contact parameter ``d`` and the measured final
+orientation ``theta_f`` (deg), optionally its own pin friction ``mu_c``. The
+fit finds the ``K`` support points (part frame) whose quasi-static rollouts
+(model minpower) reproduce the measured ``theta_f`` best.
+
+Method
+------
+- *Weights by statics.* A rigid part at rest presses with its centre of
+  pressure at its centroid, so the weights are not free: for given points
+  they are the non-negative solution of ``sum w_k p_k = 0``, ``sum w_k = 1``
+  nearest to equal weights (``scipy.optimize.nnls`` on the equations, and a
+  pull towards ``1/K`` weighted ``PULL`` times less); for ``K = 3`` that is
+  the centroid's barycentric coordinates. Points whose hull does not hold the centroid
+  cannot balance the part and are rejected.
+- *Loss.* The residual of a push is ``wrap(theta_f_model - theta_f_measured)``
+  in (-180, 180] deg; a push the model does not complete (a miss or a jam
+  where the part was pushed) counts ``OUTCOME_PENALTY_DEG``. The loss is the
+  sum of ``HUBER_DEG^2 * 2 (sqrt(1 + (r / HUBER_DEG)^2) - 1)`` (soft L1:
+  quadratic for small residuals, linear for outliers, so one bad
+  measurement does not drag the fit).
+- *Search.* ``starts`` random tripods (or ``K`` points) in the outline
+  (:func:`~pipeline.parts.support_family.sample_tripods` for ``K = 3``) are
+  scored; the ``refine`` best are refined by Nelder-Mead over the ``2K``
+  coordinates (a point outside the outline is an infinite loss), and the
+  best of them restarted from its own result while that helps.
+
+The result reports per-push residuals and their RMS, median and 90th
+percentile of ``|r|``, next to those of uniform pressure on the same pushes,
+so a user sees whether the support explains the data better.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy import optimize
+
+from pipeline.errors import PinfeedError
+from pipeline.maps import simulate
+from pipeline.parts.part import Part
+from pipeline.parts.support import Support, boundary_distance, inside_outline, point_support
+
+COLUMNS = ("theta_i_deg", "d", "theta_f_deg")
+OPTIONAL = ("mu_c",)
+OUTCOME_PENALTY_DEG = 90.0  # residual of a push the model misses or jams
+HUBER_DEG = 2.0  # residuals beyond this count linearly in the loss
+PULL = 1e-4  # weight of the pull towards equal weights against the statics equations
+MAX_PUSHES = 100_000
+RESTARTS = 3  # Nelder-Mead restarts from its own result (the best start only)
+
+
+@dataclass
+class Pushes:
+    """Measured pushes: arrays of equal length (degrees; ``mu_c`` may be NaN: use the default)."""
+    theta_i: np.ndarray
+    d: np.ndarray
+    theta_f: np.ndarray
+    mu_c: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.theta_i.size)
+
+
+def read_pushes(path) -> Pushes:
+    """Read a pushes CSV: a header naming ``theta_i_deg``, ``d``, ``theta_f_deg``
+    (and optionally ``mu_c``), one push per row. Any problem is a one-line
+    :class:`PinfeedError`."""
+    path = Path(path)
+    if not path.is_file():
+        raise PinfeedError(f"pushes file {path} not found; give a CSV with the header "
+                           f"{','.join(COLUMNS)}[,mu_c]")
+    try:
+        with path.open(newline="") as fh:
+            rows = list(csv.reader(line for line in fh if line.strip() and not line.startswith("#")))
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise PinfeedError(f"cannot read pushes file {path}: {err}") from None
+    if not rows:
+        raise PinfeedError(f"pushes file {path} is empty; give the header {','.join(COLUMNS)}[,mu_c] "
+                           f"and one push per row")
+    header = [h.strip() for h in rows[0]]
+    missing = [c for c in COLUMNS if c not in header]
+    if missing:
+        raise PinfeedError(f"pushes file {path} has no column {', '.join(missing)} (header: "
+                           f"{','.join(header)}); the columns are {','.join(COLUMNS)}[,mu_c]")
+    cols = [c for c in COLUMNS + OPTIONAL if c in header]
+    data = {c: [] for c in cols}
+    for n, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise PinfeedError(f"pushes file {path}, line {n}: {len(row)} fields, the header has "
+                               f"{len(header)}")
+        for c in cols:
+            text = row[header.index(c)].strip()
+            try:
+                value = float(text)
+            except ValueError:
+                raise PinfeedError(f"pushes file {path}, line {n}: {c} = {text!r} is not a "
+                                   f"number") from None
+            if not math.isfinite(value):
+                raise PinfeedError(f"pushes file {path}, line {n}: {c} = {text} is not finite")
+            data[c].append(value)
+    if not data[COLUMNS[0]]:
+        raise PinfeedError(f"pushes file {path} has a header but no pushes")
+    if len(data[COLUMNS[0]]) > MAX_PUSHES:
+        raise PinfeedError(f"pushes file {path} has more than {MAX_PUSHES} pushes")
+    mu = np.array(data["mu_c"]) if "mu_c" in data else np.full(len(data["d"]), np.nan)
+    if np.any(mu < 0):
+        raise PinfeedError(f"pushes file {path}: a mu_c is negative; friction coefficients are >= 0")
+    return Pushes(np.array(data["theta_i_deg"]), np.array(data["d"]), np.array(data["theta_f_deg"]), mu)
+
+
+@dataclass
+class SupportFit:
+    """What :func:`fit_support` found."""
+    support: Support
+    residuals_deg: np.ndarray
+    uniform_residuals_deg: np.ndarray
+    pushes: int
+    evaluations: int
+
+    @staticmethod
+    def _stats(r) -> dict:
+        a = np.abs(r)
+        return {"rms_deg": float(np.sqrt(np.mean(a * a))), "median_deg": float(np.median(a)),
+                "p90_deg": float(np.percentile(a, 90)), "max_deg": float(a.max())}
+
+    @property
+    def spec(self) -> str:
+        """The fitted support as ``--support`` text (``points:x,y,w ...``, mm, part frame)."""
+        return "points:" + " ".join(f"{x:.3f},{y:.3f},{w:.4f}" for (x, y), w in
+                                     zip(self.support.points, self.support.weights))
+
+    def to_dict(self) -> dict:
+        """The JSON ``pinfeed support fit --json`` prints."""
+        fit, uni = self._stats(self.residuals_deg), self._stats(self.uniform_residuals_deg)
+        return {"support": self.spec, "points": self.support.points.tolist(),
+                "weights": self.support.weights.tolist(), "pushes": self.pushes,
+                "residuals_deg": [round(float(r), 4) for r in self.residuals_deg],
+                **fit, **{f"uniform_{k}": v for k, v in uni.items()},
+                "uniform_residuals_deg": [round(float(r), 4) for r in self.uniform_residuals_deg],
+                "evaluations": self.evaluations}
+
+
+def statics_weights(points: np.ndarray) -> np.ndarray | None:
+    """Non-negative weights that put the centre of pressure of ``points`` at the
+    origin, nearest equal weights; ``None`` if no such weights exist."""
+    k = points.shape[0]
+    scale = max(1e-12, float(np.abs(points).max()))
+    # The two statics equations and sum w = 1 weigh 1/PULL times the pull, so
+    # they hold to rounding whenever they can hold at all.
+    a = np.vstack([np.vstack([points.T / scale, np.ones(k)]) / PULL, np.eye(k)])
+    b = np.concatenate([[0.0, 0.0, 1.0 / PULL], np.full(k, 1.0 / k)])
+    w, _ = optimize.nnls(a, b)
+    if w.sum() <= 0:
+        return None
+    w = w / w.sum()
+    if np.hypot(*(w @ points)) > 1e-7 * scale:  # the centroid is outside the points' hull
+        return None
+    return w
+
+
+class _Objective:
+    """The loss of a point layout on the pushes (counts its evaluations)."""
+
+    def __init__(self, part, pushes, mu_default, pin_radius):
+        self.part, self.pushes, self.pin_radius = part, pushes, float(pin_radius)
+        self.mu = np.where(np.isnan(pushes.mu_c), mu_default, pushes.mu_c)
+        self.verts = np.asarray(part.vertices, dtype=float)
+        self.evaluations = 0
+
+    def residuals(self, support) -> np.ndarray:
+        res = simulate.rollout_points(self.part, self.pushes.theta_i, self.pushes.d, self.mu,
+                                      self.pin_radius, "minpower", support=support)
+        r = (res["theta_f"] - self.pushes.theta_f + 180.0) % 360.0 - 180.0
+        pushed = res["status"] == 0
+        return np.where(pushed | (res["status"] == 1), r, OUTCOME_PENALTY_DEG)
+
+    def support_of(self, flat) -> Support | None:
+        pts = np.asarray(flat, dtype=float).reshape(-1, 2)
+        if not np.all(inside_outline(self.verts, pts) | (boundary_distance(self.verts, pts) < 1e-9)):
+            return None
+        w = statics_weights(pts)
+        if w is None:
+            return None
+        return point_support(self.part, pts, w, kind="points", label="fitted")
+
+    def loss(self, flat) -> float:
+        support = self.support_of(flat)
+        if support is None:
+            return math.inf
+        self.evaluations += 1
+        r = self.residuals(support) / HUBER_DEG
+        return float(np.sum(2.0 * (np.sqrt(1.0 + r * r) - 1.0)))
+
+
+def _random_layouts(part, k, n, seed) -> list[np.ndarray]:
+    """``n`` random layouts of ``k`` points in the outline that hold the centroid."""
+    from pipeline.parts.support_family import sample_tripods
+    if k == 3:
+        return [m.points.ravel() for m in sample_tripods(part, n, 0.0, seed)]
+    rng = np.random.default_rng([seed, 27])
+    verts = np.asarray(part.vertices, dtype=float)
+    lo, hi = verts.min(axis=0), verts.max(axis=0)
+    out = []
+    for _ in range(200 * n):
+        pts = rng.uniform(lo, hi, (k, 2))
+        if np.all(inside_outline(verts, pts)) and statics_weights(pts) is not None:
+            out.append(pts.ravel())
+            if len(out) == n:
+                break
+    return out
+
+
+def _nelder_mead(loss, start, a: float, restarts: int = RESTARTS):
+    """Nelder-Mead from ``start``, restarted from its result with a fresh simplex
+    (an initial step of 5 % of ``a``) while that improves the loss (a collapsed
+    simplex otherwise stops short of the minimum on these kinked losses)."""
+    best = None
+    x = np.asarray(start, dtype=float)
+    for _ in range(1 + restarts):
+        simplex = np.vstack([x, x + 0.05 * a * np.eye(x.size)])
+        res = optimize.minimize(loss, x, method="Nelder-Mead",
+                                options={"xatol": 1e-3, "fatol": 1e-6, "maxfev": 100 * x.size,
+                                         "initial_simplex": simplex})
+        if best is not None and res.fun >= best.fun - 1e-9:
+            break
+        best, x = res, res.x
+    return best
+
+
+def fit_support(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: float, n_points: int = 3,
+                starts: int = 48, refine: int = 3, seed: int = 0) -> SupportFit:
+    """The ``n_points``-point support (statics weights) that best explains
+    ``pushes`` (see the module notes); ``mu_c`` is used where a push gives none."""
+    if not 3 <= int(n_points) <= 12:
+        raise PinfeedError(f"--points must be 3 to 12 (a support that holds the centroid needs 3), "
+                           f"got {n_points}")
+    if int(starts) < 1 or int(refine) < 1:
+        raise PinfeedError(f"--starts must be at least 1, got {starts}")
+    if mu_c is None and np.any(np.isnan(pushes.mu_c)):
+        raise PinfeedError("give --mu-c or a mu_c column in the pushes file")
+    if mu_c is not None and not (math.isfinite(mu_c) and mu_c >= 0):
+        raise PinfeedError(f"--mu-c must be a number >= 0, got {mu_c}")
+    if len(pushes) < 2 * n_points:
+        raise PinfeedError(f"{len(pushes)} pushes cannot fix {n_points} support points "
+                           f"({2 * n_points} unknowns); measure at least {2 * n_points} pushes")
+    objective = _Objective(part, pushes, mu_c if mu_c is not None else 0.0, pin_radius)
+    layouts = _random_layouts(part, int(n_points), int(starts), seed)
+    if not layouts:
+        raise PinfeedError(f"no {n_points} points inside the outline hold the centroid; try --points 3")
+    scored = sorted(layouts, key=objective.loss)[:max(1, int(refine))]
+    best = min((_nelder_mead(objective.loss, start, part.a, restarts=0) for start in scored),
+               key=lambda res: res.fun)
+    best = _nelder_mead(objective.loss, best.x, part.a)  # the best of them, restarted
+    support = objective.support_of(best.x)
+    return SupportFit(support, objective.residuals(support), objective.residuals(None), len(pushes),
+                      objective.evaluations)
