@@ -243,11 +243,13 @@ def cmd_catalog_list(args):
     if args.json:
         _print_json(rows, indent=1)
         return
-    print(f"{'family':<18} {'part':<28} {'models':<22} {'mu_c':<18} {'v_pin/v_b':<16} {'d x theta_i'}")
+    print(f"{'family':<18} {'part':<28} {'models':<22} {'mu_c':<18} {'v_pin/v_b':<16} {'d x theta_i':<12} "
+          f"supports")
     for r in rows:
         print(f"{r['family']:<18} {r['part_id']:<28} {','.join(r['models']):<22} "
               f"{','.join(f'{m:g}' for m in r['mu_c']):<18} "
-              f"{','.join(f'{v:g}' for v in r['v_pin']):<16} {r['n_d']} x {r['n_theta']}")
+              f"{','.join(f'{v:g}' for v in r['v_pin']):<16} {r['n_d']} x {r['n_theta']:<8} "
+              f"{'; '.join(r['supports'])}")
 
 
 def cmd_catalog_show(args):
@@ -258,8 +260,9 @@ def cmd_catalog_show(args):
     info = {k: e0[k] for k in ("family", "part_id", "part_name", "part_vertices", "pin_radius",
                                "d", "theta_step", "config_hash", "pinfeed_version", "git_commit")}
     info["shards"] = [dict({k: e[k] for k in ("model", "mu_c", "file", "sha256", "created")},
-                           v_pin=e.get("v_pin", 0.0))
-                      for e in sorted(entries, key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0)))]
+                           v_pin=e.get("v_pin", 0.0), support=e.get("support", "uniform"))
+                      for e in sorted(entries, key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0),
+                                                              e.get("support_key", "")))]
     if args.json:
         _print_json(info, indent=1)
         return
@@ -270,14 +273,14 @@ def cmd_catalog_show(args):
     print(f"made by pinfeed {info['pinfeed_version']} ({info['git_commit']}), config {info['config_hash']}")
     for sh in info["shards"]:
         print(f"  {sh['model']:<10} mu_c={sh['mu_c']:<6g} v_pin/v_b={sh['v_pin']:<5g} {sh['file']}  "
-              f"{sh['created']}")
+              f"{sh['created']}" + ("" if sh["support"] == "uniform" else f"  support {sh['support']}"))
 
 
 def _query(args):
     cat = _catalog(args)
     d = parse_values(args.d, "--d") if args.d is not None else None
     ds = cat.query(args.part, model=args.model, mu_c=args.mu_c, d=d, method=args.method,
-                   v_pin=args.v_pin)
+                   v_pin=args.v_pin, support=args.support)
     if getattr(args, "theta_i", None) is not None:
         ds = ds.sel(theta_i=parse_values(args.theta_i, "--theta-i"), method="nearest")
     return ds
@@ -297,7 +300,7 @@ def cmd_catalog_query(args):
                              "theta_f": float(sub["theta_f"].values[k]), "dy": float(sub["dy"].values[k])})
     if args.json:
         _print_json({"part": ds.attrs.get("part_id"), "model": args.model, "v_pin": args.v_pin,
-                     "selection": ds.attrs["selection"], "rows": rows})
+                     "support": str(ds["support"].values), "selection": ds.attrs["selection"], "rows": rows})
         return
     print(f"selection: {ds.attrs['selection']}")
     print(f"{'mu_c':>6} {'d':>6} {'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9}")
@@ -837,6 +840,9 @@ def _add_catalog_commands(sub) -> None:
                        help="how to pick stored mu_c and d values (default nearest)")
         q.add_argument("--v-pin", dest="v_pin", type=float, default=0.0,
                        help="pin speed ratio v_pin/v_b of the maps (stored exactly; default 0, static)")
+        q.add_argument("--support", default="uniform", metavar="SPEC",
+                       help="support distribution of the maps (sweep.supports; stored exactly): its "
+                            "text ('tripod', 'rim:64', 'points:...') or file key; default uniform")
         if name == "query":
             q.add_argument("--theta-i", default=None,
                            help="only these initial orientations (nearest stored)")

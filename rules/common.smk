@@ -10,7 +10,7 @@ wildcard_constraints:
     family="[A-Za-z0-9_]+",
     part="[A-Za-z0-9_]+-[0-9a-f]{10}",
     model="minpower|tip|ellipsoid|dynamic",
-    tag="mu_c=[0-9.eE+-]+(_v_pin=[0-9.eE+-]+)?(_belt=[0-9.eE+-]+_mu_s=[0-9.eE+-]+)?",
+    tag="mu_c=[0-9.eE+-]+(_v_pin=[0-9.eE+-]+)?(_belt=[0-9.eE+-]+_mu_s=[0-9.eE+-]+)?(_support=[A-Za-z0-9-]+)?",
 
 
 def part_shards(wildcards):
@@ -29,6 +29,7 @@ def shard_params(wildcards):
         "theta_step": sweep["theta_step"],
         "pin_radius": sweep["pin_radius"],
         "kernel": sweep["kernel"],
+        **({"support": job.support} if job.support != "uniform" else {}),
     }
 
 

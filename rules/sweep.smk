@@ -1,4 +1,4 @@
-# Stage 1: one map shard per (family, part, model, mu_c, v_pin).
+# Stage 1: one map shard per (family, part, model, mu_c, v_pin[, belt speed][, support]).
 
 
 rule sweep_shard:

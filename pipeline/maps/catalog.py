@@ -12,10 +12,14 @@ Queries return lazy (dask-backed) xarray objects::
     ds = cat.query(part="asym_triangle", model="minpower", mu_c=0.2, d=0.3)
     ds.attrs["selection"]   # e.g. "mu_c 0.2 -> nearest stored 0.15; d 0.3 -> 0.3"
     moving = cat.query("asym_triangle", mu_c=0.15, v_pin=-2)   # a dynamic pin's maps
-    cube = cat.cube("paper_triangles")   # dims (part, model, mu_c, v_pin, d, theta_i)
+    tripod = cat.query("asym_triangle", mu_c=0.15, support="tripod")   # issue 25
+    cube = cat.cube("paper_triangles")   # dims (part, model, mu_c, v_pin[, support], d, theta_i)
 
 Shards written before dynamic pins existed have no ``v_pin`` attribute and
-count as static pins (v_pin = 0).
+count as static pins (v_pin = 0); shards without a ``support`` attribute are
+uniform pressure. A query serves one support (default uniform), named by
+its text (``tripod``, ``rim:64``, ``points:...``) or its file key
+(``pipeline.parts.support.support_key``).
 
 Integrity: each entry records the shard's SHA-256, size and modification
 time. Opening a catalog (``catalog list/show``, every query) compares size and
@@ -38,6 +42,7 @@ import xarray as xr
 from pipeline.checks import schema_problem
 from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_json
+from pipeline.parts.support import support_key
 
 INDEX_NAME = "index.json"
 # The planner's refinement shards (pipeline.planning.lattice_store) live under
@@ -69,6 +74,7 @@ INDEX_SCHEMA = {
                 "part_vertices": {"type": "array", "minItems": 3,
                                   "items": {"type": "array", "minItems": 2, "maxItems": 2, "items": _NUM}},
                 "mu_c": _NUM, "pin_radius": _NUM, "v_pin": _NUM, "theta_step": _NUM,
+                "support": _STR, "support_key": _STR,
                 "d": {"type": "array", "items": _NUM},
                 "n_theta": {"type": "integer", "minimum": 1},
             },
@@ -114,6 +120,8 @@ def entry_from_file(root: Path, path: Path) -> dict:
         "pin_radius": float(attrs["pin_radius"]),
         "v_pin": float(attrs.get("v_pin", 0.0)),
         "belt_speed": float(attrs.get("belt_speed", 0.0)),
+        "support": str(attrs.get("support", "uniform")),
+        "support_key": _support_key(str(attrs.get("support", "uniform"))),
         "mu_s": float(attrs.get("mu_s", 0.5)),
         "d": d,
         "theta_step": float(attrs["theta_step"]),
@@ -179,7 +187,7 @@ def damaged_shard(root: Path, problem: str, entry: dict | None = None) -> dict:
         return {"file": entry["file"], "problem": problem, "family": entry["family"],
                 "part_id": entry["part_id"], "part_name": entry["part_name"], "model": entry["model"],
                 "mu_c": entry["mu_c"], "v_pin": entry.get("v_pin", 0.0),
-                "belt_speed": entry.get("belt_speed", 0.0)}
+                "belt_speed": entry.get("belt_speed", 0.0), "support_key": entry.get("support_key", "")}
     file = problem.split(".h5: ", 1)[0] + ".h5" if ".h5: " in problem else ""
     try:
         rel = Path(file).resolve().relative_to(Path(root).resolve())
@@ -187,13 +195,15 @@ def damaged_shard(root: Path, problem: str, entry: dict | None = None) -> dict:
         rel = Path(file)
     parts = rel.parts
     tag = dict(re.findall(r"(mu_c|v_pin|belt)=(-?[0-9.eE+-]+?)(?=_[a-z]|$)", rel.stem))
+    support = re.search(r"_support=([A-Za-z0-9-]+)$", rel.stem)
     known = len(parts) == 4
     part_id = parts[1] if known else None
     return {"file": rel.as_posix(), "problem": problem, "family": parts[0] if known else None,
             "part_id": part_id, "part_name": part_id.rsplit("-", 1)[0] if part_id else None,
             "model": parts[2] if known else None,
             "mu_c": float(tag["mu_c"]) if "mu_c" in tag else None,
-            "v_pin": float(tag.get("v_pin", 0.0)), "belt_speed": float(tag.get("belt", 0.0))}
+            "v_pin": float(tag.get("v_pin", 0.0)), "belt_speed": float(tag.get("belt", 0.0)),
+            "support_key": support.group(1) if support else ""}
 
 
 class Catalog:
@@ -264,11 +274,13 @@ class Catalog:
             r = rows.setdefault(e["part_id"], {"family": e["family"], "part_id": e["part_id"],
                                                "part_name": e["part_name"], "n_vertices": len(e["part_vertices"]),
                                                "models": set(), "mu_c": set(), "v_pin": set(),
-                                               "n_d": len(e["d"]), "n_theta": e["n_theta"]})
+                                               "supports": set(), "n_d": len(e["d"]), "n_theta": e["n_theta"]})
             r["models"].add(e["model"])
             r["mu_c"].add(e["mu_c"])
             r["v_pin"].add(e.get("v_pin", 0.0))
-        return [dict(r, models=sorted(r["models"]), mu_c=sorted(r["mu_c"]), v_pin=sorted(r["v_pin"]))
+            r["supports"].add(e.get("support", "uniform"))
+        return [dict(r, models=sorted(r["models"]), mu_c=sorted(r["mu_c"]), v_pin=sorted(r["v_pin"]),
+                     supports=sorted(r["supports"], key=lambda s: (s != "uniform", s)))
                 for r in rows.values()]
 
     def entries_for(self, part: str) -> list[dict]:
@@ -298,11 +310,12 @@ class Catalog:
         return [d for d in self.damaged if part in (d["part_id"], d["part_name"])
                 and all(d.get(k) is None or d[k] == v for k, v in fields.items())]
 
-    def _refuse_damaged_in(self, part, model, mu_c, method, v_pin, belt_speed) -> None:
+    def _refuse_damaged_in(self, part, model, mu_c, method, v_pin, belt_speed, key="") -> None:
         """Raise when a damaged shard would have been served by this query: its
         friction is the one (or one of those) chosen among all the part's
         frictions, whole or damaged."""
-        where = {"model": model, "v_pin": float(v_pin), "belt_speed": float(belt_speed)}
+        where = {"model": model, "v_pin": float(v_pin), "belt_speed": float(belt_speed),
+                 "support_key": key}
         bad = self.damaged_of(part, **where)
         if mu_c is not None and bad:
             whole = {e["mu_c"] for e in self.entries if part in (e["part_id"], e["part_name"])
@@ -322,28 +335,9 @@ class Catalog:
             self._verified.add(path)
         return xr.open_dataset(path, engine="h5netcdf", chunks={})
 
-    def query(self, part: str, model: str = "minpower", mu_c=None, d=None,
-              method: str = "nearest", v_pin: float = 0.0,
-              belt_speed: float = 0.0) -> xr.Dataset:
-        """Maps of one part, model and pin speed, lazily.
-
-        ``mu_c`` and ``d`` select stored values: ``method="nearest"`` takes the
-        nearest stored value, ``"bracket"`` the stored values on either side (or
-        the exact one). ``None`` keeps all. ``v_pin`` (speed ratio v_pin / v_b,
-        default 0: static pins) must be stored exactly, since maps of different
-        speeds are not interpolated. ``attrs["selection"]`` says what was
-        chosen. ``belt_speed`` (mm/s, default 0: quasi-static) selects the
-        dynamic model's maps at that speed, stored exactly (``model`` is then
-        ``"dynamic"``). Returns dims ``(mu_c, d, theta_i)``.
-        """
-        if float(belt_speed) > 0.0:
-            model = "dynamic"
-        if method not in ("nearest", "bracket"):
-            raise PinfeedError(f"unknown selection method {method!r}; use nearest or bracket")
-        _check_finite(mu_c=mu_c, d=d, v_pin=v_pin)
-        if mu_c is not None and float(mu_c) < 0:
-            raise PinfeedError(f"mu_c must be a finite number >= 0, got {mu_c!r}")
-        self._refuse_damaged_in(part, model, mu_c, method, v_pin, belt_speed)
+    def _stored(self, part, model, belt_speed, support, key, v_pin) -> list[dict]:
+        """The entries of one part, model, belt speed, support and pin speed
+        (each stored exactly), or a one-line error naming what is stored."""
         found = [e for e in self.entries_for(part) if e["model"] == model]
         if not found:
             models = sorted({e["model"] for e in self.entries_for(part)})
@@ -354,12 +348,46 @@ class Catalog:
             raise PinfeedError(f"part {part!r} has no {model} maps at belt speed {float(belt_speed):g} mm/s; "
                                f"stored belt speeds: {', '.join(f'{v:g}' for v in belts)} "
                                f"(add it to sweep.belt_speed)")
+        supports = sorted({e.get("support", "uniform") for e in found}, key=lambda s: (s != "uniform", s))
+        found = [e for e in found if e.get("support_key", "") == key]
+        if not found:
+            raise PinfeedError(f"part {part!r} has no {model} maps on support {support!r}; stored supports: "
+                               f"{', '.join(supports)} (add it to sweep.supports)")
         speeds = sorted({e.get("v_pin", 0.0) for e in found})
         found = [e for e in found if e.get("v_pin", 0.0) == float(v_pin)]
         if not found:
             raise PinfeedError(f"part {part!r} has no {model} maps at v_pin/v_b = {float(v_pin):g}; "
                                f"stored speeds: {', '.join(f'{v:g}' for v in speeds)} (add it to sweep.v_pin)")
+        return found
+
+    def query(self, part: str, model: str = "minpower", mu_c=None, d=None,
+              method: str = "nearest", v_pin: float = 0.0,
+              belt_speed: float = 0.0, support: str = "uniform") -> xr.Dataset:
+        """Maps of one part, model and pin speed, lazily.
+
+        ``mu_c`` and ``d`` select stored values: ``method="nearest"`` takes the
+        nearest stored value, ``"bracket"`` the stored values on either side (or
+        the exact one). ``None`` keeps all. ``v_pin`` (speed ratio v_pin / v_b,
+        default 0: static pins) must be stored exactly, since maps of different
+        speeds are not interpolated. ``attrs["selection"]`` says what was
+        chosen. ``belt_speed`` (mm/s, default 0: quasi-static) selects the
+        dynamic model's maps at that speed, stored exactly (``model`` is then
+        ``"dynamic"``). ``support`` (issue 25; default uniform) selects the maps
+        of one support, by its text or file key, stored exactly; the result has
+        a scalar ``support`` coordinate. Returns dims ``(mu_c, d, theta_i)``.
+        """
+        key = _support_key(support)
+        if float(belt_speed) > 0.0:
+            model = "dynamic"
+        if method not in ("nearest", "bracket"):
+            raise PinfeedError(f"unknown selection method {method!r}; use nearest or bracket")
+        _check_finite(mu_c=mu_c, d=d, v_pin=v_pin)
+        if mu_c is not None and float(mu_c) < 0:
+            raise PinfeedError(f"mu_c must be a finite number >= 0, got {mu_c!r}")
+        self._refuse_damaged_in(part, model, mu_c, method, v_pin, belt_speed, key)
+        found = self._stored(part, model, belt_speed, support, key, v_pin)
         notes = [] if float(v_pin) == 0.0 else [f"v_pin {float(v_pin):g} stored exactly"]
+        notes += [] if not key else [f"support {found[0]['support']}"]
         stored_mu = sorted({e["mu_c"] for e in found})
         if mu_c is not None:
             chosen = _select(stored_mu, float(mu_c), method)
@@ -369,6 +397,8 @@ class Catalog:
         parts = [self._open_entry(e).expand_dims(mu_c=[e["mu_c"]]) for e in found]
         ds = xr.concat(parts, dim="mu_c", combine_attrs="drop_conflicts")
         ds["mu_c"].attrs.update(units="1", long_name="pin-part friction coefficient")
+        ds = ds.assign_coords(support=((), found[0].get("support", "uniform"),
+                                       {"long_name": "support distribution (issue 25)"}))
         if d is not None:
             stored_d = [float(x) for x in ds["d"].values]
             picks = []
@@ -381,7 +411,9 @@ class Catalog:
         return ds
 
     def cube(self, family: str) -> xr.Dataset:
-        """All maps of a family as one lazy cube (part, model, mu_c, v_pin, d, theta_i)."""
+        """All maps of a family as one lazy cube (part, model, mu_c, v_pin, d,
+        theta_i), with a ``support`` dimension after ``v_pin`` when the family
+        has maps on supports other than uniform; combinations not stored are NaN."""
         # Quasi-static maps only: dynamic maps at belt speed > 0 are queried
         # one speed at a time (``query(..., belt_speed=...)``).
         found = [e for e in self.entries if e["family"] == family and not e.get("belt_speed", 0.0)]
@@ -391,15 +423,26 @@ class Catalog:
             fams = sorted({e["family"] for e in self.entries})
             raise PinfeedError(f"unknown family {family!r}; known families: {', '.join(fams) or 'none'}")
         pieces = []
+        supports = {e.get("support", "uniform") for e in found} != {"uniform"}
         for e in found:
             ds = self._open_entry(e)
             ds = ds.drop_attrs() if hasattr(ds, "drop_attrs") else ds.assign_attrs({})
-            pieces.append(ds.expand_dims(part=[e["part_id"]], model=[e["model"]], mu_c=[e["mu_c"]],
-                                         v_pin=[e.get("v_pin", 0.0)]))
+            dims = dict(part=[e["part_id"]], model=[e["model"]], mu_c=[e["mu_c"]], v_pin=[e.get("v_pin", 0.0)])
+            if supports:
+                dims["support"] = [e.get("support", "uniform")]
+            pieces.append(ds.expand_dims(**dims))
         cube = xr.combine_by_coords(pieces, combine_attrs="drop", join="outer")  # missing speeds: NaN
         cube.attrs.update(family=family, title=f"pinfeed map cube of family {family}")
         cube["v_pin"].attrs.update(units="1", long_name="pin speed across the belt over belt speed")
+        if supports:
+            cube["support"].attrs.update(long_name="support distribution (issue 25)")
         return cube
+
+
+def _support_key(support) -> str:
+    """The file key of a support given by its text or its key ('' for uniform)."""
+    text = str(support)
+    return text if re.fullmatch(r"points-[0-9a-f]{10}", text) else support_key(text)
 
 
 def _refuse_damaged(bad: list[dict], what: str) -> None:

@@ -200,17 +200,15 @@ def _model_xml(pieces, r_pin, mu_c, mass, izz, pin_start, pin_dir, timestep=TIME
 def mujoco_rollout(part, theta_i_deg, d, mu_c, r_pin_mm, belt_speed_mm_s, mu_s=0.5, v_pin=0.0,
                    max_travel=math.inf, trajectory=False, record_every=40,
                    mass=PART_MASS, support=None):
-    """One passage in MuJoCo. Lengths in mm, speeds in mm/s, angles in degrees.
-    ``support``: a point support (``Support``, part frame, checked by the
-    caller) whose points carry the belt friction, each its weight's share of
-    the load; ``None`` spreads the load over a grid of the area (uniform).
+    """One passage in MuJoCo. Lengths in mm, speeds in mm/s, angles in degrees;
+    ``support``: a checked point support (its points carry the belt friction
+    by weight) or ``None`` (a grid over the area: uniform).
 
     Returns ``(status, jam_reason, theta_f_rad, dy_mm, contact_travel_mm,
     feature_changes, peak_force, trajectory, force)`` with status codes
     0 ok, 1 miss, 2 jammed, 3 truncated (as the kernels); ``trajectory``
     rows ``(s, x, y, theta_rad)`` and ``force`` rows ``(s, F_x, F_y)`` (force
-    on the pin, units of mu_s m g; s = belt travel since first contact, mm).
-    """
+    on the pin, units of mu_s m g; s = belt travel since first contact, mm)."""
     mujoco = _mujoco()
     xy, a, izz, pts, load = _support(part, mass, mu_s, support)
     r_pin = r_pin_mm / 1000.0

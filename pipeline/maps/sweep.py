@@ -4,7 +4,11 @@ Static pins (v_pin = 0) keep the file name ``mu_c=MU.h5``, so catalogs
 written before dynamic pins existed stay valid; a moving pin's shard is
 ``mu_c=MU_v_pin=V.h5`` (V the speed ratio v_pin / v_b). Belt speeds > 0
 (``sweep.belt_speed``) add shards of the dynamic model under
-``dynamic/mu_c=MU[_v_pin=V]_belt=S_mu_s=M.h5``.
+``dynamic/mu_c=MU[_v_pin=V]_belt=S_mu_s=M.h5``. Supports other than uniform
+(``sweep.supports``, issue 25) add minpower shards
+``mu_c=MU[_v_pin=V]_support=KEY.h5`` (``parts.support.support_key``); uniform keeps
+every name, file and byte as it was. The catalog stacks a family's shards
+along a ``support`` dimension and queries one support at a time.
 
 A shard is an HDF5 file (xarray, h5netcdf engine) that describes itself:
 CF-style variable attributes, the part's outline, every sweep parameter, the
@@ -27,6 +31,7 @@ from pipeline.maps import simulate
 from pipeline.maps.io import write_atomic
 from pipeline.parts.families import family_parts
 from pipeline.parts.part import Part
+from pipeline.parts.support import parse_support, support_key
 from pipeline.provenance import provenance_attrs
 
 SCHEMA_VERSION = 1
@@ -42,27 +47,35 @@ class ShardJob:
     v_pin: float = 0.0
     belt_speed: float = 0.0  # mm/s; > 0 only for the dynamic model
     mu_s: float = 0.5
+    support: str = "uniform"  # a support's text (parse_support); minpower only when not uniform
+
+    @property
+    def tag(self) -> str:
+        """The shard's file stem (:func:`shard_tag`)."""
+        return shard_tag(self.mu_c, self.v_pin, self.belt_speed, self.mu_s, self.support)
 
     def path(self, catalog_dir) -> Path:
         """The shard's file under ``catalog_dir``."""
-        return shard_path(catalog_dir, self.family, self.part.id, self.model, self.mu_c, self.v_pin,
-                          self.belt_speed, self.mu_s)
+        return Path(catalog_dir) / self.family / self.part.id / self.model / f"{self.tag}.h5"
 
 
-def shard_tag(mu_c, v_pin=0.0, belt_speed=0.0, mu_s=0.5) -> str:
+def shard_tag(mu_c, v_pin=0.0, belt_speed=0.0, mu_s=0.5, support="uniform") -> str:
     """File stem of a shard: ``mu_c=0.15`` (static pin) or ``mu_c=0.15_v_pin=-2.0``;
-    dynamic maps add ``_belt=150.0_mu_s=0.5`` (belt speed in mm/s)."""
+    dynamic maps add ``_belt=150.0_mu_s=0.5`` (belt speed in mm/s), supports
+    other than uniform ``_support=KEY`` (``parts.support.support_key``)."""
     tag = f"mu_c={mu_label(mu_c)}"
     tag = tag if float(v_pin) == 0.0 else f"{tag}_v_pin={mu_label(v_pin)}"
     if float(belt_speed) > 0.0:
         tag = f"{tag}_belt={mu_label(belt_speed)}_mu_s={mu_label(mu_s)}"
-    return tag
+    key = support_key(support)
+    return f"{tag}_support={key}" if key else tag
 
 
 def shard_path(catalog_dir, family, part_id, model, mu_c, v_pin=0.0, belt_speed=0.0,
-               mu_s=0.5) -> Path:
+               mu_s=0.5, support="uniform") -> Path:
     """The shard file ``catalog_dir/family/part_id/model/TAG.h5`` (see :func:`shard_tag`)."""
-    return Path(catalog_dir) / family / part_id / model / f"{shard_tag(mu_c, v_pin, belt_speed, mu_s)}.h5"
+    return (Path(catalog_dir) / family / part_id / model
+            / f"{shard_tag(mu_c, v_pin, belt_speed, mu_s, support)}.h5")
 
 
 def shard_jobs(config) -> list[ShardJob]:
@@ -83,14 +96,22 @@ def shard_jobs(config) -> list[ShardJob]:
                     for v in config["sweep"]["v_pin"]:
                         jobs.append(ShardJob(family, part, "dynamic", float(mu), float(v),
                                              float(speed), mu_s))
+            # Supports other than uniform: minpower shards (the model that takes them).
+            for support in config["sweep"].get("supports", ["uniform"]):
+                if not support_key(support):
+                    continue
+                parse_support(support, part)  # a support outside this part: a one-line error
+                for mu in config["sweep"]["mu_c"]:
+                    for v in config["sweep"]["v_pin"]:
+                        jobs.append(ShardJob(family, part, "minpower", float(mu), float(v),
+                                             support=" ".join(str(support).split())))
     return jobs
 
 
 def find_job(config, family, part_id, model, tag) -> ShardJob:
     """The job of a shard named by its folder parts and file stem (``shard_tag``)."""
     for job in shard_jobs(config):
-        if (job.family, job.part.id, job.model) == (family, part_id, model) \
-                and shard_tag(job.mu_c, job.v_pin, job.belt_speed, job.mu_s) == tag:
+        if (job.family, job.part.id, job.model) == (family, part_id, model) and job.tag == tag:
             return job
     from pipeline.errors import PinfeedError
     raise PinfeedError(f"the config has no shard {family}/{part_id}/{model}/{tag}")
@@ -107,12 +128,14 @@ def compute_shard(config, job: ShardJob, threads=None, backend=None):
                               sweep["pin_radius"], model=job.model, v_pin=job.v_pin, threads=threads,
                               **({"belt_speed": job.belt_speed, "mu_s": job.mu_s} if job.belt_speed > 0 else {}),
                               ds_max=kernel.get("ds_max", 0.1), tol=kernel.get("tol", 1e-7),
-                              backend=backend or sweep.get("backend", "cpu"))
+                              backend=backend or sweep.get("backend", "cpu"),
+                              **({"support": job.support} if support_key(job.support) else {}))
     ds.attrs.update(provenance_attrs())
     ds.attrs.update({
         "title": f"pinfeed configuration maps: {job.part.id}, {job.model}, mu_c={job.mu_c:g}, "
                  f"v_pin/v_b={job.v_pin:g}"
-                 + (f", belt {job.belt_speed:g} mm/s, mu_s={job.mu_s:g}" if job.belt_speed > 0 else ""),
+                 + (f", belt {job.belt_speed:g} mm/s, mu_s={job.mu_s:g}" if job.belt_speed > 0 else "")
+                 + (f", support {job.support}" if support_key(job.support) else ""),
         "family": job.family,
         "theta_step": float(sweep["theta_step"]),
         "config_hash": config_hash(config),

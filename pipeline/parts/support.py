@@ -32,7 +32,9 @@ they are.
 """
 from __future__ import annotations
 
+import hashlib
 import math
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -290,6 +292,18 @@ def filled_support(part, n: int) -> Support:
                     pts.append(a + (p + 2 / 3) * u + (q + 2 / 3) * v)  # upside down
         wts.extend([area / (n * n)] * (n * n))
     return point_support(part, np.array(pts), np.array(wts), label=f"filled:{n}")
+
+
+def support_key(support: str) -> str:
+    """A support's name in a file name: ``tripod``, ``rim-64``, or for explicit
+    points ``points-`` and the first 10 hex digits of the SHA-256 of its text;
+    empty for uniform."""
+    text = " ".join(str(support).split())
+    if text in ("", "uniform"):
+        return ""
+    if text.startswith("points"):
+        return "points-" + hashlib.sha256(text.encode()).hexdigest()[:10]
+    return re.sub(r"[^A-Za-z0-9]+", "-", text).strip("-")
 
 
 def parse_support(text: str | None, part) -> Support:

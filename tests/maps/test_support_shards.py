@@ -1,0 +1,134 @@
+"""Shards with a support (issue 25, ``sweep.supports``): written, indexed and
+queried back equal to a direct kernel call on the same support; uniform
+shards keep their names; the cube's ``support`` dimension; an unknown or a
+damaged support shard named in one line; the CLI; the workflow's jobs."""
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from cli_runs import run_cli
+from workflow_runs import run_snakemake
+
+from pipeline.config import load_config, validate_config
+from pipeline.errors import PinfeedError
+from pipeline.maps import simulate
+from pipeline.maps.catalog import Catalog
+from pipeline.maps.sweep import run_sweep, shard_jobs
+from pipeline.parts.part import Part
+from pipeline.parts.support import support_key
+
+POINTS = "points:-5,-3,1 5,-3,1 0,6,1"
+TINY = {
+    "families": {"fam": {"parts": [{"name": "tri", "vertices": [[0, 0], [60, 0], [15, 35]]}]}},
+    "sweep": {"models": ["minpower", "ellipsoid"], "mu_c": [0.2], "d": [-0.4, 0.3],
+              "theta_step": 45, "pin_radius": 3.0, "supports": ["uniform", "tripod", POINTS]},
+}
+TRI = Part.from_vertices(TINY["families"]["fam"]["parts"][0]["vertices"], name="tri")
+
+
+@pytest.fixture(scope="module")
+def swept(tmp_path_factory):
+    cfg = validate_config(dict(json.loads(json.dumps(TINY)),
+                               catalog_dir=str(tmp_path_factory.mktemp("cat") / "catalog")))
+    run_sweep(cfg, progress=False, threads=1)
+    return cfg
+
+
+@pytest.mark.parametrize("support", ["tripod", POINTS, "uniform"])
+def test_query_equals_a_direct_kernel_call(swept, support):
+    cat = Catalog.open(swept["catalog_dir"])
+    assert not cat.problems and len(cat.entries) == 2 + 2  # uniform x 2 models, 2 supports x minpower
+    q = cat.query("tri", mu_c=0.2, support=support).load()
+    direct = simulate.compute_map(TRI, np.arange(0, 360, 45.0), [-0.4, 0.3], 0.2, 3.0,
+                                  support=None if support == "uniform" else support)
+    for name in ("theta_f", "dy", "status"):
+        np.testing.assert_array_equal(q[name].values[0], direct[name].values)
+    assert str(q["support"].values) == support
+    by_key = cat.query("tri", mu_c=0.2, support=support_key(support) or "uniform").load()
+    np.testing.assert_array_equal(by_key["theta_f"].values, q["theta_f"].values)
+
+
+def test_supports_change_the_maps_and_name_their_files(swept):
+    paths = [j.path(swept["catalog_dir"]) for j in shard_jobs(swept)]
+    names = sorted(p.name for p in paths)
+    assert names == sorted(["mu_c=0.2.h5", "mu_c=0.2.h5", "mu_c=0.2_support=tripod.h5",
+                            f"mu_c=0.2_support={support_key(POINTS)}.h5"])
+    assert support_key(POINTS).startswith("points-") and len(support_key(POINTS)) == 17
+    cat = Catalog.open(swept["catalog_dir"])
+    uni = cat.query("tri", mu_c=0.2).load()["theta_f"].values
+    tri = cat.query("tri", mu_c=0.2, support="tripod").load()["theta_f"].values
+    assert np.nanmax(np.abs(tri - uni)) > 1.0
+
+
+def test_default_config_keeps_its_shard_names():
+    """Uniform pressure alone (the default) adds nothing to any name."""
+    cfg = load_config()
+    assert cfg["sweep"]["supports"] == ["uniform"]
+    jobs = shard_jobs(cfg)
+    assert all("support" not in j.path("cat").name for j in jobs)
+    explicit = dict(cfg, sweep=dict(cfg["sweep"], supports=["uniform"]))
+    assert [j.path("c") for j in shard_jobs(explicit)] == [j.path("c") for j in jobs]
+
+
+def test_cube_has_a_support_dimension(swept):
+    cube = Catalog.open(swept["catalog_dir"]).cube("fam")
+    assert "support" in cube.dims and set(cube["support"].values) == {"uniform", "tripod", POINTS}
+    tip = cube["theta_f"].sel(model="ellipsoid", support="tripod").load().values
+    assert np.all(np.isnan(tip))  # not stored: a support is swept with minpower only
+
+
+def test_unknown_support_is_one_line(swept):
+    with pytest.raises(PinfeedError, match="no minpower maps on support 'rim:8'; stored supports: "
+                                           "uniform, points:.*, tripod"):
+        Catalog.open(swept["catalog_dir"]).query("tri", mu_c=0.2, support="rim:8")
+
+
+def test_damaged_support_shard_is_named_only_where_it_is_used(swept, capsys, tmp_path):
+    import shutil
+    root = tmp_path / "copy"
+    shutil.copytree(swept["catalog_dir"], root)
+    shard = root / "fam" / TRI.id / "minpower" / "mu_c=0.2_support=tripod.h5"
+    shard.write_bytes(os.urandom(shard.stat().st_size))
+    cat = Catalog.open(root)
+    with pytest.raises(PinfeedError, match="support=tripod.h5"):
+        cat.query("tri", mu_c=0.2, support="tripod")
+    assert cat.query("tri", mu_c=0.2, support=POINTS).load()["theta_f"].size  # the others still served
+    code, out, err = run_cli(capsys, ["catalog", "query", "--catalog", str(root), "--part", "tri", "--mu-c", "0.2",
+                                      "--support", "tripod"])
+    assert code == 2 and err.strip().splitlines()[-1].startswith("pinfeed: error:")
+
+
+def test_cli_lists_and_queries_supports(swept, capsys):
+    code, out, _ = run_cli(capsys, ["catalog", "list", "--catalog", swept["catalog_dir"], "--json"])
+    assert code == 0 and json.loads(out)[0]["supports"] == ["uniform", POINTS, "tripod"]
+    code, out, err = run_cli(capsys, ["catalog", "query", "--catalog", swept["catalog_dir"], "--part", "tri",
+                                      "--mu-c", "0.2", "--d", "0.3", "--support", "tripod", "--json"])
+    assert code == 0, err
+    res = json.loads(out)
+    assert res["support"] == "tripod" and "support tripod" in res["selection"]
+    direct = simulate.compute_map(TRI, np.arange(0, 360, 45.0), [0.3], 0.2, 3.0, support="tripod")
+    assert [r["theta_f"] for r in res["rows"]] == pytest.approx(direct["theta_f"].values[0].tolist())
+
+
+def test_bad_support_in_the_config_is_one_line():
+    cfg = dict(json.loads(json.dumps(TINY)), catalog_dir="cat")
+    cfg["sweep"]["supports"] = ["uniform", "points:500,0,1"]
+    with pytest.raises(PinfeedError, match="outside the outline"):
+        shard_jobs(validate_config(cfg))
+
+
+def test_workflow_plans_the_support_shards(tmp_path):
+    import yaml
+    cfg = dict(json.loads(json.dumps(TINY)), catalog_dir="cat", results_dir="res",
+               planner={"parts": [], "mu_c": 0.2, "pins": [0.0, 10.0]})
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(cfg))
+    run = run_snakemake(tmp_path, "--configfile", str(tmp_path / "s.yaml"), "--dry-run", "--quiet", "all")
+    assert run.returncode == 0, run.stderr[-2000:]
+    text = run.stdout + run.stderr
+    assert "sweep_shard" in text
+    dry = run_snakemake(tmp_path, "--configfile", str(tmp_path / "s.yaml"), "--dry-run", "--summary")
+    assert "mu_c=0.2_support=tripod.h5" in dry.stdout and f"_support={support_key(POINTS)}.h5" in dry.stdout
