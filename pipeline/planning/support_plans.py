@@ -118,6 +118,8 @@ def support_study(part: Part, config: dict, family, uniform_entry: dict | None, 
       member of the family (:func:`verify_under_family`); ``survives`` when it
       still orients the part within the tolerance (a part that needs no pin
       survives: the resting states do not depend on the support);
+      ``widening``: its verified width (the narrowest arc holding the
+      required share of trials) under uniform pressure and under the family;
     - ``family_plan``: when it does not survive, the plan for the family
       (:func:`~pipeline.planning.plan.plan_tight` with the family).
 
@@ -140,6 +142,9 @@ def support_study(part: Part, config: dict, family, uniform_entry: dict | None, 
             progress(f"replaying the recommended plan {' '.join(rec['pins'])} under {family.label}")
         out["survival"] = verify_under_family(part, config, rec, mu_c, family)
         out["survives"] = bool(out["survival"]["orientation"]["orients"])
+        uniform_width = ((rec.get("verification") or {}).get("orientation") or {}).get("width_deg")
+        out["widening"] = {"uniform_width_deg": uniform_width,
+                           "family_width_deg": out["survival"]["orientation"]["width_deg"]}
     if not out["survives"]:
         if progress:
             progress(f"planning for every member of {family.label}")

@@ -165,6 +165,10 @@ def _support_section(res: dict, files: dict, base) -> list[str]:
         detail = (f": {o['in_tolerance']}/{o['trials']} trials in one set of {o['tolerance_deg']:g} deg "
                   f"(needs {o['needed']})") if o else " (no pin needed: resting states do not depend on support)"
         word = "survives" if res["survives"] else '<span class="warn">does not survive</span>'
+        widen = res.get("widening") or {}
+        if widen.get("uniform_width_deg") is not None and widen.get("family_width_deg") is not None:
+            detail += (f"; its final set widens from {widen['uniform_width_deg']:.1f} deg (uniform) to "
+                       f"{widen['family_width_deg']:.1f} deg (the narrowest arc holding the required share)")
         p.append(f"<li><b>The recommended plan {html.escape(rec)} {word}</b> the family at mu_c "
                  f"{html.escape(res['mu_c'])}{detail}.</li>")
     fp = res.get("family_plan")

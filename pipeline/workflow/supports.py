@@ -59,6 +59,10 @@ def support_summary_text(result: dict) -> str:
         return text + "; the recommended plan survives the family"
     fam = result["family_plan"] or {}
     rec = " ".join(result["uniform_plan"] or [])
+    widen = result.get("widening") or {}
+    if widen.get("family_width_deg") is not None:
+        rec += (f" (its final set widens from {widen['uniform_width_deg']:.1f} to "
+                f"{widen['family_width_deg']:.1f} deg)")
     return (text + f"; the recommended plan {rec} does not survive it"
             + (f"; {' '.join(fam['pins'])} orients the part for every member" if fam.get("orients")
                else f"; {fam.get('evidence', 'no plan found')}"))

@@ -83,6 +83,9 @@ def test_survival_and_the_family_plan_agree_with_the_oracle(stage):
     assert rec and stored["uniform_plan"] == rec["pins"]
     share = _family_share(rec["pins"], rec["pin_heights_mm"], family)
     assert stored["survives"] is False and share < 0.95  # the oracle agrees: the uniform plan fails
+    widen = stored["widening"]
+    assert widen["uniform_width_deg"] == rec["verification"]["orientation"]["width_deg"]
+    assert widen["family_width_deg"] > 12.0 > widen["uniform_width_deg"]
     fam = stored["family_plan"]
     assert fam["orients"], fam["evidence"]
     assert _family_share(fam["pins"], fam["pin_heights_mm"], family) >= 0.95
@@ -98,6 +101,7 @@ def test_report_section_and_figure(stage):
     for number in ("shift_median_deg", "shift_p90_deg", "shift_max_deg"):
         assert f"{stored['spread'][number]} deg" in html
     assert "does not survive" in html and " ".join(stored["family_plan"]["pins"]) in html
+    assert f"widens from {stored['widening']['uniform_width_deg']:.1f} deg" in html
     assert figure.stat().st_size > 20_000 and figure.read_bytes()[:4] == b"\x89PNG"
 
 
