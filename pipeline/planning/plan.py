@@ -28,6 +28,7 @@ from pipeline.parts.part import Part
 from pipeline.planning.arcs import format_arcs
 from pipeline.planning.certify import carried_plan
 from pipeline.planning.complete import FixedPinSearch, FixedPlan, FixedSearch, orientation_rank
+from pipeline.planning.family import planning_family
 from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required,
                                       check_tolerance, judge)
@@ -98,7 +99,7 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     prefixes (``planner.dynamic``).
 
     ``family`` (a :class:`~pipeline.parts.support_family.SupportFamily`, see
-    :func:`pipeline.planning.support_plans.planning_family`): the plans must
+    :func:`pipeline.planning.family.planning_family`): the plans must
     orient the part for every member; the search, the carried sets and the
     verification sample its members (``support_family`` in the result).
     ``None``: uniform pressure."""
@@ -376,7 +377,6 @@ def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progre
                                 belt_speed=belt_speed, mu_s=mu_s)
                 for v in speeds}
     out = []
-    from pipeline.planning.support_plans import planning_family  # it builds on this module
     try:
         for mu_c in plan_frictions(config):
             t0 = time.perf_counter()

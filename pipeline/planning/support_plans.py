@@ -1,9 +1,6 @@
-"""Plans that hold whatever the part rests on (issue 25).
+"""The support study (issue 25): plans against a support family.
 
-:func:`planning_family` readies a support family for the planner: it checks
-that the planner's mechanics take point supports and finds the family's
-extremes (``support_spread``) on a coarse map grid at the planner's
-friction. :func:`support_study` answers a user's three questions for one
+:func:`support_study` answers a user's three questions for one
 part (spec section 9): how far the family moves ``theta_f`` from uniform
 pressure over the configured map grid, whether the recommended (uniform)
 plan survives the family, and if it does not, the plan that does.
@@ -14,49 +11,16 @@ import dataclasses
 
 import numpy as np
 
-from pipeline.errors import PinfeedError
 from pipeline.maps.support_spread import extreme_members, family_spread
 from pipeline.parts.part import Part
-from pipeline.parts.support_family import SupportFamily, parse_support_family
+from pipeline.parts.support_family import SupportFamily
+from pipeline.planning.family import as_family, check_family_mechanics
 from pipeline.planning.orient import judge
 from pipeline.planning.plan import plan_tight, planner_tolerance, verify_required
 from pipeline.planning.propagate import resting_states
-from pipeline.planning.settings import friction_label, nominal_friction, parse_friction
+from pipeline.planning.settings import friction_label, parse_friction
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import verify_plan
-
-EXTREMES_THETA_STEP = 3.0  # deg: the coarse grid the planner's extremes are found on
-
-
-def check_family_mechanics(config: dict) -> None:
-    """Refuse (one line) a family with mechanics that assume uniform pressure."""
-    pc = config["planner"]
-    if pc.get("model", "minpower") != "minpower" or pc.get("belt_speed") is not None:
-        raise PinfeedError(f"a support family needs the quasi-static minpower model (the planner has "
-                           f"model {pc.get('model')!r}, belt speed {pc.get('belt_speed')}); the other "
-                           f"models assume uniform pressure: use model minpower without a belt speed")
-
-
-def as_family(part: Part, family) -> SupportFamily:
-    """``family`` as a :class:`SupportFamily` of ``part`` (parsing its text)."""
-    return family if isinstance(family, SupportFamily) else parse_support_family(family, part)
-
-
-def planning_family(part: Part, family, config: dict, mu_c=None) -> SupportFamily | None:
-    """The family (text or :class:`SupportFamily`) with its extremes found on
-    the sweep's ``d`` and every ``EXTREMES_THETA_STEP`` degrees of theta_i at
-    the planner's nominal friction (``mu_c``, default ``planner.mu_c``);
-    ``None`` for uniform pressure alone."""
-    family = as_family(part, family)
-    if family.is_uniform:
-        return None
-    check_family_mechanics(config)
-    if family.extremes or len(family) == 1:
-        return family if family.extremes else dataclasses.replace(family, extremes=(0,))
-    mu = nominal_friction(parse_friction(config["planner"]["mu_c"]) if mu_c is None else mu_c)
-    spread = family_spread(part, family, np.arange(0.0, 360.0, EXTREMES_THETA_STEP),
-                           config["sweep"]["d"], mu, config["sweep"]["pin_radius"])
-    return dataclasses.replace(family, extremes=spread.extremes)
 
 
 def map_spread(part: Part, family: SupportFamily, config: dict) -> tuple:

@@ -115,7 +115,7 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     family = config["planner"].get("support_family")
     if family:
         from pipeline.parts.support_family import parse_support_family
-        from pipeline.planning.support_plans import check_family_mechanics
+        from pipeline.planning.family import check_family_mechanics
         if mode != "tight":
             raise PinfeedError("--support-family plans with the tight planner (its trials sample the "
                                "family); the paper-mode planner's map shards assume one support: use "

@@ -19,7 +19,7 @@ from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 from pipeline.parts.support_family import parse_support_family
 from pipeline.planning.complete import FixedPinSearch
-from pipeline.planning.support_plans import planning_family
+from pipeline.planning.family import planning_family
 from pipeline.planning.verify import DEFAULTS, corner_inputs, perturbed_batch, trial_inputs
 
 MU = (0.1, 0.2)
