@@ -108,7 +108,8 @@ def _add_physics(p, d_required=True, belt=False):
     p.add_argument("--v-pin", type=float, default=0.0,
                    help="pin speed across the belt / belt speed (default 0: static pin)")
     p.add_argument("--support", default=None, metavar="SPEC",
-                   help="where the part presses on the belt (model minpower): uniform (default), "
+                   help=f"where the part presses on the belt (model minpower{' or mujoco' if belt else ''}): "
+                   "uniform (default), "
                    "points:\"x0,y0,w0 x1,y1,w1 ...\" (mm, part frame: centroid at the origin, "
                    "drawing axes; w defaults to 1), rim or rim:N (N points on the outline), "
                    "tripod (three hull vertices holding the centroid)")

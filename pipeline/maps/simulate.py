@@ -85,7 +85,7 @@ def resolve_support(part: Part, support, model: str = "minpower") -> Support | N
         return None
     if model not in ("minpower", "mujoco"):
         raise PinfeedError(f"support {support.label!r} needs model minpower or mujoco (model {model} "
-                           f"assumes uniform pressure); use model minpower or support uniform")
+                           f"assumes uniform pressure); use model minpower or mujoco, or support uniform")
     return support
 
 
