@@ -255,3 +255,17 @@ def test_shard_missing_an_attribute_is_damaged_not_a_crash(swept, tmp_path):
     assert len(cat.problems) == 1 and "damaged attributes (KeyError" in cat.problems[0]
     with pytest.raises(PinfeedError, match=support_key(POINTS)):
         Catalog.open(root).query("tri", mu_c=0.2, support=POINTS)
+
+
+def test_planner_maps_are_not_taken_from_a_support_shard(swept, tmp_path):
+    """ensure_maps (pinfeed plan on a part) wants uniform maps: a tripod shard at
+    the planner's friction does not stand in for them."""
+    from pipeline.workflow.plan import ensure_maps
+    root = _copy(swept, tmp_path)
+    (root / "fam" / TRI.id / "minpower" / "mu_c=0.2.h5").unlink()
+    Catalog.rebuild(root)
+    cfg = dict(swept, catalog_dir=str(root), planner=dict(swept["planner"], mu_c=0.2, model="minpower"))
+    cfg["planner"]["dynamic"] = dict(cfg["planner"]["dynamic"], speeds=[])
+    cat = ensure_maps(cfg, TRI, family="fam")
+    assert (root / "fam" / TRI.id / "minpower" / "mu_c=0.2.h5").is_file()
+    assert str(cat.query("tri", mu_c=0.2)["support"].values) == "uniform"

@@ -99,3 +99,26 @@ def test_uniform_shard_records_the_hash_of_a_config_without_the_key(built):
     explicit = validate_config(dict(text, sweep=dict(BASE["sweep"], supports=["uniform"])), name="plain")
     entry = next(e for e in before["index"] if e["support_key"] == "")
     assert entry["config_hash"] == config_hash(plain) == config_hash(explicit)
+
+
+def test_plan_reads_the_uniform_shards_only(tmp_path):
+    """The planner queries uniform maps, so a part's plan job takes its uniform
+    shards as input and not its support shards (adding a support re-plans nothing);
+    the support shards still get their bands."""
+    cfg = yaml.safe_load(yaml.safe_dump(BASE))
+    cfg["sweep"]["supports"] = ["uniform", "tripod"]
+    cfg["planner"]["parts"] = ["tri"]
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(cfg))
+    dry = run_snakemake(tmp_path, "--configfile", str(tmp_path / "p.yaml"), "--dry-run")
+    assert dry.returncode == 0, dry.stderr[-3000:]
+    jobs, rule = {}, None
+    for line in (dry.stdout + dry.stderr).splitlines():
+        if line.startswith("rule "):
+            rule = line.split()[1].rstrip(":")
+        elif rule and line.strip().startswith(("input:", "output:")):
+            key, files = line.strip().split(":", 1)
+            jobs.setdefault(rule, []).append((key, [f.strip() for f in files.split(",")]))
+    plan_inputs = [files for key, files in jobs["plan"] if key == "input"][0]
+    assert UNIFORM in plan_inputs and TRIPOD not in plan_inputs
+    band_outputs = [f for key, files in jobs["bands"] if key == "output" for f in files]
+    assert any(f.endswith("mu_c=0.2_support=tripod.json") for f in band_outputs)
