@@ -371,6 +371,17 @@ class Catalog:
             self._verified.add(path)
         return xr.open_dataset(path, engine="h5netcdf", chunks={})
 
+    def entries_on(self, part: str, support: str) -> list[dict]:
+        """The entries of one part on one support (its text or file key), or a
+        one-line error naming the part's stored supports."""
+        found = self.entries_for(part)
+        on = [e for e in found if e.get("support_key", "") == _support_key(support)]
+        if not on:
+            supports = sorted({e.get("support", "uniform") for e in found}, key=lambda s: (s != "uniform", s))
+            raise PinfeedError(f"part {part!r} has no maps on support {support!r}; stored supports: "
+                               f"{', '.join(supports)} (add it to sweep.supports)")
+        return on
+
     def _stored(self, part, model, belt_speed, support, key, v_pin) -> list[dict]:
         """The entries of one part, model, belt speed, support and pin speed
         (each stored exactly), or a one-line error naming what is stored."""

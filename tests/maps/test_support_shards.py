@@ -269,3 +269,17 @@ def test_planner_maps_are_not_taken_from_a_support_shard(swept, tmp_path):
     cat = ensure_maps(cfg, TRI, family="fam")
     assert (root / "fam" / TRI.id / "minpower" / "mu_c=0.2.h5").is_file()
     assert str(cat.query("tri", mu_c=0.2)["support"].values) == "uniform"
+
+
+def test_cli_show_selects_a_support(swept, capsys):
+    code, out, err = run_cli(capsys, ["catalog", "show", "tri", "--catalog", swept["catalog_dir"],
+                                      "--support", "tripod", "--json"])
+    assert code == 0, err
+    assert [(s["model"], s["support"]) for s in json.loads(out)["shards"]] == [("minpower", "tripod")]
+    code, out, _ = run_cli(capsys, ["catalog", "show", "tri", "--catalog", swept["catalog_dir"]])
+    assert code == 0 and out.count("support ") == 2  # tripod and points named, uniform rows plain
+    code, _, err = run_cli(capsys, ["catalog", "show", "tri", "--catalog", swept["catalog_dir"],
+                                    "--support", "rim:8"])
+    last = err.strip().splitlines()[-1]
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert last.startswith("pinfeed: error: part 'tri' has no maps on support 'rim:8'; stored supports: uniform")
