@@ -257,6 +257,8 @@ def cmd_catalog_show(args):
     """``pinfeed catalog show``: a part's stored shards and provenance."""
     cat = _catalog(args)
     entries = cat.entries_for(args.part)
+    if args.support is not None:
+        entries = cat.entries_on(args.part, args.support)
     e0 = entries[0]
     info = {k: e0[k] for k in ("family", "part_id", "part_name", "part_vertices", "pin_radius",
                                "d", "theta_step", "config_hash", "pinfeed_version", "git_commit")}
@@ -829,6 +831,8 @@ def _add_catalog_commands(sub) -> None:
     q.add_argument("--json", action="store_true")
     q = catalog_parser("show", "everything stored about one part", cmd_catalog_show)
     q.add_argument("part", help="part name or id")
+    q.add_argument("--support", default=None, metavar="SPEC",
+                   help="only the shards of this support (its text or file key); default: every support")
     q.add_argument("--json", action="store_true")
     for name, func, help_text in (("query", cmd_catalog_query, "maps of one part, model, friction, d"),
                                   ("plot", cmd_catalog_plot, "draw stored maps like the paper's Table 1")):

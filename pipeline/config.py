@@ -132,7 +132,29 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
                            f"(the sensor plans on the planner's maps); planned parts: "
                            f"{', '.join(cfg['planner']['parts']) or 'none'}")
     _check_support_study(cfg)
+    _check_sweep_supports(cfg)
     return cfg
+
+
+def _check_sweep_supports(cfg: dict) -> None:
+    """sweep/supports: supports other than uniform are swept with minpower (the
+    only model that takes one), so minpower must be swept; two supports may not
+    share a file key. Each support is checked against each part by
+    ``maps.sweep.shard_jobs``."""
+    from pipeline.parts.support import support_key
+    supports = cfg["sweep"]["supports"]
+    others = [s for s in supports if support_key(s)]
+    if others and "minpower" not in cfg["sweep"]["models"]:
+        raise PinfeedError(f"config error at sweep/supports: {others[0]} needs minpower in sweep/models "
+                           f"(the only model that takes a support; "
+                           f"{', '.join(cfg['sweep']['models'])} are swept on uniform pressure only)")
+    seen = {}
+    for s in supports:
+        key = support_key(s) or "uniform"
+        if key in seen:
+            raise PinfeedError(f"config error at sweep/supports: {seen[key]!r} and {s!r} are the same "
+                               f"support (file key {key}); list it once")
+        seen[key] = s
 
 
 def _check_support_study(cfg: dict) -> None:
@@ -225,9 +247,22 @@ def load_config(path=None) -> dict:
     return validate_config(config, base_dir=path.resolve().parent, name=config_name(path))
 
 
+# Keys whose default value is left out of the config hash: a key added after
+# catalogs were written must not change the hash (a shard's config_hash
+# attribute, so its bytes) of a config that does not use it.
+HASH_NEUTRAL_DEFAULTS = {("sweep", "supports"): ["uniform"]}
+
+
 def config_hash(config: dict) -> str:
-    """Hash of the validated config (canonical JSON), recorded in stored files."""
-    blob = json.dumps(config, sort_keys=True, separators=(",", ":"), default=float)
+    """Hash of the validated config (canonical JSON), recorded in stored files.
+    Keys of :data:`HASH_NEUTRAL_DEFAULTS` at their default value are left out,
+    so ``sweep.supports: [uniform]`` (given or not) hashes as before the key existed."""
+    hashed = config
+    for (section, key), default in HASH_NEUTRAL_DEFAULTS.items():
+        sub = config.get(section)
+        if isinstance(sub, dict) and key in sub and sub[key] == default:
+            hashed = dict(hashed, **{section: {k: v for k, v in sub.items() if k != key}})
+    blob = json.dumps(hashed, sort_keys=True, separators=(",", ":"), default=float)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 

@@ -1,5 +1,6 @@
 # Shared helpers: the shard list and per-shard parameters, from the config.
 from pipeline.maps.sweep import shard_jobs
+from pipeline.parts.support import support_key
 from pipeline.workflow.supports import studied_parts
 
 CATALOG = config["catalog_dir"]
@@ -14,8 +15,10 @@ wildcard_constraints:
 
 
 def part_shards(wildcards):
-    """The shard files of the part named ``wildcards.name`` (what its plan reads)."""
-    return [path for path, job in JOBS.items() if job.part.name == wildcards.name]
+    """The shard files of the part named ``wildcards.name`` (what its plan reads:
+    uniform pressure only, so adding a support to sweep.supports re-plans nothing)."""
+    return [path for path, job in JOBS.items()
+            if job.part.name == wildcards.name and not support_key(job.support)]
 
 
 def shard_params(wildcards):

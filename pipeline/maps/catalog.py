@@ -105,6 +105,42 @@ def entry_from_file(root: Path, path: Path) -> dict:
             raise PinfeedError(f"{path}: foreign file, not a pinfeed shard (no catalog attributes)")
         d = [float(x) for x in ds["d"].values]
         n_theta = int(ds.sizes["theta_i"])
+    try:
+        return _entry(root, path, attrs, d, n_theta)
+    except PinfeedError:
+        raise
+    except (KeyError, ValueError, TypeError) as exc:
+        raise PinfeedError(f"{path}: damaged attributes ({type(exc).__name__}: "
+                           f"{str(exc).splitlines()[0][:120] if str(exc) else 'unreadable'}); "
+                           f"delete the shard and rerun the sweep") from None
+
+
+def _check_support_attrs(path: Path, attrs: dict) -> str:
+    """The shard's support (its ``support`` attribute, uniform if absent), checked
+    against its file name (``_support=KEY``, none for uniform) and, for a point
+    support, its points and weights; a mismatch is a damaged shard."""
+    support = str(attrs.get("support", "uniform"))
+    named = re.search(r"_support=([A-Za-z0-9-]+)$", path.stem)
+    named = named.group(1) if named else ""
+    if _support_key(support) != named:
+        raise PinfeedError(f"{path}: damaged support attribute {support[:60]!r}: the file name says "
+                           f"{'support ' + named if named else 'uniform'}; delete the shard and rerun "
+                           f"the sweep")
+    if named:
+        pts = np.asarray(attrs.get("support_points", []), float).ravel()
+        wts = np.asarray(attrs.get("support_weights", []), float).ravel()
+        if (str(attrs.get("model")) != "minpower" or "support_kind" not in attrs or not len(wts)
+                or pts.size != 2 * wts.size or not np.all(np.isfinite(pts)) or not np.all(np.isfinite(wts))
+                or np.any(wts <= 0)):
+            raise PinfeedError(f"{path}: damaged support attributes (support {support[:60]!r} needs model "
+                               f"minpower, support_kind and matching finite support_points and positive "
+                               f"support_weights); delete the shard and rerun the sweep")
+    return support
+
+
+def _entry(root: Path, path: Path, attrs: dict, d: list, n_theta: int) -> dict:
+    """The index entry of a readable shard (see :func:`entry_from_file`)."""
+    support = _check_support_attrs(path, attrs)
     verts = np.asarray(attrs["part_vertices"], float).reshape(-1, 2).tolist()
     return {
         "file": path.relative_to(root).as_posix(),
@@ -120,8 +156,8 @@ def entry_from_file(root: Path, path: Path) -> dict:
         "pin_radius": float(attrs["pin_radius"]),
         "v_pin": float(attrs.get("v_pin", 0.0)),
         "belt_speed": float(attrs.get("belt_speed", 0.0)),
-        "support": str(attrs.get("support", "uniform")),
-        "support_key": _support_key(str(attrs.get("support", "uniform"))),
+        "support": support,
+        "support_key": _support_key(support),
         "mu_s": float(attrs.get("mu_s", 0.5)),
         "d": d,
         "theta_step": float(attrs["theta_step"]),
@@ -335,6 +371,17 @@ class Catalog:
             self._verified.add(path)
         return xr.open_dataset(path, engine="h5netcdf", chunks={})
 
+    def entries_on(self, part: str, support: str) -> list[dict]:
+        """The entries of one part on one support (its text or file key), or a
+        one-line error naming the part's stored supports."""
+        found = self.entries_for(part)
+        on = [e for e in found if e.get("support_key", "") == _support_key(support)]
+        if not on:
+            supports = sorted({e.get("support", "uniform") for e in found}, key=lambda s: (s != "uniform", s))
+            raise PinfeedError(f"part {part!r} has no maps on support {support!r}; stored supports: "
+                               f"{', '.join(supports)} (add it to sweep.supports)")
+        return on
+
     def _stored(self, part, model, belt_speed, support, key, v_pin) -> list[dict]:
         """The entries of one part, model, belt speed, support and pin speed
         (each stored exactly), or a one-line error naming what is stored."""
@@ -351,8 +398,10 @@ class Catalog:
         supports = sorted({e.get("support", "uniform") for e in found}, key=lambda s: (s != "uniform", s))
         found = [e for e in found if e.get("support_key", "") == key]
         if not found:
+            hint = ("supports other than uniform are swept with model minpower only"
+                    if key and model != "minpower" else "add it to sweep.supports")
             raise PinfeedError(f"part {part!r} has no {model} maps on support {support!r}; stored supports: "
-                               f"{', '.join(supports)} (add it to sweep.supports)")
+                               f"{', '.join(supports)} ({hint})")
         speeds = sorted({e.get("v_pin", 0.0) for e in found})
         found = [e for e in found if e.get("v_pin", 0.0) == float(v_pin)]
         if not found:

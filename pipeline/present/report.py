@@ -110,7 +110,9 @@ def _part_section(name: str, part: dict, base, catalog, config: dict) -> list[st
         p.append('<details class="files"><summary>Catalog shards of this part '
                  f'({len(part["shards"])})</summary><ul>' + "".join(
                      f"<li>{_link(Path(catalog) / e['file'], base, e['file'])}: {html.escape(e['model'])}, "
-                     f"mu_c {e['mu_c']:g}, v_pin/v_b {e.get('v_pin', 0.0):+g}</li>" for e in part["shards"])
+                     f"mu_c {e['mu_c']:g}, v_pin/v_b {e.get('v_pin', 0.0):+g}"
+                     + (f", support {html.escape(e['support'])}" if e.get("support_key") else "")
+                     + "</li>" for e in part["shards"])
                  + "</ul></details>")
     p.append(f'<h3 id="{_anchor(name, "outline")}">Outline</h3>')
     p.append(f"<p>Part id {html.escape(res['part']['id'])}; initial states: " + ", ".join(

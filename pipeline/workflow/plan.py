@@ -82,7 +82,8 @@ def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:
     wrote = False
     for v in [0.0] + [float(x) for x in pc.get("dynamic", {}).get("speeds", [])]:
         have = any(e["part_id"] == part.id and e["model"] == pc["model"]
-                   and e["mu_c"] == mu and e.get("v_pin", 0.0) == v for e in entries)
+                   and e["mu_c"] == mu and e.get("v_pin", 0.0) == v
+                   and not e.get("support_key") for e in entries)
         if not have:
             write_shard(config, ShardJob(fam, part, pc["model"], mu, v))
             wrote = True

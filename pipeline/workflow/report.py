@@ -227,7 +227,8 @@ def make_report(config, plan_paths, verify_paths, out, sensing_paths=(), speed_p
             parts.setdefault(name, {})["layout"] = read_json(files["layout_json"])
         parts[name] = {**parts.get(name, {}), "plan": plan, "verify": read_json(verify_path), "files": files,
                        "shards": sorted((e for e in cat.entries if e["part_id"] == plan["part"]["id"]),
-                                        key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0)))}
+                                        key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0),
+                                                      e.get("support_key", "")))}
     for path in sensing_paths:  # force/torque sensor on the first pin (rules/sense.smk)
         res = read_json(path)
         parts[res["part"]["name"]]["sensing"] = res
