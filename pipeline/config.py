@@ -250,18 +250,26 @@ def load_config(path=None) -> dict:
 # Keys whose default value is left out of the config hash: a key added after
 # catalogs were written must not change the hash (a shard's config_hash
 # attribute, so its bytes) of a config that does not use it.
-HASH_NEUTRAL_DEFAULTS = {("sweep", "supports"): ["uniform"]}
+HASH_NEUTRAL_DEFAULTS = {("sweep", "supports"): ["uniform"],
+                         ("planner", "support_family"): None,
+                         ("support_study",): {"family": None, "parts": []}}
 
 
 def config_hash(config: dict) -> str:
     """Hash of the validated config (canonical JSON), recorded in stored files.
     Keys of :data:`HASH_NEUTRAL_DEFAULTS` at their default value are left out,
-    so ``sweep.supports: [uniform]`` (given or not) hashes as before the key existed."""
+    so a config that does not use issue 25's keys (``sweep.supports: [uniform]``,
+    no ``planner.support_family``, no ``support_study``) hashes as before they
+    existed."""
     hashed = config
-    for (section, key), default in HASH_NEUTRAL_DEFAULTS.items():
-        sub = config.get(section)
+    for path, default in HASH_NEUTRAL_DEFAULTS.items():
+        *sections, key = path
+        sub = hashed
+        for name in sections:
+            sub = sub.get(name) if isinstance(sub, dict) else None
         if isinstance(sub, dict) and key in sub and sub[key] == default:
-            hashed = dict(hashed, **{section: {k: v for k, v in sub.items() if k != key}})
+            trimmed = {k: v for k, v in sub.items() if k != key}
+            hashed = dict(hashed, **{sections[0]: trimmed}) if sections else trimmed
     blob = json.dumps(hashed, sort_keys=True, separators=(",", ":"), default=float)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 

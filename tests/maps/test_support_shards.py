@@ -209,7 +209,9 @@ def test_config_hash_ignores_the_default_supports():
     del base["sweep"]["supports"]
     cfg = validate_config(base)
     assert cfg["sweep"]["supports"] == ["uniform"]
-    without = dict(cfg, sweep={k: v for k, v in cfg["sweep"].items() if k != "supports"})
+    without = dict(cfg, sweep={k: v for k, v in cfg["sweep"].items() if k != "supports"},
+                   planner={k: v for k, v in cfg["planner"].items() if k != "support_family"})
+    without.pop("support_study")  # issue 25's other keys at their defaults: left out too
     blob = json.dumps(without, sort_keys=True, separators=(",", ":"), default=float)
     import hashlib
     assert config_hash(cfg) == hashlib.sha256(blob.encode()).hexdigest()[:16]
@@ -217,6 +219,8 @@ def test_config_hash_ignores_the_default_supports():
     assert config_hash(explicit) == config_hash(cfg)
     tripod = validate_config(dict(base, sweep=dict(base["sweep"], supports=["uniform", "tripod"])))
     assert config_hash(tripod) != config_hash(cfg)
+    studied = validate_config(dict(base, support_study={"family": "tripods:3"}))
+    assert config_hash(studied) != config_hash(cfg)
 
 
 def test_default_config_shards_hard_coded():
