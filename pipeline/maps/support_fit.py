@@ -25,7 +25,7 @@ Method
   measurement does not drag the fit).
 - *Search.* ``starts`` random tripods (or ``K`` points) in the outline
   (:func:`~pipeline.parts.support_family.sample_tripods` for ``K = 3``) are
-  scored; from the ``refine`` best, a trust-region least-squares solver
+  scored; from each of the ``refine`` best, a trust-region least-squares solver
   (``scipy.optimize.least_squares``, method ``trf``, the same soft-L1 loss,
   finite-difference Jacobian) moves the ``2K`` coordinates. While it
   searches, a point outside the outline is moved to the outline's nearest
@@ -33,7 +33,8 @@ Method
   both pay a penalty residual of ``PENALTY_DEG_PER_MM`` per mm of the
   violation, so the solver sees a continuous loss and walks back. The
   answer is the best *feasible* layout any evaluation saw (points inside
-  the outline, centre of pressure at the centroid). Gauss-Newton steps use
+  the outline, centre of pressure at the centroid), refined once more from
+  itself with a fresh trust region. Gauss-Newton steps use
   the residuals' structure that a simplex search (Nelder-Mead, the first
   version) ignores: about ten times fewer rollouts, and it converges where
   the simplex stalled short of the light legs.
@@ -287,7 +288,7 @@ def _least_squares(objective: _Objective, start, a: float):
 
 
 def fit_support(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: float, n_points: int = 3,
-                starts: int = 48, refine: int = 3, seed: int = 0) -> SupportFit:
+                starts: int = 48, refine: int = 4, seed: int = 0) -> SupportFit:
     """The ``n_points``-point support (statics weights) that best explains
     ``pushes`` (see the module notes); ``mu_c`` is used where a push gives none."""
     if not 3 <= int(n_points) <= 12:
@@ -309,6 +310,7 @@ def fit_support(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: floa
     scored = sorted(layouts, key=objective.loss)[:max(1, int(refine))]
     for start in scored:
         _least_squares(objective, start, part.a)
+    _least_squares(objective, objective.best_flat, part.a)  # again from the best, a fresh trust region
     support = objective.support_of(objective.best_flat)
     return SupportFit(support, objective.residuals(support), objective.residuals(None), len(pushes),
                       objective.evaluations)
