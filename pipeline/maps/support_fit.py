@@ -295,7 +295,7 @@ def fit_support(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: floa
         raise PinfeedError(f"--points must be 3 to 12 (a support that holds the centroid needs 3), "
                            f"got {n_points}")
     if int(starts) < 1 or int(refine) < 1:
-        raise PinfeedError(f"--starts must be at least 1, got {starts}")
+        raise PinfeedError(f"--starts and --refine must be at least 1, got {starts} and {refine}")
     if mu_c is None and np.any(np.isnan(pushes.mu_c)):
         raise PinfeedError("give --mu-c or a mu_c column in the pushes file")
     if mu_c is not None and not (math.isfinite(mu_c) and mu_c >= 0):

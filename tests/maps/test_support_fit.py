@@ -106,13 +106,13 @@ def test_cli_fit_and_csv(tmp_path, capsys, monkeypatch):
     back = read_pushes(path)
     np.testing.assert_allclose(back.theta_f, p.theta_f, atol=1e-6)
     code, out, err = run_cli(capsys, ["support", "fit", "--vertices", "0,0 60,0 15,35", "--pushes",
-                                      str(path), "--starts", "16", "--json", "--out", "fit.json"])
+                                      str(path), "--starts", "16", "--refine", "2", "--json", "--out", "fit.json"])
     assert code == 0, err
     shown = json.loads(out)
     assert shown["support"].startswith("points:") and len(shown["residuals_deg"]) == 24
     assert shown["rms_deg"] < 0.5 < shown["uniform_rms_deg"]
     stored = json.loads((tmp_path / "fit.json").read_text())
-    assert stored["settings"]["starts"] == 16 and stored["pinfeed_version"]
+    assert stored["settings"]["starts"] == 16 and stored["settings"]["refine"] == 2 and stored["pinfeed_version"]
     code, out, _ = run_cli(capsys, ["rollout", "--vertices", "0,0 60,0 15,35", "--theta-i",
                                     f"{p.theta_i[0]:.6f}", "--d", f"{p.d[0]:.6f}", "--mu-c", str(MU),
                                     "--pin-radius", "3", "--support", shown["support"], "--json"])
@@ -143,7 +143,7 @@ def test_bad_pushes_are_one_line(tmp_path, capsys, monkeypatch, text, words):
 
 def test_bad_settings():
     p = Pushes(np.arange(10.0), np.full(10, 0.3), np.arange(10.0), np.full(10, np.nan))
-    for kwargs, words in (({"n_points": 2}, "3 to 12"), ({"starts": 0}, "--starts"),
+    for kwargs, words in (({"n_points": 2}, "3 to 12"), ({"starts": 0}, "--starts"), ({"refine": 0}, "--refine"),
                           ({"mu_c": None}, "--mu-c or a mu_c column"), ({"mu_c": -1.0}, ">= 0")):
         args = dict(mu_c=0.2, pin_radius=3.0, **{k: v for k, v in kwargs.items() if k != "mu_c"})
         if "mu_c" in kwargs:
