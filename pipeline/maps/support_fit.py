@@ -31,13 +31,15 @@ Method
   searches, a point outside the outline is moved to the outline's nearest
   point and a layout that cannot balance the part keeps its nearest weights;
   both pay a penalty residual of ``PENALTY_DEG_PER_MM`` per mm of the
-  violation, so the solver sees a continuous loss and walks back. The
-  answer is the best *feasible* layout any evaluation saw (points inside
-  the outline, centre of pressure at the centroid), refined once more from
-  itself with a fresh trust region. Gauss-Newton steps use
-  the residuals' structure that a simplex search (Nelder-Mead, the first
-  version) ignores: about ten times fewer rollouts, and it converges where
-  the simplex stalled short of the light legs.
+  violation, so the solver sees a continuous loss and walks back. One more
+  run starts from the best feasible layout so far with a fresh trust
+  region; the answer is the best *feasible* layout any evaluation saw
+  (points inside the outline, centre of pressure at the centroid).
+  Gauss-Newton steps use the residuals' structure that a simplex search
+  (Nelder-Mead, the first version) ignores: four to seven times fewer
+  rollouts, and it converges where the simplex stalled short of the light
+  legs. The light legs are weakly determined even so (README: measured
+  recovery); fits from two ``seed`` values that agree are the check.
 
 The result reports per-push residuals and their RMS, median and 90th
 percentile of ``|r|``, next to those of uniform pressure on the same pushes,
