@@ -899,14 +899,14 @@ def cmd_support_fit(args):
     part = _plan_part_arg(args, config)
     pushes = read_pushes(args.pushes)
     fit = fit_support(part, pushes, args.mu_c, args.pin_radius, n_points=args.points,
-                      starts=args.starts, seed=args.seed)
+                      starts=args.starts, refine=args.refine, seed=args.seed)
     result = {"part": part.name, "part_id": part.id, **fit.to_dict()}
     if args.out:
         from pipeline.maps.io import write_json
         from pipeline.provenance import provenance_attrs
         write_json({**result, "settings": {"mu_c": args.mu_c, "pin_radius": args.pin_radius,
                                            "points": args.points, "starts": args.starts,
-                                           "seed": args.seed, "pushes_file": str(args.pushes)},
+                                           "refine": args.refine, "seed": args.seed, "pushes_file": str(args.pushes)},
                     **provenance_attrs()}, args.out)
     if args.json:
         _print_json(result)
@@ -940,6 +940,7 @@ def _add_support_commands(sub) -> None:
     q.add_argument("--pin-radius", dest="pin_radius", type=float, default=3.0, help="pin radius, mm (default 3)")
     q.add_argument("--points", type=int, default=3, help="support points to fit, 3 to 12 (default 3)")
     q.add_argument("--starts", type=int, default=48, help="random layouts tried before refining (default 48)")
+    q.add_argument("--refine", type=int, default=4, help="best layouts refined by least squares (default 4)")
     q.add_argument("--seed", type=int, default=0, help="seed of the random layouts (default 0)")
     q.add_argument("--out", default=None, help="store the fit as JSON (with its settings and provenance)")
     q.add_argument("--json", action="store_true", help="print JSON instead of text")
