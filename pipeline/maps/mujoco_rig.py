@@ -316,6 +316,9 @@ def _support(part, mass, mu_s, support=None):
     xy = xy_mm / 1000.0
     a = a_mm / 1000.0
     izz = mass * jpol / area / 1e6
+    if support is not None:  # the same points as the kernels (part frame, centroid at the origin)
+        pts = (np.asarray(support.points, dtype=float) - com) / 1000.0
+        return xy, a, izz, pts, mu_s * mass * G * np.asarray(support.weights, dtype=float)
     # Support grid (body frame), centred on the centroid.
     s = GRID_MM / 1000.0
     span = np.arange(-math.ceil(a / s), math.ceil(a / s) + 1) * s
@@ -323,9 +326,6 @@ def _support(part, mass, mu_s, support=None):
     pts = np.column_stack([gx.ravel(), gy.ravel()])
     pts = pts[_inside(xy, pts)]
     load = mu_s * mass * G / len(pts)
-    if support is not None:  # the same points as the kernels (part frame, centroid at the origin)
-        pts = (np.asarray(support.points, dtype=float) - com) / 1000.0
-        load = mu_s * mass * G * np.asarray(support.weights, dtype=float)
     return xy, a, izz, pts, load
 
 

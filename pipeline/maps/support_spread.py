@@ -37,27 +37,42 @@ class FamilySpread:
     maps : the members' maps stacked along ``support`` (member labels).
     shift : ``theta_f`` shift from uniform per member and cell (deg; NaN
         where either passage does not push the part).
-    extremes : indices of the extreme members (see the module docstring).
     """
 
     uniform: xr.Dataset
     maps: xr.Dataset
     shift: xr.DataArray
-    extremes: tuple
 
-    def summary(self) -> dict:
-        """The numbers a report shows: over the cells where every member and
-        uniform push the part, the largest shift of any member per cell
-        (median, p90, max over cells), and the share of cells whose outcome
-        (ok / miss / jammed) some member changes."""
-        worst = np.abs(self.shift).max("support", skipna=False).values.ravel()
-        worst = worst[np.isfinite(worst)]
-        changed = (self.maps["status"] != self.uniform["status"]).any("support").values
-        pct = (lambda q: round(float(np.percentile(worst, q)), 2)) if worst.size else (lambda q: None)
-        return {"members": int(self.maps.sizes["support"]), "cells": int(changed.size),
-                "cells_compared": int(worst.size), "shift_median_deg": pct(50), "shift_p90_deg": pct(90),
-                "shift_max_deg": pct(100), "outcome_changed_share": round(float(changed.mean()), 4),
-                "extremes": [str(self.maps["support"].values[k]) for k in self.extremes]}
+    @property
+    def flat_shift(self) -> np.ndarray:
+        """The shift as ``(members, cells)``."""
+        return self.shift.values.reshape(self.shift.sizes["support"], -1)
+
+    @property
+    def changed(self) -> np.ndarray:
+        """Per cell (flat), whether some member's outcome (ok / miss / jammed) differs from uniform's."""
+        return (self.maps["status"] != self.uniform["status"]).any("support").values.ravel()
+
+    @property
+    def extremes(self) -> tuple:
+        """Indices of the extreme members (see the module docstring)."""
+        return extreme_members(self.flat_shift)
+
+
+def spread_numbers(shift: np.ndarray, changed: np.ndarray) -> dict:
+    """The numbers a report shows for shifts ``(members, cells)`` and changed
+    outcomes ``(cells,)``: over the cells where every member and uniform push
+    the part, the largest shift of any member per cell (median, p90, max over
+    cells, deg), and the share of cells whose outcome some member changes."""
+    worst = np.abs(shift).max(axis=0)
+    worst = worst[np.isfinite(worst)]
+
+    def pct(q):
+        return round(float(np.percentile(worst, q)), 2) if worst.size else None
+
+    return {"cells": int(changed.size), "cells_compared": int(worst.size),
+            "shift_median_deg": pct(50), "shift_p90_deg": pct(90), "shift_max_deg": pct(100),
+            "outcome_changed_share": round(float(changed.mean()), 4)}
 
 
 def _wrap(x):
@@ -95,5 +110,4 @@ def family_spread(part: Part, family, theta_i, d, mu_c: float, pin_radius: float
     shift = xr.DataArray(_wrap(stacked["theta_f"] - uniform["theta_f"]), dims=stacked["theta_f"].dims,
                          coords=stacked["theta_f"].coords).where(both_ok)
     shift.attrs = {"units": "degree", "long_name": "shift of the final orientation from uniform support"}
-    flat = shift.values.reshape(shift.sizes["support"], -1)
-    return FamilySpread(uniform, stacked, shift, extreme_members(flat))
+    return FamilySpread(uniform, stacked, shift)

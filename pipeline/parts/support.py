@@ -232,7 +232,7 @@ def tripod_support(part) -> Support:
             for k in range(j + 1, n):
                 a, b, c = hull[i], hull[j], hull[k]
                 area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
-                lam = _barycentric(a, b, c)
+                lam = barycentric(a, b, c)
                 if area > best_area and np.all(lam >= 0):
                     best, best_area = (np.array([a, b, c]), lam), area
     if best is None:  # pragma: no cover - the centroid lies in some hull triangle
@@ -240,7 +240,7 @@ def tripod_support(part) -> Support:
     return point_support(part, best[0], best[1], kind="tripod", label="tripod")
 
 
-def _barycentric(a, b, c) -> np.ndarray:
+def barycentric(a, b, c) -> np.ndarray:
     """Barycentric coordinates of the origin in the triangle ``a, b, c``."""
     m = np.array([[a[0], b[0], c[0]], [a[1], b[1], c[1]], [1.0, 1.0, 1.0]])
     return np.linalg.solve(m, np.array([0.0, 0.0, 1.0]))

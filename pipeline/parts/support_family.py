@@ -36,8 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pipeline.errors import PinfeedError
-from pipeline.parts.support import (UNIFORM, Support, boundary_distance, filled_support, inside_outline,
-                                    parse_support, point_support)
+from pipeline.parts.support import (UNIFORM, Support, barycentric, boundary_distance, filled_support,
+                                    inside_outline, parse_support, point_support)
 
 DEFAULT_TRIPODS = 12
 DEFAULT_INSET = 0.2  # of a
@@ -156,10 +156,10 @@ def sample_tripods(part, n: int, inset: float = DEFAULT_INSET, seed: int = 0) ->
     out = []
     for _ in range(200 * n):
         tri = pool[rng.choice(pool.shape[0], 3, replace=False)]
-        m = np.vstack([tri.T, np.ones(3)])
-        if abs(np.linalg.det(m)) < 1e-9 * part.a ** 2:
+        (ux, uy), (vx, vy) = tri[1] - tri[0], tri[2] - tri[0]
+        if abs(ux * vy - uy * vx) < 1e-9 * part.a ** 2:  # twice the area: three points in a line
             continue
-        lam = np.linalg.solve(m, np.array([0.0, 0.0, 1.0]))
+        lam = barycentric(*tri)
         if np.all(lam >= MIN_LEG_WEIGHT):
             out.append(point_support(part, tri, lam, kind="points",
                                      label=f"tripod {len(out) + 1}/{n}"))

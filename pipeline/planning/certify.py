@@ -65,7 +65,7 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict, fam
         branches[label] = []
         for members in _clusters(path[-1][0], alive):
             steps = []
-            for pin, k, (theta_k, y_k) in zip(pins, range(len(pins)), path):
+            for k, (pin, (theta_k, y_k)) in enumerate(zip(pins, path)):
                 d = contact_parameter(pin.y + offs[members, k], before[k][members], part.a)
                 arc = narrowest_arc(theta_k[members], members.size) or (0.0, 360.0)
                 after = snapped_state(arc[0], arc[1], float(y_k[members].min()), float(y_k[members].max()),

@@ -140,3 +140,11 @@ def judge(finals, n_trials: int, tolerance: float, order: int = 1,
             "set": None if arc is None else {"start": round(arc[0], 4), "width": round(arc[1], 4)},
             "spread_deg": None if spread is None else round(spread[1], 4),
             "sets_within_tolerance": arcs_to_cover(finals, tolerance, order)}
+
+
+def judge_verification(result: dict, tolerance: float, order: int = 1,
+                       required: float = DEFAULT_REQUIRED) -> dict:
+    """:func:`judge` on the trials of a ``verify.verify_plan`` result (its
+    ``trials_detail``; jammed trials count as failures)."""
+    finals = [t["final_theta"] for t in result["trials_detail"] if not t["reason"].startswith("jammed")]
+    return judge(finals, result["trials"], tolerance, order, required)

@@ -31,7 +31,7 @@ from pipeline.planning.complete import FixedPinSearch, FixedPlan, FixedSearch, o
 from pipeline.planning.family import planning_family
 from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required,
-                                      check_tolerance, judge)
+                                      check_tolerance, judge_verification)
 from pipeline.planning.propagate import Tolerances, Uncertainty, resting_states
 from pipeline.planning.search import TightPlanner
 from pipeline.planning.settings import candidate_pins, friction_label, parse_friction
@@ -215,8 +215,7 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
                           config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
                           kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
                           mu_s=planner.mu_s, family=family)
-        finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
-        verdict = judge(finals, res["trials"], tolerance, planner.order, required)
+        verdict = judge_verification(res, tolerance, planner.order, required)
         plan.verification = {"trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
                              **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}

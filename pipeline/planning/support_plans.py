@@ -11,11 +11,11 @@ import dataclasses
 
 import numpy as np
 
-from pipeline.maps.support_spread import extreme_members, family_spread
+from pipeline.maps.support_spread import extreme_members, family_spread, spread_numbers
 from pipeline.parts.part import Part
 from pipeline.parts.support_family import SupportFamily
 from pipeline.planning.family import as_family, check_family_mechanics
-from pipeline.planning.orient import judge
+from pipeline.planning.orient import judge_verification
 from pipeline.planning.plan import plan_tight, planner_tolerance, verify_required
 from pipeline.planning.propagate import resting_states
 from pipeline.planning.settings import friction_label, parse_friction
@@ -24,29 +24,20 @@ from pipeline.planning.verify import verify_plan
 
 
 def map_spread(part: Part, family: SupportFamily, config: dict) -> tuple:
-    """``(summary, spreads)``: the family's shift from uniform over the
+    """``(summary, spreads, extremes)``: the family's shift from uniform over the
     configured map grid (sweep ``d`` and ``theta_step``) at every swept
-    friction, and the :class:`FamilySpread` per friction. The summary pools
-    the cells of all frictions (see ``FamilySpread.summary``) and names the
-    extremes over all of them."""
+    friction, the :class:`FamilySpread` per friction and the extreme members'
+    indices. The summary pools
+    the cells of all frictions (``support_spread.spread_numbers``) and names
+    the extremes over all of them."""
     sweep = config["sweep"]
     theta = np.arange(0.0, 360.0, float(sweep["theta_step"]))
     spreads = {float(mu): family_spread(part, family, theta, sweep["d"], float(mu), sweep["pin_radius"])
                for mu in sweep["mu_c"]}
-    shifts = np.concatenate([s.shift.values.reshape(len(family), -1) for s in spreads.values()], axis=1)
-    worst = np.abs(shifts).max(axis=0)
-    worst = worst[np.isfinite(worst)]
-    changed = np.concatenate([(s.maps["status"] != s.uniform["status"]).any("support").values.ravel()
-                              for s in spreads.values()])
+    shifts = np.concatenate([s.flat_shift for s in spreads.values()], axis=1)
     extremes = extreme_members(shifts)
-
-    def pct(q):
-        return round(float(np.percentile(worst, q)), 2) if worst.size else None
-
     summary = {"family": family.label, "members": len(family), "frictions": sorted(spreads),
-               "cells": int(changed.size), "cells_compared": int(worst.size),
-               "shift_median_deg": pct(50), "shift_p90_deg": pct(90), "shift_max_deg": pct(100),
-               "outcome_changed_share": round(float(changed.mean()), 4),
+               **spread_numbers(shifts, np.concatenate([s.changed for s in spreads.values()])),
                "extremes": [family.labels[k] for k in extremes]}
     return summary, spreads, extremes
 
@@ -60,9 +51,8 @@ def verify_under_family(part: Part, config: dict, plan: dict, mu_c, family: Supp
                       config["planner"]["model"], dict(VERIFY_DEFAULTS, **config.get("verify", {})),
                       speeds={k: v for k, v in speeds.items() if v}, kernel=config["sweep"].get("kernel"),
                       family=family)
-    finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
-    verdict = judge(finals, res["trials"], planner_tolerance(config), part.symmetry_order(),
-                    verify_required(config))
+    verdict = judge_verification(res, planner_tolerance(config), part.symmetry_order(),
+                                 verify_required(config))
     by_member = {}
     for t in res["trials_detail"]:
         row = by_member.setdefault(t["support"], {"trials": 0, "failures": 0})

@@ -193,27 +193,24 @@ def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw, support=
     speeds ``v_pin`` and, with ``support`` (an index per row into
     ``supports``), rest on different supports: one batch per (speed,
     support), results in row order."""
-    v_pin = np.asarray(v_pin, dtype=float)
-    if support is None or supports is None:
-        groups = [(v, None) for v in np.unique(v_pin)]
-        rows_of = lambda g: np.flatnonzero(v_pin == g[0])  # noqa: E731
-    else:
-        support = np.asarray(support, dtype=int)
-        groups = sorted({(float(v), int(s)) for v, s in zip(v_pin, support)})
-        rows_of = lambda g: np.flatnonzero((v_pin == g[0]) & (support == g[1]))  # noqa: E731
+    v_pin = np.broadcast_to(np.asarray(v_pin, dtype=float), theta.shape)
+    supports = supports or [None]
+    support = np.zeros(theta.size, int) if support is None else np.asarray(support, dtype=int)
+    groups, group_of = np.unique(np.column_stack([v_pin, support]), axis=0, return_inverse=True)
+    group_of = group_of.ravel()
 
-    def batch(rows, group):
-        v, s = group
-        extra = {} if s is None or supports[s] is None else {"support": supports[s]}
+    def batch(rows, g):
+        v, s = groups[g]
+        extra = {} if supports[int(s)] is None else {"support": supports[int(s)]}
         return simulate.rollout_points(part, theta[rows], d[rows], mu[rows], pin_radius, model,
                                        v_pin=float(v), **kw, **extra)
 
     if len(groups) == 1:
-        return batch(np.arange(theta.size), groups[0])
+        return batch(np.arange(theta.size), 0)
     out = None
-    for group in groups:
-        rows = rows_of(group)
-        res = batch(rows, group)
+    for g in range(len(groups)):
+        rows = np.flatnonzero(group_of == g)
+        res = batch(rows, g)
         if out is None:
             out = {key: np.empty(theta.size, dtype=arr.dtype) for key, arr in res.items()}
         for key, arr in res.items():
