@@ -22,13 +22,33 @@ trying every sequence, level by level:
    subset (``SCREEN``: 12 and 8). A sequence whose subset already has more
    failures than the whole verification allows is rejected (exact: more
    trials cannot mend it);
-4. replay all the verification trials for the survivors and judge them;
-5. stop at the first level where some sequence orients.
+4. replay all the verification trials for the survivors and judge them
+   (the *selection* trials);
+5. certify each sequence that orients on them on *held-out* trials
+   (``verify.holdout_settings``: a fresh seed no screen or selection drew
+   from, at least as many trials): only a sequence whose held-out verdict
+   orients the part counts, so a sequence chosen because its sample was
+   lucky does not pass (the winner's curse);
+6. stop at the first level where some sequence is certified.
 
-Among the orienting sequences of that level the narrowest verified width
-wins, then the larger margin in d; at least ``candidates`` survivors of step
-3 are judged (all of them if fewer), so the width ranking is over those;
-blocks after that are not screened (``not_screened`` in the level's counts).
+"Orients" is the claim rule of :mod:`pipeline.planning.orient`: the lower
+confidence bound on the share of trials in one arc of ``T`` is at least
+``verify.required`` (``verify.rule: point`` judges by the share alone).
+Among the certified sequences of that level the narrowest held-out width
+wins, then the larger margin in d, except that a sequence with a negative
+margin yields to one with a positive margin whose width is within
+``planner.width_slack_deg`` (:func:`robust_order`); at least ``candidates``
+survivors of step 3 are judged (all of them if fewer), so the width ranking
+is over those; blocks after that are not screened (``not_screened`` in the
+level's counts).
+
+The *margin in d* of a sequence is how far, as a share of the part's size
+``a``, every contact offset ``|d|`` its nominal paths meet stays inside the
+band ``planner.d_min <= |d| / a <= planner.d_max``: negative means some
+pin meets the part outside it, next to a critical contact (near the line
+through the centroid, where the turning direction flips, or near the end of
+the outline, where the pin may miss), so a pin placed within its tolerance
+may change the outcome.
 
 When no sequence of up to ``N`` pins orients, the result says so with the
 evidence: per level, how many sequences were enumerated, kept, screened out
@@ -52,7 +72,8 @@ from pipeline.planning.enumerate import Level, NominalTree
 from pipeline.planning.propagate import resting_states
 from pipeline.planning.settings import nominal_friction
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
-from pipeline.planning.verify import replay, trial_inputs
+from pipeline.planning.confidence import DEFAULT_CONFIDENCE, check_confidence
+from pipeline.planning.verify import holdout_settings, replay, trial_inputs
 
 SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
 PROBE = (6, 2)  # random trials and corners per resting state that order the candidates
@@ -60,11 +81,14 @@ SCREEN = (12, 8)  # random trials and corners per resting state in the screen
 SCREEN_BLOCK = 96  # candidates screened at once
 MAX_ROWS = 150_000  # trials replayed in one batch
 EVIDENCE_PER_LEVEL = 4  # several-set sequences judged per level when nothing orients
+WIDTH_SLACK_DEG = 1.0  # planner.width_slack_deg: a safe margin outranks this much width
 
 
 def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None, n_moving: int = 0) -> tuple:
     """The ranking of plans (best first): plans that orient the part, by fewest
-    pins, narrowest verified width, largest margin in d; then plans ending in
+    pins, narrowest verified width, largest margin in d; then the near misses
+    that clear the point rule but not its confidence bound, in the same order;
+    then plans ending in
     several sets within the tolerance (those that jam too often last, then
     those with moving pins: a moving pin is there to orient the part, and a
     sensor finishes fixed pins' sets as well), by fewest sets, fewest pins,
@@ -72,8 +96,8 @@ def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None, n_
     v = verdict or {}
     width = v.get("width_deg")
     margin = -margin if margin is not None and np.isfinite(margin) else 0.0
-    if v.get("orients"):
-        return (0, 0, 0, 0, n_pins, width, margin)
+    if v.get("orients") or v.get("point_rule"):
+        return (0, 0 if v.get("orients") else 1, 0, 0, n_pins, width, margin)
     trials = v.get("trials", 1)
     jams_decide = trials - v.get("jammed", 0) < v.get("needed", trials)  # too many jams for any set
     share = v.get("in_tolerance", 0) / max(1, trials)
@@ -81,15 +105,48 @@ def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None, n_
             -share, margin)
 
 
+def _safe(margin) -> bool:
+    return margin is None or not np.isfinite(margin) or margin >= 0.0
+
+
+def robust_order(plans, key, width, margin, slack: float = WIDTH_SLACK_DEG) -> list:
+    """``plans`` sorted by ``key`` (best first), except that robustness ranks
+    before a tenth of a degree: a plan with a negative margin in d yields to the
+    best later plan of the same claim and pin count (the first five entries of
+    ``key``) whose margin is not negative and whose width (``width(plan)``,
+    deg) is within ``slack`` degrees of its own. ``margin(plan)`` may be None
+    or infinite (no pin touches: nothing to be near)."""
+    rest = sorted(plans, key=key)
+    out = []
+    while rest:
+        best = rest[0]
+        kb = key(best)
+        if kb[0] == 0 and not _safe(margin(best)) and width(best) is not None:
+            for p in rest[1:]:
+                if key(p)[:5] == kb[:5] and _safe(margin(p)) and width(p) is not None \
+                        and width(p) <= width(best) + slack:
+                    best = p
+                    break
+        out.append(best)
+        rest.remove(best)
+    return out
+
+
 @dataclass
 class FixedPlan:
-    """A fixed-pin sequence and its verdict on the verification trials."""
+    """A fixed-pin sequence and its verdict: on the held-out trials once it has
+    been certified (``selection``: its verdict on the trials that chose it),
+    else on the verification (selection) trials."""
     labels: tuple
     heights: tuple
     nominal_span: float
     margin: float
     verdict: dict | None = None
     speeds: tuple = ()  # v_pin / v_b of each pin (empty: all fixed)
+    selection: dict | None = None
+
+    def width(self):
+        return (self.verdict or {}).get("width_deg")
 
     def rank_key(self):
         """Orienting first, then fewer pins, narrower verified width, larger margin."""
@@ -107,6 +164,8 @@ class FixedSearch:
     tolerance: float
     required: float
     levels: list = field(default_factory=list)
+    confidence: float = DEFAULT_CONFIDENCE
+    rule: str = "bound"
     rollouts: int = 0
     seconds: float = 0.0
     resting: dict | None = None  # the verdict on the resting states themselves (no pin)
@@ -133,7 +192,7 @@ class FixedSearch:
         if self.plans:
             best = self.plans[0]
             return (f"{len(best.labels)} fixed pins orient this part within {self.tolerance:g} deg "
-                    f"(verified width {best.verdict['width_deg']:.1f} deg); no sequence of fewer does")
+                    f"(held-out width {best.verdict['width_deg']:.1f} deg); no sequence of fewer does")
         text = f"no fixed-pin sequence of up to {self.depth} pins orients this part within {self.tolerance:g} deg"
         if self.best_effort:
             b = self.best_effort[0]
@@ -147,7 +206,8 @@ class FixedSearch:
         """The search's record for the plan file (``fixed_pin_search``)."""
         return {"orients": self.orients, "needs_no_pin": self.needs_no_pin, "resting": self.resting,
                 "depth": self.depth, "tolerance_deg": self.tolerance,
-                "required": self.required, "evidence": self.evidence(), "levels": self.levels,
+                "required": self.required, "confidence": self.confidence, "rule": self.rule,
+                "evidence": self.evidence(), "levels": self.levels,
                 "nominal_rollouts": self.rollouts, "seconds": round(self.seconds, 2),
                 "best_effort": [{"pins": list(b.labels), "pin_heights_mm": list(b.heights),
                                  **b.verdict} for b in self.best_effort]}
@@ -182,7 +242,8 @@ class FixedPinSearch:
     def __init__(self, part: Part, pins: dict, mu_c, tolerance: float, required: float,
                  verify: dict, pin_radius: float, model: str = "minpower", kernel: dict | None = None,
                  d_min: float = 0.1, d_max: float = 0.9, belt_speed: float | None = None,
-                 mu_s: float = 0.5, speeds: dict | None = None, family=None):
+                 mu_s: float = 0.5, speeds: dict | None = None, family=None,
+                 width_slack: float = WIDTH_SLACK_DEG):
         self.part, self.mu_c, self.model = part, mu_c, model
         self.belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
         self.labels = list(pins)
@@ -191,6 +252,10 @@ class FixedPinSearch:
         self.tolerance = orient.check_tolerance(tolerance)
         self.required = orient.check_required(required)
         self.cfg = dict(VERIFY_DEFAULTS, **(verify or {}))
+        self.confidence = check_confidence(self.cfg.get("confidence", DEFAULT_CONFIDENCE))
+        self.rule = orient.check_rule(self.cfg.get("rule", "bound"))
+        self.holdout = holdout_settings(self.cfg)
+        self.width_slack = float(width_slack)
         self.pin_radius = float(pin_radius)
         self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **(kernel or {})}
         self.order = part.symmetry_order()
@@ -209,7 +274,8 @@ class FixedPinSearch:
         every sequence then starts with them); stop at the first level with an
         orienting plan."""
         t0 = time.perf_counter()
-        result = FixedSearch([], [], int(depth), self.tolerance, self.required)
+        result = FixedSearch([], [], int(depth), self.tolerance, self.required,
+                             confidence=self.confidence, rule=self.rule)
         runners_up, levels = [], []
         self.prefix, root = prefix or FixedPlan((), (), 0.0, np.inf), None
         if prefix is not None:
@@ -230,16 +296,20 @@ class FixedPinSearch:
                          f"{record['judged']} replayed in full, {record['orienting']} orient the part")
             runners_up.extend(judged)
             if found:
-                result.plans = sorted(found, key=FixedPlan.rank_key)[:keep]
+                result.plans = self.ranked(found)[:keep]
                 break
             levels.append(level)
         if not result.plans:  # the evidence: the best several-set results of every level
             for level in levels:
                 runners_up.extend(self._several_sets(level, min(candidates, EVIDENCE_PER_LEVEL)))
-            result.best_effort = sorted(runners_up, key=FixedPlan.rank_key)[:keep]
+            result.best_effort = self.ranked(runners_up)[:keep]
         result.rollouts = self.tree.rollouts
         result.seconds = time.perf_counter() - t0
         return result
+
+    def ranked(self, plans) -> list:
+        """``plans`` best first (:func:`robust_order` with ``planner.width_slack_deg``)."""
+        return robust_order(plans, FixedPlan.rank_key, FixedPlan.width, lambda p: p.margin, self.width_slack)
 
     def _after(self, prefix: FixedPlan):
         """The nominal level after ``prefix`` (its pins replayed exactly from the
@@ -260,7 +330,7 @@ class FixedPinSearch:
     def _level(self, level, candidates):
         """``(orienting plans, every judged plan, the level's counts)``."""
         record = {"sequences": level.size, "nominal_within": 0, "screened_out": 0, "judged": 0,
-                  "orienting": 0, "not_screened": 0}
+                  "orienting": 0, "not_screened": 0, "held_out": 0, "certified": 0}
         if level.size == 0:
             return [], [], record
         span = orient.row_spans(level.theta, self.order)
@@ -272,14 +342,14 @@ class FixedPinSearch:
         n_pins = len(self.prefix.labels) + level.seq.shape[1]
         inputs = self._trials(n_pins)
         n_total = sum(x[0].size for x in inputs)
-        allowed = n_total - orient.needed(n_total, self.required)
+        allowed = orient.max_failures(n_total, self.required, self.confidence, self.rule)
         # A probe of a few trials per state orders the candidates (most promising
         # first) and already rejects the hopeless ones.
         probe_fails = self._failures(level, within, self._screen_rows(inputs, *PROBE))
         order = within[probe_fails <= allowed][np.argsort(probe_fails[probe_fails <= allowed], kind="stable")]
         record["screened_out"] = int(within.size - order.size)
         screen, full = self._screen_rows(inputs, *SCREEN), self._stack(inputs)
-        found, judged = [], []
+        found, found_idx, judged = [], [], []
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
         done = 0
         while done < order.size and not (found and len(judged) >= candidates):
@@ -295,11 +365,32 @@ class FixedPinSearch:
                     judged.append(plan)
                     if verdict["orients"]:
                         found.append(plan)
+                        found_idx.append(idx)
                 if found and len(judged) >= candidates:
                     break
         record["judged"], record["orienting"] = len(judged), len(found)
         record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
-        return found, judged, record
+        certified = self._certify(level, found, np.asarray(found_idx, dtype=int), n_pins)
+        record["held_out"], record["certified"] = len(found), len(certified)
+        return certified, judged, record
+
+    def _certify(self, level, found, idx, n_pins) -> list:
+        """The plans of ``found`` (level rows ``idx``) whose verdict on the held-out
+        trials orients the part; each plan's ``verdict`` becomes its held-out
+        verdict (with the width's bootstrap interval) and ``selection`` keeps
+        the verdict on the trials that chose it."""
+        if not found:
+            return []
+        rows = self._stack(trial_inputs(self.states, self.mu_c, n_pins, self.holdout, self.family))
+        out = []
+        step = max(1, MAX_ROWS // rows[0].size)
+        for start in range(0, idx.size, step):
+            chunk = idx[start:start + step]
+            for plan, held in zip(found[start:start + step], self._judge(level, chunk, rows, interval=True)):
+                plan.selection, plan.verdict = plan.verdict, held
+                if held["orients"]:
+                    out.append(plan)
+        return out
 
     def _plan(self, level, idx, span, verdict) -> FixedPlan:
         seq, pre = level.seq[idx], self.prefix
@@ -357,10 +448,11 @@ class FixedPinSearch:
                 out[start + k] = rows[0].size - held
         return out
 
-    def _judge(self, level, idx, rows):
+    def _judge(self, level, idx, rows, interval: bool = False):
         tf, jam = self._replay(level, idx, rows)
         for k in range(idx.size):
-            yield orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order, self.required)
+            yield orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order, self.required,
+                               self.confidence, interval, self.rule)
 
     # ------------------------------------------------------------------ when nothing orients
 

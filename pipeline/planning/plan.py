@@ -2,11 +2,14 @@
 
 This is what ``pinfeed plan`` and the workflow's plan stage call: it runs the
 search (``search.TightPlanner``), replays the best candidates by full
-rollouts (``verify.verify_plan``: the configured number of perturbed trials
-per initial state plus every corner of the perturbation box), re-ranks them
-with the verified success and recommends the best plan that fails at most
+rollouts on held-out trials (``verify.verify_plan`` with
+``verify.holdout_settings``: perturbed trials from a seed no screen or
+selection drew from, at least as many per initial state as the
+verification's, plus every corner of the perturbation box), re-ranks them
+with that verdict and recommends the best plan that fails at most
 ``MAX_FAILURE`` of its trials. A plan that fails more is never recommended:
-a warning with the reason is returned instead.
+a warning with the reason is returned instead. Each plan keeps its verdict
+on the trials that chose it apart, as ``verification.selection``.
 
 Outcomes computed for the propagation are kept in the catalog under
 ``refine/PART_ID/MODEL/v_pin=V.h5`` (see :mod:`pipeline.planning.lattice_store`) and
@@ -27,17 +30,19 @@ from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import format_arcs
 from pipeline.planning.certify import carried_plan
-from pipeline.planning.complete import FixedPinSearch, FixedPlan, FixedSearch, orientation_rank
+from pipeline.planning.complete import (WIDTH_SLACK_DEG, FixedPinSearch, FixedPlan, FixedSearch,
+                                        orientation_rank, robust_order)
 from pipeline.planning.family import planning_family
 from pipeline.planning.lattice_store import load_lattice, save_lattice
-from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required,
-                                      check_tolerance, judge_verification)
+from pipeline.planning.confidence import DEFAULT_CONFIDENCE, check_confidence
+from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required, check_rule,
+                                      check_tolerance, describe_claim, judge_verification)
 from pipeline.planning.propagate import Tolerances, Uncertainty, resting_states
 from pipeline.planning.search import TightPlanner
 from pipeline.planning.settings import candidate_pins, friction_label, parse_friction
 from pipeline.planning.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
-from pipeline.planning.verify import verify_plan
+from pipeline.planning.verify import holdout_settings, verify_plan
 
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
@@ -111,16 +116,19 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     # No pin is the plan with the fewest pins: then nothing is certified or recommended.
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
     candidates = [carried_plan(planner, p.labels, p.margin, verify_cfg, family) for p in chosen]
+    selections = [p.selection or p.verdict for p in chosen]
     moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, config, mu_c, planner)
     moving_search = None
     if moving is not None:
         moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress, family)
         candidates += [carried_plan(moving, p.labels, p.margin, verify_cfg, family)
                        for p in moving_search.plans]
+        selections += [p.selection or p.verdict for p in moving_search.plans]
         planner = moving
     states = resting_states(part)
-    _verify_candidates(part, config, mu_c, planner, candidates, states, progress, family)
-    candidates.sort(key=_rank)
+    _verify_candidates(part, config, mu_c, planner, candidates, states, progress, family, selections)
+    candidates = robust_order(candidates, _rank, lambda p: p.verification["orientation"].get("width_deg"),
+                              lambda p: p.margin, planner_width_slack(config))
     good = [p for p in candidates if _acceptable(p)]
     result = _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed, moving_search)
     if family is not None:
@@ -138,6 +146,25 @@ def verify_required(config: dict) -> float:
     return check_required(config.get("verify", {}).get("required", DEFAULT_REQUIRED))
 
 
+def verify_confidence(config: dict) -> float:
+    """``verify.confidence`` (default 0.95): how sure the claim "orients" is."""
+    return check_confidence(config.get("verify", {}).get("confidence", DEFAULT_CONFIDENCE))
+
+
+def verify_rule(config: dict) -> str:
+    """``verify.rule`` (default ``bound``): judge by the confidence bound or the share alone."""
+    return check_rule(config.get("verify", {}).get("rule", "bound"))
+
+
+def planner_width_slack(config: dict) -> float:
+    """``planner.width_slack_deg`` (default 1): how much wider a plan with a safe
+    margin in d may be and still rank before one with a negative margin."""
+    slack = float(config["planner"].get("width_slack_deg", WIDTH_SLACK_DEG))
+    if not slack >= 0.0:
+        raise PinfeedError(f"planner.width_slack_deg must be 0 or more degrees, got {slack!r}")
+    return slack
+
+
 def _pin_search(part, config, mu_c, planner, moving: bool, family=None) -> FixedPinSearch:
     """The complete search over the planner's fixed pins (``moving`` False) or
     its moving pins (True), with the config's tolerance, verification and
@@ -148,7 +175,8 @@ def _pin_search(part, config, mu_c, planner, moving: bool, family=None) -> Fixed
                           verify_required(config), config.get("verify", {}), sweep["pin_radius"],
                           pc["model"], sweep.get("kernel"), pc["d_min"], pc["d_max"],
                           belt_speed=planner.belt_speed, mu_s=planner.mu_s,
-                          speeds={k: p.v_pin for k, p in pins.items()}, family=family)
+                          speeds={k: p.v_pin for k, p in pins.items()}, family=family,
+                          width_slack=planner_width_slack(config))
 
 
 def _fixed_search(part, config, mu_c, planner, depth, keep, progress, family=None) -> FixedSearch:
@@ -202,32 +230,36 @@ def _acceptable(plan) -> bool:
 
 
 def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, states, progress,
-                       family=None) -> None:
-    """Replay each candidate by perturbed full rollouts (``verify_plan``) and
-    attach the summary as ``plan.verification``, with the orientation verdict
-    (``orient.judge``: one set within the tolerance?) as ``orientation``."""
+                       family=None, selections=None) -> None:
+    """Replay each candidate by perturbed full rollouts on the held-out trials
+    (``verify_plan`` with ``holdout_settings``) and attach the summary as
+    ``plan.verification``, with the orientation verdict (``orient.judge``: one
+    set within the tolerance, with confidence?) as ``orientation`` and the
+    verdict on the trials that chose it (``selections``, in order) as
+    ``selection``."""
     pc = config["planner"]
-    verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
+    verify_cfg = holdout_settings(dict(VERIFY_DEFAULTS, **config.get("verify", {})))
     tolerance, required = planner_tolerance(config), verify_required(config)
+    confidence, rule = verify_confidence(config), verify_rule(config)
+    selections = list(selections or []) + [None] * len(candidates)
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
-    for plan in candidates:
+    for plan, selection in zip(candidates, selections):
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
                           config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
                           kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
                           mu_s=planner.mu_s, family=family)
-        verdict = judge_verification(res, tolerance, planner.order, required)
-        plan.verification = {"trials": res["trials"], "successes": res["successes"],
+        verdict = judge_verification(res, tolerance, planner.order, required, confidence, rule)
+        plan.verification = {"held_out": True, "seed": verify_cfg["seed"],
+                             "trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
                              **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}
                                 if "belt_speed" in res else {}),
                              **({"support_family": res["support_family"]}
                                 if "support_family" in res else {}),
-                             "orientation": verdict}
+                             "orientation": verdict, "selection": selection}
         if progress:
-            width = verdict["width_deg"]
-            progress(f"mu_c {friction_label(mu_c)}: verified {' '.join(plan.pins)}: "
-                     f"{verdict['in_tolerance']}/{res['trials']} trials in one set of {tolerance:g} deg"
-                     + (f", verified width {width:.1f} deg" if width is not None else ""))
+            progress(f"mu_c {friction_label(mu_c)}: held-out check of {' '.join(plan.pins)}: "
+                     + describe_claim(verdict))
 
 
 def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance: float,
@@ -250,6 +282,9 @@ def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance
                 f"({format_arcs(best.final_sets)}), failed {best.verification['failures']} of "
                 f"{best.verification['trials']} trials")
     verdict = good[0].verification["orientation"]
+    if verdict.get("point_rule"):
+        return (f"no plan clears the confidence bound on held-out trials; the best, "
+                f"{' '.join(good[0].pins)}, is a near miss: {describe_claim(verdict)}")
     return (f"{why}; the recommended plan ends in {verdict['sets_within_tolerance']} "
             f"sets of at most {tolerance:g} deg: a sensor must tell them apart")
 

@@ -25,6 +25,7 @@ import numpy as np
 
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, JAMMED, MISS, TRUNCATED
 
+from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
@@ -33,6 +34,26 @@ from pipeline.planning.arcs import in_arc, merge_arcs
 PERTURB_DEFAULTS = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 DEFAULTS = {"trials": 300, "corners": True, **PERTURB_DEFAULTS, "seed": 1}
 TRUNCATE_SIGMA = 2.0
+HOLDOUT_STREAM = 4_001  # salt of the held-out trials' seed: a stream no screen or selection draws from
+
+
+def holdout_settings(settings: dict, attempt: int = 0) -> dict:
+    """The verification settings of the held-out trials that certify a plan.
+
+    The search screens and selects plans on the trials of ``settings`` (seed
+    ``seed``); the plan it picks is certified on fresh trials from a seed
+    derived from ``(seed, HOLDOUT_STREAM, attempt)``, which no screen or
+    selection draws from, ``holdout_trials`` per state (default: as many as
+    ``trials``; fewer is refused). The same settings give the same held-out
+    trials. The box corners are replayed again (they are not random)."""
+    cfg = dict(DEFAULTS, **(settings or {}))
+    n = cfg.get("holdout_trials")
+    n = int(cfg["trials"]) if n is None else int(n)
+    if n < int(cfg["trials"]):
+        raise PinfeedError(f"verify.holdout_trials ({n}) must be at least verify.trials ({cfg['trials']}): "
+                           "the trials that certify a plan may not be fewer than those that chose it")
+    seed = int(np.random.SeedSequence([int(cfg["seed"]), HOLDOUT_STREAM, int(attempt)]).generate_state(1)[0])
+    return dict(cfg, trials=n, seed=seed, holdout=True)
 
 
 def _truncated_normal(rng, sigma, n):
