@@ -411,7 +411,24 @@ def _plan_summary(plan, pins=None) -> dict:
             "claimed_width_deg": _claimed_width(plan), "claim": plan.get("claim"),
             "verified_width_deg": orientation["width_deg"] if orientation else None,
             "orients": orientation["orients"] if orientation else None,
+            **_claim_numbers(orientation),
+            "selection": _selection_counts(plan),
             "verification": _verification_counts(plan)}
+
+
+def _claim_numbers(orientation) -> dict:
+    """The held-out claim's share with its lower bound, and the width's interval."""
+    o = orientation or {}
+    return {key: o.get(key) for key in ("share", "share_lower_bound", "confidence", "point_rule",
+                                        "width_interval_deg")}
+
+
+def _selection_counts(plan) -> dict | None:
+    """The verdict on the trials that chose the plan, apart from the held-out claim."""
+    s = (plan.get("verification") or {}).get("selection")
+    if not s:
+        return None
+    return {key: s.get(key) for key in ("orients", "in_tolerance", "trials", "width_deg")}
 
 
 def _claimed_width(plan) -> float | None:
@@ -475,6 +492,7 @@ def _print_plan_result(result, part, config, mode):
                   f"({plan.extra.get('claim', 'propagated')}): {format_arcs(plan.final_arcs)}; "
                   f"{_orientation_text(v)}; margin in d "
                   + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
+            _print_claim(plan)
     if mode == "tight" or result.plans is None:
         return
     print(f"paper-mode planner (adjusted bands), {result.extra['selection']}:")
@@ -487,6 +505,22 @@ def _print_plan_result(result, part, config, mode):
         print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
               f"{format_arcs(plan.final_arcs)}; "
               f"margin in d {plan.margin:.3f}")
+
+
+def _print_claim(plan) -> None:
+    """The held-out claim with its uncertainty, the selection trials apart, the margin in words."""
+    from pipeline.planning.complete import margin_text
+    from pipeline.planning.orient import describe_claim
+    v = plan.verification
+    o = v.extra.get("orientation") if v else None
+    if o and "share_lower_bound" in o:
+        where = "held-out trials" if v.extra.get("held_out") else "trials"
+        print(f"      {where}: {describe_claim(o)}")
+        sel = v.extra.get("selection")
+        if sel:
+            print(f"      selection trials (chose the plan; no claim): {sel['in_tolerance']}/{sel['trials']} "
+                  "in one set" + (f", width {sel['width_deg']:.1f} deg" if sel.get("width_deg") is not None else ""))
+    print(f"      {margin_text(plan.margin)}")
 
 
 def _orientation_text(v) -> str:

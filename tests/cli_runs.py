@@ -27,6 +27,7 @@ def small_config_file(tmp_path):
     from pipeline.config import load_config
     cfg = load_config(None)
     cfg["verify"]["trials"] = 20
+    cfg["verify"]["rule"] = "point"  # 20 trials cannot carry a 99.5 % claim with confidence
     cfg["planner"]["candidates"] = 3
     cfg["speed"].update(trials=5, speeds=[50.0, 300.0], resolution=25.0)
     cfg.pop("name", None)

@@ -105,6 +105,18 @@ def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None, n_
             -share, margin)
 
 
+def margin_text(margin) -> str:
+    """The margin in d for people, in words."""
+    if margin is None or not np.isfinite(margin):
+        return "margin in d: n/a (no pin touches the part on its nominal paths)"
+    if margin >= 0.0:
+        return (f"margin in d {margin:+.3f}: every contact of the nominal paths stays {margin:.3f} a "
+                "inside the safe band d_min <= |d|/a <= d_max, away from the critical contacts")
+    return (f"margin in d {margin:+.3f}: a contact of the nominal paths lies {-margin:.3f} a outside the "
+            "safe band d_min <= |d|/a <= d_max, next to a critical contact, so a pin within its "
+            "placement tolerance may change the outcome")
+
+
 def _safe(margin) -> bool:
     return margin is None or not np.isfinite(margin) or margin >= 0.0
 

@@ -23,6 +23,8 @@ def _label(row: dict) -> str:
     pins += " pin" if n == 1 else " pins"
     if row["orients"]:
         how = "" if row["verified_width_deg"] is None else f", {row['verified_width_deg']:.1f} deg"
+        if row.get("share_lower_bound") is not None:
+            how += f" (>= {100 * row['share_lower_bound']:.1f} % in one set)"
     else:
         how = f": {row.get('sets')} sets of at most {row['tolerance_deg']:g} deg (sensor)"
     rate = "" if row.get("throughput_per_min") is None else f", {row['throughput_per_min']:.0f}/min"
@@ -34,8 +36,9 @@ def atlas_section(atlas: dict, thumbnails: dict, base, anchor) -> list[str]:
     ``base``: the page's folder; ``anchor(name)``: a part section's anchor."""
     tol = atlas.get("tolerance_deg")
     p = ['<h2 id="atlas">Feedability atlas</h2>',
-         f"<p>Which parts pins orient within {tol:g} deg (at least {100 * (atlas.get('required') or 0.995):g} % "
-         f"of the verified trials in one set; depth {atlas.get('depth')}), with how many pins, how "
+         f"<p>Which parts pins orient within {tol:g} deg (with {100 * (atlas.get('confidence') or 0.95):g} % confidence, at least "
+         f"{100 * (atlas.get('required') or 0.995):g} % of the trials in one set, judged on held-out "
+         f"trials; depth {atlas.get('depth')}), with how many pins, how "
          "precisely (verified width) and how fast (throughput at the layout's belt speed). "
          "Frame colour: " + ", ".join(f'<span style="color:{c}">{html.escape(LEGEND[k])}</span>'
                                       for k, c in COLOURS.items() if LEGEND[k] and k != "no plan") + ".</p>",

@@ -30,7 +30,8 @@ from pipeline.planning.types import validate_plan_file
 from pipeline.provenance import provenance_attrs
 
 COLUMNS = ("part", "part_id", "outcome", "orients", "tolerance_deg", "fixed_pins", "moving_pins",
-           "sensor_needed", "verified_width_deg", "sets", "trials", "in_set", "plan", "mu_c",
+           "sensor_needed", "verified_width_deg", "width_low_deg", "width_high_deg", "sets", "trials",
+           "in_set", "share", "share_lower_bound", "confidence", "plan", "mu_c",
            "speed_limit_mm_s", "belt_speed_mm_s", "throughput_per_min", "planning_seconds", "evidence")
 
 
@@ -61,8 +62,12 @@ def atlas_row(plan_result: dict, speed: dict | None = None, layout: dict | None 
         "moving_pins": 0 if no_pin else None if plan is None else n_moving,
         "sensor_needed": not orients,
         "verified_width_deg": verdict.get("width_deg"),
+        "width_low_deg": (verdict.get("width_interval_deg") or [None, None])[0],
+        "width_high_deg": (verdict.get("width_interval_deg") or [None, None])[1],
         "sets": 1 if orients else verdict.get("sets_within_tolerance"),
         "trials": verdict.get("trials"), "in_set": verdict.get("in_tolerance"),
+        "share": verdict.get("share"), "share_lower_bound": verdict.get("share_lower_bound"),
+        "confidence": verdict.get("confidence"),
         "plan": None if plan is None else " ".join(plan["pins"]),
         "mu_c": entry.get("friction"),
         "speed_limit_mm_s": (speed or {}).get("speed_limit_mm_s"),
@@ -88,7 +93,9 @@ def build_atlas(config: dict, plan_paths, speed_paths=(), layout_paths=()) -> di
         name = res["part"]["name"]
         rows.append(atlas_row(res, speeds.get(name), layouts.get(name)))
     return {"config": config.get("name"), "tolerance_deg": config["planner"].get("tolerance_deg"),
-            "required": config.get("verify", {}).get("required"), "depth": config["planner"]["depth"],
+            "required": config.get("verify", {}).get("required"),
+            "confidence": config.get("verify", {}).get("confidence", 0.95),
+            "rule": config.get("verify", {}).get("rule", "bound"), "depth": config["planner"]["depth"],
             "columns": list(COLUMNS), "rows": rows, **provenance_attrs()}
 
 

@@ -236,7 +236,7 @@ def test_workflow_plans_verifies_and_draws_moving_pins(tmp_path):
         "planner": {"parts": ["tri"], "model": "ellipsoid", "mu_c": 0.2, "depth": 1,
                     "pins": [-10, -5, 0, 5, 10, 15, 20, 25, 30, 35, 40],
                     "dynamic": {"speeds": [-1.5], "depth": 1}},
-        "verify": {"trials": 3}, "sensing": {"trials": 3}, "figures": {"d": [0.4], "animation_frames": 3},
+        "verify": {"trials": 3, "rule": "point"}, "sensing": {"trials": 3}, "figures": {"d": [0.4], "animation_frames": 3},
     }
     (tmp_path / "cfg.yaml").write_text(yaml.safe_dump(cfg))
     run = _snakemake(tmp_path, "--configfile", str(tmp_path / "cfg.yaml"))

@@ -207,7 +207,7 @@ def test_the_verify_stage_replays_the_recommended_tight_plan_as_stored(tight_fil
     entry = data["tight"][0]
     data.update(initial_states=entry["initial_states"], plans=[], pins={}, mu_c=entry["mu_c"])
     config = load_config(None)
-    config["verify"] = dict(config.get("verify", {}), trials=4)
+    config["verify"] = dict(config.get("verify", {}), trials=4, rule="point")
     out = verify_part(data, config)
     assert [c["kind"] for c in out["checks"]] == [f"tight, mu_c {entry['friction']}"]
     rec = entry["recommended"]

@@ -18,7 +18,7 @@ TINY = {
               "d": [-0.8, -0.6, -0.4, -0.2, 0.2, 0.4, 0.6, 0.8], "theta_step": 10, "pin_radius": 3.0},
     "planner": {"parts": ["tri", "rect"], "model": "ellipsoid", "mu_c": 0.2, "depth": 1,
                 "pins": [-10, -5, 0, 5, 10, 15, 20, 25, 30, 35, 40], "dynamic": {"speeds": []}},
-    "verify": {"trials": 3}, "sensing": {"trials": 3, "parts": ["tri"]},
+    "verify": {"trials": 3, "rule": "point"}, "sensing": {"trials": 3, "parts": ["tri"]},
     "speed": {"trials": 3, "speeds": [50, 200]},
     "figures": {"d": [0.4], "animation_frames": 3, "animation_fps": 2},
 }

@@ -30,7 +30,7 @@ def planned(tmp_path_factory):
     pc = config["planner"]
     pc.update(depth=2, mu_c=0.15, frictions=[], tolerance_deg=12.0)
     pc["dynamic"].update(depth=0, speeds=[])
-    config["verify"].update(trials=10)
+    config["verify"].update(trials=10, rule="point")
     paths = []
     for name, vertices in PARTS.items():
         path = root / "plans" / f"{name}.json"

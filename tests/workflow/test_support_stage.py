@@ -35,7 +35,7 @@ def stage(tmp_path_factory):
     pc = config["planner"]
     pc.update(depth=4, mu_c=MU, frictions=[], tolerance_deg=12.0, pins=[-5, 5, 15, 25, 35, 45])
     pc["dynamic"].update(depth=0, speeds=[])
-    config["verify"].update(trials=20)
+    config["verify"].update(trials=20, rule="point")
     config["support_study"] = {"family": FAMILY, "parts": ["asym_triangle"]}
     plan_path = write_json(plan_tight_only(TRIANGLE, config), root / "plans" / "asym_triangle.json")
     out, figure = root / "support" / "asym_triangle.json", root / "figures" / "support_maps_asym_triangle.png"

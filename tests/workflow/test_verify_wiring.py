@@ -65,7 +65,7 @@ def received(monkeypatch):
 
 def _config():
     return {"planner": {"model": "minpower", "mu_c": CONFIG_MU}, "sweep": {"pin_radius": 3.0},
-            "verify": {"trials": 3}}
+            "verify": {"trials": 3, "rule": "point"}}
 
 
 def _check(seen):
