@@ -166,7 +166,7 @@ def test_moving_pins_only_when_fixed_pins_cannot_and_their_plan_holds():
     from pipeline.planning.plan import plan_tight
     config = load_config()
     config["planner"].update(pins="auto", depth=1, tolerance_deg=10.0)
-    config["verify"]["trials"] = 30
+    config["verify"].update(trials=30, rule="point")  # few trials: the point rule
     part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]], name="trapezoid")
     entry = plan_tight(part, config, (0.1, 0.3))
     assert not entry["fixed_pin_search"]["orients"]
@@ -187,7 +187,7 @@ def test_no_plan_recommends_fixed_pins_for_a_sensor():
     config = load_config()
     config["planner"].update(pins=[0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0], depth=1, tolerance_deg=12.0)
     config["planner"]["dynamic"].update(speeds=[-2.0, 2.0], depth=1)
-    config["verify"]["trials"] = 30
+    config["verify"].update(trials=30, rule="point")  # few trials: the point rule
     part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]], name="trapezoid")
     entry = plan_tight(part, config, 0.15)
     assert not entry["orients"] and not entry["moving_pin_search"]["orients"]
