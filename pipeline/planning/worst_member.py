@@ -58,6 +58,9 @@ from pipeline.planning.verify import corner_inputs, replay, trial_inputs
 DEFAULT_BUDGET = 150  # member evaluations per search (planner.worst_member_budget)
 JAM_SCORE = 180.0  # deg: a jam is as far outside the set as anything can be
 RANDOM_STARTS = 6  # seeded random members besides the geometric corners
+RANDOM_SHARE = 0.5  # of the budget spent on the starts (corners, then seeded random members)
+LARGEST_STARTS = 8  # largest leg triangles on the inset outline among the starts
+EDGE_POINTS = 5  # points per inset edge (besides its corner) the largest triangles' legs take
 MAX_ROUNDS = 3  # worst member found -> joins the verification -> searched again
 _PENALTY = 1.0e3
 _POOL = 20_000
@@ -98,10 +101,21 @@ class TripodSpace:
                 "weights": None if lam is None else np.round(lam, 4).tolist()}
 
     def corners(self) -> list[np.ndarray]:
-        """Legs at the inset outline's corners (every triple), and the smallest
-        leg triangles about the centroid (three turns)."""
+        """Legs at the inset outline's corners (every triple that holds the
+        centroid), the ``LARGEST_STARTS`` largest leg triangles with legs on
+        the inset outline (corners and ``EDGE_POINTS`` points along each
+        edge: where no corner triple holds the centroid, as on a rectangle,
+        these are the extreme tripods), and the smallest leg triangles about
+        the centroid (three turns)."""
         pts = inset_corners(np.asarray(self.part.vertices, float), self.inset * self.part.a)
         out = [np.array(t).ravel() for t in itertools.combinations(pts, 3)]
+        out = [x for x in out if self.violation(x) == 0.0]
+        rim = [p + (q - p) * t for p, q in zip(pts, np.roll(pts, -1, axis=0))
+               for t in np.linspace(0.0, 1.0, EDGE_POINTS + 1, endpoint=False)]
+        big = [np.array(t) for t in itertools.combinations(rim, 3)]
+        big = [t.ravel() for t in big if self.violation(t.ravel()) == 0.0]
+        big.sort(key=_area, reverse=True)
+        out += [x for x in big if not any(np.allclose(x, y) for y in out)][:LARGEST_STARTS]
         r = max(0.05, 1.0 - self.inset) * 0.1 * self.part.a
         for turn in (0.0, 40.0, 80.0):
             ang = np.radians(turn + np.array([90.0, 210.0, 330.0]))
@@ -174,6 +188,12 @@ class WarpSpace:
 
     def describe(self) -> str:
         return f"warps of amplitude up to {self.amplitude:g}"
+
+
+def _area(x: np.ndarray) -> float:
+    """Twice the area of the leg triangle ``x`` (6 numbers)."""
+    (ux, uy), (vx, vy) = x[2:4] - x[0:2], x[4:6] - x[0:2]
+    return abs(ux * vy - uy * vx)
 
 
 def _weights(legs: np.ndarray, a: float) -> np.ndarray | None:
@@ -400,7 +420,8 @@ def _search_space(probe, space, arc, period, budget, rng, keep, used, stop_when_
         return -obj
 
     starts = [(x, "geometric corner") for x in space.corners()]
-    starts += [(x, "random start") for x in space.random(rng, RANDOM_STARTS)]
+    n_random = max(RANDOM_STARTS, int(RANDOM_SHARE * budget) - len(starts))
+    starts += [(x, "random start") for x in space.random(rng, n_random)]
     try:
         values = [f(x, src) for x, src in starts]
         for i in np.argsort(values):

@@ -27,7 +27,7 @@ from pipeline.planning.worst_member import (FamilyChecker, FamilyCheckSettings, 
                                             check_plan_for_family, member_space)
 
 TRIANGLE = Part.from_vertices([(0, 0), (60, 0), (15, 35)], "asym_triangle")
-QUAD = Part.from_vertices([(0, 0), (50, 0), (42, 26), (6, 30)], "quad")
+RECTANGLE = Part.from_vertices([(0, 0), (40, 0), (40, 20), (0, 20)], "rectangle")
 BOX = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 
 
@@ -88,36 +88,40 @@ def _corner_finals(part, heights, support, mu):
     return np.mod(th, 360.0)  # a jam is NaN: counted as outside
 
 
-def _outside(theta, start, width):
-    rel = np.mod(theta - start, 360.0)
-    out = np.where(rel <= width + 1e-6, 0.0, np.minimum(rel - width, 360.0 - rel))
+def _outside(theta, start, width, period=360.0):
+    rel = np.mod(theta - start, period)
+    out = np.where(rel <= width + 1e-6, 0.0, np.minimum(rel - width, period - rel))
     return np.where(np.isnan(theta), 180.0, out)
 
 
 # --------------------------------------------------------------------------- soundness
 
-@pytest.mark.parametrize("part, pins, depth", [
-    (TRIANGLE, {"A": -3.0, "B": 8.0, "C": 19.0, "D": 30.0}, 3),
-    (QUAD, {"A": -3.0, "B": 7.0, "C": 17.0, "D": 27.0}, 3),
-])
-def test_no_grid_tripod_breaks_a_plan_the_search_returns(part, pins, depth):
+def _pins(part, n):
+    top = max(y for _, y in part.stable_states()) * 1.8
+    return {f"Q{k}": float(y) for k, y in enumerate(np.linspace(-0.1 * part.a, top, n), start=1)}
+
+
+@pytest.mark.parametrize("part, n_pins, depth, tolerance, grid_step", [
+    (TRIANGLE, 5, 4, 20.0, 1 / 9), (RECTANGLE, 6, 3, 30.0, 1 / 5)])
+def test_no_grid_tripod_breaks_a_plan_the_search_returns(part, n_pins, depth, tolerance, grid_step):
     mu = (0.1, 0.2)
     family = parse_support_family("tripods:4", part)
-    st = _settings(mu, 12.0, 20)
-    search = FixedPinSearch(part, pins, mu, 12.0, 0.995, st.verify, 3.0, family=family)
+    st = _settings(mu, tolerance, 20, budget=60)
+    search = FixedPinSearch(part, _pins(part, n_pins), mu, tolerance, 0.995, st.verify, 3.0, family=family)
     search.member_check = FamilyChecker(part, family, st)
-    result = search.run(depth, candidates=4)
+    result = search.run(depth, candidates=2)
     assert result.plans, result.evidence()
     plan = result.plans[0]
     check = search.member_check.result(plan.labels, plan.heights)
     assert check["holds"] and check["worst_member"]["outside_deg"] <= 0.0
     start, width = check["set_deg"]
-    grid = _grid_tripods(part, 0.2, part.a / 7.0)
-    assert len(grid) >= 40  # dense enough to mean something
+    period = 360.0 / part.symmetry_order()
+    grid = _grid_tripods(part, 0.2, grid_step * part.a)
+    assert len(grid) >= 100  # dense enough to mean something
     worst = 0.0
     for legs, w in grid:
         finals = _corner_finals(part, plan.heights, point_support(part, legs, w), mu)
-        worst = max(worst, float(_outside(finals, start, width).max()))
+        worst = max(worst, float(_outside(finals, start, width, period).max()))
     assert worst == 0.0, f"a grid tripod puts a final {worst:.2f} deg outside {plan.labels}' set"
 
 
