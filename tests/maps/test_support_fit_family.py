@@ -48,7 +48,7 @@ def test_every_member_explains_the_pushes_within_their_noise():
     for member in family.members:
         assert _chi2(member, pushes) <= threshold * (1 + 1e-6), member.label
     for member, reported in zip(family.members, fit.chi2):
-        assert _chi2(member, pushes) == pytest.approx(reported, rel=1e-3, abs=1e-3)
+        assert _chi2(member, pushes) == pytest.approx(reported, rel=0.02)  # the text rounds to 1 um
 
 
 @pytest.mark.parametrize("n, noise", [(5, 0.5), (6, None)])
