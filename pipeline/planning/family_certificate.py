@@ -92,6 +92,7 @@ def family_certificate(part, heights, family, check: dict, st, n_members: int = 
         "search": {"space": check["space"], "budget": check["budget"], "rounds": len(check["rounds"])},
         "worst_member": {k: worst.get(k) for k in ("parameters", "outside_deg", "breaks",
                                                     "nominal_finals_deg", "found_by", "evaluations")},
+        "carried_sets": _ASSUMES["carried sets"].format(family.label),
         "fresh": {"members": len(members), "trials": int(tf.size), "seed": [st.seed, 34],
                   "members_outside": leaving, "confidence": confidence,
                   "share_outside_upper_bound": round(share_upper_bound(leaving, len(members), confidence), 5),
@@ -112,3 +113,41 @@ def family_certificate_line(cert: dict) -> str:
             f"fresh members leave the set (share <= {100 * f['share_outside_upper_bound']:.2f} % at "
             f"{100 * f['confidence']:g} % confidence), {f['in_tolerance']} of {f['trials']} fresh trials "
             f"in one set of {cert['tolerance_deg']:g} deg")
+
+
+# --------------------------------------------------------------------------- what downstream stages assume
+
+_ASSUMES = {
+    "speed limit": "the speed limit assumes uniform pressure: the dynamic model integrates the uniform "
+                   "belt force and refuses point supports, so it is not checked for the support family {}",
+    "layout": "the layout's belt speed and pin spacing assume uniform pressure (the dynamic model "
+              "refuses point supports): they are not checked for the support family {}",
+    "carried sets": "the carried sets are sampled over the support family {}'s drawn members (and the "
+                    "worst members that broke an earlier verdict); the worst member found last is checked "
+                    "against the claimed final set only",
+}
+
+
+def plan_family_label(source) -> str | None:
+    """The support family a stored plan was made for (its label), or None: ``source``
+    is a plan file (:class:`~pipeline.planning.types.PlanFile` or its dict) or one
+    of its ``tight`` entries."""
+    entries = source.get("tight") if isinstance(source, dict) else getattr(source, "tight", None)
+    for entry in (entries if entries is not None else [source]):
+        extra = entry if isinstance(entry, dict) else getattr(entry, "extra", {})
+        family = (extra or {}).get("support_family")
+        if family:
+            return family["label"] if isinstance(family, dict) else str(family)
+    return None
+
+
+def family_assumption(source, stage: str) -> dict:
+    """``{}`` for a plan made for uniform pressure; else ``{"assumes": "uniform
+    pressure", "assumption": one line}`` for ``stage`` (``"speed limit"``,
+    ``"layout"``) of a plan made for a support family (``source`` as for
+    :func:`plan_family_label`)."""
+    label = plan_family_label(source)
+    if label is None:
+        return {}
+    assumes = "uniform pressure" if stage != "carried sets" else "the sampled members"
+    return {"assumes": assumes, "assumption": _ASSUMES[stage].format(label)}

@@ -160,3 +160,36 @@ def test_a_search_with_no_budget_is_one_line(budget):
     with pytest.raises(PinfeedError, match="a search with no budget") as err:
         check_budget(budget)
     assert "\n" not in str(err.value)
+
+
+# --------------------------------------------------------------------------- the certificate
+
+def test_certificate_of_a_plan_that_holds():
+    from scipy.stats import beta
+
+    from pipeline.planning.family_certificate import family_certificate, family_certificate_line
+    family = parse_support_family("tripods:4", RECTANGLE)
+    st = _settings((0.1, 0.2), 30.0, 20, budget=40)
+    pins = _pins(RECTANGLE, 6)
+    heights = (pins["Q5"], pins["Q1"], pins["Q5"])
+    check = check_plan_for_family(RECTANGLE, heights, family, st)
+    assert check["holds"]
+    cert = family_certificate(RECTANGLE, heights, family, check, st)
+    fresh = cert["fresh"]
+    assert fresh["members"] >= 300
+    k, n = fresh["members_outside"], fresh["members"]
+    closed = 1 - 0.05 ** (1 / n) if k == 0 else beta.ppf(0.95, k + 1, n - k)
+    assert fresh["share_outside_upper_bound"] == pytest.approx(closed, abs=1e-5)
+    assert cert["worst_member"]["outside_deg"] <= 0.0 and cert["verification"]["members"] >= 4
+    line = family_certificate_line(cert)
+    assert "\n" not in line and f"of {n} fresh members" in line
+
+
+def test_downstream_stages_say_they_assume_uniform_pressure():
+    from pipeline.planning.family_certificate import family_assumption
+    plan_file = {"tight": [{"support_family": {"label": "tripods:12", "members": []}}]}
+    for stage in ("speed limit", "layout"):
+        note = family_assumption(plan_file, stage)
+        assert note["assumes"] == "uniform pressure" and "tripods:12" in note["assumption"]
+        assert "\n" not in note["assumption"]
+    assert family_assumption({"tight": [{}]}, "speed limit") == {}
