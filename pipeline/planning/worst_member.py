@@ -91,10 +91,12 @@ class TripodSpace:
         return bad + np.maximum(0.0, MIN_LEG_WEIGHT - lam).sum() * self.part.a
 
     def member(self, x, label: str) -> Support:
+        """The tripod with legs ``x`` (6 numbers, mm) and weights by statics."""
         legs = np.asarray(x, float).reshape(3, 2)
         return point_support(self.part, legs, _weights(legs, self.part.a), kind="points", label=label)
 
     def params(self, x) -> dict:
+        """Legs (mm) and weights of ``x`` for outputs."""
         legs = np.asarray(x, float).reshape(3, 2)
         lam = _weights(legs, self.part.a)
         return {"legs_mm": np.round(legs, 4).tolist(),
@@ -123,6 +125,7 @@ class TripodSpace:
         return [x for x in out if self.violation(x) == 0.0]
 
     def random(self, rng, n: int) -> list[np.ndarray]:
+        """Up to ``n`` feasible tripods with legs uniform in the inset outline."""
         verts = np.asarray(self.part.vertices, float)
         lo, hi = verts.min(axis=0), verts.max(axis=0)
         xy = rng.uniform(lo, hi, (_POOL, 2))
@@ -137,9 +140,11 @@ class TripodSpace:
         return out
 
     def sample(self, rng, n: int) -> list[Support]:
+        """``n`` random members (a fresh sample for the certificate)."""
         return [self.member(x, f"fresh tripod {k + 1}") for k, x in enumerate(self.random(rng, n))]
 
     def describe(self) -> str:
+        """The space in words."""
         return f"tripods {self.inset:g} a inside the outline"
 
 
@@ -164,29 +169,36 @@ class WarpSpace:
         return q / max(1.0, float(np.max(np.abs(q))))
 
     def violation(self, x) -> float:
+        """Always 0: every coefficient vector is rescaled into the bound."""
         return 0.0
 
     def member(self, x, label: str) -> Support:
+        """The warped pressure of coefficients ``x`` (3 numbers)."""
         w = self.base.weights * (1.0 + self.amplitude * self._q(x))
         return point_support(self.part, self.base.points, w, kind="points", label=label)
 
     def params(self, x) -> dict:
+        """The coefficients of ``x`` as used (within the bound) and the amplitude."""
         q = np.asarray(x, float) @ self.modes
         scale = 1.0 / max(1.0, float(np.max(np.abs(q))))
         return {"coefficients": np.round(np.asarray(x, float) * scale, 4).tolist(),
                 "amplitude": self.amplitude}
 
     def corners(self) -> list[np.ndarray]:
+        """Each mode at full amplitude, both signs (the dome and dish among them)."""
         return [s * e for e in np.eye(3) for s in (-1.0, 1.0)]
 
     def random(self, rng, n: int) -> list[np.ndarray]:
+        """``n`` seeded random coefficient vectors inside the bound."""
         c = rng.normal(size=(n, 3))
         return list(c / np.linalg.norm(c, axis=1, keepdims=True) * rng.uniform(0.3, 1.0, (n, 1)))
 
     def sample(self, rng, n: int) -> list[Support]:
+        """``n`` random members (a fresh sample for the certificate)."""
         return [self.member(x, f"fresh warp {k + 1}") for k, x in enumerate(self.random(rng, n))]
 
     def describe(self) -> str:
+        """The space in words."""
         return f"warps of amplitude up to {self.amplitude:g}"
 
 
@@ -233,6 +245,7 @@ class MemberSpace:
     fixed: list
 
     def describe(self) -> str:
+        """The space in words (for the plan file)."""
         parts = [s.describe() for s in self.spaces] + [f"{len(self.fixed)} listed member(s)"] * bool(self.fixed)
         return "; ".join(parts)
 
@@ -340,9 +353,11 @@ class WorstMember:
 
     @property
     def breaks(self) -> bool:
+        """True when some final lies outside the set."""
         return self.objective > 0.0
 
     def to_dict(self) -> dict:
+        """JSON-ready: the member, its parameters, how far outside, its nominal finals."""
         return {"member": self.support.to_dict(), "parameters": self.params,
                 "outside_deg": round(self.objective, 4), "breaks": self.breaks,
                 "nominal_finals_deg": np.round(self.finals[self.nominal], 3).tolist(),
@@ -453,6 +468,7 @@ class FamilyCheckSettings:
 
     @classmethod
     def from_config(cls, config: dict, mu_c) -> "FamilyCheckSettings":
+        """The settings of a validated config at friction ``mu_c``."""
         pc = config["planner"]
         return cls(mu_c, orient.check_tolerance(pc.get("tolerance_deg", orient.DEFAULT_TOLERANCE)),
                    orient.check_required(config.get("verify", {}).get("required", orient.DEFAULT_REQUIRED)),
@@ -541,6 +557,7 @@ class FamilyChecker:
 
     @staticmethod
     def key(labels, heights) -> tuple:
+        """The cache key of a plan: its labels and heights."""
         return tuple(labels), tuple(round(float(h), 9) for h in heights)
 
     def result(self, labels, heights) -> dict | None:
