@@ -316,3 +316,131 @@ def fit_support(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: floa
     support = objective.support_of(objective.best_flat)
     return SupportFit(support, objective.residuals(support), objective.residuals(None), len(pushes),
                       objective.evaluations)
+
+
+# --------------------------------------------------------------------------- a family of fits
+
+MAX_FAMILY = 8  # members a fitted family lists at most
+FAMILY_CONFIDENCE = 0.95  # chi-square quantile a consistent support's residuals stay within
+
+
+class _RecordingObjective(_Objective):
+    """An :class:`_Objective` that also keeps every feasible layout it scored,
+    with its sum of squared residuals (deg^2)."""
+
+    def __init__(self, *args):
+        super().__init__(*args)
+        self.seen: list[tuple[np.ndarray, float]] = []
+
+    def _keep(self, flat, r) -> float:
+        self.seen.append((np.array(flat, dtype=float), float(np.sum(np.square(r)))))
+        return super()._keep(flat, r)
+
+
+@dataclass
+class FamilyFit:
+    """What :func:`fit_support_family` found: the supports consistent with the pushes."""
+    members: list  # Support, best fit first
+    chi2: list  # sum of (residual / noise)^2 of each member
+    threshold: float  # the chi-square quantile they stay within
+    noise_deg: float
+    noise_estimated: bool
+    pushes: int
+    evaluations: int
+    consistent: int  # layouts within the threshold among all scored
+
+    @property
+    def spec(self) -> str:
+        """The family as ``--support-family`` text: ``points:x,y,w x,y,w ...; points:...``."""
+        return "; ".join("points:" + " ".join(f"{x:.3f},{y:.3f},{w:.4f}" for (x, y), w in
+                                              zip(m.points, m.weights)) for m in self.members)
+
+    def to_dict(self) -> dict:
+        """The JSON ``pinfeed support fit --family --json`` prints."""
+        return {"support_family": self.spec, "members": len(self.members),
+                "chi2": [round(c, 3) for c in self.chi2], "chi2_threshold": round(self.threshold, 3),
+                "confidence": FAMILY_CONFIDENCE, "noise_deg": round(self.noise_deg, 4),
+                "noise_estimated": self.noise_estimated, "pushes": self.pushes,
+                "consistent_layouts": self.consistent, "evaluations": self.evaluations}
+
+    def line(self) -> str:
+        """One line for the terminal."""
+        how = "estimated from the best fit" if self.noise_estimated else "given"
+        return (f"{len(self.members)} supports explain the {self.pushes} pushes within their noise "
+                f"({self.noise_deg:.3g} deg, {how}; chi-square <= {self.threshold:.1f} at "
+                f"{FAMILY_CONFIDENCE:.0%}): --support-family \"{self.spec}\"")
+
+
+def _spread_pick(flats: np.ndarray, n: int) -> list[int]:
+    """Up to ``n`` indices of ``flats`` far apart (greedy farthest points from the first)."""
+    chosen = [0]
+    dist = np.linalg.norm(flats - flats[0], axis=1)
+    while len(chosen) < min(n, len(flats)):
+        i = int(np.argmax(dist))
+        if dist[i] <= 1e-6:
+            break
+        chosen.append(i)
+        dist = np.minimum(dist, np.linalg.norm(flats - flats[i], axis=1))
+    return chosen
+
+
+def fit_support_family(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: float,
+                       noise_deg: float | None = None, n_points: int = 3, starts: int = 48,
+                       refine: int = 4, seed: int = 0, max_members: int = MAX_FAMILY) -> FamilyFit:
+    """The ``n_points``-point supports consistent with ``pushes`` within their noise.
+
+    The fit of :func:`fit_support` is run, keeping every feasible layout it
+    scores; a layout is *consistent* when ``sum (r / noise)^2`` of its
+    residuals stays within the ``FAMILY_CONFIDENCE`` quantile of the
+    chi-square distribution with one degree of freedom per push (what the
+    true support's residuals do with that probability when the measurement
+    noise is normal with sigma ``noise_deg``). ``noise_deg`` ``None``
+    estimates it from the best fit (``RMS * sqrt(n / (n - 2K))``). Up to
+    ``max_members`` consistent layouts far apart (the best fit first) form the
+    family.
+
+    Raises
+    ------
+    PinfeedError
+        One line: fewer pushes than the family's parameters (``2 n_points``,
+        and one more when the noise is estimated), a noise level that is not
+        a positive number.
+    """
+    from scipy.stats import chi2 as chi2_dist
+
+    k = int(n_points)
+    need = 2 * k + (1 if noise_deg is None else 0)
+    if len(pushes) < need:
+        raise PinfeedError(f"a support family from {len(pushes)} pushes: {k}-point supports have {2 * k} "
+                           f"parameters{' and the noise is estimated' if noise_deg is None else ''}; "
+                           f"measure at least {need} pushes")
+    if noise_deg is not None and not (math.isfinite(float(noise_deg)) and float(noise_deg) > 0):
+        raise PinfeedError(f"--noise-deg must be a number of degrees > 0, got {noise_deg}")
+    best = fit_support(part, pushes, mu_c, pin_radius, k, starts, refine, seed)
+    recorder = _RecordingObjective(part, pushes, mu_c if mu_c is not None else 0.0, pin_radius)
+    layouts = _random_layouts(part, k, int(starts), seed + 1) + [best.support.points.ravel()]
+    for flat in sorted(layouts, key=recorder.loss)[:max(1, int(refine))]:
+        _least_squares(recorder, flat, part.a)
+    n = len(pushes)
+    estimated = noise_deg is None
+    sigma = (float(np.sqrt(np.mean(np.square(best.residuals_deg)) * n / (n - 2 * k)))
+             if estimated else float(noise_deg))
+    sigma = max(sigma, 1e-6)
+    threshold = float(chi2_dist.ppf(FAMILY_CONFIDENCE, n))
+    seen = [(best.support.points.ravel(), float(np.sum(np.square(best.residuals_deg))))] + recorder.seen
+    ok = [(f, s / sigma ** 2) for f, s in seen if s / sigma ** 2 <= threshold]
+    if not ok:
+        raise PinfeedError(f"no {k}-point support explains the {n} pushes within a noise of {sigma:.3g} deg "
+                           f"(the best fit's RMS residual is "
+                           f"{np.sqrt(np.mean(np.square(best.residuals_deg))):.3g} deg); give a larger "
+                           f"--noise-deg or check the pushes")
+    flats = np.array([f for f, _ in ok])
+    pick = _spread_pick(flats, int(max_members))
+    members, chi = [], []
+    for i in pick:
+        pts = flats[i].reshape(-1, 2)
+        members.append(point_support(part, pts, statics_weights(pts), kind="points",
+                                     label=f"fitted {len(members) + 1}"))
+        chi.append(ok[i][1])
+    return FamilyFit(members, chi, threshold, sigma, estimated, n, best.evaluations + recorder.evaluations,
+                     len(ok))

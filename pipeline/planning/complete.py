@@ -279,6 +279,7 @@ class FixedPinSearch:
                                 self.kernel, float(self.cfg["pin_halfwidth"]), d_min, d_max,
                                 belt=self.belt, speeds=self.speeds, supports=nominal)
         self.prefix = FixedPlan((), (), 0.0, np.inf)  # the pins every sequence starts with (run)
+        self.member_check = None  # with a family: worst_member.FamilyChecker (set by the planner)
 
     def run(self, depth: int, candidates: int = 12, keep: int = 5, progress=None,
             prefix: FixedPlan | None = None) -> FixedSearch:
@@ -375,7 +376,7 @@ class FixedPinSearch:
                 for idx, verdict in zip(chunk, self._judge(level, chunk, full)):
                     plan = self._plan(level, idx, span[idx], verdict)
                     judged.append(plan)
-                    if verdict["orients"]:
+                    if verdict["orients"] and self._holds_for_family(plan):
                         found.append(plan)
                         found_idx.append(idx)
                 if found and len(judged) >= candidates:
@@ -403,6 +404,17 @@ class FixedPinSearch:
                 if held["orients"]:
                     out.append(plan)
         return out
+
+    def _holds_for_family(self, plan: FixedPlan) -> bool:
+        """True without a family check; else whether the family's worst member
+        found by ``member_check`` leaves the plan's set (a plan it breaks no
+        longer orients: the search goes on as after a failed verification)."""
+        if self.member_check is None:
+            return True
+        if self.member_check(plan.labels, plan.heights, plan.verdict, plan.speeds):
+            return True
+        plan.verdict = dict(plan.verdict, orients=False, broken_by_worst_member=True)
+        return False
 
     def _plan(self, level, idx, span, verdict) -> FixedPlan:
         seq, pre = level.seq[idx], self.prefix

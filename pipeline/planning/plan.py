@@ -33,6 +33,8 @@ from pipeline.planning.certify import carried_plan
 from pipeline.planning.complete import (WIDTH_SLACK_DEG, FixedPinSearch, FixedPlan, FixedSearch,
                                         orientation_rank, robust_order)
 from pipeline.planning.family import planning_family
+from pipeline.planning.family_certificate import family_certificate
+from pipeline.planning.worst_member import FamilyChecker, FamilyCheckSettings
 from pipeline.planning.lattice_store import load_lattice, save_lattice
 from pipeline.planning.confidence import DEFAULT_CONFIDENCE, check_confidence
 from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required, check_rule,
@@ -111,7 +113,8 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     depth = int(depth if depth is not None else config["planner"]["depth"])
     family = None if family is None or family.is_uniform else family
     planner = planner_for(part, config, mu_c, lattices)
-    fixed = _fixed_search(part, config, mu_c, planner, depth, keep, progress, family)
+    checker = family_checker(part, config, mu_c, family)
+    fixed = _fixed_search(part, config, mu_c, planner, depth, keep, progress, family, checker)
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
     # No pin is the plan with the fewest pins: then nothing is certified or recommended.
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
@@ -120,19 +123,21 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, config, mu_c, planner)
     moving_search = None
     if moving is not None:
-        moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress, family)
+        moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress, family, checker)
         candidates += [carried_plan(moving, p.labels, p.margin, verify_cfg, family)
                        for p in moving_search.plans]
         selections += [p.selection or p.verdict for p in moving_search.plans]
         planner = moving
     states = resting_states(part)
     _verify_candidates(part, config, mu_c, planner, candidates, states, progress, family, selections)
+    judge_for_family(candidates, checker)
     candidates = robust_order(candidates, _rank, lambda p: p.verification["orientation"].get("width_deg"),
                               lambda p: p.margin, planner_width_slack(config))
     good = [p for p in candidates if _acceptable(p)]
     result = _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed, moving_search)
     if family is not None:
         result["support_family"] = family.to_dict()
+        certify_for_family(result, part, config, mu_c, family, checker, good)
     return result
 
 
@@ -165,23 +170,26 @@ def planner_width_slack(config: dict) -> float:
     return slack
 
 
-def _pin_search(part, config, mu_c, planner, moving: bool, family=None) -> FixedPinSearch:
+def _pin_search(part, config, mu_c, planner, moving: bool, family=None, checker=None) -> FixedPinSearch:
     """The complete search over the planner's fixed pins (``moving`` False) or
     its moving pins (True), with the config's tolerance, verification and
     kernel settings and the planner's belt."""
     pc, sweep = config["planner"], config["sweep"]
     pins = {k: p for k, p in planner.pins.items() if bool(p.v_pin) == moving}
-    return FixedPinSearch(part, {k: p.y for k, p in pins.items()}, mu_c, planner_tolerance(config),
+    search = FixedPinSearch(part, {k: p.y for k, p in pins.items()}, mu_c, planner_tolerance(config),
                           verify_required(config), config.get("verify", {}), sweep["pin_radius"],
                           pc["model"], sweep.get("kernel"), pc["d_min"], pc["d_max"],
                           belt_speed=planner.belt_speed, mu_s=planner.mu_s,
                           speeds={k: p.v_pin for k, p in pins.items()}, family=family,
                           width_slack=planner_width_slack(config))
+    search.member_check = checker
+    return search
 
 
-def _fixed_search(part, config, mu_c, planner, depth, keep, progress, family=None) -> FixedSearch:
+def _fixed_search(part, config, mu_c, planner, depth, keep, progress, family=None,
+                  checker=None) -> FixedSearch:
     """The complete fixed-pin search with the planner's pins and the config's settings."""
-    search = _pin_search(part, config, mu_c, planner, moving=False, family=family)
+    search = _pin_search(part, config, mu_c, planner, moving=False, family=family, checker=checker)
     return search.run(depth, candidates=int(config["planner"].get("candidates", 12)), keep=keep,
                       progress=progress)
 
@@ -194,7 +202,8 @@ def _moving_planner(part, config, mu_c, planner):
     return planner_for(part, config, mu_c, planner.lattices, moving=True)
 
 
-def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=None) -> FixedSearch:
+def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=None,
+                   checker=None) -> FixedSearch:
     """Up to ``planner.dynamic.depth`` moving pins after no fixed pin and after
     each of the ``MOVING_PREFIXES`` best fixed-pin results, by the same
     enumeration, screen and judgement as the fixed pins (every moving-pin
@@ -202,7 +211,7 @@ def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=No
     pc, dyn = config["planner"], config["planner"]["dynamic"]
     if progress:
         progress(f"mu_c {friction_label(mu_c)}: fixed pins do not orient the part: adding moving pins")
-    search = _pin_search(part, config, mu_c, moving, moving=True, family=family)
+    search = _pin_search(part, config, mu_c, moving, moving=True, family=family, checker=checker)
     depth = int(dyn["depth"])
     total = FixedSearch([], [], depth, planner_tolerance(config), verify_required(config))
     for prefix in [None, *chosen[:MOVING_PREFIXES]]:
@@ -226,6 +235,8 @@ def _acceptable(plan) -> bool:
     claimed sets hold all but ``MAX_FAILURE`` of the trials."""
     v = plan.verification
     verdict = v["orientation"]
+    if not v.get("family_check", {}).get("holds", True):
+        return False  # the family's worst member breaks it
     return verdict["orients"] or v["failures"] <= MAX_FAILURE * v["trials"]
 
 
@@ -432,3 +443,57 @@ def _labelled(progress, label: str):
     if progress is None:
         return None
     return lambda message: progress(message if message.startswith(label) else f"{label}: {message}")
+
+
+# ---------------------------------------------------------------------- support families: the family's edge
+
+def family_checker(part: Part, config: dict, mu_c, family) -> FamilyChecker | None:
+    """The worst-member check for plans for ``family`` (None without a family),
+    with the planner's verification settings and ``planner.worst_member_budget``."""
+    if family is None or family.is_uniform:
+        return None
+    return FamilyChecker(part, family, FamilyCheckSettings.from_config(config, mu_c))
+
+
+def judge_for_family(candidates, checker: FamilyChecker | None) -> None:
+    """Each candidate that orients on the sampled verification is checked for
+    the family's worst member (``worst_member.check_plan_for_family``): the
+    record goes into ``verification["family_check"]`` and a plan the worst
+    member breaks no longer orients (and cannot be recommended)."""
+    if checker is None:
+        return
+    for plan in candidates:
+        if not plan.verification["orientation"]["orients"]:
+            continue
+        checker(plan.pins, plan.pin_heights_mm, None, plan.pin_speeds)
+        check = {k: v for k, v in checker.result(plan.pins, plan.pin_heights_mm).items()
+                 if not k.startswith("_")}
+        plan.verification["family_check"] = check
+        if not check["holds"]:
+            plan.verification["orientation"] = dict(plan.verification["orientation"], orients=False,
+                                                    broken_by_worst_member=True)
+
+
+def certify_for_family(result: dict, part: Part, config: dict, mu_c, family, checker, good) -> None:
+    """The family certificate of the recommended plan (``family_certificate``
+    in ``result`` and in the recommended plan), or, when no plan holds for the
+    family, a warning naming the worst member that broke the best one."""
+    if checker is None:
+        return
+    rec = good[0] if good else None
+    check = rec and rec.verification.get("family_check")
+    if check and check["holds"]:
+        cert = family_certificate(part, rec.pin_heights_mm, family, check, checker.settings,
+                                  speeds=rec.pin_speeds)
+        result["family_certificate"] = cert
+        result["recommended"]["family_certificate"] = cert
+        return
+    broken = [r for r in checker.results.values() if not r["holds"] and r["worst_member"]]
+    if broken:
+        worst = max(broken, key=lambda r: r["verdict"]["in_tolerance"])["worst_member"]
+        result["family_certificate"] = None
+        result["warning"] = ((result["warning"] + "; ") if result["warning"] else "") + (
+            f"no plan of up to {result['depth']} pins holds for the whole family {family.label}: "
+            f"{len(broken)} plan(s) that passed the sampled verification are broken by a worst member "
+            f"(e.g. {worst['parameters']}, nominal finals {worst['nominal_finals_deg']} deg, "
+            f"{worst['outside_deg']:.2f} deg outside the set)")

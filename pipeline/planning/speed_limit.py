@@ -201,6 +201,7 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
     success fraction), ``planned_belt_speed`` (``None``: planned
     quasi-static), ``trials``, ``trials_per_speed``, ``seconds`` and ``method``.
     """
+    from pipeline.planning.family_certificate import family_assumption
     from pipeline.planning.plan import pick_tight_plan
     from pipeline.planning.settings import friction_label
     from pipeline.planning.types import as_plan_file
@@ -229,7 +230,8 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
             "trials_per_speed": res["trials_per_speed"], "seconds": res["seconds"],
             "method": f"dynamic model, {trials} perturbed trials per initial state plus corners "
                       f"at each speed; limit = highest speed with >= {100 * required:g} % in the "
-                      f"final set, {resolution:g} mm/s bisection"}
+                      f"final set, {resolution:g} mm/s bisection",
+            **family_assumption(entry, "speed limit")}
 
 
 def speed_settings(config: dict) -> dict:

@@ -395,11 +395,23 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
                    "final_sets": [s.to_dict() for s in plan.final_sets],
                    "n_final_sets": plan.n_final_sets}
     out["warnings"] = warnings + final_sets_warning(out["plan"])
+    _family_assumption(out, result)
     out["method"]["belt_speed"] = source
     out["method"]["throughput"] = "60 x belt speed / pitch" if belt_speed else "none: no belt speed"
     _record_speed_limit(out, curve, trials, stored)
     out.update(provenance_attrs())
     return out
+
+
+def _family_assumption(out: dict, result) -> None:
+    """For a plan made for a support family: ``assumes`` and a one-line
+    ``assumption`` (also among the warnings): the belt speed and spacing come
+    from the dynamic model, which assumes uniform pressure."""
+    from pipeline.planning.family_certificate import family_assumption
+    note = family_assumption(result, "layout")
+    if note:
+        out.update(note)
+        out["warnings"].append(note["assumption"])
 
 
 def _record_speed_limit(out: dict, curve: dict, trials: int, stored: dict | None) -> None:

@@ -1,0 +1,153 @@
+"""What a plan's claim "for the support family" rests on, in one record.
+
+A plan recommended for a support family passed three checks: the sampled
+verification on the members the family text draws, the worst-member search
+(:mod:`pipeline.planning.worst_member`; worst members that broke the plan
+joined the verification and the plan was judged again), and the fresh sample
+below. The certificate records all three:
+
+* the members and trials of the verification the claim rests on;
+* the worst member found: its parameters (leg positions and weights, or warp
+  coefficients), its nominal finals and how far its farthest final lies
+  outside the plan's set (negative: inside, by that much);
+* a *fresh* seeded sample of at least ``MIN_FRESH_MEMBERS`` members that
+  neither the planner nor the search saw (seed stream ``[verify.seed, 34]``),
+  each replayed from every resting state nominally and with
+  ``FRESH_TRIALS`` perturbed trials: how many members put any trial outside
+  the set, and the one-sided 95 % Clopper-Pearson upper bound on the share
+  of such members in the family (:func:`~pipeline.planning.confidence.share_upper_bound`).
+
+The upper bound is a statement about members drawn the way the family text
+draws them (uniform legs in the inset outline, or uniform warp directions);
+the worst-member search is the statement about the family's edge.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.planning import orient
+from pipeline.planning.confidence import DEFAULT_CONFIDENCE, share_upper_bound
+from pipeline.planning.propagate import resting_states
+from pipeline.planning.verify import perturbed_batch, replay
+from pipeline.planning.worst_member import JAM_SCORE, member_space, outside
+
+MIN_FRESH_MEMBERS = 300
+FRESH_TRIALS = 4  # perturbed trials per member and resting state (besides the nominal one)
+
+
+def fresh_members(part, family, n: int, seed: int) -> list:
+    """``n`` members of each continuous part of ``family`` (tripods, warps),
+    drawn with ``default_rng([seed, 34])``, and every listed member."""
+    space = member_space(part, family)
+    rng = np.random.default_rng([int(seed), 34])
+    out = []
+    for s in space.spaces:
+        out.extend(s.sample(rng, n))
+    return out + list(space.fixed)
+
+
+def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIALS, seed: int = 0):
+    """Final orientations ``(members, states * (1 + trials))`` and jam flags of
+    every member, each from every resting state nominally and with ``trials``
+    perturbed starts (the verification's perturbation box)."""
+    rng = np.random.default_rng([int(seed), 35])
+    n_pins = len(heights)
+    rows = []
+    for theta, y_c in resting_states(part).values():
+        th, yc, mu, offs = perturbed_batch(theta, y_c, st.mu_c, n_pins, st.verify, rng, trials * len(members))
+        mid = float(np.mean(st.mu_c)) if isinstance(st.mu_c, (tuple, list)) else float(st.mu_c)
+        rows.append((np.full(len(members), theta), np.full(len(members), y_c), np.full(len(members), mid),
+                     np.zeros((len(members), n_pins)), np.arange(len(members))))
+        rows.append((th, yc, mu, offs, np.repeat(np.arange(len(members)), trials)))
+    th, yc, mu, offs, sup = (np.concatenate([r[k] for r in rows]) for k in range(5))
+    kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
+    tf, _, jam, _ = replay(part, list(heights), list(speeds) or [0.0] * n_pins, th, yc, mu, offs,
+                           st.pin_radius, st.model, **kw, support=sup,
+                           supports=[None if m.is_uniform else m for m in members])
+    order = np.argsort(sup, kind="stable")
+    per = th.size // len(members)
+    return tf[order].reshape(len(members), per), (jam[order] != "").reshape(len(members), per)
+
+
+def family_certificate(part, heights, family, check: dict, st, n_members: int = MIN_FRESH_MEMBERS,
+                       speeds=(), confidence: float = DEFAULT_CONFIDENCE) -> dict:
+    """The certificate of a plan (pins at ``heights``) for ``family`` given its
+    worst-member ``check`` (:func:`~pipeline.planning.worst_member.check_plan_for_family`);
+    a JSON-ready dict (see the module docstring)."""
+    n_members = max(int(n_members), MIN_FRESH_MEMBERS)
+    period = 360.0 / part.symmetry_order()
+    members = fresh_members(part, family, n_members, st.seed)
+    tf, jam = fresh_replay(part, heights, members, st, speeds, seed=st.seed)
+    arc = check.get("set_deg")
+    dist = np.where(jam, JAM_SCORE, outside(tf, tuple(arc), period)) if arc else np.full(tf.shape, JAM_SCORE)
+    leaving = int(np.sum(dist.max(axis=1) > 0.0))
+    verdict = orient.judge(tf[~jam], tf.size, st.tolerance, part.symmetry_order(), st.required)
+    worst = check.get("worst_member") or {}
+    return {
+        "family": family.label, "holds": bool(check["holds"] and verdict["orients"]),
+        "set_deg": arc, "tolerance_deg": st.tolerance, "required": st.required,
+        "verification": {"members": check["members"], "trials": check["trials"],
+                         "in_tolerance": check["verdict"]["in_tolerance"],
+                         "width_deg": check["verdict"]["width_deg"]},
+        "search": {"space": check["space"], "budget": check["budget"], "rounds": len(check["rounds"])},
+        "worst_member": {k: worst.get(k) for k in ("parameters", "outside_deg", "breaks",
+                                                    "nominal_finals_deg", "found_by", "evaluations")},
+        "carried_sets": _ASSUMES["carried sets"].format(family.label),
+        "fresh": {"members": len(members), "trials": int(tf.size), "seed": [st.seed, 34],
+                  "members_outside": leaving, "confidence": confidence,
+                  "share_outside_upper_bound": round(share_upper_bound(leaving, len(members), confidence), 5),
+                  "in_tolerance": verdict["in_tolerance"], "width_deg": verdict["width_deg"],
+                  "orients": verdict["orients"]},
+    }
+
+
+def family_certificate_line(cert: dict) -> str:
+    """One line for ``pinfeed plan --support-family``: what "for the family" rests on."""
+    w, f = cert["worst_member"], cert["fresh"]
+    where = ("inside the set by" if (w.get("outside_deg") or 0) <= 0 else "outside the set by")
+    verdict = "holds" if cert["holds"] else "does NOT hold"
+    return (f"family {cert['family']}: the plan {verdict} for {cert['verification']['members']} members "
+            f"({cert['verification']['trials']} trials) and the worst member found "
+            f"({w.get('found_by')}, {cert['search']['budget']} evaluations; farthest final "
+            f"{where} {abs(w.get('outside_deg') or 0):.2f} deg); {f['members_outside']} of {f['members']} "
+            f"fresh members leave the set (share <= {100 * f['share_outside_upper_bound']:.2f} % at "
+            f"{100 * f['confidence']:g} % confidence), {f['in_tolerance']} of {f['trials']} fresh trials "
+            f"in one set of {cert['tolerance_deg']:g} deg")
+
+
+# --------------------------------------------------------------------------- what downstream stages assume
+
+_ASSUMES = {
+    "speed limit": "the speed limit assumes uniform pressure: the dynamic model integrates the uniform "
+                   "belt force and refuses point supports, so it is not checked for the support family {}",
+    "layout": "the layout's belt speed and pin spacing assume uniform pressure (the dynamic model "
+              "refuses point supports): they are not checked for the support family {}",
+    "carried sets": "the carried sets are sampled over the support family {}'s drawn members (and the "
+                    "worst members that broke an earlier verdict); the worst member found last is checked "
+                    "against the claimed final set only",
+}
+
+
+def plan_family_label(source) -> str | None:
+    """The support family a stored plan was made for (its label), or None: ``source``
+    is a plan file (:class:`~pipeline.planning.types.PlanFile` or its dict) or one
+    of its ``tight`` entries."""
+    entries = source.get("tight") if isinstance(source, dict) else getattr(source, "tight", None)
+    for entry in (entries if entries is not None else [source]):
+        extra = entry if isinstance(entry, dict) else getattr(entry, "extra", {})
+        family = (extra or {}).get("support_family")
+        if family:
+            return family["label"] if isinstance(family, dict) else str(family)
+    return None
+
+
+def family_assumption(source, stage: str) -> dict:
+    """``{}`` for a plan made for uniform pressure; else ``{"assumes": "uniform
+    pressure", "assumption": one line}`` for ``stage`` (``"speed limit"``,
+    ``"layout"``) of a plan made for a support family (``source`` as for
+    :func:`plan_family_label`)."""
+    label = plan_family_label(source)
+    if label is None:
+        return {}
+    assumes = "uniform pressure" if stage != "carried sets" else "the sampled members"
+    return {"assumes": assumes, "assumption": _ASSUMES[stage].format(label)}

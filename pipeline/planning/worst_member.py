@@ -1,0 +1,565 @@
+"""The worst member of a support family for one plan: a search, not a sample.
+
+A plan for a support family is verified on trials that rest on the members the
+family text draws (``tripods:12`` draws 12 tripods). A finite sample does not
+contain the family's edge, and the edge is where a plan breaks. This module
+searches the family's *parameter space* for the member whose final
+orientations lie farthest outside the plan's set:
+
+* ``tripods:N[:inset=F]``: three leg positions (6 numbers) anywhere in the
+  outline at least ``F a`` from its edge, weights by statics (the centroid's
+  barycentric coordinates), every leg carrying at least 5 %;
+* ``warp:AMP``: the three quadratic coefficients ``c`` of the pressure
+  ``1 + AMP q``, ``q = c . modes`` kept within ``max |q| <= 1``;
+* any other item (``tripod``, ``rim:N``, ``points:...``, ``uniform``): every
+  member as given.
+
+The *objective* of a member is the largest signed angular distance (degrees)
+of its final orientations outside the plan's set, over the resting states'
+nominal rollouts and every corner of the verification's perturbation box
+(positive outside the set, negative inside: a member deep inside scores the
+depth of its nearest final, so the optimiser is not lost on a plateau). A
+jam scores ``JAM_SCORE``. Physics goes through the public rollout API
+(``verify.replay``) only.
+
+The search is a seeded multi-start Nelder-Mead (``scipy.optimize``) on the
+raw parameters with a penalty outside the feasible set, started from the
+family's geometric corners (legs at the inset outline's corners, every
+triple of them for an outline with more than 3 corners; the smallest leg
+triangle about the centroid; the warp modes at full amplitude, both signs)
+and from seeded random members. It stops as soon as a member breaks the plan
+or the budget (rollout evaluations of one member) is spent.
+
+:func:`check_plan_for_family` judges a plan again with the worst members
+found joining the verification; :class:`FamilyChecker` is what the complete
+search calls on each plan that passed its sampled verification.
+"""
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize
+
+from pipeline.errors import PinfeedError
+from pipeline.parts.support import (Support, barycentric, boundary_distance, filled_support,
+                                    inside_outline, point_support)
+from pipeline.parts.support_family import (DEFAULT_INSET, MIN_LEG_WEIGHT, WARP_FILL, SupportFamily,
+                                           parse_support_family, warp_modes)
+from pipeline.planning import orient
+from pipeline.planning.propagate import resting_states
+from pipeline.planning.settings import nominal_friction
+from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
+from pipeline.planning.verify import corner_inputs, replay, trial_inputs
+
+DEFAULT_BUDGET = 150  # member evaluations per search (planner.worst_member_budget)
+JAM_SCORE = 180.0  # deg: a jam is as far outside the set as anything can be
+RANDOM_STARTS = 6  # seeded random members besides the geometric corners
+RANDOM_SHARE = 0.5  # of the budget spent on the starts (corners, then seeded random members)
+LARGEST_STARTS = 8  # largest leg triangles on the inset outline among the starts
+EDGE_POINTS = 5  # points per inset edge (besides its corner) the largest triangles' legs take
+MAX_ROUNDS = 3  # worst member found -> joins the verification -> searched again
+_PENALTY = 1.0e3
+_POOL = 20_000
+
+
+# --------------------------------------------------------------------------- parameter spaces
+
+@dataclass
+class TripodSpace:
+    """Three legs in the outline at least ``inset a`` from its edge that hold the centroid."""
+
+    part: object
+    inset: float
+
+    kind = "tripods"
+    size = 6
+
+    def violation(self, x: np.ndarray) -> float:
+        """0 for a feasible tripod, else how far it is from one (mm-ish)."""
+        legs = np.asarray(x, float).reshape(3, 2)
+        verts = np.asarray(self.part.vertices, float)
+        dist = boundary_distance(verts, legs)
+        signed = np.where(inside_outline(verts, legs), dist, -dist)
+        bad = np.maximum(0.0, self.inset * self.part.a * (1 - 1e-9) - signed).sum()
+        lam = _weights(legs, self.part.a)
+        if lam is None:
+            return bad + 1.0
+        return bad + np.maximum(0.0, MIN_LEG_WEIGHT - lam).sum() * self.part.a
+
+    def member(self, x, label: str) -> Support:
+        """The tripod with legs ``x`` (6 numbers, mm) and weights by statics."""
+        legs = np.asarray(x, float).reshape(3, 2)
+        return point_support(self.part, legs, _weights(legs, self.part.a), kind="points", label=label)
+
+    def params(self, x) -> dict:
+        """Legs (mm) and weights of ``x`` for outputs."""
+        legs = np.asarray(x, float).reshape(3, 2)
+        lam = _weights(legs, self.part.a)
+        return {"legs_mm": np.round(legs, 4).tolist(),
+                "weights": None if lam is None else np.round(lam, 4).tolist()}
+
+    def corners(self) -> list[np.ndarray]:
+        """Legs at the inset outline's corners (every triple that holds the
+        centroid), the ``LARGEST_STARTS`` largest leg triangles with legs on
+        the inset outline (corners and ``EDGE_POINTS`` points along each
+        edge: where no corner triple holds the centroid, as on a rectangle,
+        these are the extreme tripods), and the smallest leg triangles about
+        the centroid (three turns)."""
+        pts = inset_corners(np.asarray(self.part.vertices, float), self.inset * self.part.a)
+        out = [np.array(t).ravel() for t in itertools.combinations(pts, 3)]
+        out = [x for x in out if self.violation(x) == 0.0]
+        rim = [p + (q - p) * t for p, q in zip(pts, np.roll(pts, -1, axis=0))
+               for t in np.linspace(0.0, 1.0, EDGE_POINTS + 1, endpoint=False)]
+        big = [np.array(t) for t in itertools.combinations(rim, 3)]
+        big = [t.ravel() for t in big if self.violation(t.ravel()) == 0.0]
+        big.sort(key=_area, reverse=True)
+        out += [x for x in big if not any(np.allclose(x, y) for y in out)][:LARGEST_STARTS]
+        r = max(0.05, 1.0 - self.inset) * 0.1 * self.part.a
+        for turn in (0.0, 40.0, 80.0):
+            ang = np.radians(turn + np.array([90.0, 210.0, 330.0]))
+            out.append(np.column_stack([r * np.cos(ang), r * np.sin(ang)]).ravel())
+        return [x for x in out if self.violation(x) == 0.0]
+
+    def random(self, rng, n: int) -> list[np.ndarray]:
+        """Up to ``n`` feasible tripods with legs uniform in the inset outline."""
+        verts = np.asarray(self.part.vertices, float)
+        lo, hi = verts.min(axis=0), verts.max(axis=0)
+        xy = rng.uniform(lo, hi, (_POOL, 2))
+        pool = xy[inside_outline(verts, xy) & (boundary_distance(verts, xy) >= self.inset * self.part.a)]
+        out = []
+        for _ in range(200 * n if pool.shape[0] >= 3 else 0):
+            x = pool[rng.choice(pool.shape[0], 3, replace=False)].ravel()
+            if self.violation(x) == 0.0:
+                out.append(x)
+                if len(out) == n:
+                    break
+        return out
+
+    def sample(self, rng, n: int) -> list[Support]:
+        """``n`` random members (a fresh sample for the certificate)."""
+        return [self.member(x, f"fresh tripod {k + 1}") for k, x in enumerate(self.random(rng, n))]
+
+    def describe(self) -> str:
+        """The space in words."""
+        return f"tripods {self.inset:g} a inside the outline"
+
+
+@dataclass
+class WarpSpace:
+    """Pressures ``1 + amplitude q``, ``q`` a mix of the three quadratic modes with ``max |q| <= 1``."""
+
+    part: object
+    amplitude: float
+    base: Support = field(init=False)
+    modes: np.ndarray = field(init=False)
+
+    kind = "warp"
+    size = 3
+
+    def __post_init__(self):
+        self.base = filled_support(self.part, WARP_FILL)
+        self.modes = warp_modes(self.base.points, self.base.weights, self.part.a)
+
+    def _q(self, x) -> np.ndarray:
+        q = np.asarray(x, float) @ self.modes
+        return q / max(1.0, float(np.max(np.abs(q))))
+
+    def violation(self, x) -> float:
+        """Always 0: every coefficient vector is rescaled into the bound."""
+        return 0.0
+
+    def member(self, x, label: str) -> Support:
+        """The warped pressure of coefficients ``x`` (3 numbers)."""
+        w = self.base.weights * (1.0 + self.amplitude * self._q(x))
+        return point_support(self.part, self.base.points, w, kind="points", label=label)
+
+    def params(self, x) -> dict:
+        """The coefficients of ``x`` as used (within the bound) and the amplitude."""
+        q = np.asarray(x, float) @ self.modes
+        scale = 1.0 / max(1.0, float(np.max(np.abs(q))))
+        return {"coefficients": np.round(np.asarray(x, float) * scale, 4).tolist(),
+                "amplitude": self.amplitude}
+
+    def corners(self) -> list[np.ndarray]:
+        """Each mode at full amplitude, both signs (the dome and dish among them)."""
+        return [s * e for e in np.eye(3) for s in (-1.0, 1.0)]
+
+    def random(self, rng, n: int) -> list[np.ndarray]:
+        """``n`` seeded random coefficient vectors inside the bound."""
+        c = rng.normal(size=(n, 3))
+        return list(c / np.linalg.norm(c, axis=1, keepdims=True) * rng.uniform(0.3, 1.0, (n, 1)))
+
+    def sample(self, rng, n: int) -> list[Support]:
+        """``n`` random members (a fresh sample for the certificate)."""
+        return [self.member(x, f"fresh warp {k + 1}") for k, x in enumerate(self.random(rng, n))]
+
+    def describe(self) -> str:
+        """The space in words."""
+        return f"warps of amplitude up to {self.amplitude:g}"
+
+
+def _area(x: np.ndarray) -> float:
+    """Twice the area of the leg triangle ``x`` (6 numbers)."""
+    (ux, uy), (vx, vy) = x[2:4] - x[0:2], x[4:6] - x[0:2]
+    return abs(ux * vy - uy * vx)
+
+
+def _weights(legs: np.ndarray, a: float) -> np.ndarray | None:
+    """Statics' leg weights (the centroid's barycentric coordinates), or None
+    for three legs in a line."""
+    (ux, uy), (vx, vy) = legs[1] - legs[0], legs[2] - legs[0]
+    if abs(ux * vy - uy * vx) < 1e-9 * a * a:
+        return None
+    return barycentric(*legs)
+
+
+def inset_corners(verts: np.ndarray, distance: float) -> np.ndarray:
+    """The corners of the outline moved inwards by ``distance`` along each
+    corner's bisector (exact for a convex outline; a reflex corner's point is
+    kept only if it lies at least ``distance`` from every edge)."""
+    n = verts.shape[0]
+    out = []
+    for i in range(n):
+        p, prev, nxt = verts[i], verts[i - 1], verts[(i + 1) % n]
+        u1, u2 = (prev - p) / np.linalg.norm(prev - p), (nxt - p) / np.linalg.norm(nxt - p)
+        bis = u1 + u2
+        if np.linalg.norm(bis) < 1e-12:
+            continue
+        half = math.acos(float(np.clip(u1 @ u2, -1.0, 1.0))) / 2.0
+        out.append(p + bis / np.linalg.norm(bis) * distance / math.sin(half))
+    pts = np.array(out).reshape(-1, 2)
+    ok = inside_outline(verts, pts) & (boundary_distance(verts, pts) >= distance * (1 - 1e-9))
+    return pts[ok]
+
+
+@dataclass
+class MemberSpace:
+    """A family's parameter space: continuous parts (tripods, warps) and fixed members."""
+
+    label: str
+    spaces: list
+    fixed: list
+
+    def describe(self) -> str:
+        """The space in words (for the plan file)."""
+        parts = [s.describe() for s in self.spaces] + [f"{len(self.fixed)} listed member(s)"] * bool(self.fixed)
+        return "; ".join(parts)
+
+
+def member_space(part, family) -> MemberSpace:
+    """The parameter space of ``family`` (its text or a :class:`SupportFamily`).
+
+    Raises
+    ------
+    PinfeedError
+        One line when a tripod space holds no tripod (the inset leaves no
+        three points that hold the centroid with every leg >= 5 %).
+    """
+    label = family.label if isinstance(family, SupportFamily) else str(family)
+    spaces, fixed = [], []
+    for item in label.split(";"):
+        item = item.strip()
+        kind, _, rest = item.partition(":")
+        fields = dict(f.split("=", 1) for f in rest.split(":") if "=" in f)
+        if kind.strip() == "tripods":
+            space = TripodSpace(part, float(fields.get("inset", DEFAULT_INSET)))
+            if not (space.corners() or space.random(np.random.default_rng([0, 33]), 1)):
+                raise PinfeedError(
+                    f"support family {item!r} has no member: no three points {space.inset:g} a "
+                    f"({space.inset * part.a:.3g} mm) inside the outline hold the centroid with every "
+                    f"leg carrying >= {MIN_LEG_WEIGHT:.0%}; lower the inset (tripods:N:inset=F)")
+            spaces.append(space)
+        elif kind.strip() == "warp":
+            spaces.append(WarpSpace(part, float([f for f in rest.split(":") if "=" not in f][0])))
+        elif item:
+            fixed.extend(parse_support_family(item, part).members)
+    return MemberSpace(label, spaces, fixed)
+
+
+# --------------------------------------------------------------------------- the objective
+
+@dataclass
+class PlanProbe:
+    """What a member is scored on: a plan's pins and the trials that probe it."""
+
+    part: object
+    heights: tuple
+    mu_c: object
+    settings: dict
+    pin_radius: float = 3.0
+    model: str = "minpower"
+    kernel: dict = field(default_factory=dict)
+    speeds: tuple = ()
+    inputs: tuple = field(init=False)
+    nominal: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        cfg = dict(VERIFY_DEFAULTS, **(self.settings or {}))
+        n = len(self.heights)
+        rows = []
+        for theta, y_c in resting_states(self.part).values():
+            rows.append((np.array([theta]), np.array([y_c]), np.array([nominal_friction(self.mu_c)]),
+                         np.zeros((1, n))))
+            rows.append(corner_inputs(theta, y_c, self.mu_c, n, cfg))
+        self.inputs = tuple(np.concatenate([r[k] for r in rows]) for k in range(4))
+        sizes = np.array([r[0].size for r in rows])
+        self.nominal = np.concatenate([[0], np.cumsum(sizes)[:-1]])[0::2]  # each state's nominal row
+
+    def finals(self, support: Support | None, inputs=None) -> tuple[np.ndarray, np.ndarray]:
+        """``(theta_f, jammed)`` of every probe trial resting on ``support``."""
+        th, yc, mu, offs = self.inputs if inputs is None else inputs
+        kw = {k: self.kernel[k] for k in ("ds_max", "tol") if k in self.kernel}
+        speeds = list(self.speeds) or [0.0] * len(self.heights)
+        tf, _, jam, _ = replay(self.part, list(self.heights), speeds, th, yc, mu, offs, self.pin_radius, self.model, **kw,
+                               support=np.zeros(th.size, int), supports=[support])
+        return tf, jam != ""
+
+
+def outside(theta, arc: tuple, period: float = 360.0) -> np.ndarray:
+    """Signed angular distance (deg) of each ``theta`` outside the arc
+    ``(start, width)``: positive outside, minus the distance to the nearer
+    end inside."""
+    start, width = arc
+    rel = np.mod(np.asarray(theta, float) - start, period)
+    inside = rel <= width
+    beyond = np.minimum(rel - width, period - rel)
+    return np.where(inside, -np.minimum(rel, width - rel), beyond)
+
+
+def score(probe: PlanProbe, support, arc, period: float) -> tuple[float, np.ndarray]:
+    """``(objective, finals)`` of one member (see the module docstring)."""
+    tf, jam = probe.finals(support)
+    dist = np.where(jam, JAM_SCORE, outside(tf, arc, period))
+    return float(dist.max()), tf
+
+
+# --------------------------------------------------------------------------- the search
+
+@dataclass
+class WorstMember:
+    """The member a search found farthest outside the set."""
+
+    support: Support
+    params: dict
+    objective: float
+    finals: np.ndarray
+    evaluations: int
+    source: str
+    nominal: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+
+    @property
+    def breaks(self) -> bool:
+        """True when some final lies outside the set."""
+        return self.objective > 0.0
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the member, its parameters, how far outside, its nominal finals."""
+        return {"member": self.support.to_dict(), "parameters": self.params,
+                "outside_deg": round(self.objective, 4), "breaks": self.breaks,
+                "nominal_finals_deg": np.round(self.finals[self.nominal], 3).tolist(),
+                "probe_finals": int(self.finals.size), "evaluations": self.evaluations,
+                "found_by": self.source}
+
+
+class _Stop(Exception):
+    pass
+
+
+def check_budget(budget) -> int:
+    """The search budget as an int >= 1, or a one-line :class:`PinfeedError`."""
+    try:
+        n = int(budget)
+    except (TypeError, ValueError):
+        n = 0
+    if n < 1:
+        raise PinfeedError(f"a search with no budget: planner.worst_member_budget is {budget!r}; "
+                           f"give the number of member evaluations, at least 1 (e.g. {DEFAULT_BUDGET})")
+    return n
+
+
+def search_worst_member(probe: PlanProbe, space: MemberSpace, arc: tuple, period: float = 360.0,
+                        budget: int = DEFAULT_BUDGET, seed: int = 0,
+                        stop_when_broken: bool = True) -> WorstMember:
+    """The member of ``space`` whose probe finals lie farthest outside ``arc``
+    (``(start, width)`` degrees) within ``budget`` member evaluations.
+
+    Every fixed member is scored; then, for each continuous space, its
+    geometric corners and ``RANDOM_STARTS`` seeded random members are scored
+    and Nelder-Mead runs from the highest-scoring starts until the budget is
+    spent (the budget is shared between the spaces)."""
+    budget = check_budget(budget)
+    best = {"obj": -np.inf}
+    used = [0]
+
+    def keep(obj, tf, support, params, source):
+        if obj > best["obj"]:
+            best.update(obj=obj, tf=tf, support=support, params=params, source=source)
+
+    for m in space.fixed:
+        obj, tf = score(probe, None if m.is_uniform else m, arc, period)
+        used[0] += 1
+        keep(obj, tf, m, {"member": m.label}, "listed member")
+    rng = np.random.default_rng([int(seed), 33])
+    share = max(1, (budget - used[0]) // max(1, len(space.spaces)))
+    for space_k in space.spaces:
+        _search_space(probe, space_k, arc, period, share, rng, keep, used, stop_when_broken, best)
+        if stop_when_broken and best["obj"] > 0:
+            break
+    if best["obj"] == -np.inf:
+        raise PinfeedError(f"support family {space.label!r} has no member to search")
+    return WorstMember(best["support"], best["params"], float(best["obj"]), best["tf"], used[0],
+                       best["source"], probe.nominal)
+
+
+def _search_space(probe, space, arc, period, budget, rng, keep, used, stop_when_broken, best):
+    """Multi-start Nelder-Mead over one continuous space (see :func:`search_worst_member`)."""
+    spent = [0]
+
+    def f(x, source):
+        bad = space.violation(x)
+        if bad > 0:
+            return _PENALTY + bad
+        if spent[0] >= budget:
+            raise _Stop
+        spent[0] += 1
+        used[0] += 1
+        support = space.member(x, f"worst {space.kind} member")
+        obj, tf = score(probe, support, arc, period)
+        keep(obj, tf, support, space.params(x), source)
+        if stop_when_broken and obj > 0:
+            raise _Stop
+        return -obj
+
+    starts = [(x, "geometric corner") for x in space.corners()]
+    n_random = max(RANDOM_STARTS, int(RANDOM_SHARE * budget) - len(starts))
+    starts += [(x, "random start") for x in space.random(rng, n_random)]
+    try:
+        values = [f(x, src) for x, src in starts]
+        for i in np.argsort(values):
+            x0, src = starts[i]
+            step = 0.05 * probe.part.a if space.kind == "tripods" else 0.2
+            simplex = np.vstack([x0, x0 + step * np.eye(space.size)])
+            minimize(f, x0, args=(f"Nelder-Mead from a {src}",), method="Nelder-Mead",
+                     options={"initial_simplex": simplex, "maxfev": max(10, budget // 4),
+                              "xatol": 1e-3, "fatol": 1e-3})
+    except _Stop:
+        pass
+
+
+# --------------------------------------------------------------------------- judged again
+
+@dataclass
+class FamilyCheckSettings:
+    """How a plan is checked for a family: the planner's verification settings and the search's."""
+
+    mu_c: object
+    tolerance: float
+    required: float
+    verify: dict
+    pin_radius: float = 3.0
+    model: str = "minpower"
+    kernel: dict = field(default_factory=dict)
+    budget: int = DEFAULT_BUDGET
+    seed: int = 0
+
+    @classmethod
+    def from_config(cls, config: dict, mu_c) -> "FamilyCheckSettings":
+        """The settings of a validated config at friction ``mu_c``."""
+        pc = config["planner"]
+        return cls(mu_c, orient.check_tolerance(pc.get("tolerance_deg", orient.DEFAULT_TOLERANCE)),
+                   orient.check_required(config.get("verify", {}).get("required", orient.DEFAULT_REQUIRED)),
+                   dict(VERIFY_DEFAULTS, **config.get("verify", {})), config["sweep"]["pin_radius"],
+                   pc.get("model", "minpower"), dict(config["sweep"].get("kernel") or {}),
+                   check_budget(pc.get("worst_member_budget", DEFAULT_BUDGET)),
+                   int(config.get("verify", {}).get("seed", 1)))
+
+
+def claimed_arc(verdict: dict, tolerance: float) -> tuple | None:
+    """The set a family plan claims: its verified set widened about its middle
+    to the tolerance (the widest arc the claim "one arc of at most T" allows
+    around the trials); ``None`` when the verdict has no set."""
+    s = verdict.get("set")
+    if not s:
+        return None
+    grow = max(0.0, tolerance - s["width"]) / 2.0
+    return (s["start"] - grow, max(s["width"], tolerance))
+
+
+def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings, speeds=()) -> dict:
+    """The verification's trials of a plan (``verify.trial_inputs``) on ``family``, judged."""
+    inputs = trial_inputs(resting_states(part), st.mu_c, len(heights), st.verify, family)
+    th, yc, mu, offs, sup = (np.concatenate([r[k] for r in inputs]) for k in range(5))
+    kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
+    tf, _, jam, _ = replay(part, list(heights), list(speeds) or [0.0] * len(heights), th, yc, mu, offs,
+                           st.pin_radius,
+                           st.model, **kw, support=sup, supports=family.kernel_supports)
+    return orient.judge(tf[jam == ""], th.size, st.tolerance, part.symmetry_order(), st.required)
+
+
+def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckSettings,
+                          verdict: dict | None = None, speeds=()) -> dict:
+    """Search the worst member of ``family`` for the plan of pins at ``heights``
+    (mm); when it breaks the plan, the member joins the verification's members
+    and the plan is judged again, up to ``MAX_ROUNDS`` times.
+
+    Returns a JSON-ready dict: ``holds`` (the last search found no member
+    outside the re-judged set and the re-judged verification orients),
+    ``worst_member`` (:meth:`WorstMember.to_dict`), ``members`` and ``trials``
+    of the last verification, ``rounds`` (what each search found), the
+    ``verdict`` and ``set_deg`` the claim rests on, ``space``."""
+    space = member_space(part, family)
+    probe = PlanProbe(part, tuple(float(h) for h in heights), st.mu_c, st.verify, st.pin_radius,
+                      st.model, st.kernel, tuple(float(v) for v in speeds))
+    period = 360.0 / part.symmetry_order()
+    verdict = verdict or verify_members(part, heights, family, st, speeds)
+    joined, rounds, worst = family, [], None
+    for k in range(MAX_ROUNDS):
+        arc = claimed_arc(verdict, st.tolerance)
+        if not verdict["orients"] or arc is None:
+            break
+        worst = search_worst_member(probe, space, arc, period, st.budget, st.seed + k)
+        rounds.append({"set_deg": [round(arc[0] % period, 3), round(arc[1], 3)], **worst.to_dict()})
+        if not worst.breaks:
+            break
+        extra = dataclasses.replace(worst.support, label=f"worst member {k + 1}")
+        joined = SupportFamily(f"{joined.label} + worst member {k + 1}", joined.members + (extra,),
+                               tuple(joined.representatives) + (len(joined.members),))
+        verdict = verify_members(part, heights, joined, st, speeds)
+    holds = bool(verdict["orients"] and worst is not None and not worst.breaks)
+    arc = claimed_arc(verdict, st.tolerance)
+    return {"holds": holds, "space": space.describe(), "budget": st.budget,
+            "members": len(joined.members), "trials": verdict["trials"],
+            "verdict": verdict, "set_deg": None if arc is None else [round(arc[0] % period, 3), round(arc[1], 3)],
+            "worst_member": None if worst is None else worst.to_dict(), "rounds": rounds,
+            "_family": joined}
+
+
+class FamilyChecker:
+    """What the complete search asks of a plan that passed its sampled
+    verification: does the worst member of the family break it?
+    Results are kept per pin sequence (``results``)."""
+
+    def __init__(self, part, family: SupportFamily, settings: FamilyCheckSettings):
+        self.part, self.family, self.settings = part, family, settings
+        member_space(part, family)  # an empty space is an error before any search
+        self.results: dict = {}
+
+    def __call__(self, labels, heights, verdict: dict | None = None, speeds=()) -> bool:
+        key = self.key(labels, heights)
+        if key not in self.results:
+            self.results[key] = check_plan_for_family(self.part, heights, self.family, self.settings,
+                                                      verdict, speeds)
+        return self.results[key]["holds"]
+
+    @staticmethod
+    def key(labels, heights) -> tuple:
+        """The cache key of a plan: its labels and heights."""
+        return tuple(labels), tuple(round(float(h), 9) for h in heights)
+
+    def result(self, labels, heights) -> dict | None:
+        """The check of a plan already checked (else None)."""
+        return self.results.get(self.key(labels, heights))
