@@ -62,8 +62,17 @@ def verify_under_family(part: Part, config: dict, plan: dict, mu_c, family: Supp
             "by_member": by_member}
 
 
+def _fixed_pins_only(config: dict) -> dict:
+    """``config`` without moving pins: the study's family plan is a fixed-pin
+    plan (moving pins under a family, each candidate checked against the
+    family's worst member, take far longer than a workflow stage should;
+    ``pinfeed plan --support-family`` still tries them)."""
+    planner = dict(config["planner"], dynamic=dict(config["planner"].get("dynamic", {}), depth=0))
+    return dict(config, planner=planner)
+
+
 def support_study(part: Part, config: dict, family, uniform_entry: dict | None, progress=None) -> dict:
-    """The three numbers of issue 25 for ``part`` (a JSON-ready dict):
+    """The support study of ``part``: three numbers (a JSON-ready dict):
 
     - ``spread``: how far the family moves theta_f from uniform over the
       configured map grid (:func:`map_spread`);
@@ -74,8 +83,10 @@ def support_study(part: Part, config: dict, family, uniform_entry: dict | None, 
       survives: the resting states do not depend on the support);
       ``widening``: its verified width (the narrowest arc holding the
       required share of trials) under uniform pressure and under the family;
-    - ``family_plan``: when it does not survive, the plan for the family
-      (:func:`~pipeline.planning.plan.plan_tight` with the family).
+    - ``family_plan``: when it does not survive, the fixed-pin plan for the
+      family (:func:`~pipeline.planning.plan.plan_tight` with the family and
+      no moving pins), each candidate checked against the family's worst
+      member (:mod:`pipeline.planning.worst_member`).
 
     The figure's maps come back apart, under ``"_spreads"`` (not JSON)."""
     family = as_family(part, family)
@@ -102,7 +113,7 @@ def support_study(part: Part, config: dict, family, uniform_entry: dict | None, 
     if not out["survives"]:
         if progress:
             progress(f"planning for every member of {family.label}")
-        res = plan_tight(part, config, mu_c, family=family, progress=progress)
+        res = plan_tight(part, _fixed_pins_only(config), mu_c, family=family, progress=progress)
         best = res["recommended"]
         out["family_plan"] = {
             "orients": res["orients"], "warning": res["warning"],
