@@ -158,6 +158,7 @@ class FixedPlan:
     selection: dict | None = None
 
     def width(self):
+        """The verified width (deg) of the plan's verdict, None if too many trials jammed."""
         return (self.verdict or {}).get("width_deg")
 
     def rank_key(self):

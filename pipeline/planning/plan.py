@@ -269,7 +269,7 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
                                 if "support_family" in res else {}),
                              "orientation": verdict, "selection": selection}
         if progress:
-            progress(f"mu_c {friction_label(mu_c)}: held-out check of {' '.join(plan.pins)}: "
+            progress(f"mu_c {friction_label(mu_c)}: verified {' '.join(plan.pins)} on held-out trials: "
                      + describe_claim(verdict))
 
 

@@ -310,15 +310,19 @@ def _width_cell(plan: dict) -> str:
     if not o:
         return "<td>n/a</td>"
     width = "n/a" if o["width_deg"] is None else f"{o['width_deg']:.1f}"
+    notes = []
+    if (plan.get("verification") or {}).get("held_out"):
+        notes.append("held-out trials")
     iv = o.get("width_interval_deg")
     if iv and iv[0] is not None and iv[1] is not None:
-        width += f" [{iv[0]:.1f}, {iv[1]:.1f}]"
-    bound = ("" if "share_lower_bound" not in o else
-             f", share >= {100 * o['share_lower_bound']:.2f} % at {100 * o['confidence']:g} % confidence")
-    held = " held-out" if (plan.get("verification") or {}).get("held_out") else ""
-    verdict = ("" if o["orients"] else " (near miss: clears the point rule only)" if o.get("point_rule")
-               else f" (does not orient: {o['sets_within_tolerance']} sets)")
-    text = f"{width}: {o['in_tolerance']}/{o['trials']}{held} in {o['tolerance_deg']:g} deg{bound}{verdict}"
+        notes.append(f"width {100 * o['confidence']:g} % interval {iv[0]:.1f}-{iv[1]:.1f} deg")
+    if "share_lower_bound" in o:
+        notes.append(f"share >= {100 * o['share_lower_bound']:.2f} % at {100 * o['confidence']:g} % confidence")
+    if not o["orients"]:
+        notes.append("near miss: clears the point rule only" if o.get("point_rule")
+                     else f"does not orient: {o['sets_within_tolerance']} sets")
+    text = (f"{width}: {o['in_tolerance']}/{o['trials']} in {o['tolerance_deg']:g} deg"
+            + (f" ({'; '.join(notes)})" if notes else ""))
     return f"<td>{html.escape(text)}</td>" if o["orients"] else f"<td style='color:#b00'>{html.escape(text)}</td>"
 
 

@@ -121,7 +121,7 @@ def test_judge_works_modulo_symmetry():
     """Two sets 180 deg apart are one orientation of a 2-fold symmetric part."""
     finals = [10.0] * 50 + [190.5] * 50
     assert not orient.judge(finals, 100, 5.0, order=1)["orients"]
-    verdict = orient.judge(finals, 100, 5.0, order=2)
+    verdict = orient.judge(finals, 100, 5.0, order=2, rule="point")  # 100 trials: the point rule
     assert verdict["orients"] and verdict["width_deg"] == pytest.approx(0.5)
 
 

@@ -47,7 +47,7 @@ def test_small_and_large_parts_plan_with_fitted_pins(across):
     part = Part.from_vertices(TRIANGLE * across / 60.0)
     radius = 3.0 * across / 60.0  # the pin scaled with the part (scale invariance, spec section 4)
     search = FixedPinSearch(part, fitted_pins(part), (0.1, 0.3), 15.0, 0.995,
-                            {"trials": 10, "y_halfwidth": 0.5 * across / 60.0,
+                            {"trials": 10, "rule": "point", "y_halfwidth": 0.5 * across / 60.0,
                              "pin_halfwidth": 0.3 * across / 60.0}, radius)
     result = search.run(3, candidates=2, keep=1)
     assert result.plans, result.evidence()
