@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -9,6 +10,9 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path[:0] = [str(ROOT), str(HERE / "_ext")]
 os.environ.setdefault("MPLBACKEND", "Agg")
+# The gallery's pages are generated into docs/gallery/ by running the examples;
+# start from nothing so that a renamed or removed example leaves no stale page.
+shutil.rmtree(HERE / "gallery", ignore_errors=True)
 
 project = "pinfeed"
 author = "pinfeed developers"
@@ -37,6 +41,9 @@ napoleon_use_ivar = True
 autodoc_typehints = "none"
 autodoc_member_order = "bysource"
 autodoc_default_options = {"members": True, "undoc-members": False}
+
+# Keep quotes as typed: option values and shell text must stay copyable.
+smartquotes = False
 
 html_theme = "furo"
 html_title = "pinfeed"
