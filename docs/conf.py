@@ -44,6 +44,7 @@ autodoc_default_options = {"members": True, "undoc-members": False}
 
 # Keep quotes as typed: option values and shell text must stay copyable.
 smartquotes = False
+highlight_language = "text"   # usage lines and shell text are not Python
 
 html_theme = "furo"
 html_title = "pinfeed"
