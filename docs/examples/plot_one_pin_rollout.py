@@ -1,8 +1,8 @@
 """
-A part meeting one pin (Fig. 2)
-===============================
+A part meeting one pin
+======================
 
-The paper's Fig. 2 shows a part turning against an overhead pin until it
+Each step of the paper's Fig. 2 is a part turning against an overhead pin until it
 leaves it. This example rolls the asymmetric triangle out against one pin at
 contact parameter d = 0.3 and plots how far it has turned against the belt's travel
 since first contact, for three initial orientations.
