@@ -12,14 +12,20 @@ MU_C, PIN_RADIUS, THRESHOLD_T, FACTOR_C = 0.15, 3.0, 5.0, 2.0
 D_VALUES = [d for d in np.round(np.arange(-0.9, 0.91, 0.1), 1) if d != 0]
 
 
-def best_plan_figure(part, depth: int = 3, theta_step: float = 2.0):
-    """The best fixed-pin plan of ``part`` on a coarse map grid, drawn as the
-    paper's pin-sequence figure; returns ``(figure, plan dict)``."""
+def best_plan(part, depth: int = 3, theta_step: float = 2.0):
+    """The paper planner's best fixed-pin plan of ``part`` on a coarse map grid:
+    ``(planner, candidate pins, plan dict)``."""
     maps = simulate.compute_map(part, theta_i=np.arange(0, 360, theta_step), d=D_VALUES,
                                 mu_c=MU_C, pin_radius=PIN_RADIUS)
     pins = candidate_pins(part, {"pins": "auto"})
     planner = Planner(part, load_maps(maps, THRESHOLD_T, FACTOR_C), pins, d_min=0.1, d_max=0.9)
-    plan = planner.search(depth, keep=1)[0].to_dict()
+    return planner, pins, planner.search(depth, keep=1)[0].to_dict()
+
+
+def best_plan_figure(part, depth: int = 3, theta_step: float = 2.0):
+    """The best fixed-pin plan of ``part`` on a coarse map grid, drawn as the
+    paper's pin-sequence figure; returns ``(figure, plan dict)``."""
+    planner, pins, plan = best_plan(part, depth, theta_step)
     paths = {}
     for label, state in planner.initial_states().items():
         theta, y = state.arc[0], state.y_lo

@@ -125,8 +125,16 @@ def test_every_local_link_and_image_resolves(built_docs):
 
 def test_the_gallery_ran_every_example(built_docs):
     examples = sorted((ROOT / "docs" / "examples").glob("plot_*.py"))
-    assert len(examples) >= 6
+    assert len(examples) >= 7
     for example in examples:
         page = built_docs / "gallery" / (example.stem + ".html")
         assert page.exists(), example.name
         assert re.search(r"<img[^>]+sphx_glr_" + example.stem, page.read_text()), example.name
+
+
+def test_readme_is_short_and_its_links_resolve():
+    readme = (ROOT / "README.md").read_text()
+    assert len(readme.splitlines()) <= 150
+    targets = re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", readme)
+    assert len(targets) > 20
+    assert [t for t in targets if not re.match(r"^[a-z]+:", t) and not (ROOT / t).exists()] == []
