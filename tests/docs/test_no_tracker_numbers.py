@@ -26,13 +26,13 @@ def test_the_pattern_catches_what_it_should():
 
 
 def doc_sources():
-    files = [ROOT / "README.md"]
+    files = [ROOT / "README.md", *sorted((ROOT / "config").glob("*.yaml"))]  # the schema's text is the config reference
     files += [p for p in (ROOT / "docs").rglob("*") if p.suffix in DOC_SUFFIXES
               and "_build" not in p.parts and "gallery" not in p.parts and "_tools" not in p.parts]
     return files
 
 
-def test_readme_and_docs_name_no_tracker_number():
+def test_readme_docs_and_configs_name_no_tracker_number():
     found = {str(p.relative_to(ROOT)): tracker_mentions(p.read_text()) for p in doc_sources()}
     assert {k: v for k, v in found.items() if v} == {}
 
