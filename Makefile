@@ -36,7 +36,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/rollout_speed.py
 
 clean:
-	rm -rf $(VENV) results .pytest_cache
+	rm -rf $(VENV) results .pytest_cache docs/_build docs/gallery docs/sg_execution_times.rst
 
 # The manual: Sphinx, warnings as errors, into docs/_build/html.
 docs: $(STAMP)
