@@ -4,12 +4,12 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: run unlock demo test bench clean
+.PHONY: run unlock demo test bench clean docs
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test,cuda]'
+	$(BIN)/python -m pip install --quiet -e '.[test,cuda,docs]'
 	touch $(STAMP)
 
 # The main job: the Snakemake workflow on the embedded default config
@@ -36,4 +36,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/rollout_speed.py
 
 clean:
-	rm -rf $(VENV) results .pytest_cache
+	rm -rf $(VENV) results .pytest_cache docs/_build docs/gallery docs/sg_execution_times.rst
+
+# The manual: Sphinx, warnings as errors, into docs/_build/html.
+docs: $(STAMP)
+	PYTHONPATH=$(CURDIR) $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html

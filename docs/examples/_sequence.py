@@ -1,0 +1,39 @@
+"""Shared by the pin-sequence examples: coarse maps, the paper's planner, and
+the nominal path of every resting state through the best plan."""
+import numpy as np
+
+from pipeline.maps import simulate
+from pipeline.parts.contact import contact_parameter
+from pipeline.planning.paper import Planner, load_maps
+from pipeline.planning.settings import candidate_pins
+from pipeline.present.figures.sequence import sequence_figure
+
+MU_C, PIN_RADIUS, THRESHOLD_T, FACTOR_C = 0.15, 3.0, 5.0, 2.0
+D_VALUES = [d for d in np.round(np.arange(-0.9, 0.91, 0.1), 1) if d != 0]
+
+
+def best_plan(part, depth: int = 3, theta_step: float = 2.0):
+    """The paper planner's best fixed-pin plan of ``part`` on a coarse map grid:
+    ``(planner, candidate pins, plan dict)``."""
+    maps = simulate.compute_map(part, theta_i=np.arange(0, 360, theta_step), d=D_VALUES,
+                                mu_c=MU_C, pin_radius=PIN_RADIUS)
+    pins = candidate_pins(part, {"pins": "auto"})
+    planner = Planner(part, load_maps(maps, THRESHOLD_T, FACTOR_C), pins, d_min=0.1, d_max=0.9)
+    return planner, pins, planner.search(depth, keep=1)[0].to_dict()
+
+
+def best_plan_figure(part, depth: int = 3, theta_step: float = 2.0):
+    """The best fixed-pin plan of ``part`` on a coarse map grid, drawn as the
+    paper's pin-sequence figure; returns ``(figure, plan dict)``."""
+    planner, pins, plan = best_plan(part, depth, theta_step)
+    paths = {}
+    for label, state in planner.initial_states().items():
+        theta, y = state.arc[0], state.y_lo
+        path = [(theta, y)]
+        for pin in plan["pins"]:
+            one = simulate.rollout(part, theta, contact_parameter(pins[pin], y, part.a), MU_C, PIN_RADIUS)
+            theta, y = float(one["theta_f"]), y + float(one["dy"])
+            path.append((theta, y))
+        paths[label] = path
+    title = f"{part.name}: best fixed-pin plan on a {theta_step:g}-degree grid, mu_c {MU_C:g}"
+    return sequence_figure(part, plan, pins, paths, PIN_RADIUS, title), plan
