@@ -1,4 +1,4 @@
-"""Time the planner on new parts (issue 23): depth 4 over the default friction
+"""Time the planner on new parts: depth 4 over the default friction
 range with pins fitted to each part, from an empty refinement store, on at
 least eight parts of different shapes (the default triangles, a right and a
 scalene triangle, a T bracket, an L bracket, a trapezoid, a slot-like hexagon

@@ -1,4 +1,4 @@
-"""Cost of a point-support rollout against a uniform one (issue 25: at most twice).
+"""Cost of a point-support rollout against a uniform one (at most twice).
 
 The scalene triangle, theta_i every 2 degrees x the paper's 18 d values,
 pin radius 3 mm, mu_c = 0.2 and 0.0, on one Numba thread; the rate is

@@ -10,7 +10,7 @@ float64 (19 x 29, 4.3 KiB) that does not depend on the polygon; the polygon, its
 quadrature rule and the grid live in global memory. There is no polygon
 size limit beyond the step budget that applies on the CPU too.
 
-A point support (issue 25, kernel code ``models.MINPOWER_POINTS``) needs
+A point support (kernel code ``models.MINPOWER_POINTS``) needs
 nothing more: its points travel in ``quad``, and the same scalar code runs.
 
 Install with ``pip install .[cuda]`` (numba-cuda with the CUDA 12 wheels).

@@ -17,7 +17,7 @@ mass ``m``, polar radius of gyration ``k`` about the centroid) has twist
     Fr       dV/ds     = W_F(xi) + f
     Fr k^2   domega/ds = W_M(xi) + c x f,        Fr = v_b^2 / (mu_s g a)
 
-so the mass drops out and only the Froude-like number ``Fr`` (issue 18's
+so the mass drops out and only the Froude-like number ``Fr`` (the fast-belt model's
 ``v^2 / (mu_s g a)``) matters; ``Fr -> 0`` is the quasi-static limit.
 
 **Belt friction.** Uniform pressure ``1/A`` and Coulomb friction ``mu_s``

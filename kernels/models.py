@@ -22,7 +22,7 @@ Models (spec section 3):
     Ellipsoidal limit surface ``H = |f|^2 + m^2 / m_max^2``; the twist is
     ``grad H``.
 
-Support (issue 25): ``MINPOWER`` presses the part evenly over its area (the
+Support: ``MINPOWER`` presses the part evenly over its area (the
 spec's uniform pressure, closed forms of ``support.py``); ``MINPOWER_POINTS``
 presses it on K weighted points, ``P = sum_k w_k |u(p_k)|``, with the points
 in the first K rows of ``quad`` (``(x, y, w)``, weights summing to 1) and the
@@ -49,7 +49,7 @@ MINPOWER = 0
 TIP = 1
 ELLIPSOID = 2
 MODEL_NAMES = ("minpower", "tip", "ellipsoid")
-# Kernel code of the minpower model over a point support (issue 25): the
+# Kernel code of the minpower model over a point support: the
 # rollout's ``quad`` then holds the support points (see ``_minimise_points``)
 # instead of the fan quadrature. Not a public model name: the public API
 # selects it with ``model="minpower"`` and a ``support``.

@@ -92,7 +92,7 @@ _TAKE_PER_TOL = 0.1  # minpower solve threshold per unit of tol (see _solve_take
 _DTHETA_CAP = 0.2  # radians of contact-normal turn per step
 _GROW_MAX = 2.0  # largest step growth between accepted steps
 
-# Step budget (issue 12): a rollout ends with status ``truncated`` and reason
+# Step budget: a rollout ends with status ``truncated`` and reason
 # "step budget" after this many integration steps (accepted, rejected and
 # event-locating steps, plus re-contacts after a separation), so no input can
 # make it run without end. A normal rollout takes 20 to 200 steps; the budget

@@ -31,7 +31,7 @@ translation) the closed forms lose digits to cancellation, and a collapsed
 Gauss rule on the centroid fan is exact to rounding because the integrand is
 smooth there.
 
-A point support (issue 25) replaces the area integral by a weighted sum over
+A point support replaces the area integral by a weighted sum over
 K points, ``P = sum_k w_k |u(p_k)|``: ``_point_power`` at the end of this
 module (the same sums as the quadrature branch, with the kinks of P at the
 points left to ``models._minimise_points``).

@@ -2,7 +2,7 @@
 what is refused and why, each as a one-line :class:`PinfeedError`.
 
 The limits keep a valid-looking input from running without end or
-allocating without bound (issue 12, "Hardening"):
+allocating without bound ("Hardening"):
 
 * a list or range of numbers holds at most ``MAX_VALUES`` values, all
   finite and distinct, and one map at most ``MAX_MAP`` rollouts;
@@ -15,7 +15,7 @@ allocating without bound (issue 12, "Hardening"):
 * output files have a known suffix and a folder that exists or can be made;
 * a belt speed is slow enough that the pin pushes the part rather than
   throwing it (Froude number at most ``FROUDE_MAX``), and belt friction
-  ``mu_s`` lies in (0, ``MU_S_MAX``] (issue 18).
+  ``mu_s`` lies in (0, ``MU_S_MAX``].
 """
 from __future__ import annotations
 
@@ -111,7 +111,7 @@ def check_finite_tree(obj, where: str = "") -> None:
             check_finite_tree(v, f"{where}/{k}")
 
 
-# Belt speed and belt friction (issue 18), for the models at belt speed.
+# Belt speed and belt friction, for the models at belt speed.
 G_MM_S2 = 9810.0
 MU_S_MAX = 5.0
 # Largest v^2 / (mu_s g a): beyond it a plastic impact at belt speed sends the

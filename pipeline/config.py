@@ -258,7 +258,7 @@ HASH_NEUTRAL_DEFAULTS = {("sweep", "supports"): ["uniform"],
 def config_hash(config: dict) -> str:
     """Hash of the validated config (canonical JSON), recorded in stored files.
     Keys of :data:`HASH_NEUTRAL_DEFAULTS` at their default value are left out,
-    so a config that does not use issue 25's keys (``sweep.supports: [uniform]``,
+    so a config that does not use the support keys (``sweep.supports: [uniform]``,
     no ``planner.support_family``, no ``support_study``) hashes as before they
     existed."""
     hashed = config

@@ -12,7 +12,7 @@ Queries return lazy (dask-backed) xarray objects::
     ds = cat.query(part="asym_triangle", model="minpower", mu_c=0.2, d=0.3)
     ds.attrs["selection"]   # e.g. "mu_c 0.2 -> nearest stored 0.15; d 0.3 -> 0.3"
     moving = cat.query("asym_triangle", mu_c=0.15, v_pin=-2)   # a dynamic pin's maps
-    tripod = cat.query("asym_triangle", mu_c=0.15, support="tripod")   # issue 25
+    tripod = cat.query("asym_triangle", mu_c=0.15, support="tripod")
     cube = cat.cube("paper_triangles")   # dims (part, model, mu_c, v_pin[, support], d, theta_i)
 
 Shards written before dynamic pins existed have no ``v_pin`` attribute and
@@ -421,7 +421,7 @@ class Catalog:
         speeds are not interpolated. ``attrs["selection"]`` says what was
         chosen. ``belt_speed`` (mm/s, default 0: quasi-static) selects the
         dynamic model's maps at that speed, stored exactly (``model`` is then
-        ``"dynamic"``). ``support`` (issue 25; default uniform) selects the maps
+        ``"dynamic"``). ``support`` (default uniform) selects the maps
         of one support, by its text or file key, stored exactly; the result has
         a scalar ``support`` coordinate. Returns dims ``(mu_c, d, theta_i)``.
         """
@@ -447,7 +447,7 @@ class Catalog:
         ds = xr.concat(parts, dim="mu_c", combine_attrs="drop_conflicts")
         ds["mu_c"].attrs.update(units="1", long_name="pin-part friction coefficient")
         ds = ds.assign_coords(support=((), found[0].get("support", "uniform"),
-                                       {"long_name": "support distribution (issue 25)"}))
+                                       {"long_name": "support distribution"}))
         if d is not None:
             stored_d = [float(x) for x in ds["d"].values]
             picks = []
@@ -484,7 +484,7 @@ class Catalog:
         cube.attrs.update(family=family, title=f"pinfeed map cube of family {family}")
         cube["v_pin"].attrs.update(units="1", long_name="pin speed across the belt over belt speed")
         if supports:
-            cube["support"].attrs.update(long_name="support distribution (issue 25)")
+            cube["support"].attrs.update(long_name="support distribution")
         return cube
 
 

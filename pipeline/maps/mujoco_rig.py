@@ -1,4 +1,4 @@
-"""MuJoCo rig: the same pin passage in an independent physics engine (issue 18).
+"""MuJoCo rig: the same pin passage in an independent physics engine.
 
 It shares no code with the kernels: mass properties, the support grid, the
 triangulation of a non-convex outline and the pin path are computed here with

@@ -441,7 +441,7 @@ def status_names(codes) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------
-# Models at belt speed (issue 18): "dynamic" (kernels.dynamic) and "mujoco"
+# Models at belt speed: "dynamic" (kernels.dynamic) and "mujoco"
 # (pipeline.maps.mujoco_rig, an independent engine). Quasi-static models above.
 
 BELT_MODELS = ("dynamic", "mujoco")

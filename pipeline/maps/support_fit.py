@@ -1,4 +1,4 @@
-"""Fit a point support to measured pushes (issue 25: ``pinfeed support fit``).
+"""Fit a point support to measured pushes (``pinfeed support fit``).
 
 A *push* is one passage of a part past one pin: its initial orientation
 ``theta_i`` (deg), its contact parameter ``d`` and the measured final

@@ -1,4 +1,4 @@
-"""How far a support family moves a part's configuration maps from uniform pressure (issue 25).
+"""How far a support family moves a part's configuration maps from uniform pressure.
 
 :func:`family_spread` computes one map per member of a
 :class:`~pipeline.parts.support_family.SupportFamily` on the same grid as

@@ -5,7 +5,7 @@ written before dynamic pins existed stay valid; a moving pin's shard is
 ``mu_c=MU_v_pin=V.h5`` (V the speed ratio v_pin / v_b). Belt speeds > 0
 (``sweep.belt_speed``) add shards of the dynamic model under
 ``dynamic/mu_c=MU[_v_pin=V]_belt=S_mu_s=M.h5``. Supports other than uniform
-(``sweep.supports``, issue 25) add minpower shards
+(``sweep.supports``) add minpower shards
 ``mu_c=MU[_v_pin=V]_support=KEY.h5`` (``parts.support.support_key``); uniform keeps
 every name, file and byte as it was. The catalog stacks a family's shards
 along a ``support`` dimension and queries one support at a time.

@@ -1,6 +1,6 @@
 """The contact parameter ``d``: where a pin meets a part, in units of the part's size.
 
-One helper for one idea (issue 14): every layer that turns a pin height into
+One helper for one idea: every layer that turns a pin height into
 ``d`` calls :func:`contact_parameter`.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Support distributions: where, and how hard, a part presses on the belt (issue 25).
+"""Support distributions: where, and how hard, a part presses on the belt.
 
 Every model of spec section 3 assumes uniform pressure over the part's area.
 A real part rests on a few high points (a burr, a warp, a boss). A

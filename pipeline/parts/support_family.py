@@ -1,4 +1,4 @@
-"""Support families: every distribution the engineer believes a part may rest on (issue 25).
+"""Support families: every distribution the engineer believes a part may rest on.
 
 A :class:`SupportFamily` is a finite list of :class:`~pipeline.parts.support.Support`
 members that stands for a set of distributions. Plans made for a family must

@@ -246,7 +246,7 @@ class FixedPinSearch:
         others are fixed); :meth:`run` with a ``prefix`` lets them follow a
         fixed-pin sequence.
     family : a :class:`~pipeline.parts.support_family.SupportFamily` the
-        plans must orient the part for (issue 25): the nominal paths run under
+        plans must orient the part for: the nominal paths run under
         each of its ``representatives`` (the union over them is what must fit
         the tolerance) and the trials sample its members as the verification
         does; ``None``: uniform pressure.

@@ -25,7 +25,7 @@ A sequence is dropped (with all its extensions) when, on its nominal path:
 Nothing else is pruned: every other sequence of up to ``depth`` pins is
 enumerated (``NominalTree.levels``).
 
-With several supports (issue 25: a support family's representatives), every
+With several supports (a support family's representatives), every
 resting state is rolled out under each of them: the level's columns are
 (support, resting state) pairs, so the rules above and the planner's span
 of the nominal finals take the union over the supports.

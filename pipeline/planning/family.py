@@ -1,4 +1,4 @@
-"""A support family ready to plan with (issue 25; spec section 9.4).
+"""A support family ready to plan with (spec section 9.4).
 
 :func:`planning_family` checks that the planner's mechanics take point
 supports and finds the family's extremes

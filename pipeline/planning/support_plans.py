@@ -1,4 +1,4 @@
-"""The support study (issue 25): plans against a support family.
+"""The support study: plans against a support family.
 
 :func:`support_study` answers a user's three questions for one
 part (spec section 9): how far the family moves ``theta_f`` from uniform

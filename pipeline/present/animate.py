@@ -365,7 +365,7 @@ def animate_stored(result, config: dict, out, plan_index=None, frames: int = 120
     return {**done, **inputs}
 
 
-# ------------------------------------------------------- a layout's feeder (issue 19)
+# ------------------------------------------------------- a layout's feeder
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""A feeder you can build (issue 19): pin stations, part pitch, belt width, throughput.
+"""A feeder you can build: pin stations, part pitch, belt width, throughput.
 
 Plain inputs (a part, the plan's pin labels and heights, the initial resting
 states, the friction) and replayed trials with trajectories:

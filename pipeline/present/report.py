@@ -148,7 +148,7 @@ def _part_section(name: str, part: dict, base, catalog, config: dict) -> list[st
 
 
 def _support_section(res: dict, files: dict, base) -> list[str]:
-    """The three numbers of issue 25: theta_f's shift from uniform to the
+    """The support study's three numbers: theta_f's shift from uniform to the
     family, whether the recommended plan survives it, the plan that does."""
     s, fam = res["spread"], res["family"]
     p = [f"<p>Support family <b>{html.escape(fam['label'])}</b> ({len(fam['members'])} members; "

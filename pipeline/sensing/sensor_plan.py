@@ -7,7 +7,7 @@ reading tells which initial state arrived, the final set that state reaches
 is known, so initial states the sensor tells apart may end in different
 sets.
 
-Where the plans come from (issue 11: one propagation for every planner). The
+Where the plans come from (one propagation for every planner). The
 sensor planner runs no search of its own: it reads the plan stage's stored
 result (``RESULTS/plans/NAME.json``, from ``pinfeed plan --out`` or the
 workflow) and takes the tight planner's *verified* plans at one friction

@@ -1,4 +1,4 @@
-"""The function of ``rules/support.smk``: a part's plans against a support family (issue 25)."""
+"""The function of ``rules/support.smk``: a part's plans against a support family."""
 from __future__ import annotations
 
 from pipeline.config import config_hash

@@ -1,4 +1,4 @@
-"""Configuration maps under uniform support and under a support family's extremes, overlaid (issue 25)."""
+"""Configuration maps under uniform support and under a support family's extremes, overlaid."""
 from __future__ import annotations
 
 import math
