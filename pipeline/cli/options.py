@@ -96,8 +96,9 @@ def add_outline_args(p, required=True):
     p.add_argument("--join-tol", dest="join_tol", type=float, default=None, metavar="TOL",
                    help="largest gap between piece ends that are joined, in the drawing's units "
                    "(default 1e-4 of the drawing's size)")
-    p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=0.05, metavar="MM",
-                   help="chordal tolerance for flattening arcs and curves, mm (default 0.05)")
+    p.add_argument("--flatten-tol", dest="flatten_tol", type=float, default=None, metavar="MM",
+                   help="chordal tolerance for flattening arcs and curves, mm (default 0.05, or 1/2000 of "
+                   "the drawing's diagonal when that is larger)")
     p.add_argument("--name", default=None, help="part name used in outputs (default: part, or the "
                    "outline file's name)")
 

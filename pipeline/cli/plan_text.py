@@ -6,6 +6,8 @@
 """
 from __future__ import annotations
 
+from pipeline.planning.arcs import format_arcs, merge_modulo
+
 
 def _verification_counts(plan) -> dict | None:
     v = plan.get("verification")
@@ -63,7 +65,6 @@ def plan_json(result, mode) -> dict:
 
 def print_plan_result(result, part, config, mode):
     """A plan result (the dict ``plan_command`` returns), for people."""
-    from pipeline.planning.arcs import format_arcs
     from pipeline.planning.plan import mechanics_label, planner_belt
     from pipeline.planning.types import as_plan_file
     result = as_plan_file(result)
@@ -72,6 +73,7 @@ def print_plan_result(result, part, config, mode):
     for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
         print(f"  state {k}: resting on the fence at theta = {theta:.1f} deg, y_c = {y_c:.2f} mm")
     for t in result.tight or ():
+        order = t.symmetry_order or part.symmetry_order()
         st = t.stats
         print(f"tight planner, friction {t.friction}: {st['rollouts']} new rollouts in "
               f"{st['seconds']:.0f} s, stored under {config['catalog_dir']}/refine/{part.id}/")
@@ -89,7 +91,7 @@ def print_plan_result(result, part, config, mode):
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))
             mark = " (recommended)" if t.recommended is not None and plan == t.recommended else ""
             print(f"  #{k}{mark}: {heights} -> claimed {plan.n_final_sets} set(s) "
-                  f"({plan.extra.get('claim', 'propagated')}): {format_arcs(plan.final_arcs)}; "
+                  f"({plan.extra.get('claim', 'propagated')}): {sets_text(plan.final_arcs, order)}; "
                   f"{_orientation_text(v)}; margin in d "
                   + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
     if mode == "tight" or result.plans is None:
@@ -104,6 +106,16 @@ def print_plan_result(result, part, config, mode):
         print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
               f"{format_arcs(plan.final_arcs)}; "
               f"margin in d {plan.margin:.3f}")
+
+
+def sets_text(arcs, order: int) -> str:
+    """Final orientation sets for people, one arc per set: on a part with ``order``-fold
+    rotational symmetry (``order`` > 1) the copies ``360 / order`` deg apart are one
+    set, shown once in [0, 360 / order) and marked ``(xK by symmetry)``."""
+    if order <= 1 or not arcs:
+        return format_arcs(arcs)
+    pairs = [(s["start"], s["width"]) if isinstance(s, dict) else tuple(s) for s in arcs]
+    return f"{format_arcs(merge_modulo(pairs, order))} (x{order} by symmetry)"
 
 
 def _orientation_text(v) -> str:

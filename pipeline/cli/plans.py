@@ -149,7 +149,7 @@ def add_plan_commands(sub) -> None:
                    "10): a plan orients the part when verify.required (99.5%%) of its trials end in one "
                    "set this narrow")
     p.add_argument("--support-family", dest="support_family", default=None, metavar="SPEC",
-                   help="supports the plan must hold for (issue 25): 'tripods:N[:inset=F][:seed=S]', "
+                   help="supports the plan must hold for: 'tripods:N[:inset=F][:seed=S]', "
                         "'warp:AMP[:N]', a support ('tripod', 'rim:N', 'points:x,y,w ...') or a list "
                         "'SPEC; SPEC'; 'uniform' for none (default: planner.support_family)")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"],
