@@ -6,16 +6,17 @@ stderr and exits with status 2; nothing already stored is touched.
 
 One module per verb or group of verbs, each building its own parsers:
 
-========================  =====================================================
-:mod:`~.maps`             ``rollout``, ``map``, ``plot-map``, ``demo``
-:mod:`~.plans`            ``sweep``, ``plan``, ``atlas`` (:mod:`~.plan_text`
-                          prints plans)
-:mod:`~.catalog`          ``catalog index|list|show|query|plot``
-:mod:`~.sense`            ``sense classify``
-:mod:`~.support`          ``support fit``
-:mod:`~.feeder`           ``speed``, ``layout``, ``animate``
-:mod:`~.options`          the option groups they share
-========================  =====================================================
+==============  =======================================================
+module          verbs
+==============  =======================================================
+``maps``        ``rollout``, ``map``, ``plot-map``, ``demo``
+``plans``       ``sweep``, ``plan``, ``atlas`` (``plan_text`` prints plans)
+``catalog``     ``catalog index|list|show|query|plot``
+``sense``       ``sense classify``
+``support``     ``support fit``
+``feeder``      ``speed``, ``layout``, ``animate``
+``options``     the option groups they share
+==============  =======================================================
 
 :func:`build_parser` returns the whole parser (the manual's command reference
 is generated from it); :func:`main` runs it, with shell completion by
@@ -62,7 +63,6 @@ def join_signed_values(argv):
             out.append(tok)
             i += 1
     return out
-
 
 
 def build_parser() -> argparse.ArgumentParser:
