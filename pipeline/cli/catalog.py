@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sys
 
-from pipeline.cli.options import bands_option, parse_values, print_json
+from pipeline.cli.options import add_json_option, bands_option, parse_values, print_json
 from pipeline.errors import PinfeedError
 
 
@@ -130,12 +130,12 @@ def add_catalog_commands(sub) -> None:
 
     catalog_parser("index", "rebuild the index from the shards on disk", cmd_catalog_index)
     q = catalog_parser("list", "list the parts stored", cmd_catalog_list)
-    q.add_argument("--json", action="store_true")
+    add_json_option(q)
     q = catalog_parser("show", "everything stored about one part", cmd_catalog_show)
     q.add_argument("part", help="part name or id")
     q.add_argument("--support", default=None, metavar="SPEC",
                    help="only the shards of this support (its text or file key); default: every support")
-    q.add_argument("--json", action="store_true")
+    add_json_option(q)
     for name, func, help_text in (("query", cmd_catalog_query, "maps of one part, model, friction, d"),
                                   ("plot", cmd_catalog_plot, "draw stored maps like the paper's Table 1")):
         q = catalog_parser(name, help_text, func)
@@ -153,7 +153,7 @@ def add_catalog_commands(sub) -> None:
         if name == "query":
             q.add_argument("--theta-i", default=None,
                            help="only these initial orientations (nearest stored)")
-            q.add_argument("--json", action="store_true")
+            add_json_option(q)
         else:
             q.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
             q.add_argument("--bands", default=None, metavar="T,C",

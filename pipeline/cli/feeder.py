@@ -11,7 +11,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from pipeline.cli.options import add_config_option, add_results_option, print_json, results_arg
+from pipeline.cli.options import (add_config_option, add_json_option, add_results_option, print_json,
+                                  results_arg)
 
 
 def cmd_speed(args):
@@ -152,7 +153,7 @@ def add_stored_plan_commands(sub) -> None:
                         "with the plan, else the config's speed.trials); other settings recompute it")
     add_config_option(p)
     add_results_option(p)
-    p.add_argument("--json", action="store_true")
+    add_json_option(p)
     p.set_defaults(func=cmd_speed)
 
 
@@ -178,5 +179,5 @@ def add_layout_commands(sub) -> None:
                    "the layout JSON (.json; 'pinfeed animate --layout' reads RESULTS/layout_NAME.json)")
     add_config_option(p)
     add_results_option(p)
-    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    add_json_option(p, "print JSON instead of text")
     p.set_defaults(func=cmd_layout)

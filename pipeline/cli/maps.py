@@ -10,7 +10,8 @@ import math
 
 import numpy as np
 
-from pipeline.cli.options import add_physics, bands_option, parse_values, part_from_args, print_json
+from pipeline.cli.options import (add_json_option, add_physics, bands_option, parse_values, part_from_args,
+                                  print_json)
 from pipeline.errors import PinfeedError
 
 PAPER_D = [-0.9, -0.8, -0.7, -0.6, -0.5, -0.4, -0.3, -0.2, -0.1,
@@ -124,7 +125,7 @@ def add_map_commands(sub) -> None:
                    "force history with --json")
     p.add_argument("--max-travel", type=float, default=None,
                    help="stop after this belt travel since first contact (mm): status truncated")
-    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    add_json_option(p, "print JSON instead of a table")
     p.set_defaults(func=cmd_rollout)
 
     p = sub.add_parser("map", help="compute one map set (dims d, theta_i) into an HDF5 file")

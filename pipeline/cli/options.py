@@ -7,8 +7,8 @@
   support (:func:`add_physics`);
 * the workflow's files: ``--config`` and ``--results`` (:func:`add_config_option`,
   :func:`add_results_option`, :func:`results_arg`);
-* output: ``--json`` documents (:func:`print_json`) and value lists
-  (:func:`parse_values`).
+* output: ``--json`` documents (:func:`add_json_option`, :func:`print_json`)
+  and value lists (:func:`parse_values`).
 """
 from __future__ import annotations
 
@@ -140,6 +140,11 @@ def add_results_option(p, holding: str = "plans/") -> None:
     """``--results``: the results folder holding ``holding``."""
     p.add_argument("--results", default=None, help=f"results folder holding {holding} "
                    "(default: the config's, RESULTS_DIR/NAME)")
+
+
+def add_json_option(p, help_text: str | None = None) -> None:
+    """``--json``: one JSON document on stdout instead of text (:func:`print_json`)."""
+    p.add_argument("--json", action="store_true", help=help_text)
 
 
 def results_arg(args, config) -> Path:

@@ -11,8 +11,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from pipeline.cli.options import (add_config_option, add_outline_args, parse_values, plan_part_arg,
-                                  print_json)
+from pipeline.cli.options import (add_config_option, add_json_option, add_outline_args, parse_values,
+                                  plan_part_arg, print_json)
 from pipeline.cli.plan_text import plan_json, print_plan_result
 from pipeline.errors import PinfeedError
 
@@ -169,7 +169,7 @@ def add_plan_commands(sub) -> None:
     p.add_argument("--out", default=None, help="store the plan JSON here (default: RESULTS/plans/NAME.json, "
                    "where speed, layout and animate look; a part the workflow plans is stored only "
                    "with --out)")
-    p.add_argument("--json", action="store_true")
+    add_json_option(p)
     p.set_defaults(func=cmd_plan)
 
     p = sub.add_parser("atlas", help="the feedability atlas: which planned parts pins orient, with how "
@@ -177,6 +177,6 @@ def add_plan_commands(sub) -> None:
     add_config_option(p)
     p.add_argument("--results", default=None, help="results folder holding atlas.json "
                    "(default: the config's results_dir/NAME)")
-    p.add_argument("--json", action="store_true", help="print the atlas JSON")
+    add_json_option(p, "print the atlas JSON")
     p.set_defaults(func=cmd_atlas)
 

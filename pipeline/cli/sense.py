@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import argparse
 
-from pipeline.cli.options import add_config_option, add_results_option, print_json, results_arg
+from pipeline.cli.options import (add_config_option, add_json_option, add_results_option, print_json,
+                                  results_arg)
 
 
 PROFILE_FORMAT = """\
@@ -87,6 +88,6 @@ def add_sense_commands(sub) -> None:
     add_config_option(q)
     q.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
     add_results_option(q, "plans/ and sensing/")
-    q.add_argument("--json", action="store_true", help="print JSON instead of text")
+    add_json_option(q, "print JSON instead of text")
     q.set_defaults(func=cmd_sense_classify)
 

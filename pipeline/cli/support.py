@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import argparse
 
-from pipeline.cli.options import add_config_option, add_outline_args, plan_part_arg, print_json
+from pipeline.cli.options import (add_config_option, add_json_option, add_outline_args, plan_part_arg,
+                                  print_json)
 
 
 PUSHES_FORMAT = """pushes CSV: a header, then one push per row ('#' lines are comments):
@@ -72,6 +73,6 @@ def add_support_commands(sub) -> None:
     q.add_argument("--refine", type=int, default=4, help="best layouts refined by least squares (default 4)")
     q.add_argument("--seed", type=int, default=0, help="seed of the random layouts (default 0)")
     q.add_argument("--out", default=None, help="store the fit as JSON (with its settings and provenance)")
-    q.add_argument("--json", action="store_true", help="print JSON instead of text")
+    add_json_option(q, "print JSON instead of text")
     q.set_defaults(func=cmd_support_fit)
 
