@@ -2,8 +2,11 @@
 
 A drawing may hold loose LINE/ARC pieces in any order and direction,
 polylines with bulges, circles, ellipses, splines, paths, polygons and rects.
-Every curve is flattened to a polygon whose chords stay within
-``flatten_tol`` mm of the curve; duplicate pieces are dropped; pieces whose
+Every curve is flattened to a polygon whose chords stay within a chordal
+tolerance of the curve: ``flatten_tol`` mm when given, else 0.05 mm or a
+fixed fraction (:data:`FLATTEN_FRACTION`) of the drawing's diagonal, whichever
+is larger, so that a large drawing (or one in the wrong units) still gets a
+modest vertex count; duplicate pieces are dropped; pieces whose
 ends lie within ``join_tol`` (drawing units; default 1e-4 of the drawing's
 size) are joined end to end into closed loops. The largest closed loop is the
 part (or the loop picked by ``layer`` / ``id``); the loops and open chains
@@ -31,7 +34,8 @@ import numpy as np
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import PolygonError, check_outline
 
-DEFAULT_FLATTEN_TOL = 0.05  # mm
+DEFAULT_FLATTEN_TOL = 0.05  # mm: the default chordal tolerance of a drawing up to 100 mm across
+FLATTEN_FRACTION = 5e-4  # of the drawing's diagonal: the default chordal tolerance of a larger one
 JOIN_TOL_FRACTION = 1e-4  # default join tolerance, as a fraction of the drawing's size
 # Exact millimetres per unit: the same shape must hash to the same part id
 # whichever file it came from (ezdxf's inch factor is 25.4000000001,
@@ -106,7 +110,7 @@ class _Piece:
 
 
 def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa: A002 (CLI's --id)
-                 flatten_tol: float = DEFAULT_FLATTEN_TOL, units: str | None = None,
+                 flatten_tol: float | None = None, units: str | None = None,
                  join_tol: float | None = None) -> Outline:
     """The part outline in ``path`` (.dxf or .svg).
 
@@ -114,7 +118,9 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
     ----------
     layer, id : pick the outline by DXF layer, or by SVG element id / DXF
         entity handle; otherwise the largest closed loop is the outline.
-    flatten_tol : chordal tolerance for curves, mm.
+    flatten_tol : chordal tolerance for curves, mm (``None``: :data:`DEFAULT_FLATTEN_TOL`
+        or :data:`FLATTEN_FRACTION` of the drawing's diagonal, whichever is larger,
+        which keeps the vertex count of a large drawing modest).
     units : ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``: overrides the file's units.
     join_tol : largest gap between piece ends that are joined, in drawing
         units (``None``: 1e-4 of the drawing's size).
@@ -131,11 +137,11 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
         raise OutlineError(f"no outline file at {path}")
     suffix = path.suffix.lower()
     if suffix == ".dxf":
-        pieces, unit = _dxf_pieces(path, layer, id, flatten_tol, units)
+        pieces, unit, tol_mm = _dxf_pieces(path, layer, id, flatten_tol, units)
     elif suffix == ".svg":
         if layer is not None:
             raise OutlineError(f"{path}: --layer picks a DXF layer; pick an SVG element with --id")
-        pieces, unit = _svg_pieces(path, id, flatten_tol, units)
+        pieces, unit, tol_mm = _svg_pieces(path, id, flatten_tol, units)
     else:
         raise OutlineError(f"{path}: unknown outline format {suffix or '(none)'}; give a .dxf or .svg file")
     if not pieces:
@@ -148,19 +154,29 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
         xy = check_outline(loop.points * unit.scale)
     except PolygonError as exc:
         raise OutlineError(f"{path}: outline {loop.name}: {exc}") from None
-    return Outline(vertices=xy, source=str(path), name=loop.name, flatten_tol=float(flatten_tol),
+    return Outline(vertices=xy, source=str(path), name=loop.name, flatten_tol=float(tol_mm),
                    units=unit, left_out=left_out)
 
 
 def _check_options(flatten_tol, units, join_tol) -> None:
     def positive(x):
         return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and x > 0
-    if not positive(flatten_tol):
+    if flatten_tol is not None and not positive(flatten_tol):
         raise OutlineError(f"--flatten-tol must be a length in mm > 0, got {flatten_tol!r}")
     if join_tol is not None and not positive(join_tol):
         raise OutlineError(f"--join-tol must be a length in drawing units > 0, got {join_tol!r}")
     if units is not None and units not in MM_PER_UNIT:
         raise OutlineError(f"--units must be one of {', '.join(MM_PER_UNIT)}, got {units!r}")
+
+
+def _chordal_tolerance(flatten_tol, diagonal: float, scale: float) -> float:
+    """The chordal tolerance in drawing units: ``flatten_tol`` mm when given, else
+    :data:`DEFAULT_FLATTEN_TOL` mm or :data:`FLATTEN_FRACTION` of the drawing's
+    ``diagonal`` (drawing units), whichever is larger; ``scale`` is mm per drawing unit."""
+    if flatten_tol is not None:
+        return flatten_tol / scale
+    relative = FLATTEN_FRACTION * diagonal if math.isfinite(diagonal) else 0.0
+    return max(DEFAULT_FLATTEN_TOL / scale, relative)
 
 
 def _extent(pieces) -> float:
@@ -185,7 +201,8 @@ def _dxf_units(doc, override) -> Units:
                  units.conversion_factor(code, units.MM))
 
 
-def _dxf_pieces(path: Path, layer, handle, tol, override) -> tuple[list[_Piece], Units]:
+def _dxf_pieces(path: Path, layer, handle, flatten_tol, override) -> tuple[list[_Piece], Units, float]:
+    """The flattened pieces of a DXF's chosen entities, their units and the chordal tolerance (mm)."""
     import ezdxf
     from ezdxf import path as ezpath
     try:
@@ -194,23 +211,22 @@ def _dxf_pieces(path: Path, layer, handle, tol, override) -> tuple[list[_Piece],
         raise OutlineError(f"{path} is not a readable DXF file: {exc}".splitlines()[0]) from None
     unit = _dxf_units(doc, override)
     kinds = {"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE"}
+    chosen = [(e, ezpath.make_path(e)) for e in _dxf_entities(doc.modelspace())
+              if e.dxftype() in kinds and (layer is None or e.dxf.layer == layer)
+              and (handle is None or e.dxf.handle.upper() == str(handle).upper())]
+    box = ezpath.bbox([p for _, p in chosen], fast=True) if chosen else None
+    diagonal = float(np.hypot(box.size.x, box.size.y)) if box is not None and box.has_data else 0.0
+    tol = _chordal_tolerance(flatten_tol, diagonal, unit.scale)
     pieces = []
-    for e in _dxf_entities(doc.modelspace()):
-        kind = e.dxftype()
-        if kind not in kinds:
-            continue
-        if layer is not None and e.dxf.layer != layer:
-            continue
-        if handle is not None and e.dxf.handle.upper() != str(handle).upper():
-            continue
+    for e, curve in chosen:
         # ezdxf flattens with a maximum chord-to-curve distance: the chordal tolerance.
-        pts = np.array([(v.x, v.y) for v in ezpath.make_path(e).flattening(distance=tol / unit.scale)],
-                       dtype=float)
+        pts = np.array([(v.x, v.y) for v in curve.flattening(distance=tol)], dtype=float)
         if len(pts) < 2:
             continue
+        kind = e.dxftype()
         closed = bool(getattr(e, "closed", False) or getattr(e, "is_closed", False)) or kind == "CIRCLE"
         pieces.append(_Piece(pts, f"{kind} {e.dxf.handle} on layer {e.dxf.layer}", closed))
-    return pieces, unit
+    return pieces, unit, tol * unit.scale
 
 
 def _dxf_entities(space):
@@ -262,7 +278,8 @@ def _svg_units(svg, override) -> tuple[Units, float]:
                  user_mm), 1.0 / px_per_user
 
 
-def _svg_pieces(path: Path, want_id, tol, override) -> tuple[list[_Piece], Units]:
+def _svg_pieces(path: Path, want_id, flatten_tol, override) -> tuple[list[_Piece], Units, float]:
+    """The flattened pieces of an SVG's chosen shapes, their units and the chordal tolerance (mm)."""
     import svgelements as se
     try:
         svg = se.SVG.parse(str(path), ppi=96.0)  # transforms and viewBox applied
@@ -270,7 +287,7 @@ def _svg_pieces(path: Path, want_id, tol, override) -> tuple[list[_Piece], Units
         raise OutlineError(f"{path} is not a readable SVG file: {exc}".splitlines()[0]) from None
     unit, user_per_px = _svg_units(svg, override)
     flip = np.array([user_per_px, -user_per_px])
-    pieces = []
+    chosen = []
     for k, el in enumerate(svg.elements()):
         if not isinstance(el, se.Shape) or isinstance(el, se.Group):
             continue
@@ -280,12 +297,26 @@ def _svg_pieces(path: Path, want_id, tol, override) -> tuple[list[_Piece], Units
         label = f"<{type(el).__name__.lower()} id={eid!r}>" if eid else f"{type(el).__name__.lower()} #{k}"
         shape = se.Path(el)
         shape.reify()  # bake the transform into the coordinates
-        tol_px = tol / (unit.scale * user_per_px)
+        chosen.append((label, shape))
+    tol_px = _chordal_tolerance(flatten_tol, _svg_diagonal(s for _, s in chosen) * user_per_px,
+                                unit.scale) / user_per_px
+    pieces = []
+    for label, shape in chosen:
         subs = [(sub, closed) for sub, closed in _subpaths(shape, tol_px) if len(sub) >= 2]
         for i, (sub, closed) in enumerate(subs, start=1):
             pts = np.array(sub, dtype=float) * flip
             pieces.append(_Piece(pts, label + (f" subpath {i}" if len(subs) > 1 else ""), closed))
-    return pieces, unit
+    return pieces, unit, tol_px * user_per_px * unit.scale
+
+
+def _svg_diagonal(shapes) -> float:
+    """The diagonal of the shapes' joint bounding box (svgelements' pixels; 0 for none)."""
+    boxes = [b for b in (shape.bbox() for shape in shapes) if b is not None]
+    if not boxes:
+        return 0.0
+    lo = np.min([b[:2] for b in boxes], axis=0)
+    hi = np.max([b[2:] for b in boxes], axis=0)
+    return float(np.hypot(*(hi - lo)))
 
 
 def _subpaths(shape, tol_px):

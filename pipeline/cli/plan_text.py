@@ -1,0 +1,129 @@
+"""What ``pinfeed plan`` prints: a plan result for people, and its ``--json`` summary.
+
+:func:`print_plan_result` prints the part's stable states, each tight plan
+(pins, claimed final sets, verified width, margin) and paper mode's plans;
+:func:`plan_json` is the one JSON document of ``plan --json``.
+"""
+from __future__ import annotations
+
+from pipeline.planning.arcs import format_arcs, merge_modulo
+
+
+def _verification_counts(plan) -> dict | None:
+    v = plan.get("verification")
+    if not v:
+        return None
+    reasons = {}
+    for row in v.get("rows", []):
+        for k, n in row.get("reasons", {}).items():
+            reasons[k] = reasons.get(k, 0) + n
+    return {"trials": v["trials"], "successes": v["successes"], "failures": v["failures"],
+            "reasons": reasons}
+
+
+def _plan_summary(plan, pins=None) -> dict:
+    heights = plan.get("pin_heights_mm") or [pins[p] for p in plan["pins"]]
+    orientation = (plan.get("verification") or {}).get("orientation")
+    return {"pins": list(plan["pins"]), "pin_heights_mm": list(heights),
+            "final_sets": plan["final_sets"], "n_final_sets": plan["n_final_sets"],
+            "claimed_width_deg": _claimed_width(plan), "claim": plan.get("claim"),
+            "verified_width_deg": orientation["width_deg"] if orientation else None,
+            "orients": orientation["orients"] if orientation else None,
+            "verification": _verification_counts(plan)}
+
+
+def _claimed_width(plan) -> float | None:
+    """Width (deg) of the claimed final orientation, if it is one arc."""
+    sets = plan.get("final_sets") or []
+    return float(sets[0]["width"]) if len(sets) == 1 else None
+
+
+def plan_json(result, mode) -> dict:
+    """The one JSON document of ``plan --json``: the tight plans per friction and paper mode's."""
+    out = {"part": result["part"]["name"], "part_id": result["part"]["id"], "mode": mode,
+           "belt_speed": result.get("belt_speed"), "mu_s": result.get("mu_s")}
+    tight = result.get("tight")
+    if tight:
+        first = tight[0]
+        out.update(mu_c=first["mu_c"], warning=first["warning"], tolerance_deg=first.get("tolerance_deg"),
+                   support_family=(first.get("support_family") or {}).get("label", "uniform"),
+                   orients=first.get("orients"), pins_used=first.get("pins_used"),
+                   evidence=(first.get("fixed_pin_search") or {}).get("evidence"),
+                   recommended=_plan_summary(first["recommended"]) if first["recommended"] else None,
+                   plans=[_plan_summary(p) for p in first["plans"]],
+                   rejected=[_plan_summary(p) for p in first["rejected"]],
+                   frictions=[{"mu_c": t["mu_c"], "warning": t["warning"],
+                               "plans": [_plan_summary(p) for p in t["plans"]]} for t in tight])
+    if "plans" in result and mode != "tight":
+        paper = {"mu_c": result["mu_c"], "plans": [_plan_summary(p, result["pins"]) for p in result["plans"]]}
+        if mode == "paper":
+            out.update(paper)
+        else:
+            out["paper"] = paper
+    return out
+
+
+def print_plan_result(result, part, config, mode):
+    """A plan result (the dict ``plan_command`` returns), for people."""
+    from pipeline.planning.plan import mechanics_label, planner_belt
+    from pipeline.planning.types import as_plan_file
+    result = as_plan_file(result)
+    pc = config["planner"]
+    print(f"part {part.id}: model {mechanics_label(pc['model'], *planner_belt(config))}, depth {pc['depth']}")
+    for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
+        print(f"  state {k}: resting on the fence at theta = {theta:.1f} deg, y_c = {y_c:.2f} mm")
+    for t in result.tight or ():
+        order = t.symmetry_order or part.symmetry_order()
+        st = t.stats
+        print(f"tight planner, friction {t.friction}: {st['rollouts']} new rollouts in "
+              f"{st['seconds']:.0f} s, stored under {config['catalog_dir']}/refine/{part.id}/")
+        family = t.extra.get("support_family")
+        if family:
+            print(f"  for every member of the support family {family['label']} ({len(family['members'])} "
+                  f"supports; nominal paths under {', '.join(family['extremes'])})")
+        search = t.extra.get("fixed_pin_search")
+        if search:
+            print(f"  {search['evidence']}")
+        if t.warning:
+            print(f"  WARNING: {t.warning}")
+        for k, plan in enumerate(t.plans, start=1):
+            v = plan.verification
+            heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))
+            mark = " (recommended)" if t.recommended is not None and plan == t.recommended else ""
+            print(f"  #{k}{mark}: {heights} -> claimed {plan.n_final_sets} set(s) "
+                  f"({plan.extra.get('claim', 'propagated')}): {sets_text(plan.final_arcs, order)}; "
+                  f"{_orientation_text(v)}; margin in d "
+                  + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
+    if mode == "tight" or result.plans is None:
+        return
+    print(f"paper-mode planner (adjusted bands), {result.extra['selection']}:")
+    if not result.plans:
+        print("  no allowed pin sequence within the depth")
+    speeds = result.pin_speeds
+    for k, plan in enumerate(result.plans, start=1):
+        heights = ", ".join(f"{q} at {result.pins[q]:g} mm" + (f" moving {speeds[q]:+g} v_b" if q in speeds else "")
+                            for q in plan.pins)
+        print(f"  #{k}: {heights} -> {plan.n_final_sets} final set(s): "
+              f"{format_arcs(plan.final_arcs)}; "
+              f"margin in d {plan.margin:.3f}")
+
+
+def sets_text(arcs, order: int) -> str:
+    """Final orientation sets for people, one arc per set: on a part with ``order``-fold
+    rotational symmetry (``order`` > 1) the copies ``360 / order`` deg apart are one
+    set, shown once in [0, 360 / order) and marked ``(xK by symmetry)``."""
+    if order <= 1 or not arcs:
+        return format_arcs(arcs)
+    pairs = [(s["start"], s["width"]) if isinstance(s, dict) else tuple(s) for s in arcs]
+    return f"{format_arcs(merge_modulo(pairs, order))} (x{order} by symmetry)"
+
+
+def _orientation_text(v) -> str:
+    """Verified width next to the claim: how many trials ended in one set within the tolerance."""
+    o = v.extra.get("orientation") if v else None
+    if not o:
+        return f"verified {v.successes}/{v.trials} trials in the claimed sets" if v else "not verified"
+    width = "n/a" if o["width_deg"] is None else f"{o['width_deg']:.1f} deg"
+    verdict = "orients" if o["orients"] else f"{o['sets_within_tolerance']} sets of {o['tolerance_deg']:g} deg"
+    return (f"verified width {width} ({verdict}: {o['in_tolerance']}/{v.trials} trials in one set of "
+            f"{o['tolerance_deg']:g} deg; {v.successes}/{v.trials} in the claimed sets)")
