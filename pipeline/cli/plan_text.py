@@ -29,7 +29,24 @@ def _plan_summary(plan, pins=None) -> dict:
             "claimed_width_deg": _claimed_width(plan), "claim": plan.get("claim"),
             "verified_width_deg": orientation["width_deg"] if orientation else None,
             "orients": orientation["orients"] if orientation else None,
+            **_claim_numbers(orientation),
+            "selection": _selection_counts(plan),
             "verification": _verification_counts(plan)}
+
+
+def _claim_numbers(orientation) -> dict:
+    """The held-out claim's share with its lower confidence bound, and the width's interval."""
+    o = orientation or {}
+    return {key: o.get(key) for key in ("share", "share_lower_bound", "confidence", "point_rule",
+                                        "width_interval_deg")}
+
+
+def _selection_counts(plan) -> dict | None:
+    """The verdict on the trials that chose the plan, apart from the held-out claim."""
+    s = (plan.get("verification") or {}).get("selection")
+    if not s:
+        return None
+    return {key: s.get(key) for key in ("orients", "in_tolerance", "trials", "width_deg")}
 
 
 def _claimed_width(plan) -> float | None:
@@ -48,6 +65,7 @@ def plan_json(result, mode) -> dict:
         out.update(mu_c=first["mu_c"], warning=first["warning"], tolerance_deg=first.get("tolerance_deg"),
                    support_family=(first.get("support_family") or {}).get("label", "uniform"),
                    orients=first.get("orients"), pins_used=first.get("pins_used"),
+                   family_certificate=first.get("family_certificate"),
                    evidence=(first.get("fixed_pin_search") or {}).get("evidence"),
                    recommended=_plan_summary(first["recommended"]) if first["recommended"] else None,
                    plans=[_plan_summary(p) for p in first["plans"]],
@@ -84,6 +102,10 @@ def print_plan_result(result, part, config, mode):
         search = t.extra.get("fixed_pin_search")
         if search:
             print(f"  {search['evidence']}")
+        cert = t.extra.get("family_certificate")
+        if cert:
+            from pipeline.planning.family_certificate import family_certificate_line
+            print(f"  {family_certificate_line(cert)}")
         if t.warning:
             print(f"  WARNING: {t.warning}")
         for k, plan in enumerate(t.plans, start=1):
@@ -94,6 +116,7 @@ def print_plan_result(result, part, config, mode):
                   f"({plan.extra.get('claim', 'propagated')}): {sets_text(plan.final_arcs, order)}; "
                   f"{_orientation_text(v)}; margin in d "
                   + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
+            _print_claim(plan)
     if mode == "tight" or result.plans is None:
         return
     print(f"paper-mode planner (adjusted bands), {result.extra['selection']}:")
@@ -116,6 +139,22 @@ def sets_text(arcs, order: int) -> str:
         return format_arcs(arcs)
     pairs = [(s["start"], s["width"]) if isinstance(s, dict) else tuple(s) for s in arcs]
     return f"{format_arcs(merge_modulo(pairs, order))} (x{order} by symmetry)"
+
+
+def _print_claim(plan) -> None:
+    """The held-out claim with its uncertainty, the selection trials apart, the margin in words."""
+    from pipeline.planning.complete import margin_text
+    from pipeline.planning.orient import describe_claim
+    v = plan.verification
+    o = v.extra.get("orientation") if v else None
+    if o and "share_lower_bound" in o:
+        where = "held-out trials" if v.extra.get("held_out") else "trials"
+        print(f"      {where}: {describe_claim(o)}")
+        sel = v.extra.get("selection")
+        if sel:
+            print(f"      selection trials (chose the plan; no claim): {sel['in_tolerance']}/{sel['trials']} "
+                  "in one set" + (f", width {sel['width_deg']:.1f} deg" if sel.get("width_deg") is not None else ""))
+    print(f"      {margin_text(plan.margin)}")
 
 
 def _orientation_text(v) -> str:

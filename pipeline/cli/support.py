@@ -28,6 +28,9 @@ def cmd_support_fit(args):
     config = load_config(args.config)
     part = plan_part_arg(args, config)
     pushes = read_pushes(args.pushes)
+    if args.family:
+        _fit_family(args, part, pushes)
+        return
     fit = fit_support(part, pushes, args.mu_c, args.pin_radius, n_points=args.points,
                       starts=args.starts, refine=args.refine, seed=args.seed)
     result = {"part": part.name, "part_id": part.id, **fit.to_dict()}
@@ -54,6 +57,24 @@ def cmd_support_fit(args):
         print(f"stored at {args.out}")
 
 
+def _fit_family(args, part, pushes) -> None:
+    """``support fit --family``: the supports consistent with the pushes within their noise."""
+    from pipeline.maps.support_fit import fit_support_family
+    fam = fit_support_family(part, pushes, args.mu_c, args.pin_radius, noise_deg=args.noise_deg,
+                             n_points=args.points, starts=args.starts, refine=args.refine, seed=args.seed)
+    result = {"part": part.name, "part_id": part.id, **fam.to_dict()}
+    if args.out:
+        from pipeline.maps.io import write_json
+        from pipeline.provenance import provenance_attrs
+        write_json({**result, **provenance_attrs()}, args.out)
+    if args.json:
+        print_json(result)
+        return
+    print(fam.line())
+    if args.out:
+        print(f"stored at {args.out}")
+
+
 def add_support_commands(sub) -> None:
     """``support fit``: a point support from measured pushes."""
     sup = sub.add_parser("support", help="support distributions: fit one to measured pushes")
@@ -72,6 +93,11 @@ def add_support_commands(sub) -> None:
     q.add_argument("--starts", type=int, default=48, help="random layouts tried before refining (default 48)")
     q.add_argument("--refine", type=int, default=4, help="best layouts refined by least squares (default 4)")
     q.add_argument("--seed", type=int, default=0, help="seed of the random layouts (default 0)")
+    q.add_argument("--family", action="store_true",
+                   help="return every support consistent with the pushes within their noise, as a "
+                        "--support-family text (default: the one best support)")
+    q.add_argument("--noise-deg", dest="noise_deg", type=float, default=None,
+                   help="with --family: the pushes' measurement noise, deg (default: estimated from the best fit)")
     q.add_argument("--out", default=None, help="store the fit as JSON (with its settings and provenance)")
     add_json_option(q, "print JSON instead of text")
     q.set_defaults(func=cmd_support_fit)

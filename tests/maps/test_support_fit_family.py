@@ -64,3 +64,22 @@ def test_bad_noise_is_one_line():
     truth = point_support(TRIANGLE, LEGS, statics_weights(LEGS))
     with pytest.raises(PinfeedError, match="noise-deg"):
         fit_support_family(TRIANGLE, _pushes(truth, 10, seed=2), MU, 3.0, noise_deg=-1.0)
+
+
+def test_cli_fit_family_prints_a_family_text_and_refuses_too_few_pushes(tmp_path, capsys):
+    from cli_runs import run_cli
+    pushes = _pushes(point_support(TRIANGLE, LEGS, statics_weights(LEGS)), 14, 5)
+    csv = tmp_path / "pushes.csv"
+    csv.write_text("theta_i_deg,d,theta_f_deg\n" + "".join(
+        f"{t:.4f},{d:.4f},{f:.4f}\n" for t, d, f in zip(pushes.theta_i, pushes.d, pushes.theta_f)))
+    args = ["support", "fit", "--vertices", "0,0 60,0 15,35", "--name", "asym_triangle", "--pushes", str(csv),
+            "--mu-c", str(MU), "--family", "--noise-deg", "1.5", "--starts", "16", "--refine", "2"]
+    code, out, err = run_cli(capsys, args)
+    assert code == 0, err
+    text = out.split('--support-family "')[1].rstrip().rstrip('"')
+    assert len(parse_support_family(text, TRIANGLE).members) >= 1
+    few = tmp_path / "few.csv"
+    few.write_text("theta_i_deg,d,theta_f_deg\n" + "".join(
+        f"{t:.4f},{d:.4f},{f:.4f}\n" for t, d, f in list(zip(pushes.theta_i, pushes.d, pushes.theta_f))[:4]))
+    code, out, err = run_cli(capsys, args[:7] + [str(few)] + args[8:])
+    assert code == 2 and err.count("\n") == 1 and "pushes" in err
