@@ -5,7 +5,7 @@ members that stands for a set of distributions. Plans made for a family must
 orient the part for every member (``pinfeed plan --support-family``); maps
 and reports compare the members with uniform pressure. How a family is
 sampled and how its extremes are found is spec section 9
-(``docs/spec-supports.md``); in short:
+(``docs/explanation/spec-supports.md``); in short:
 
 ``tripods:N[:inset=F][:seed=S]``
     Any three points within the outline, at least ``F a`` from its edge
