@@ -135,3 +135,40 @@ def test_margin_is_said_in_words():
     assert "inside the safe band" in margin_text(0.026)
     assert "no pin touches" in margin_text(float("inf"))
     assert orientation_rank({"orients": True, "point_rule": True, "width_deg": 3.0}, 2, 0.1)[:2] == (0, 0)
+
+
+def _default_raw_config():
+    import yaml
+
+    from pipeline.config import DEFAULT_CONFIG
+    with open(DEFAULT_CONFIG) as fh:
+        return yaml.safe_load(fh)
+
+
+@pytest.mark.parametrize("bad", [0.0, 1.0, -0.5, 1.5])
+def test_confidence_outside_unit_interval_is_refused_by_config_validation(bad):
+    from pipeline.config import validate_config
+    raw = _default_raw_config()
+    raw["verify"]["confidence"] = bad
+    with pytest.raises(PinfeedError) as err:
+        validate_config(raw)
+    assert "\n" not in str(err.value) and "verify/confidence" in str(err.value)
+
+
+@pytest.mark.parametrize("bad", [0.0, 1.0, 1.5])
+def test_confidence_outside_unit_interval_is_refused_by_the_planner_settings(bad):
+    from pipeline.planning.plan import verify_confidence
+    with pytest.raises(PinfeedError) as err:
+        verify_confidence({"verify": {"confidence": bad}})
+    assert "\n" not in str(err.value) and "verify.confidence" in str(err.value)
+
+
+def test_fewer_held_out_than_selection_trials_is_refused_by_config_validation():
+    from pipeline.config import validate_config
+    raw = _default_raw_config()
+    raw["verify"]["holdout_trials"] = raw["verify"]["trials"] - 1
+    with pytest.raises(PinfeedError) as err:
+        validate_config(raw)
+    assert "\n" not in str(err.value) and "verify/holdout_trials" in str(err.value)
+    raw["verify"]["holdout_trials"] = raw["verify"]["trials"]
+    assert validate_config(raw)["verify"]["holdout_trials"] == raw["verify"]["trials"]
