@@ -158,6 +158,7 @@ class FixedPlan:
     selection: dict | None = None
 
     def width(self):
+        """The verified width (deg) of the plan's verdict; None before it is judged."""
         return (self.verdict or {}).get("width_deg")
 
     def rank_key(self):
