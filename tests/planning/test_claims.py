@@ -172,3 +172,17 @@ def test_fewer_held_out_than_selection_trials_is_refused_by_config_validation():
     assert "\n" not in str(err.value) and "verify/holdout_trials" in str(err.value)
     raw["verify"]["holdout_trials"] = raw["verify"]["trials"]
     assert validate_config(raw)["verify"]["holdout_trials"] == raw["verify"]["trials"]
+
+
+def test_describe_claim_says_share_bound_width_and_verdict_in_one_line():
+    clean = orient.judge(np.linspace(0.0, 5.0, N), N, 10.0, required=REQUIRED, interval=True)
+    text = orient.describe_claim(clean)
+    assert "\n" not in text and text.endswith(": orients the part")
+    assert f"{N}/{N} trials" in text and "at least 99.73 % with 95 % confidence" in text
+    assert "bootstrap interval" in text
+    # 5 failures in 1092: the point rule holds (99.54 %) but its lower bound (about 99.0 %) does not
+    near = orient.judge(_synthetic_finals(N - 5, N), N, 10.0, required=REQUIRED)
+    assert near["point_rule"] and not near["orients"]
+    assert orient.describe_claim(near).endswith("a near miss)")
+    worse = orient.judge(_synthetic_finals(N - 20, N), N, 10.0, required=REQUIRED)
+    assert orient.describe_claim(worse).endswith(": does not orient the part")
