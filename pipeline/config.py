@@ -133,7 +133,19 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
                            f"{', '.join(cfg['planner']['parts']) or 'none'}")
     _check_support_study(cfg)
     _check_sweep_supports(cfg)
+    _check_holdout_trials(cfg)
     return cfg
+
+
+def _check_holdout_trials(cfg: dict) -> None:
+    """The held-out trials that certify a plan may not be fewer than the
+    verification trials that chose it (one-line error otherwise)."""
+    verify = cfg.get("verify", {})
+    held, trials = verify.get("holdout_trials"), verify.get("trials", 300)
+    if held is not None and int(held) < int(trials):
+        raise PinfeedError(f"config error at verify/holdout_trials: {held} is fewer than verify/trials "
+                           f"({trials}); the trials that certify a plan may not be fewer than those "
+                           "that chose it (give at least that many, or null for as many)")
 
 
 def _check_sweep_supports(cfg: dict) -> None:

@@ -158,7 +158,8 @@ class FixedPlan:
     selection: dict | None = None
 
     def width(self):
-        """The verified width (deg) of the plan's verdict, None if too many trials jammed."""
+        """The verified width (deg) of the plan's verdict (None before it is judged, or
+        when too many trials jammed)."""
         return (self.verdict or {}).get("width_deg")
 
     def rank_key(self):

@@ -135,3 +135,54 @@ def test_margin_is_said_in_words():
     assert "inside the safe band" in margin_text(0.026)
     assert "no pin touches" in margin_text(float("inf"))
     assert orientation_rank({"orients": True, "point_rule": True, "width_deg": 3.0}, 2, 0.1)[:2] == (0, 0)
+
+
+def _default_raw_config():
+    import yaml
+
+    from pipeline.config import DEFAULT_CONFIG
+    with open(DEFAULT_CONFIG) as fh:
+        return yaml.safe_load(fh)
+
+
+@pytest.mark.parametrize("bad", [0.0, 1.0, -0.5, 1.5])
+def test_confidence_outside_unit_interval_is_refused_by_config_validation(bad):
+    from pipeline.config import validate_config
+    raw = _default_raw_config()
+    raw["verify"]["confidence"] = bad
+    with pytest.raises(PinfeedError) as err:
+        validate_config(raw)
+    assert "\n" not in str(err.value) and "verify/confidence" in str(err.value)
+
+
+@pytest.mark.parametrize("bad", [0.0, 1.0, 1.5])
+def test_confidence_outside_unit_interval_is_refused_by_the_planner_settings(bad):
+    from pipeline.planning.plan import verify_confidence
+    with pytest.raises(PinfeedError) as err:
+        verify_confidence({"verify": {"confidence": bad}})
+    assert "\n" not in str(err.value) and "verify.confidence" in str(err.value)
+
+
+def test_fewer_held_out_than_selection_trials_is_refused_by_config_validation():
+    from pipeline.config import validate_config
+    raw = _default_raw_config()
+    raw["verify"]["holdout_trials"] = raw["verify"]["trials"] - 1
+    with pytest.raises(PinfeedError) as err:
+        validate_config(raw)
+    assert "\n" not in str(err.value) and "verify/holdout_trials" in str(err.value)
+    raw["verify"]["holdout_trials"] = raw["verify"]["trials"]
+    assert validate_config(raw)["verify"]["holdout_trials"] == raw["verify"]["trials"]
+
+
+def test_describe_claim_says_share_bound_width_and_verdict_in_one_line():
+    clean = orient.judge(np.linspace(0.0, 5.0, N), N, 10.0, required=REQUIRED, interval=True)
+    text = orient.describe_claim(clean)
+    assert "\n" not in text and text.endswith(": orients the part")
+    assert f"{N}/{N} trials" in text and "at least 99.73 % with 95 % confidence" in text
+    assert "bootstrap interval" in text
+    # 5 failures in 1092: the point rule holds (99.54 %) but its lower bound (about 99.0 %) does not
+    near = orient.judge(_synthetic_finals(N - 5, N), N, 10.0, required=REQUIRED)
+    assert near["point_rule"] and not near["orients"]
+    assert orient.describe_claim(near).endswith("a near miss)")
+    worse = orient.judge(_synthetic_finals(N - 20, N), N, 10.0, required=REQUIRED)
+    assert orient.describe_claim(worse).endswith(": does not orient the part")

@@ -32,9 +32,10 @@ def test_recommended_plan_passes_a_fresh_replay(name, tmp_path):
     held = rec["verification"]
     assert held["held_out"] and held["orientation"]["share_lower_bound"] >= config["verify"]["required"]
     assert held["selection"] is not None and held["seed"] != config["verify"]["seed"]
+    speeds = dict(zip(rec["pins"], rec.get("pin_speeds") or [0.0] * len(rec["pins"])))
     fresh = verify_plan(part, rec, dict(zip(rec["pins"], rec["pin_heights_mm"])), resting_states(part), mu_c,
                         config["sweep"]["pin_radius"], config["planner"]["model"],
-                        dict(config["verify"], seed=FRESH_SEED), speeds=rec.get("pin_speeds") or {},
+                        dict(config["verify"], seed=FRESH_SEED), speeds=speeds,
                         kernel=config["sweep"].get("kernel"))
     verdict = judge_verification(fresh, entry["tolerance_deg"], entry["symmetry_order"],
                                  config["verify"]["required"], config["verify"]["confidence"])

@@ -134,9 +134,14 @@ def test_report_numbers_match_the_verify_json(workflow):
     for name in ("tri", "rect"):
         for t in json.loads((results / "plans" / f"{name}.json").read_text())["tight"]:
             o = (t["recommended"] or {}).get("verification", {}).get("orientation")
-            if o:
+            if o:  # the width with its bootstrap interval, the held-out share with its lower bound
+                lo, hi = o["width_interval_deg"]
+                held = " held-out" if t["recommended"]["verification"]["held_out"] else ""
                 widths.append((f"{o['width_deg']:.1f}" if o["width_deg"] is not None else "n/a")
-                              + f": {o['in_tolerance']}/{o['trials']} in {o['tolerance_deg']:g} deg")
+                              + (f" [{lo:.1f}, {hi:.1f}]" if lo is not None and hi is not None else "")
+                              + f": {o['in_tolerance']}/{o['trials']}{held} in {o['tolerance_deg']:g} deg"
+                              + f", share >= {100 * o['share_lower_bound']:.2f} % at {100 * o['confidence']:g} %"
+                              " confidence")
     assert [r[6].split(" (")[0] for r in side if r[0].startswith("tight")] == widths
     assert all(int(r[3]) == 3 + 2 ** (3 + len(r[0].split())) for r in table)  # verify.trials 3 + corners
 
