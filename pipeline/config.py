@@ -264,7 +264,12 @@ def load_config(path=None) -> dict:
 # attribute, so its bytes) of a config that does not use it.
 HASH_NEUTRAL_DEFAULTS = {("sweep", "supports"): ["uniform"],
                          ("planner", "support_family"): None,
-                         ("support_study",): {"family": None, "parts": []}}
+                         ("support_study",): {"family": None, "parts": []},
+                         # the claim's settings: a config that leaves them alone keeps its hash
+                         # (and its shards' recorded hash); the code version records the change
+                         ("verify", "confidence"): 0.95, ("verify", "rule"): "bound",
+                         ("verify", "holdout_trials"): None, ("planner", "width_slack_deg"): 1.0,
+                         ("planner", "worst_member_budget"): 150}
 
 
 def config_hash(config: dict) -> str:

@@ -186,3 +186,19 @@ def test_describe_claim_says_share_bound_width_and_verdict_in_one_line():
     assert orient.describe_claim(near).endswith("a near miss)")
     worse = orient.judge(_synthetic_finals(N - 20, N), N, 10.0, required=REQUIRED)
     assert orient.describe_claim(worse).endswith(": does not orient the part")
+
+
+def test_claim_settings_at_their_defaults_leave_the_config_hash():
+    """A config that does not touch the claim's settings keeps its hash (and the
+    hash its map shards record); changing one changes it."""
+    from pipeline.config import config_hash, load_config
+    config = load_config()
+    before = config_hash(config)
+    for section, key in [("verify", "confidence"), ("verify", "rule"), ("verify", "holdout_trials"),
+                         ("planner", "width_slack_deg"), ("planner", "worst_member_budget")]:
+        assert key in config[section]
+        del config[section][key]
+    assert config_hash(config) == before
+    changed = load_config()
+    changed["verify"]["confidence"] = 0.9
+    assert config_hash(changed) != before
