@@ -71,8 +71,18 @@ NodeName=$NODE NodeAddr=127.0.0.1 CPUs=$CPUS RealMemory=$MEMORY State=UNKNOWN
 PartitionName=debug Nodes=$NODE Default=YES MaxTime=INFINITE State=UP
 CONF
 export SLURM_CONF="$FOLDER/slurm.conf"
+# The Snakemake SLURM job step drops SLURM_* variables (SLURM_CONF too) before
+# its inner srun, which then looks at the compiled-in /etc/slurm/slurm.conf:
+# with SLURM_UP_SYSTEM_CONF=1 (and no such file yet) link it there while up.
+SYSTEM_CONF=/etc/slurm/slurm.conf
+LINKED_SYSTEM_CONF=""
+if [ "${SLURM_UP_SYSTEM_CONF:-0}" = "1" ] && [ ! -e "$SYSTEM_CONF" ] && mkdir -p /etc/slurm 2>/dev/null \
+        && ln -s "$SLURM_CONF" "$SYSTEM_CONF" 2>/dev/null; then
+    LINKED_SYSTEM_CONF="$SYSTEM_CONF"
+fi
 
 stop_cluster() {
+    if [ -n "$LINKED_SYSTEM_CONF" ]; then rm -f "$LINKED_SYSTEM_CONF"; fi
     for pidfile in "$FOLDER/slurmd.pid" "$FOLDER/slurmctld.pid" "$FOLDER/munge/munged.pid"; do
         if [ -s "$pidfile" ]; then kill "$(cat "$pidfile")" 2>/dev/null || true; fi
     done
