@@ -111,7 +111,7 @@ def _running_plan_job(env, timeout=400):
 
 
 # Provenance that differs by design between two runs: the write time, and the
-# commit of the code the job imported (a shared editable install may differ).
+# commit recorded when each job ran (HEAD may move between the two runs).
 RUN_STAMPS = {"created", "git_commit"}
 
 
