@@ -12,6 +12,8 @@ rule atlas:
         csv=f"{RESULTS}/atlas.csv",
     log:
         f"{LOGS}/atlas.log",
+    benchmark:
+        f"{LOGS}/benchmark/atlas.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:

@@ -15,6 +15,8 @@ rule layout:
         settings=config["layout"],
     log:
         f"{LOGS}/layout/{{name}}.log",
+    benchmark:
+        f"{LOGS}/benchmark/layout/{{name}}.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:

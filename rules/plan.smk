@@ -29,6 +29,8 @@ rule plan:
         sweep={k: config["sweep"][k] for k in ("pin_radius", "kernel")},
     log:
         f"{LOGS}/plan/{{name}}.log",
+    benchmark:
+        f"{LOGS}/benchmark/plan/{{name}}.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:

@@ -15,6 +15,8 @@ rule speed:
         pin_radius=config["sweep"]["pin_radius"],
     log:
         f"{LOGS}/speed/{{name}}.log",
+    benchmark:
+        f"{LOGS}/benchmark/speed/{{name}}.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:

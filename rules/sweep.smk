@@ -8,6 +8,8 @@ rule sweep_shard:
         spec=shard_params,
     log:
         "logs/sweep/{family}/{part}/{model}/{tag}.log",
+    benchmark:
+        "logs/benchmark/sweep/{family}/{part}/{model}/{tag}.tsv"
     threads: 2
     resources:
         mem_mb=1000,
