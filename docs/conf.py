@@ -29,7 +29,7 @@ extensions = [
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
-exclude_patterns = ["_build", "_tools", "_ext", "examples/README.txt", "**/GALLERY_HEADER.rst"]
+exclude_patterns = ["_build", "_ext", "examples/README.txt", "**/GALLERY_HEADER.rst"]
 myst_enable_extensions = ["colon_fence", "deflist"]
 myst_heading_anchors = 3
 suppress_warnings = ["config.cache"]  # the gallery's conf entries hold functions

@@ -1,4 +1,4 @@
-# Stage 8: the feedability atlas (issue 23): one row per planned part from its
+# Stage 8: the feedability atlas: one row per planned part from its
 # plan, speed limit and layout files, as JSON and CSV; the report opens with it.
 
 

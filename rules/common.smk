@@ -44,5 +44,5 @@ PLANNED = config["planner"]["parts"]
 BAND_FILES = [
     p.replace(f"{CATALOG}/", f"{RESULTS}/bands/", 1).replace(".h5", ".json") for p in JOBS
 ]
-# Parts whose plans are replayed against the support family (support_study; issue 25).
+# Parts whose plans are replayed against the support family (support_study).
 STUDIED = studied_parts(config)

@@ -1,4 +1,4 @@
-# Stage 7: a feeder to build (issue 19): pin stations, part pitch, belt width,
+# Stage 7: a feeder to build: pin stations, part pitch, belt width,
 # throughput and the drawing (JSON, DXF, SVG, PNG) of each planned part.
 
 

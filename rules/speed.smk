@@ -1,4 +1,4 @@
-# Stage 5c (issue 18): how fast may each plan run? The recommended tight plan
+# Stage 5c: how fast may each plan run? The recommended tight plan
 # of every planned part replayed with the dynamic model at belt speeds: its
 # success against speed (a figure) and its speed limit (JSON, in the report).
 

@@ -1,4 +1,4 @@
-# Stage 5d (issue 25): plans against a support family. Per studied part: how far
+# Stage 5d: plans against a support family. Per studied part: how far
 # the family moves theta_f from uniform pressure over the sweep's map grid,
 # whether the recommended plan survives the family, and if not, the plan that
 # does (JSON, in the report), with the maps of the family's extremes overlaid.

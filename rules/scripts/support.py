@@ -1,4 +1,4 @@
-"""Snakemake script: one part's plans against the support family (issue 25)."""
+"""Snakemake script: one part's plans against the support family."""
 from pipeline.logs import log_to
 from pipeline.workflow.supports import support_part, support_summary_text
 
