@@ -25,6 +25,8 @@ import os
 from pathlib import Path
 
 import numpy as np
+import subprocess
+import sys
 import pytest
 from hypothesis import HealthCheck, settings
 
@@ -88,3 +90,25 @@ def warm_kernels(triangle):
     simulate.rollout(triangle, 30.0, 0.3, 0.2, 3.0, trajectory=True)
     simulate.compute_map(triangle, [0.0], [0.3], 0.2, 3.0)
     return True
+
+
+# ---------------------------------------------------------------- the manual (tests/docs)
+# Kept here, not in a tests/docs/conftest.py: the test folders import helpers
+# from this file by the bare name ``conftest``, which a second conftest would shadow.
+_DOCS_ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="session")
+def built_docs(tmp_path_factory) -> Path:
+    """The HTML manual, built with warnings as errors from a copy-free run of
+    Sphinx on ``docs/`` (its doctree cache in a temporary folder)."""
+    pytest.importorskip("sphinx")
+    out = tmp_path_factory.mktemp("docs_html")
+    doctrees = tmp_path_factory.mktemp("doctrees")
+    env = {**os.environ, "PYTHONPATH": f"{_DOCS_ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
+           "MPLBACKEND": "Agg"}
+    run = subprocess.run([sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q",
+                          "-d", str(doctrees), str(_DOCS_ROOT / "docs"), str(out)],
+                         cwd=_DOCS_ROOT, env=env, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, f"the docs build failed:\n{run.stdout}\n{run.stderr}"
+    return out
