@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import json
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
-import subprocess
-import sys
 import pytest
 from hypothesis import HealthCheck, settings
 
