@@ -50,6 +50,7 @@ from pipeline.parts.support import (Support, barycentric, boundary_distance, fil
 from pipeline.parts.support_family import (DEFAULT_INSET, MIN_LEG_WEIGHT, WARP_FILL, SupportFamily,
                                            parse_support_family, warp_modes)
 from pipeline.planning import orient
+from pipeline.planning.confidence import DEFAULT_CONFIDENCE
 from pipeline.planning.propagate import resting_states
 from pipeline.planning.settings import nominal_friction
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
@@ -497,7 +498,8 @@ def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings
     tf, _, jam, _ = replay(part, list(heights), list(speeds) or [0.0] * len(heights), th, yc, mu, offs,
                            st.pin_radius,
                            st.model, **kw, support=sup, supports=family.kernel_supports)
-    return orient.judge(tf[jam == ""], th.size, st.tolerance, part.symmetry_order(), st.required)
+    return orient.judge(tf[jam == ""], th.size, st.tolerance, part.symmetry_order(), st.required,
+                        st.verify.get("confidence", DEFAULT_CONFIDENCE), rule=st.verify.get("rule", "bound"))
 
 
 def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckSettings,
