@@ -5,10 +5,12 @@ folder and renamed into place, so an interrupted run never leaves a
 half-written file under the real name. A ``kill -9`` can leave the
 temporary file behind: its name starts with a dot and ends in ``.tmp``, so
 the catalog never reads it, and the workflow's start removes it
-(:func:`remove_stale_temps`).
+(:func:`remove_stale_temps`), as does a sweep once the shard it belongs to
+is in place (:func:`temps_beside`).
 """
 from __future__ import annotations
 
+import glob
 import json
 import os
 import tempfile
@@ -59,6 +61,13 @@ def remove_stale_temps(folder) -> list[Path]:
             tmp.unlink(missing_ok=True)
             gone.append(tmp)
     return gone
+
+
+def temps_beside(path) -> list[Path]:
+    """The temporary files that atomic writes of ``path`` left beside it (a
+    writer killed mid-write cannot remove its own)."""
+    path = Path(path)
+    return sorted(path.parent.glob(f".{glob.escape(path.name)}.*{TMP_SUFFIX}"))
 
 
 def write_atomic(ds: xr.Dataset, path, encoding=None) -> Path:

@@ -28,7 +28,7 @@ import numpy as np
 
 from pipeline.config import config_hash, mu_label, theta_grid
 from pipeline.maps import simulate
-from pipeline.maps.io import write_atomic
+from pipeline.maps.io import temps_beside, write_atomic
 from pipeline.parts.families import family_parts
 from pipeline.parts.part import Part
 from pipeline.parts.support import parse_support, support_key
@@ -173,7 +173,10 @@ def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
     With ``scheduler`` (a dask.distributed address such as ``tcp://host:8786``)
     the shards run as tasks on that cluster; otherwise here, one after
     another, each on ``threads`` Numba threads (or on this worker's GPU with
-    ``backend="cuda"``, overriding the config's ``sweep.backend``).
+    ``backend="cuda"``, overriding the config's ``sweep.backend``). A worker
+    that dies mid-sweep costs nothing but time: dask runs its tasks again on
+    the others, and the temporary file of a write it did not finish is
+    removed once the shard is in place.
     """
     from pipeline.maps.catalog import Catalog
     config = absolute_folders(config)
@@ -192,7 +195,21 @@ def run_sweep(config, scheduler: str | None = None, threads: int | None = None,
             written.append(write_shard(config, job, threads=threads, backend=backend))
     catalog = Catalog.rebuild(root)
     check_landed(catalog, written)
+    remove_killed_attempts(root, todo)
     return written
+
+
+def remove_killed_attempts(catalog_dir, jobs) -> list[Path]:
+    """Delete the temporary files beside the shards of ``jobs`` once those shards
+    are in place: a dask worker killed mid-write leaves its temporary file, and
+    dask runs the task again elsewhere. Two sweeps must not write the same
+    shards at the same time (one would remove the other's file in progress)."""
+    gone = []
+    for job in jobs:
+        for tmp in temps_beside(job.path(catalog_dir)):
+            tmp.unlink(missing_ok=True)
+            gone.append(tmp)
+    return gone
 
 
 def absolute_folders(config: dict) -> dict:
