@@ -214,7 +214,17 @@ class FixedSearch:
             text += (f"; best fixed-pin result: {' '.join(b.labels)} ends in {v['sets_within_tolerance']} "
                      f"set(s) of at most {self.tolerance:g} deg, at most {v['in_tolerance']} of "
                      f"{v['trials']} trials in one")
-        return text
+        return text + self._too_few_trials()
+
+    def _too_few_trials(self) -> str:
+        """Where some level's verification had too few trials for the claim at all."""
+        short = [lv for lv in self.levels if lv.get("too_few_trials")]
+        if not short:
+            return ""
+        need = orient.min_trials(self.required, self.confidence)
+        return (f"; {short[0]['too_few_trials']} trials per plan of {short[0]['pins']} pin(s) cannot show "
+                f"{100 * self.required:g} % at {100 * self.confidence:g} % confidence even with no failure "
+                f"(at least {need} are needed): raise verify.trials, or set verify.rule: point")
 
     def to_dict(self) -> dict:
         """The search's record for the plan file (``fixed_pin_search``)."""
@@ -348,16 +358,18 @@ class FixedPinSearch:
                   "orienting": 0, "not_screened": 0, "held_out": 0, "certified": 0}
         if level.size == 0:
             return [], [], record
+        n_pins = len(self.prefix.labels) + level.seq.shape[1]
+        inputs = self._trials(n_pins)
+        n_total = sum(x[0].size for x in inputs)
+        allowed = orient.max_failures(n_total, self.required, self.confidence, self.rule)
+        if allowed < 0:  # no plan of this length can be claimed, however it ends
+            record["too_few_trials"] = n_total
         span = orient.row_spans(level.theta, self.order)
         within = np.flatnonzero(span <= self.tolerance + SLACK_DEG)
         within = within[np.lexsort((-level.margin[within], span[within]))]
         record["nominal_within"] = int(within.size)
         if within.size == 0:
             return [], [], record
-        n_pins = len(self.prefix.labels) + level.seq.shape[1]
-        inputs = self._trials(n_pins)
-        n_total = sum(x[0].size for x in inputs)
-        allowed = orient.max_failures(n_total, self.required, self.confidence, self.rule)
         # A probe of a few trials per state orders the candidates (most promising
         # first) and already rejects the hopeless ones.
         probe_fails = self._failures(level, within, self._screen_rows(inputs, *PROBE))

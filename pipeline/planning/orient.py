@@ -81,6 +81,21 @@ def max_failures(n_trials: int, required: float, confidence: float = DEFAULT_CON
     return f
 
 
+def min_trials(required: float, confidence: float = DEFAULT_CONFIDENCE) -> int:
+    """The fewest trials whose every success gives a share lower bound of at
+    least ``required`` at ``confidence`` (the bound rule's floor).
+
+    Notes
+    -----
+    With no failure the one-sided Clopper-Pearson bound is
+    ``(1 - confidence) ** (1 / n)``, so ``n >= ln(1 - confidence) / ln(required)``.
+    """
+    n = max(1, math.ceil(math.log(1.0 - check_confidence(confidence)) / math.log(required)))
+    while share_lower_bound(n, n, confidence) < required:  # guard the closed form's rounding
+        n += 1
+    return n
+
+
 def _doubled(theta, period):
     """Sorted orientations modulo ``period``, followed by the same plus ``period``
     (so an arc through the period's end is a plain window)."""

@@ -202,3 +202,29 @@ def test_claim_settings_at_their_defaults_leave_the_config_hash():
     changed = load_config()
     changed["verify"]["confidence"] = 0.9
     assert config_hash(changed) != before
+
+
+@pytest.mark.parametrize("required, confidence", [(0.995, 0.95), (0.99, 0.9), (0.95, 0.99), (0.999, 0.95)])
+def test_min_trials_is_the_smallest_count_whose_clean_run_clears_the_bound(required, confidence):
+    """Against the zero-failure Clopper-Pearson bound in closed form, (1 - c) ** (1 / n)."""
+    brute = next(n for n in range(1, 100_000) if (1.0 - confidence) ** (1.0 / n) >= required)
+    assert orient.min_trials(required, confidence) == brute
+    assert orient.max_failures(brute, required, confidence) == 0
+    assert orient.max_failures(brute - 1, required, confidence) == -1
+
+
+def test_too_few_trials_for_the_claim_is_said_with_the_way_out():
+    """A search whose trials cannot support the bound at all says so, with the
+    number needed, instead of only 'no plan orients'."""
+    from pipeline.parts.part import Part
+    from pipeline.planning.complete import FixedPinSearch
+
+    part = Part.from_vertices([(0, 0), (50, 0), (0, 30)], "right_triangle")
+    search = FixedPinSearch(part, {"P1": 0.0, "P2": 8.0, "P3": 16.0}, (0.1, 0.2), 10.0, 0.995,
+                            {"trials": 10, "seed": 3, "rule": "bound"}, 3.0)
+    result = search.run(1, candidates=2, keep=2)
+    evidence = result.evidence()
+    assert not result.orients
+    assert all(lv.get("too_few_trials") for lv in result.levels)
+    assert "cannot show 99.5 % at 95 % confidence" in evidence and "at least 598 are needed" in evidence
+    assert "verify.trials" in evidence
