@@ -35,7 +35,7 @@ import json
 import os
 import platform
 import resource
-import shutil
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -67,12 +67,12 @@ def planner_sweep(config: dict) -> dict:
 
 
 def run_workflow(workdir: Path, config_path: Path, name: str, cores: int, profile: str | None,
-                 shards_only: bool) -> tuple[float, float, int]:
+                 shards_only: bool, extra: list[str] = ()) -> tuple[float, float, int]:
     """Run Snakemake to the atlas (or the catalog index); (wall s, children's CPU s, exit status)."""
     target = "catalog/index.json" if shards_only else f"results/{name}/atlas.json"
     cmd = [sys.executable, "-m", "snakemake", "--snakefile", str(ROOT / "Snakefile"),
            "--directory", str(workdir), "--configfile", str(config_path), "--cores", str(cores),
-           "--rerun-incomplete", "--quiet", "progress", target]
+           "--rerun-incomplete", "--quiet", "progress", *extra, target]
     if profile:
         cmd[cmd.index("--cores"):cmd.index("--cores") + 2] = ["--profile", str(ROOT / profile)]
     env = {**os.environ, "PYTHONPATH": str(ROOT), "PATH": f"{Path(sys.executable).parent}:{os.environ['PATH']}"}
@@ -149,6 +149,9 @@ def main() -> None:
     ap.add_argument("--sweep", choices=["planner", "config"], default="planner")
     ap.add_argument("--shards-only", action="store_true")
     ap.add_argument("--profile", default=None, help="a Snakemake profile, e.g. profiles/slurm")
+    ap.add_argument("--snakemake-args", default="",
+                    help="more Snakemake options, e.g. \"--slurm-status-command squeue\" for a cluster "
+                         "without accounting")
     ap.add_argument("--workdir", default=None, help="working folder (default: a fresh temporary one)")
     ap.add_argument("--project", default="2,4,8,16,32,64", help="core counts to project to")
     ap.add_argument("--json", default=None, help="also write the numbers to this JSON file")
@@ -167,7 +170,8 @@ def main() -> None:
     print(f"family atlas: {args.config} ({len(parts)} planned parts), sweep {args.sweep}, "
           f"{'profile ' + args.profile if args.profile else f'{args.cores} cores'}, in {workdir}", flush=True)
 
-    wall, cpu, status = run_workflow(workdir, config_path, name, args.cores, args.profile, args.shards_only)
+    wall, cpu, status = run_workflow(workdir, config_path, name, args.cores, args.profile, args.shards_only,
+                                     shlex.split(args.snakemake_args))
     jobs = read_jobs(workdir, name)
     table = stage_table(jobs)
     result = {"config": args.config, "sweep": args.sweep, "parts": len(parts), "cores": args.cores,

@@ -213,7 +213,9 @@ class FixedSearch:
             v = b.verdict
             text += (f"; best fixed-pin result: {' '.join(b.labels)} ends in {v['sets_within_tolerance']} "
                      f"set(s) of at most {self.tolerance:g} deg, at most {v['in_tolerance']} of "
-                     f"{v['trials']} trials in one")
+                     f"{v['trials']} trials in one"
+                     + (", but a member of the support family ends outside that set"
+                        if v.get("broken_by_worst_member") else ""))
         return text + self._too_few_trials()
 
     def _too_few_trials(self) -> str:

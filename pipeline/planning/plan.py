@@ -488,10 +488,14 @@ def certify_for_family(result: dict, part: Part, config: dict, mu_c, family, che
         result["family_certificate"] = cert
         result["recommended"]["family_certificate"] = cert
         return
-    broken = [r for r in checker.results.values() if not r["holds"] and r["worst_member"]]
+    broken = [(key, r) for key, r in checker.results.items() if not r["holds"] and r["worst_member"]]
     if broken:
-        worst = max(broken, key=lambda r: r["verdict"]["in_tolerance"])["worst_member"]
+        (labels, heights), record = max(broken, key=lambda kr: kr[1]["verdict"]["in_tolerance"])
+        worst = record["worst_member"]
         result["family_certificate"] = None
+        # The evidence, kept whole: the best plan it broke, that plan's set, the member.
+        result["family_worst_member"] = {"plan": list(labels), "pin_heights_mm": list(heights),
+                                         "set_deg": record["set_deg"], **worst}
         result["warning"] = ((result["warning"] + "; ") if result["warning"] else "") + (
             f"no plan of up to {result['depth']} pins holds for the whole family {family.label}: "
             f"{len(broken)} plan(s) that passed the sampled verification are broken by a worst member "

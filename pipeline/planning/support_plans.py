@@ -120,5 +120,6 @@ def support_study(part: Part, config: dict, family, uniform_entry: dict | None, 
             "evidence": res["fixed_pin_search"]["evidence"],
             "pins": best and list(best["pins"]), "pin_heights_mm": best and best["pin_heights_mm"],
             "pin_speeds": best and best.get("pin_speeds"),
-            "verification": best and best["verification"], "plans": res["plans"]}
+            "verification": best and best["verification"], "plans": res["plans"],
+            "worst_member": res.get("family_worst_member")}
     return out

@@ -65,4 +65,12 @@ def support_summary_text(result: dict) -> str:
                 f"{widen['family_width_deg']:.1f} deg)")
     return (text + f"; the recommended plan {rec} does not survive it"
             + (f"; {' '.join(fam['pins'])} orients the part for every member" if fam.get("orients")
-               else f"; {fam.get('evidence', 'no plan found')}"))
+               else f"; {fam.get('evidence', 'no plan found')}" + _worst_text(fam.get("worst_member"))))
+
+
+def _worst_text(worst: dict | None) -> str:
+    """The member that broke the best plan, in a clause (empty without one)."""
+    if not worst:
+        return ""
+    return (f"; the family's worst member found (legs {worst['parameters'].get('legs_mm', worst['parameters'])}) "
+            f"ends {worst['outside_deg']:.1f} deg outside the set of {' '.join(worst['plan'])}")

@@ -209,9 +209,13 @@ def test_config_hash_ignores_the_default_supports():
     del base["sweep"]["supports"]
     cfg = validate_config(base)
     assert cfg["sweep"]["supports"] == ["uniform"]
+    # The support keys and the claim's settings, at their defaults, are left out too.
+    planner_neutral = {"support_family", "width_slack_deg", "worst_member_budget"}
+    verify_neutral = {"confidence", "rule", "holdout_trials"}
     without = dict(cfg, sweep={k: v for k, v in cfg["sweep"].items() if k != "supports"},
-                   planner={k: v for k, v in cfg["planner"].items() if k != "support_family"})
-    without.pop("support_study")  # issue 25's other keys at their defaults: left out too
+                   planner={k: v for k, v in cfg["planner"].items() if k not in planner_neutral},
+                   verify={k: v for k, v in cfg["verify"].items() if k not in verify_neutral})
+    without.pop("support_study")
     blob = json.dumps(without, sort_keys=True, separators=(",", ":"), default=float)
     import hashlib
     assert config_hash(cfg) == hashlib.sha256(blob.encode()).hexdigest()[:16]

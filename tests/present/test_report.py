@@ -130,19 +130,22 @@ def test_report_numbers_match_the_verify_json(workflow):
             want.append([str(best["n_final_sets"]), f"{ok}/{sum(r['trials'] for r in checks[kind]['rows'])}"])
     assert [[r[3], r[5]] for r in side] == want
     assert [r[7] for r in side if r[0].startswith("tight") and r[7] != "n/a"] == limits
-    widths = []  # the verified width beside the claim, from the plan file's orientation verdict
+    cells = []  # the verified width beside the claim, from the plan file's orientation verdict
     for name in ("tri", "rect"):
         for t in json.loads((results / "plans" / f"{name}.json").read_text())["tight"]:
             o = (t["recommended"] or {}).get("verification", {}).get("orientation")
             if o:  # the width with its bootstrap interval, the held-out share with its lower bound
                 lo, hi = o["width_interval_deg"]
-                held = " held-out" if t["recommended"]["verification"]["held_out"] else ""
-                widths.append((f"{o['width_deg']:.1f}" if o["width_deg"] is not None else "n/a")
-                              + (f" [{lo:.1f}, {hi:.1f}]" if lo is not None and hi is not None else "")
-                              + f": {o['in_tolerance']}/{o['trials']}{held} in {o['tolerance_deg']:g} deg"
-                              + f", share >= {100 * o['share_lower_bound']:.2f} % at {100 * o['confidence']:g} %"
-                              " confidence")
-    assert [r[6].split(" (")[0] for r in side if r[0].startswith("tight")] == widths
+                width = f"{o['width_deg']:.1f}" if o["width_deg"] is not None else "n/a"
+                notes = (["held-out trials"] if t["recommended"]["verification"]["held_out"] else [])
+                notes += ([f"width {100 * o['confidence']:g} % interval {lo:.1f}-{hi:.1f} deg"]
+                          if lo is not None and hi is not None else [])
+                notes.append(f"share >= {100 * o['share_lower_bound']:.2f} % at {100 * o['confidence']:g} % "
+                             "confidence")
+                cells.append((f"{width}: {o['in_tolerance']}/{o['trials']} in {o['tolerance_deg']:g} deg", notes))
+    shown = [r[6] for r in side if r[0].startswith("tight")]
+    assert [c.split(" (")[0] for c in shown] == [head for head, _ in cells]
+    assert all(note in cell for cell, (_, notes) in zip(shown, cells) for note in notes)
     assert all(int(r[3]) == 3 + 2 ** (3 + len(r[0].split())) for r in table)  # verify.trials 3 + corners
 
 
