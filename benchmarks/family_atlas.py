@@ -72,7 +72,7 @@ def run_workflow(workdir: Path, config_path: Path, name: str, cores: int, profil
     target = "catalog/index.json" if shards_only else f"results/{name}/atlas.json"
     cmd = [sys.executable, "-m", "snakemake", "--snakefile", str(ROOT / "Snakefile"),
            "--directory", str(workdir), "--configfile", str(config_path), "--cores", str(cores),
-           "--rerun-incomplete", "--quiet", "progress", *extra, target]
+           "--rerun-incomplete", *extra, target]
     if profile:
         cmd[cmd.index("--cores"):cmd.index("--cores") + 2] = ["--profile", str(ROOT / profile)]
     env = {**os.environ, "PYTHONPATH": str(ROOT), "PATH": f"{Path(sys.executable).parent}:{os.environ['PATH']}"}
@@ -96,7 +96,8 @@ def read_jobs(workdir: Path, name: str) -> list[dict]:
         for path in sorted(workdir.glob(pattern)):
             with open(path) as fh:
                 row = next(csv.DictReader(fh, delimiter="\t"))
-            rows.append({"rule": rule, "job": str(path.relative_to(workdir / "logs")).removesuffix(".tsv"),
+            job = str(path.relative_to(workdir / "logs")).removesuffix(".tsv").replace("benchmark/", "")
+            rows.append({"rule": rule, "job": job,
                          "wall_s": float(row["s"]), "cpu_s": _number(row.get("cpu_time")),
                          "max_rss_mb": _number(row.get("max_rss"))})
     return rows
