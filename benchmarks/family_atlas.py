@@ -10,8 +10,8 @@ fresh working folder, then reads the per-job ``benchmark:`` files every rule
 writes (wall ``s``, ``cpu_time``, ``max_rss``) and prints, per stage: jobs,
 wall and CPU time, the peak memory of one job and the slowest job; the whole
 run's wall and CPU time; and a projection to N cores made from the measured
-per-job wall times (each stage's jobs packed longest-first onto N cores,
-stages one after another, each job holding the threads its rule asks for).
+per-job CPU times (each job's CPU time over its threads as its duration, each
+stage's jobs packed longest-first onto N cores, stages one after another).
 
 ``--sweep planner`` (the default) keeps the config's parts, planner, verify
 and speed settings but sweeps only the maps the planner reads (its model at
@@ -126,14 +126,22 @@ def stage_table(jobs: list[dict]) -> list[dict]:
     return table
 
 
+def job_seconds(job: dict) -> float:
+    """A job's duration on cores of its own: its CPU time over the threads its
+    rule holds (robust on a loaded machine, where wall time is not); its wall
+    time where no CPU time was recorded."""
+    cpu = job["cpu_s"]
+    return cpu / THREADS.get(job["rule"], 1) if cpu == cpu and cpu > 0 else job["wall_s"]
+
+
 def projection(jobs: list[dict], cores: int) -> float:
-    """Seconds to run these jobs on ``cores`` cores: per stage, jobs packed
-    longest-first onto the cores (a job of a rule in THREADS holds that many),
-    stages one after another. Per-job wall times from a contended machine make
-    this an upper estimate; it ignores Snakemake's own overhead."""
+    """Seconds to run these jobs on ``cores`` cores: per stage, jobs of
+    :func:`job_seconds` packed longest-first onto the cores (a job of a rule in
+    THREADS holds that many), stages one after another. It ignores Snakemake's
+    own overhead and any slow-down from jobs sharing memory bandwidth."""
     total = 0.0
     for rule in STAGES:
-        durations = sorted((j["wall_s"] for j in jobs if j["rule"] == rule), reverse=True)
+        durations = sorted((job_seconds(j) for j in jobs if j["rule"] == rule), reverse=True)
         width = min(THREADS.get(rule, 1), cores)
         slots = [0.0] * max(1, cores // width)
         for d in durations:
@@ -155,6 +163,8 @@ def main() -> None:
                          "without accounting")
     ap.add_argument("--workdir", default=None, help="working folder (default: a fresh temporary one)")
     ap.add_argument("--project", default="2,4,8,16,32,64", help="core counts to project to")
+    ap.add_argument("--no-run", action="store_true",
+                    help="only read the benchmark files of an earlier run in --workdir")
     ap.add_argument("--json", default=None, help="also write the numbers to this JSON file")
     args = ap.parse_args()
 
@@ -171,7 +181,7 @@ def main() -> None:
     print(f"family atlas: {args.config} ({len(parts)} planned parts), sweep {args.sweep}, "
           f"{'profile ' + args.profile if args.profile else f'{args.cores} cores'}, in {workdir}", flush=True)
 
-    wall, cpu, status = run_workflow(workdir, config_path, name, args.cores, args.profile, args.shards_only,
+    wall, cpu, status = (float("nan"), float("nan"), 0) if args.no_run else run_workflow(workdir, config_path, name, args.cores, args.profile, args.shards_only,
                                      shlex.split(args.snakemake_args))
     jobs = read_jobs(workdir, name)
     table = stage_table(jobs)
@@ -186,7 +196,7 @@ def main() -> None:
     for s in table:
         print(f"{s['stage']:<13}{s['jobs']:>5}{s['wall_sum_s']:>10.1f}{s['cpu_sum_s']:>10.1f}{s['peak_rss_mb']:>9.0f}"
               f"  {s['slowest_job']} ({s['slowest_wall_s']:.1f}, {s['slowest_cpu_s']:.1f})")
-    print("projection from per-job wall times: "
+    print("projection from per-job CPU times: "
           + ", ".join(f"{n} cores {v / 60:.1f} min" for n, v in result["projection_s"].items()))
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=1))
