@@ -14,13 +14,12 @@ $(STAMP): pyproject.toml
 
 # The main job: the Snakemake workflow on the embedded default config
 # (config/config.yaml). Resumes an interrupted run; does nothing if up to date.
-# Ends by printing the path of the report (results/<config name>/report.html).
+# Ends by printing the path of the report (results/<config name>/report.html;
+# pipeline/workflow/runner.py prints it).
 # After a killed run it removes Snakemake's stale lock and temporary files
 # when no other run is alive (pipeline/workflow/runner.py), saying so in one line.
 run: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pipeline.workflow run --cores all --rerun-incomplete
-	@$(BIN)/python -c 'from pipeline.config import load_config, results_folder; \
-	print("report:", (results_folder(load_config()) / "report.html").resolve())'
 
 # Remove Snakemake's lock by hand (only when no other run is alive).
 unlock: $(STAMP)

@@ -12,7 +12,8 @@ jobs are planned, and recovery after a run was killed (``kill -9``).
    alive, it stops with one line naming its pid.
 3. It removes the temporary files of atomic writes a killed run left behind
    (``.NAME.XXXX.tmp``; the catalog never reads them anyway).
-4. It runs Snakemake.
+4. It runs Snakemake and, when the run made the config's report, prints its
+   path (``report: .../results/NAME/report.html``).
 
 The Snakefile calls :func:`reconcile_catalog` while it loads, before
 Snakemake plans any job: Snakemake treats a missing intermediate file (a
@@ -122,16 +123,19 @@ def clear_stale_lock(folder: Path) -> str | None:
     return "a previous run was killed and left Snakemake's lock; no run is alive, so it was removed"
 
 
+def _config_path(args: list[str]) -> Path:
+    """The config file the Snakemake arguments name (``--configfile``), else the embedded default."""
+    from pipeline.config import DEFAULT_CONFIG
+    if "--configfile" in args and args.index("--configfile") + 1 < len(args):
+        return Path(args[args.index("--configfile") + 1])
+    return DEFAULT_CONFIG
+
+
 def _config_dirs(args: list[str]) -> list[Path]:
     """catalog_dir and results_dir of the config the Snakemake arguments name."""
     import yaml
-
-    from pipeline.config import DEFAULT_CONFIG
-    path = DEFAULT_CONFIG
-    if "--configfile" in args and args.index("--configfile") + 1 < len(args):
-        path = Path(args[args.index("--configfile") + 1])
     try:
-        cfg = yaml.safe_load(Path(path).read_text()) or {}
+        cfg = yaml.safe_load(_config_path(args).read_text()) or {}
     except (OSError, yaml.YAMLError):
         return []  # Snakemake reports a bad config file itself
     if not isinstance(cfg, dict):
@@ -156,7 +160,18 @@ def run(args: list[str]) -> int:
         if gone:
             print(f"pinfeed: removed {len(gone)} temporary file(s) a killed run left behind",
                   file=sys.stderr)
-        return subprocess.call(["snakemake", *args])
+        code = subprocess.call(["snakemake", *args])
+    if code == 0 and not {"-n", "--dry-run", "--dryrun"} & set(args):
+        _print_report_path(args)
+    return code
+
+
+def _print_report_path(args: list[str]) -> None:
+    """The path of the report a finished run made (none when its targets left it out)."""
+    from pipeline.config import load_config, results_folder
+    report = results_folder(load_config(_config_path(args))) / "report.html"
+    if report.is_file():
+        print(f"report: {report.resolve()}", flush=True)
 
 
 def main(argv=None) -> int:

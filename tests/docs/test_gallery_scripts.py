@@ -14,7 +14,7 @@ EXAMPLES = sorted((ROOT / "docs" / "examples").glob("plot_*.py"))
 
 
 def test_there_are_examples():
-    assert len(EXAMPLES) >= 7
+    assert len(EXAMPLES) >= 8
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
