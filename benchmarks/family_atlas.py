@@ -30,6 +30,7 @@ performance pages come from this script.
 from __future__ import annotations
 
 import argparse
+import copy
 import csv
 import json
 import os
@@ -50,16 +51,17 @@ sys.path.insert(0, str(ROOT))
 from pipeline.config import config_name, load_config  # noqa: E402
 from pipeline.planning.settings import nominal_friction, parse_friction  # noqa: E402
 
-# Stage of each rule on the way to the atlas, in the order they run.
-STAGES = ["sweep_shard", "catalog_index", "plan", "speed", "layout", "atlas"]
+# Stage of each rule on the way to the atlas that writes a benchmark file, in the order they run.
+STAGES = ["sweep_shard", "plan", "speed", "layout", "atlas"]
 THREADS = {"sweep_shard": 2}  # threads a job of the rule holds (rules/*.smk); others 1
 
 
 def planner_sweep(config: dict) -> dict:
     """The config with its sweep cut to the maps the planner reads."""
-    config = json.loads(json.dumps(config))
+    config = copy.deepcopy(config)
     pc = config["planner"]
-    speeds = [float(v) for v in (pc.get("dynamic") or {}).get("speeds", [])] if (pc.get("dynamic") or {}).get("depth", 0) else []
+    dynamic = pc.get("dynamic") or {}
+    speeds = [float(v) for v in dynamic.get("speeds", [])] if dynamic.get("depth", 0) else []
     config["sweep"].update(models=[pc["model"]], mu_c=[nominal_friction(parse_friction(pc["mu_c"]))],
                            v_pin=[0.0] + speeds)
     config["sweep"].pop("supports", None)
@@ -181,8 +183,11 @@ def main() -> None:
     print(f"family atlas: {args.config} ({len(parts)} planned parts), sweep {args.sweep}, "
           f"{'profile ' + args.profile if args.profile else f'{args.cores} cores'}, in {workdir}", flush=True)
 
-    wall, cpu, status = (float("nan"), float("nan"), 0) if args.no_run else run_workflow(workdir, config_path, name, args.cores, args.profile, args.shards_only,
-                                     shlex.split(args.snakemake_args))
+    if args.no_run:  # an earlier run's benchmark files only
+        wall, cpu, status = float("nan"), float("nan"), 0
+    else:
+        wall, cpu, status = run_workflow(workdir, config_path, name, args.cores, args.profile,
+                                         args.shards_only, shlex.split(args.snakemake_args))
     jobs = read_jobs(workdir, name)
     table = stage_table(jobs)
     result = {"config": args.config, "sweep": args.sweep, "parts": len(parts), "cores": args.cores,

@@ -117,6 +117,17 @@ def margin_text(margin) -> str:
             "placement tolerance may change the outcome")
 
 
+def _distinct(plans) -> list:
+    """``plans`` without repeats of a pin sequence (a sequence judged in its
+    level may also be among the level's fewest-cluster evidence), first kept."""
+    seen, out = set(), []
+    for p in plans:
+        if p.labels not in seen:
+            seen.add(p.labels)
+            out.append(p)
+    return out
+
+
 def _safe(margin) -> bool:
     return margin is None or not np.isfinite(margin) or margin >= 0.0
 
@@ -183,6 +194,7 @@ class FixedSearch:
     rollouts: int = 0
     seconds: float = 0.0
     resting: dict | None = None  # the verdict on the resting states themselves (no pin)
+    skipped: list = field(default_factory=list)  # moving pins: prefixes a shorter plan made moot
 
     @property
     def orients(self) -> bool:
@@ -329,7 +341,7 @@ class FixedPinSearch:
         if not result.plans:  # the evidence: the best several-set results of every level
             for level in levels:
                 runners_up.extend(self._several_sets(level, min(candidates, EVIDENCE_PER_LEVEL)))
-            result.best_effort = self.ranked(runners_up)[:keep]
+            result.best_effort = self.ranked(_distinct(runners_up))[:keep]
         result.rollouts = self.tree.rollouts
         result.seconds = time.perf_counter() - t0
         return result

@@ -206,8 +206,15 @@ def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=No
                    checker=None) -> FixedSearch:
     """Up to ``planner.dynamic.depth`` moving pins after no fixed pin and after
     each of the ``MOVING_PREFIXES`` best fixed-pin results, by the same
-    enumeration, screen and judgement as the fixed pins (every moving-pin
-    sequence after each prefix is tried); the orienting plans, best first."""
+    enumeration, screen and judgement as the fixed pins; the orienting plans,
+    best first.
+
+    A plan that orients ranks before every plan with more pins
+    (:func:`~pipeline.planning.complete.orientation_rank`), so once some
+    sequence orients with ``k`` pins a prefix of ``L`` fixed pins is searched
+    only up to ``k - L`` moving pins, and not at all when ``L >= k``
+    (``skipped`` in the search's record): the plans left out could only rank
+    after the one found."""
     pc, dyn = config["planner"], config["planner"]["dynamic"]
     if progress:
         progress(f"mu_c {friction_label(mu_c)}: fixed pins do not orient the part: adding moving pins")
@@ -215,13 +222,27 @@ def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=No
     depth = int(dyn["depth"])
     total = FixedSearch([], [], depth, planner_tolerance(config), verify_required(config))
     for prefix in [None, *chosen[:MOVING_PREFIXES]]:
-        res = search.run(depth, candidates=int(pc.get("candidates", 12)), keep=keep, prefix=prefix)
+        after = list(prefix.labels) if prefix else []
+        room = moving_room(total.plans, len(after), depth)
+        if room < 1:
+            fewest = min(len(p.labels) for p in total.plans)
+            total.skipped.append({"after": after, "why": f"a plan of {fewest} pins already orients the part"})
+            continue
+        res = search.run(room, candidates=int(pc.get("candidates", 12)), keep=keep, prefix=prefix)
         total.plans += res.plans
-        total.levels += [dict(lv, after=list(prefix.labels) if prefix else []) for lv in res.levels]
+        total.levels += [dict(lv, after=after) for lv in res.levels]
         total.rollouts += res.rollouts
         total.seconds += res.seconds
     total.plans = sorted(total.plans, key=FixedPlan.rank_key)[:keep]
     return total
+
+
+def moving_room(found: list, n_prefix: int, depth: int) -> int:
+    """How many moving pins to try after a prefix of ``n_prefix`` fixed pins:
+    ``depth``, or fewer so that no sequence has more pins than the shortest
+    orienting plan of ``found`` (0 or less: none)."""
+    fewest = min((len(p.labels) for p in found), default=None)
+    return depth if fewest is None else min(depth, fewest - n_prefix)
 
 
 def _rank(plan) -> tuple:
@@ -325,7 +346,8 @@ def _tight_result(config: dict, mu_c, depth: int, keep: int, planner, candidates
         "fixed_pin_search": fixed.to_dict(),
         "moving_pin_search": None if moving is None else {
             "orients": moving.orients, "depth": moving.depth, "levels": moving.levels,
-            "found": [list(p.labels) for p in moving.plans], "nominal_rollouts": moving.rollouts,
+            "found": [list(p.labels) for p in moving.plans], "skipped": moving.skipped,
+            "nominal_rollouts": moving.rollouts,
             "seconds": round(moving.seconds, 2)},
         "pins_used": {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0},
         "stats": {"transitions": planner.stats.transitions,

@@ -19,6 +19,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from shards import RUN_STAMPS, assert_same_shard
+
 ROOT = Path(__file__).resolve().parents[2]
 VENV_BIN = Path(sys.executable).parent
 SLURM_UP = ROOT / "tests" / "cluster" / "slurm_up.sh"
@@ -110,31 +112,6 @@ def _running_plan_job(env, timeout=400):
     pytest.fail("no plan job ran within the time limit")
 
 
-# Provenance that differs by design between two runs: the write time, and the
-# commit recorded when each job ran (HEAD may move between the two runs).
-RUN_STAMPS = {"created", "git_commit"}
-
-
-def _assert_same_shard(path_a, path_b):
-    """Every dataset equal bit for bit (dtype and values) and every attribute
-    equal except the run stamps."""
-    import h5py
-    import numpy as np
-    with h5py.File(path_a, "r") as a, h5py.File(path_b, "r") as b:
-        names_a, names_b = [], []
-        a.visit(names_a.append)
-        b.visit(names_b.append)
-        assert names_a == names_b, path_a
-        for name in ["/", *names_a]:
-            attrs_a = {k: str(v) for k, v in a[name].attrs.items() if k not in RUN_STAMPS}
-            attrs_b = {k: str(v) for k, v in b[name].attrs.items() if k not in RUN_STAMPS}
-            assert attrs_a == attrs_b, (path_a, name)
-            if isinstance(a[name], h5py.Dataset):
-                va, vb = a[name][()], b[name][()]
-                assert np.asarray(va).dtype == np.asarray(vb).dtype
-                assert np.asarray(va).tobytes() == np.asarray(vb).tobytes(), (path_a, name)
-
-
 def _atlas_without_timings(workdir):
     """The atlas JSON less its run stamps and the measured planning time."""
     import json
@@ -182,6 +159,6 @@ def test_slurm_profile_matches_local_and_survives_scancel(slurm_cluster, tmp_pat
     shards = sorted(p.relative_to(local) for p in (local / "catalog").rglob("*.h5"))
     assert shards and shards == sorted(p.relative_to(remote) for p in (remote / "catalog").rglob("*.h5"))
     for shard in shards:
-        _assert_same_shard(local / shard, remote / shard)
+        assert_same_shard(remote / shard, local / shard)
     assert _atlas_without_timings(local) == _atlas_without_timings(remote)
     assert not list(remote.rglob("*.tmp")) and not list(remote.rglob("*.partial"))

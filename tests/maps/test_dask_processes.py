@@ -18,12 +18,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import xarray as xr
 import yaml
 
 from pipeline.config import load_config, validate_config
 from pipeline.maps.catalog import Catalog
 from pipeline.maps.sweep import run_sweep
+from shards import assert_same_shard
 
 REPO = Path(__file__).resolve().parents[2]
 MU_C = [0.0, 0.05, 0.1, 0.15, 0.2, 0.25]  # one shard each
@@ -36,7 +36,6 @@ SLOW_ENOUGH = {
               "d": [round(float(x), 3) for x in np.linspace(-0.45, 0.45, 30)],
               "theta_step": 1, "pin_radius": 3.0},
 }
-WRITE_TIME_ATTRS = {"created", "git_commit"}  # differ between two runs of the same code
 STARTUP_S = 60  # scheduler file, two workers
 SWEEP_S = 120
 
@@ -153,27 +152,6 @@ def _all_files(catalog: Path) -> set[str]:
 
 def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def _bits(attrs: dict) -> dict:
-    """Attributes compared bit for bit (a NaN fill value equals itself)."""
-    return {k: v if isinstance(v, str) else (np.asarray(v).dtype.str, np.asarray(v).tobytes())
-            for k, v in attrs.items()}
-
-
-def assert_same_shard(path: Path, reference: Path) -> None:
-    """Data variables and coordinates identical bit for bit (as stored), attributes
-    identical but for the write time and commit."""
-    with xr.open_dataset(path, engine="h5netcdf", decode_cf=False) as got, \
-            xr.open_dataset(reference, engine="h5netcdf", decode_cf=False) as want:
-        assert set(got.variables) == set(want.variables), path.name
-        for name, var in want.variables.items():
-            other = got.variables[name]
-            assert (other.dims, other.dtype, other.shape) == (var.dims, var.dtype, var.shape), name
-            assert other.values.tobytes() == var.values.tobytes(), f"{path.name}: {name} differs"
-            assert _bits(other.attrs) == _bits(var.attrs), f"{path.name}: attributes of {name} differ"
-        strip = lambda attrs: {k: v for k, v in attrs.items() if k not in WRITE_TIME_ATTRS}  # noqa: E731
-        assert _bits(strip(got.attrs)) == _bits(strip(want.attrs)), path.name
 
 
 def test_sweep_survives_a_worker_killed_mid_sweep(tmp_path, processes, monkeypatch):

@@ -206,3 +206,56 @@ def test_a_square_needs_no_pin_and_the_oracle_agrees():
     assert result.needs_no_pin and result.evidence().startswith("no pin is needed")
     triangle = _search(Part.from_vertices([[0, 0], [60, 0], [15, 35]]), {"A": 10.0}, 8.0, 1)
     assert not triangle.needs_no_pin
+
+
+def _thin_triangle_entry(depth: int, prune: bool, monkeypatch):
+    """The tight plan of a 60 x 20 mm right triangle that no fixed pin of up to
+    ``depth`` orients, with (or, ``prune`` False, without) the moving search's
+    pruning of prefixes that cannot beat a plan already found."""
+    import pipeline.planning.plan as plan_module
+    from pipeline.config import load_config
+    config = load_config()
+    config["planner"].update(pins="auto", depth=depth, tolerance_deg=10.0)
+    config["planner"]["dynamic"].update(speeds=[-2.0, -1.0, 1.0, 2.0], depth=2)
+    config["verify"].update(trials=30, rule="point")  # few trials: the point rule
+    part = Part.from_vertices([[0, 0], [60, 0], [0, 20]], name="thin_triangle")
+    with monkeypatch.context() as patch:
+        if not prune:
+            patch.setattr(plan_module, "moving_room", lambda found, n_prefix, depth: depth)
+        return plan_module.plan_tight(part, config, 0.15)
+
+
+def test_moving_prefixes_that_cannot_beat_a_found_plan_change_nothing(monkeypatch):
+    """Two moving pins with no fixed pin before them orient the thin triangle;
+    searching the fixed-pin prefixes only for plans of at most two pins gives
+    the same recommended plan as searching them to the full moving depth (which
+    finds longer plans too), and a prefix of two fixed pins is skipped with its
+    reason."""
+    pruned = _thin_triangle_entry(1, True, monkeypatch)
+    full = _thin_triangle_entry(1, False, monkeypatch)
+    assert pruned["recommended"]["pins"] == full["recommended"]["pins"]
+    assert len(pruned["recommended"]["pins"]) == 2 and pruned["orients"]
+    assert max(lv["pins"] for lv in full["moving_pin_search"]["levels"]) == 3
+    assert max(lv["pins"] for lv in pruned["moving_pin_search"]["levels"]) == 2
+    assert any(lv["pins"] == 3 and lv["orienting"] for lv in full["moving_pin_search"]["levels"])
+    two_fixed = _thin_triangle_entry(2, True, monkeypatch)
+    assert two_fixed["recommended"]["pins"] == pruned["recommended"]["pins"]
+    skipped = two_fixed["moving_pin_search"]["skipped"]
+    assert skipped and all(len(s["after"]) == 2 for s in skipped)
+    assert skipped[0]["why"] == "a plan of 2 pins already orients the part"
+
+
+def test_best_fixed_pin_results_name_each_sequence_once():
+    """The evidence's best fixed-pin results (and so the prefixes moving pins
+    follow) list a sequence once, though it may be both judged and among the
+    fewest-cluster sequences of its level."""
+    from pipeline.config import load_config
+    from pipeline.planning.plan import plan_tight
+    config = load_config()
+    config["planner"].update(pins="auto", depth=3, tolerance_deg=10.0)
+    config["planner"]["dynamic"].update(depth=0)
+    config["verify"].update(trials=30, rule="point")
+    part = Part.from_vertices([[0, 0], [60, 0], [45, 50]], name="leaning_triangle")
+    best = plan_tight(part, config, 0.15)["fixed_pin_search"]["best_effort"]
+    assert len(best) == 5 and all(len(b["pins"]) == 3 for b in best[:2])
+    assert len({tuple(b["pins"]) for b in best}) == len(best)
