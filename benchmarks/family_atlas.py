@@ -13,12 +13,14 @@ run's wall and CPU time; and a projection to N cores made from the measured
 per-job CPU times (each job's CPU time over its threads as its duration, each
 stage's jobs packed longest-first onto N cores, stages one after another).
 
-``--sweep planner`` (the default) keeps the config's parts, planner, verify
-and speed settings but sweeps only the maps the planner reads (its model at
-its nominal mu_c, a static pin and each dynamic speed): the atlas needs no
-more. ``--sweep config`` sweeps everything the config lists (for
-``config/workstation.yaml``: 3 models x 5 frictions x 7 pin speeds per part);
-``--shards-only`` stops after the sweep, to time it alone.
+The atlas target needs only the shards the plans read (each part's planner
+model at the sweep friction nearest the planner's, a static pin and each
+moving-pin speed: ``pipeline.workflow.plan.planner_shards``), so
+``--sweep config`` (the default) runs the config as written and sweeps those
+alone. ``--sweep planner`` also cuts the config's sweep to the planner's
+model, its nominal friction exactly and its speeds (a catalog of those maps
+only). ``--shards-only`` stops after the sweep (``catalog/index.json``: every
+shard the config lists), to time the whole sweep alone.
 
 ``--profile profiles/slurm`` submits every job through SLURM (a cluster or
 the one-node test cluster of ``tests/cluster/slurm_up.sh``); per-job numbers
@@ -53,7 +55,6 @@ from pipeline.planning.settings import nominal_friction, parse_friction  # noqa:
 
 # Stage of each rule on the way to the atlas that writes a benchmark file, in the order they run.
 STAGES = ["sweep_shard", "plan", "speed", "layout", "atlas"]
-THREADS = {"sweep_shard": 2}  # threads a job of the rule holds (rules/*.smk); others 1
 
 
 def planner_sweep(config: dict) -> dict:
@@ -129,23 +130,22 @@ def stage_table(jobs: list[dict]) -> list[dict]:
 
 
 def job_seconds(job: dict) -> float:
-    """A job's duration on cores of its own: its CPU time over the threads its
-    rule holds (robust on a loaded machine, where wall time is not); its wall
-    time where no CPU time was recorded."""
+    """A job's duration on one core of its own: its CPU time (robust on a loaded
+    machine, where wall time is not; a job of 2 threads holds 2 cores for
+    about half as long); its wall time where no CPU time was recorded."""
     cpu = job["cpu_s"]
-    return cpu / THREADS.get(job["rule"], 1) if cpu == cpu and cpu > 0 else job["wall_s"]
+    return cpu if cpu == cpu and cpu > 0 else job["wall_s"]
 
 
 def projection(jobs: list[dict], cores: int) -> float:
     """Seconds to run these jobs on ``cores`` cores: per stage, jobs of
-    :func:`job_seconds` packed longest-first onto the cores (a job of a rule in
-    THREADS holds that many), stages one after another. It ignores Snakemake's
-    own overhead and any slow-down from jobs sharing memory bandwidth."""
+    :func:`job_seconds` packed longest-first onto the cores, stages one after
+    another. It ignores Snakemake's own overhead and any slow-down from jobs
+    sharing memory bandwidth."""
     total = 0.0
     for rule in STAGES:
         durations = sorted((job_seconds(j) for j in jobs if j["rule"] == rule), reverse=True)
-        width = min(THREADS.get(rule, 1), cores)
-        slots = [0.0] * max(1, cores // width)
+        slots = [0.0] * max(1, cores)
         for d in durations:
             i = slots.index(min(slots))
             slots[i] += d
@@ -157,7 +157,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--config", default=str(ROOT / "config" / "workstation.yaml"))
     ap.add_argument("--cores", type=int, default=2)
-    ap.add_argument("--sweep", choices=["planner", "config"], default="planner")
+    ap.add_argument("--sweep", choices=["planner", "config"], default="config")
     ap.add_argument("--shards-only", action="store_true")
     ap.add_argument("--profile", default=None, help="a Snakemake profile, e.g. profiles/slurm")
     ap.add_argument("--snakemake-args", default="",

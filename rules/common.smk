@@ -1,6 +1,9 @@
 # Shared helpers: the shard list and per-shard parameters, from the config.
+from snakemake.exceptions import WorkflowError
+
 from pipeline.maps.sweep import shard_jobs
 from pipeline.parts.support import support_key
+from pipeline.workflow.plan import planner_shards as planner_shard_paths
 from pipeline.workflow.supports import studied_parts
 
 CATALOG = config["catalog_dir"]
@@ -14,11 +17,22 @@ wildcard_constraints:
     tag="mu_c=[0-9.eE+-]+(_v_pin=[0-9.eE+-]+)?(_belt=[0-9.eE+-]+_mu_s=[0-9.eE+-]+)?(_support=[A-Za-z0-9-]+)?",
 
 
-def part_shards(wildcards):
-    """The shard files of the part named ``wildcards.name`` (what its plan reads:
-    uniform pressure only, so adding a support to sweep.supports re-plans nothing)."""
-    return [path for path, job in JOBS.items()
-            if job.part.name == wildcards.name and not support_key(job.support)]
+def shard_threads() -> int:
+    """Threads of a shard job: 2 where the run has 4 cores or more (a shard's
+    theta rows run in parallel), else 1, so that two shards run side by side
+    on 2 cores (a shard's few CPU seconds are mostly its start)."""
+    try:
+        cores = workflow.cores
+    except WorkflowError:  # no --cores (a cluster executor): the profile's set-threads decides
+        return 2
+    return 2 if cores >= 4 else 1
+
+
+def planner_shards(wildcards):
+    """The shard files the plan of the part named ``wildcards.name`` reads: its
+    planner model at the planner's friction, static and moving pins, uniform
+    pressure (adding a support or another model to the sweep re-plans nothing)."""
+    return planner_shard_paths(config, JOBS, wildcards.name)
 
 
 def shard_params(wildcards):

@@ -18,10 +18,9 @@ rule bands:
 
 rule plan:
     input:
-        # The part's own shards: a re-index ('pinfeed catalog index') or another
-        # part's new shards do not re-plan it; the index must exist (ancient).
-        shards=part_shards,
-        index=ancient(rules.catalog_index.output.index),
+        # The shards the plan reads and nothing else (pipeline.workflow.plan.planner_shards):
+        # the atlas needs only these, and other shards or a re-index re-plan nothing.
+        shards=planner_shards,
     output:
         plan=f"{RESULTS}/plans/{{name}}.json",
     params:

@@ -10,7 +10,7 @@ rule sweep_shard:
         "logs/sweep/{family}/{part}/{model}/{tag}.log",
     benchmark:
         "logs/benchmark/sweep/{family}/{part}/{model}/{tag}.tsv"
-    threads: 2
+    threads: shard_threads()
     resources:
         mem_mb=1000,
     conda:

@@ -281,6 +281,21 @@ class Catalog:
         return cls(root, entries, problems)
 
     @classmethod
+    def of_files(cls, root, paths) -> "Catalog":
+        """A catalog of the shard files ``paths`` (under ``root``) alone, each read
+        from its own attributes without the index: what a workflow job that
+        declares the shards it reads sees, whatever else the folder holds. A
+        file that is not a readable shard is a problem, as in :meth:`rebuild`."""
+        root = Path(root)
+        entries, problems = [], []
+        for path in paths:
+            try:
+                entries.append(entry_from_file(root, Path(path)))
+            except PinfeedError as exc:
+                problems.append(str(exc))
+        return cls(root, entries, problems)
+
+    @classmethod
     def open(cls, root="catalog") -> "Catalog":
         """Read the index and check it against the files on disk (size and presence;
         contents are checksummed when an entry is served)."""
@@ -514,6 +529,12 @@ def _check_finite(**values) -> None:
             raise PinfeedError(f"{name} must be a number, got {value!r}") from None
         if not np.all(np.isfinite(arr)):
             raise PinfeedError(f"{name} must be a finite number, got {value!r}")
+
+
+def nearest_stored(stored, want: float) -> float:
+    """The value of ``stored`` nearest ``want`` (the lower one on a tie), as
+    :meth:`Catalog.query` picks a friction."""
+    return _select(list(stored), float(want), "nearest")[0]
 
 
 def _select(stored: list[float], want: float, method: str) -> list[float]:

@@ -11,10 +11,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pipeline.maps.catalog import Catalog
+from pipeline.maps.catalog import Catalog, nearest_stored
 from pipeline.maps.io import read_map, write_json
 from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
+from pipeline.parts.support import support_key
 from pipeline.planning.paper import build_planner, load_maps, paper_depth
 from pipeline.planning.plan import plan_tight_all
 from pipeline.planning.speed_limit import attach_speed_limits
@@ -151,11 +152,33 @@ def bands(shard, settings: dict, out) -> dict:
     return result
 
 
-def plan(config: dict, name: str, out) -> dict:
-    """Rule ``plan``: the plans of the config's part ``name`` from the catalog
-    (:func:`plan_part`) with their speed limits (``attach_speed_limits``),
-    written to ``out``."""
-    result = attach_speed_limits(plan_part(Catalog.open(config["catalog_dir"]), name, config), config)
+def planner_shards(config: dict, jobs: dict, name: str) -> list[str]:
+    """The shard files the plan of part ``name`` reads, of ``jobs`` (path ->
+    :class:`~pipeline.maps.sweep.ShardJob`, the config's sweep): the part's
+    uniform-pressure shards of ``planner.model``, quasi-static belt, at the
+    sweep friction nearest the planner's (as the catalog query picks it), with
+    a static pin and at every ``planner.dynamic`` speed. The plan job takes
+    these as input, so the atlas needs these shards alone, and a shard of
+    another model, friction or support re-plans nothing."""
+    pc = config["planner"]
+    own = {path: job for path, job in jobs.items()
+           if job.part.name == name and not support_key(job.support) and job.model == pc["model"]
+           and not job.belt_speed}
+    if not own:
+        return []
+    mu_c = nearest_stored({job.mu_c for job in own.values()}, nominal_friction(parse_friction(pc["mu_c"])))
+    speeds = {0.0, *(float(v) for v in (pc.get("dynamic") or {}).get("speeds", []))}
+    return sorted(path for path, job in own.items() if job.mu_c == mu_c and float(job.v_pin) in speeds)
+
+
+def plan(config: dict, name: str, out, shards=None) -> dict:
+    """Rule ``plan``: the plans of the config's part ``name`` (:func:`plan_part`)
+    with their speed limits (``attach_speed_limits``), written to ``out``;
+    from the shard files ``shards`` alone when given (the job's input,
+    :func:`planner_shards`), else from the catalog's index."""
+    root = config["catalog_dir"]
+    cat = Catalog.open(root) if shards is None else Catalog.of_files(root, shards)
+    result = attach_speed_limits(plan_part(cat, name, config), config)
     write_json(result, out)
     return result
 

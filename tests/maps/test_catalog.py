@@ -68,6 +68,29 @@ def test_nearest_and_bracketing_selection_is_reported(swept):
     assert q["mu_c"].values.tolist() == [0.2]
 
 
+def test_a_catalog_of_given_files_sees_those_alone(swept):
+    """Catalog.of_files (what a plan job reads): the given shards only, whatever
+    else the folder holds and with no index; it answers as the indexed catalog
+    does, and a foreign file among them is a problem, not an entry."""
+    root = Path(swept["catalog_dir"])
+    (root / "index.json").unlink()
+    shards = sorted(str(p) for p in root.rglob("*.h5") if "/minpower/" in str(p) and "/tri-" in str(p))
+    assert len(shards) == 2
+    foreign = root / "foreign.h5"
+    with h5py.File(foreign, "w") as f:
+        f["x"] = np.arange(3)
+    cat = Catalog.of_files(root, [*shards, foreign])
+    assert len(cat.entries) == 2 and {e["model"] for e in cat.entries} == {"minpower"}
+    assert len(cat.problems) == 1 and "foreign file" in cat.problems[0]
+    with pytest.raises(PinfeedError, match="ellipsoid"):
+        cat.query("tri", model="ellipsoid", mu_c=0.2)
+    got = cat.query("tri", model="minpower", mu_c=0.17, d=0.3).load()
+    foreign.unlink()
+    full = Catalog.rebuild(root).query("tri", model="minpower", mu_c=0.17, d=0.3).load()
+    assert got.attrs["selection"] == full.attrs["selection"]
+    np.testing.assert_array_equal(got["theta_f"].values, full["theta_f"].values)
+
+
 def test_queries_are_lazy_and_cube_has_all_dims(swept):
     cat = Catalog.open(swept["catalog_dir"])
     q = cat.query("tri")

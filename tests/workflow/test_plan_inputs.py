@@ -1,0 +1,59 @@
+"""The plan job reads exactly the shards it declares: the atlas needs those alone."""
+from __future__ import annotations
+
+import re
+
+import yaml
+
+from pipeline.config import validate_config
+from pipeline.maps.sweep import shard_jobs
+from pipeline.parts.part import Part
+from pipeline.workflow.plan import planner_shards
+from workflow_runs import run_snakemake
+
+VERTS = [[0, 0], [40, 0], [10, 25]]
+TRI = Part.from_vertices(VERTS, name="tri")
+SQUARE = Part.from_vertices([[0, 0], [30, 0], [30, 30], [0, 30]], name="square")
+
+CONFIG = {
+    "catalog_dir": "cat", "results_dir": "res",
+    "families": {"fam": {"parts": [{"name": "tri", "vertices": VERTS},
+                                   {"name": "square", "vertices": SQUARE.vertices.tolist()}]}},
+    "sweep": {"models": ["minpower", "tip"], "mu_c": [0.1, 0.2, 0.3], "v_pin": [0.0, -1.0, 1.0, 2.0],
+              "d": [-0.4, 0.3], "theta_step": 10.0, "pin_radius": 3.0, "supports": ["uniform", "tripod"]},
+    "planner": {"parts": ["tri"], "model": "minpower", "mu_c": "0.2:0.3", "depth": 1,
+                "dynamic": {"speeds": [-1.0, 1.0], "depth": 1}},
+}
+
+
+def _config():
+    return validate_config(yaml.safe_load(yaml.safe_dump(CONFIG)), name="inputs")
+
+
+def test_the_plan_reads_its_model_friction_and_speeds_only():
+    """Of 2 parts x 2 models x 3 frictions x 4 pin speeds (+ tripod shards), the
+    plan of the triangle reads its minpower shards at the sweep friction
+    nearest the planner's (0.25 -> 0.2, the lower on a tie, as the catalog
+    query picks) with a static pin and the two planner speeds: three shards."""
+    config = _config()
+    jobs = {str(job.path(config["catalog_dir"])): job for job in shard_jobs(config)}
+    want = [f"cat/fam/{TRI.id}/minpower/{tag}.h5" for tag in ("mu_c=0.2", "mu_c=0.2_v_pin=-1.0", "mu_c=0.2_v_pin=1.0")]
+    assert sorted(want) == planner_shards(config, jobs, "tri")
+    assert all(path in jobs for path in want)
+    config["planner"]["mu_c"] = 0.29  # nearest is 0.3
+    assert all("mu_c=0.3" in p for p in planner_shards(config, jobs, "tri"))
+    assert planner_shards(config, jobs, "no_such_part") == []
+
+
+def test_the_atlas_target_builds_the_planner_shards_only(tmp_path):
+    """A dry run to the atlas schedules the three shards the plan reads and no
+    other shard, and no catalog index."""
+    (tmp_path / "inputs.yaml").write_text(yaml.safe_dump(CONFIG))
+    dry = run_snakemake(tmp_path, "--configfile", str(tmp_path / "inputs.yaml"), "--dry-run",
+                        "res/inputs/atlas.json")
+    assert dry.returncode == 0, dry.stderr[-3000:]
+    text = dry.stdout + dry.stderr
+    shards = sorted(set(re.findall(r"cat/fam/[^\s,]+\.h5", text)))
+    assert shards == sorted(f"cat/fam/{TRI.id}/minpower/{tag}.h5"
+                            for tag in ("mu_c=0.2", "mu_c=0.2_v_pin=-1.0", "mu_c=0.2_v_pin=1.0"))
+    assert "catalog_index" not in text
