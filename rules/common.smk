@@ -2,7 +2,6 @@
 from snakemake.exceptions import WorkflowError
 
 from pipeline.maps.sweep import shard_jobs
-from pipeline.parts.support import support_key
 from pipeline.workflow.plan import planner_shards as planner_shard_paths
 from pipeline.workflow.supports import studied_parts
 
