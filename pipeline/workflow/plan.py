@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from pipeline.errors import PinfeedError
 from pipeline.maps.catalog import Catalog, nearest_stored
 from pipeline.maps.io import read_map, write_json
 from pipeline.maps.sweep import ShardJob, write_shard
@@ -177,6 +178,11 @@ def plan(config: dict, name: str, out, shards=None) -> dict:
     from the shard files ``shards`` alone when given (the job's input,
     :func:`planner_shards`), else from the catalog's index."""
     root = config["catalog_dir"]
+    if shards is not None and not list(shards):
+        model = config["planner"]["model"]
+        raise PinfeedError(f"{name}: the sweep has no maps of this part for the planner "
+                           f"(planner.model {model}, sweep.models {', '.join(config['sweep']['models'])}); "
+                           f"add {model} to sweep.models")
     cat = Catalog.open(root) if shards is None else Catalog.of_files(root, shards)
     result = attach_speed_limits(plan_part(cat, name, config), config)
     write_json(result, out)

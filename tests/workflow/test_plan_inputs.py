@@ -57,3 +57,20 @@ def test_the_atlas_target_builds_the_planner_shards_only(tmp_path):
     assert shards == sorted(f"cat/fam/{TRI.id}/minpower/{tag}.h5"
                             for tag in ("mu_c=0.2", "mu_c=0.2_v_pin=-1.0", "mu_c=0.2_v_pin=1.0"))
     assert "catalog_index" not in text
+
+
+def test_a_plan_with_no_maps_to_read_says_which_model_is_missing(tmp_path):
+    """A sweep without the planner's model gives the plan no shard: the job
+    fails with one line naming the model to add, and writes no plan file."""
+    import pytest
+
+    from pipeline.errors import PinfeedError
+    from pipeline.workflow.plan import plan
+    config = _config()
+    config["sweep"]["models"] = ["tip"]
+    jobs = {str(job.path(config["catalog_dir"])): job for job in shard_jobs(config)}
+    shards = planner_shards(config, jobs, "tri")
+    assert shards == []
+    with pytest.raises(PinfeedError, match="add minpower to sweep.models"):
+        plan(config, "tri", tmp_path / "tri.json", shards=shards)
+    assert not (tmp_path / "tri.json").exists()
