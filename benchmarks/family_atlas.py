@@ -61,8 +61,8 @@ def planner_sweep(config: dict) -> dict:
     """The config with its sweep cut to the maps the planner reads."""
     config = copy.deepcopy(config)
     pc = config["planner"]
-    dynamic = pc.get("dynamic") or {}
-    speeds = [float(v) for v in dynamic.get("speeds", [])] if dynamic.get("depth", 0) else []
+    # every listed speed, even at dynamic depth 0: the paper-mode planner loads them all
+    speeds = [float(v) for v in (pc.get("dynamic") or {}).get("speeds", [])]
     config["sweep"].update(models=[pc["model"]], mu_c=[nominal_friction(parse_friction(pc["mu_c"]))],
                            v_pin=[0.0] + speeds)
     config["sweep"].pop("supports", None)

@@ -2,6 +2,7 @@
 from snakemake.exceptions import WorkflowError
 
 from pipeline.maps.sweep import shard_jobs
+from pipeline.parts.support import support_key
 from pipeline.workflow.plan import planner_shards as planner_shard_paths
 from pipeline.workflow.supports import studied_parts
 
@@ -25,6 +26,14 @@ def shard_threads() -> int:
     except WorkflowError:  # no --cores (a cluster executor): the profile's set-threads decides
         return 2
     return 2 if cores >= 4 else 1
+
+
+def figure_shards(wildcards):
+    """The uniform-pressure shards of the planned parts (the figures draw every
+    model and pin speed of the sweep at a plan's friction): a recomputed shard
+    re-draws them."""
+    planned = set(PLANNED)
+    return [path for path, job in JOBS.items() if job.part.name in planned and not support_key(job.support)]
 
 
 def planner_shards(wildcards):

@@ -4,7 +4,8 @@
 
 rule figures:
     input:
-        # maps are read from the planned parts' shards, which their plans depend on
+        # the maps drawn: every uniform shard of the planned parts (the plans read fewer)
+        shards=figure_shards,
         index=ancient(rules.catalog_index.output.index),
         plans=expand(f"{RESULTS}/plans/{{name}}.json", name=PLANNED),
         verify=expand(f"{RESULTS}/verify/{{name}}.json", name=PLANNED),

@@ -178,7 +178,8 @@ def plan(config: dict, name: str, out, shards=None) -> dict:
     from the shard files ``shards`` alone when given (the job's input,
     :func:`planner_shards`), else from the catalog's index."""
     root = config["catalog_dir"]
-    if shards is not None and not list(shards):
+    shards = None if shards is None else list(shards)
+    if shards is not None and not shards:
         model = config["planner"]["model"]
         raise PinfeedError(f"{name}: the sweep has no maps of this part for the planner "
                            f"(planner.model {model}, sweep.models {', '.join(config['sweep']['models'])}); "

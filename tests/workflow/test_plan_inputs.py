@@ -74,3 +74,18 @@ def test_a_plan_with_no_maps_to_read_says_which_model_is_missing(tmp_path):
     with pytest.raises(PinfeedError, match="add minpower to sweep.models"):
         plan(config, "tri", tmp_path / "tri.json", shards=shards)
     assert not (tmp_path / "tri.json").exists()
+
+
+def test_the_figures_take_every_uniform_shard_of_the_planned_parts(tmp_path):
+    """The figures draw every model and pin speed of a planned part, so their job
+    takes all its uniform shards (2 models x 3 frictions x 4 speeds), not the
+    tripod shards nor those of the part that is not planned."""
+    (tmp_path / "inputs.yaml").write_text(yaml.safe_dump(CONFIG))
+    dry = run_snakemake(tmp_path, "--dry-run", "res/inputs/verification.md",
+                        "--configfile", str(tmp_path / "inputs.yaml"))
+    assert dry.returncode == 0, dry.stderr[-3000:]
+    text = (dry.stdout + dry.stderr).split("rule figures:", 1)[1]
+    inputs = next(line for line in text.splitlines() if line.strip().startswith("input:"))
+    shards = set(re.findall(r"cat/fam/[^\s,]+\.h5", inputs))
+    assert len(shards) == 2 * 3 * 4
+    assert all(f"/{TRI.id}/" in s and "support" not in s for s in shards)
