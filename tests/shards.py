@@ -1,4 +1,5 @@
-"""Shards compared as stored: two runs of the same config must write the same bits."""
+"""Shards compared as read back: two runs of the same config must write the same bits
+(values, dtypes, shapes and attributes; chunking and filters are not compared)."""
 from __future__ import annotations
 
 import h5py

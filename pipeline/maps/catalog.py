@@ -261,8 +261,7 @@ class Catalog:
         root = Path(root)
         if not root.is_dir():
             raise PinfeedError(f"no catalog folder at {root}; run the workflow ('make run') first")
-        entries, problems = [], []
-        refinements = []
+        shards, refinements = [], []
         for path in sorted(root.rglob("*.h5")):
             if path.name.startswith("."):
                 continue  # an unfinished atomic write
@@ -272,13 +271,11 @@ class Catalog:
                 refinements.append({"file": rel.as_posix(), **refinement_fields(rel),
                                     "sha256": _sha256(path)})
                 continue
-            try:
-                entries.append(entry_from_file(root, path))
-            except PinfeedError as exc:
-                problems.append(str(exc))
-        write_json({"index_version": INDEX_VERSION, "entries": entries, "problems": problems,
+            shards.append(path)
+        cat = cls.of_files(root, shards)
+        write_json({"index_version": INDEX_VERSION, "entries": cat.entries, "problems": cat.problems,
                     "refinements": refinements}, root / INDEX_NAME)
-        return cls(root, entries, problems)
+        return cat
 
     @classmethod
     def of_files(cls, root, paths) -> "Catalog":

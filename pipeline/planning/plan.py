@@ -224,9 +224,9 @@ def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=No
     for prefix in [None, *chosen[:MOVING_PREFIXES]]:
         after = list(prefix.labels) if prefix else []
         room = moving_room(total.plans, len(after), depth)
-        if room < 1:
-            fewest = min(len(p.labels) for p in total.plans)
-            total.skipped.append({"after": after, "why": f"a plan of {fewest} pins already orients the part"})
+        if room < 1:  # then room = (pins of the shortest plan found) - len(after)
+            total.skipped.append({"after": after,
+                                  "why": f"a plan of {len(after) + room} pins already orients the part"})
             continue
         res = search.run(room, candidates=int(pc.get("candidates", 12)), keep=keep, prefix=prefix)
         total.plans += res.plans

@@ -178,13 +178,16 @@ def plan(config: dict, name: str, out, shards=None) -> dict:
     from the shard files ``shards`` alone when given (the job's input,
     :func:`planner_shards`), else from the catalog's index."""
     root = config["catalog_dir"]
-    shards = None if shards is None else list(shards)
-    if shards is not None and not shards:
-        model = config["planner"]["model"]
-        raise PinfeedError(f"{name}: the sweep has no maps of this part for the planner "
-                           f"(planner.model {model}, sweep.models {', '.join(config['sweep']['models'])}); "
-                           f"add {model} to sweep.models")
-    cat = Catalog.open(root) if shards is None else Catalog.of_files(root, shards)
+    if shards is None:
+        cat = Catalog.open(root)
+    else:
+        shards = list(shards)
+        if not shards:
+            model = config["planner"]["model"]
+            raise PinfeedError(f"{name}: the sweep has no maps of this part for the planner "
+                               f"(planner.model {model}, sweep.models {', '.join(config['sweep']['models'])}); "
+                               f"add {model} to sweep.models")
+        cat = Catalog.of_files(root, shards)
     result = attach_speed_limits(plan_part(cat, name, config), config)
     write_json(result, out)
     return result
