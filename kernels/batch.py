@@ -18,6 +18,7 @@ from numba import prange
 
 from ._numba import jit_parallel
 from .rollout import _W_COLS, _W_ROWS, _rollout_core, max_steps_for
+from .support import _table_sizes
 
 _CHUNK = 8  # rollouts per chunk: 64 bytes of each float64 output
 BLOCKS_PER_THREAD = 8
@@ -49,7 +50,7 @@ def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     peak = np.empty((nd, nt))
     n_chunks = (total + _CHUNK - 1) // _CHUNK
     n_blocks = max(1, min(n_blocks, n_chunks))
-    max_steps = max_steps_for(verts.shape[0])
+    max_steps = max_steps_for(_table_sizes(quad)[1])
     for b in prange(n_blocks):
         work = np.empty((_W_ROWS, _W_COLS))
         traj = np.empty((1, 4))

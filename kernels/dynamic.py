@@ -90,7 +90,7 @@ from numba import prange
 
 from ._numba import jit, jit_parallel
 from .geometry import _closest_feature, _other_contact_gap, _ray_first_contact
-from .support import _power
+from .support import _power, _table_sizes
 
 # Statuses as in rollout.py (ok, miss, jammed, truncated).
 OK = 0
@@ -121,22 +121,23 @@ _SAME_FEATURE = 1e-3
 
 
 @jit
-def _gyration(verts, area):
+def _gyration(quad, area):
     """Polar radius of gyration squared ``k^2 = J / A`` about the centroid
-    (the origin) of a counter-clockwise polygon of area ``area``."""
-    n = verts.shape[0]
+    (the origin) of the material of the support table ``quad`` (its support
+    polygon, holes left out; ``support._fan_quadrature``) of area ``area``."""
+    f, n = _table_sizes(quad)
     j = 0.0
     for i in range(n):
         k = (i + 1) % n
-        xi, yi = verts[i, 0], verts[i, 1]
-        xk, yk = verts[k, 0], verts[k, 1]
+        xi, yi = quad[f + i, 0], quad[f + i, 1]
+        xk, yk = quad[f + k, 0], quad[f + k, 1]
         cr = xi * yk - xk * yi
         j += cr * (xi * xi + xi * xk + xk * xk + yi * yi + yi * yk + yk * yk)
     return j / 12.0 / area
 
 
 @jit
-def _belt_wrench(verts, quad, area, vx, vy, om, eps):
+def _belt_wrench(quad, area, vx, vy, om, eps):
     """Regularised belt friction wrench ``W`` and ``K = -dW/dxi`` (body frame).
 
     Returns ``(P, W0, W1, W2, K00, K01, K02, K11, K12, K22)``; units of
@@ -144,7 +145,7 @@ def _belt_wrench(verts, quad, area, vx, vy, om, eps):
     """
     if vx == 0.0 and vy == 0.0 and om == 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = _power(verts, quad, area, vx, vy, om)
+    p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = _power(quad, area, vx, vy, om)
     if p >= eps:
         return p, -g0, -g1, -g2, h00, h01, h02, h11, h12, h22
     f = p / eps
@@ -231,7 +232,7 @@ def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, f
     rp = r_pin / a
     s_cap = max_travel / a
     two_pi = 2.0 * math.pi
-    k2 = _gyration(verts, area)
+    k2 = _gyration(quad, area)
     mx_, mw_ = fr, fr * k2
     nrec = 256 if record else 0
     traj = np.empty((nrec, 4))
@@ -278,7 +279,7 @@ def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, f
         # Twist and pin velocity in the body frame.
         vbx, vby = cs * V0 + sn * V1, -sn * V0 + cs * V1
         vpx, vpy = -cs + sn * v_pin, sn + cs * v_pin
-        p, w0, w1, w2, k00, k01, k02, k11, k12, k22 = _belt_wrench(verts, quad, area, vbx, vby,
+        p, w0, w1, w2, k00, k01, k02, k11, k12, k22 = _belt_wrench(quad, area, vbx, vby,
                                                                    om, eps)
         a00, a01, a02 = mx_ + h * k00, h * k01, h * k02
         a11, a12, a22 = mx_ + h * k11, h * k12, mw_ + h * k22
@@ -365,7 +366,7 @@ def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, f
         # Free part: at rest?
         if gap > 0.0 and p < _REST:
             vbx2, vby2 = cs * V0 + sn * V1, -sn * V0 + cs * V1
-            p2 = _power(verts, quad, area, vbx2, vby2, om)[0] if (vbx2 != 0.0 or vby2 != 0.0
+            p2 = _power(quad, area, vbx2, vby2, om)[0] if (vbx2 != 0.0 or vby2 != 0.0
                                                                   or om != 0.0) else 0.0
             if p2 < _REST:
                 cs, sn = math.cos(th), math.sin(th)

@@ -22,6 +22,11 @@ POLY_NOT_FINITE = 2
 POLY_REPEATED = 3
 POLY_SELF_INTERSECTING = 4
 POLY_ZERO_AREA = 5
+# Codes of ``_loops_problem`` (an outline and its holes).
+LOOPS_OK = 0
+LOOPS_MEET = 1
+HOLE_OUTSIDE = 2
+HOLE_IN_HOLE = 3
 
 
 @jit
@@ -146,6 +151,132 @@ def _normalise(xy):
     for j in range(n):
         a = max(a, math.hypot(out[j, 0], out[j, 1]))
     return out, abs(area), a
+
+
+@jit
+def _keyhole(xy, starts):
+    """One closed polygon whose signed edges bound the material of a part
+    with holes: the outline, then each hole, joined by bridges.
+
+    Parameters
+    ----------
+    xy : ``(N, 2)`` vertices of the loops, one after the other: the outline
+        first (counter-clockwise), then the holes (clockwise).
+    starts : ``(L + 1,)`` int64 offsets of the loops in ``xy`` (the last one
+        ``N``).
+
+    Returns
+    -------
+    ``(N + 2 (L - 1), 2)`` array: the outline, then for each hole the
+    outline's first vertex, the hole's vertices and the hole's first vertex
+    again; closing the polygon returns to the outline's first vertex.
+
+    Notes
+    -----
+    Every integral here is a signed sum over edges (module notes), so a
+    bridge, walked once each way, cancels (to rounding) wherever it runs,
+    even across another hole: the sum is the outline's integral minus the
+    holes'. With one loop the result is ``xy`` itself.
+    """
+    loops = starts.shape[0] - 1
+    n_out = starts[1] - starts[0]
+    total = n_out
+    for k in range(1, loops):
+        total += starts[k + 1] - starts[k] + 2
+    out = np.empty((total, 2))
+    m = 0
+    for j in range(starts[0], starts[1]):
+        out[m, 0], out[m, 1] = xy[j, 0], xy[j, 1]
+        m += 1
+    for k in range(1, loops):
+        out[m, 0], out[m, 1] = xy[starts[0], 0], xy[starts[0], 1]
+        m += 1
+        for j in range(starts[k], starts[k + 1]):
+            out[m, 0], out[m, 1] = xy[j, 0], xy[j, 1]
+            m += 1
+        out[m, 0], out[m, 1] = xy[starts[k], 0], xy[starts[k], 1]
+        m += 1
+    return out
+
+
+@jit
+def _normalise_loops(xy, starts):
+    """Outline and holes oriented and centred on the material's area centroid.
+
+    Parameters
+    ----------
+    xy, starts : the loops, one after the other (the outline first), and
+        their int64 offsets (see ``_keyhole``); any winding.
+
+    Returns
+    -------
+    ``(loops, area, a)``: ``xy`` with the outline counter-clockwise and the
+    holes clockwise (material on the left of every edge), minus the area
+    centroid of the material (outline minus holes); the material's area;
+    the largest centroid-vertex distance (an outline vertex: the material
+    lies inside the outline).
+    """
+    n_loops = starts.shape[0] - 1
+    out = np.empty_like(xy)
+    for k in range(n_loops):
+        lo, hi = starts[k], starts[k + 1]
+        flip = (_signed_area(xy[lo:hi]) > 0.0) != (k == 0)
+        for j in range(lo, hi):
+            src = hi - 1 - (j - lo) if flip else j
+            out[j, 0], out[j, 1] = xy[src, 0], xy[src, 1]
+    cx, cy, area = _centroid(_keyhole(out, starts))
+    a = 0.0
+    for j in range(xy.shape[0]):
+        out[j, 0] -= cx
+        out[j, 1] -= cy
+    for j in range(starts[0], starts[1]):
+        a = max(a, math.hypot(out[j, 0], out[j, 1]))
+    return out, area, a
+
+
+@jit
+def _loops_problem(xy, starts):
+    """Whether the holes lie strictly inside the outline and apart.
+
+    ``xy``, ``starts`` as for ``_keyhole`` (each loop already a simple
+    polygon). Returns ``(code, k, l)``: ``LOOPS_OK``; ``LOOPS_MEET`` when an
+    edge of loop ``k`` meets one of loop ``l`` (crossing or touching);
+    ``HOLE_OUTSIDE`` when hole ``k`` lies outside the outline; ``HOLE_IN_HOLE``
+    when hole ``k`` lies inside hole ``l`` (an island). Loop 0 is the outline.
+    """
+    n_loops = starts.shape[0] - 1
+    for k in range(n_loops):
+        for l in range(k + 1, n_loops):
+            for i in range(starts[k], starts[k + 1]):
+                i1 = i + 1 if i + 1 < starts[k + 1] else starts[k]
+                for j in range(starts[l], starts[l + 1]):
+                    j1 = j + 1 if j + 1 < starts[l + 1] else starts[l]
+                    if _segments_cross(xy[i, 0], xy[i, 1], xy[i1, 0], xy[i1, 1],
+                                       xy[j, 0], xy[j, 1], xy[j1, 0], xy[j1, 1]):
+                        return LOOPS_MEET, k, l
+    for k in range(1, n_loops):
+        px, py = xy[starts[k], 0], xy[starts[k], 1]
+        if not _point_inside(xy, starts[0], starts[1], px, py):
+            return HOLE_OUTSIDE, k, 0
+        for l in range(1, n_loops):
+            if l != k and _point_inside(xy, starts[l], starts[l + 1], px, py):
+                return HOLE_IN_HOLE, k, l
+    return LOOPS_OK, -1, -1
+
+
+@jit
+def _point_inside(xy, lo, hi, px, py):
+    """Even-odd rule: whether ``(px, py)`` lies inside the loop ``xy[lo:hi]``."""
+    inside = False
+    j = hi - 1
+    for i in range(lo, hi):
+        yi, yj = xy[i, 1], xy[j, 1]
+        if (yi > py) != (yj > py):
+            xc = xy[i, 0] + (py - yi) * (xy[j, 0] - xy[i, 0]) / (yj - yi)
+            if px < xc:
+                inside = not inside
+        j = i
+    return inside
 
 
 @jit

@@ -43,7 +43,7 @@ slow): all quantities are in units of a, far from overflow and underflow.
 import math
 
 from ._numba import jit, jit_inline
-from .support import _point_power, _power
+from .support import _point_power, _power, _table_sizes
 
 MINPOWER = 0
 TIP = 1
@@ -141,12 +141,13 @@ def _model_step(model, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
 
 
 @jit
-def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
+def _minimise(quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
     """Minimise ``P(x + y1 b + y2 c)`` over ``y`` (``k`` = 1 or 2 unknowns).
 
     Parameters
     ----------
-    verts, quad, area : polygon, its fan quadrature and area (see ``support``).
+    quad, area : the support table (``support._fan_quadrature``) and the
+        area of the material.
     x0..x2, b0..b2, c0..c2 : the affine family of twists ``x + y1 b + y2 c``.
     k : number of free parameters (``c`` is ignored when ``k == 1``).
     y1, y2 : warm start.
@@ -178,7 +179,7 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, 
     vx = x0 + y1 * b0 + y2 * c0
     vy = x1 + y1 * b1 + y2 * c1
     om = x2 + y1 * b2 + y2 * c2
-    p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = _power(verts, quad, area, vx, vy, om)
+    p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = _power(quad, area, vx, vy, om)
     converged = False
     for _ in range(_NEWTON_MAX_IT):
         d1, d2, dec = _newton_direction(g0, g1, g2, h00, h01, h02, h11, h12, h22, b0, b1, b2,
@@ -209,7 +210,7 @@ def _minimise(verts, quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, 
             vx = x0 + ty1 * b0 + ty2 * c0
             vy = x1 + ty1 * b1 + ty2 * c1
             om = x2 + ty1 * b2 + ty2 * c2
-            res = _power(verts, quad, area, vx, vy, om)
+            res = _power(quad, area, vx, vy, om)
             # The slack is above the rounding noise of P (sums of closed forms
             # with cancellation, ~1e-14 relative): near the minimum the Armijo
             # decrease is unmeasurable and must not block the last Newton step.
@@ -337,15 +338,14 @@ def _kink_optimal(pts, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, j, y1, y2):
 
 
 @jit
-def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
+def _minimise_points(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
     """``_minimise`` for a point support: minimise ``P = sum_j w_j |u_j|``
     over ``y`` on the family ``x + y1 b + y2 c``, exactly, kinks included.
 
     Parameters
     ----------
-    verts, quad : the polygon and the support: the first
-        ``len(quad) - len(verts)`` rows of ``quad`` are the points
-        ``(x, y, w)`` (``support._point_power``).
+    quad : the support table: its first ``F`` rows are the points
+        ``(x, y, w)`` (``support._point_power``, ``support._table_sizes``).
     x0..x2, b0..b2, c0..c2, k, y1, y2, take : as for ``_minimise``.
 
     Returns
@@ -373,7 +373,7 @@ def _minimise_points(verts, quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2,
     The family's parameters are exact at a kink; no smoothing of ``|u|`` is
     used anywhere.
     """
-    m = quad.shape[0] - verts.shape[0]
+    m = _table_sizes(quad)[0]
     vx = x0 + y1 * b0 + y2 * c0
     vy = x1 + y1 * b1 + y2 * c1
     om = x2 + y1 * b2 + y2 * c2
@@ -504,7 +504,7 @@ def _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy):
 
 
 @jit_inline
-def _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm, model, take, points=False):
+def _stick_solve(quad, area, cx, cy, vpx, vpy, om_warm, model, take, points=False):
     """Sticking: minimise P over twists with ``u(c) = v_p`` (1 unknown, omega).
 
     ``points``: the part rests on the point support in ``quad``
@@ -512,24 +512,24 @@ def _stick_solve(verts, quad, area, cx, cy, vpx, vpy, om_warm, model, take, poin
     not hold across a kink). Returns ``(vx, vy, om, g, H, converged)``
     (``g``, ``H``: see ``_minimise``)."""
     if points:
-        _, om, _, g, hess, conv = _minimise_points(verts, quad, vpx, vpy, 0.0, cy, -cx, 1.0,
+        _, om, _, g, hess, conv = _minimise_points(quad, vpx, vpy, 0.0, cy, -cx, 1.0,
                                                    0.0, 0.0, 0.0, 1, om_warm, 0.0, take)
         if not conv and om_warm != 0.0:
-            _, om, _, g, hess, conv = _minimise_points(verts, quad, vpx, vpy, 0.0, cy, -cx,
+            _, om, _, g, hess, conv = _minimise_points(quad, vpx, vpy, 0.0, cy, -cx,
                                                        1.0, 0.0, 0.0, 0.0, 1, 0.0, 0.0, take)
         return vpx + om * cy, vpy - om * cx, om, g, hess, conv
     om_warm, _ = _model_step(model, vpx, vpy, 0.0, cy, -cx, 1.0, 0.0, 0.0, 0.0, 1, om_warm,
                              0.0)
-    _, om, _, g, hess, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
+    _, om, _, g, hess, conv = _minimise(quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
                                         0.0, 0.0, 0.0, 1, om_warm, 0.0, take)
     if not conv and om_warm != 0.0:  # a poor warm start: solve again from translation
-        _, om, _, g, hess, conv = _minimise(verts, quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
+        _, om, _, g, hess, conv = _minimise(quad, area, vpx, vpy, 0.0, cy, -cx, 1.0,
                                             0.0, 0.0, 0.0, 1, 0.0, 0.0, take)
     return vpx + om * cy, vpy - om * cx, om, g, hess, conv
 
 
 @jit_inline
-def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take, points=False):
+def _slide_solve(quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take, points=False):
     """Sliding: minimise P over twists with ``e . u(c) = 1`` (2 unknowns).
 
     ``(wvx, wvy, wom)`` is a warm-start twist of any scale, and ``model`` a
@@ -561,17 +561,17 @@ def _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom, model, take, 
         y1 = 0.0
         y2 = 0.0
     if points:
-        _, y1, y2, g, hess, conv = _minimise_points(verts, quad, ex, ey, 0.0, -ey, ex, 0.0,
+        _, y1, y2, g, hess, conv = _minimise_points(quad, ex, ey, 0.0, -ey, ex, 0.0,
                                                     -ke * ex, -ke * ey, 1.0, 2, y1, y2, take)
         if not conv and (y1 != 0.0 or y2 != 0.0):
-            _, y1, y2, g, hess, conv = _minimise_points(verts, quad, ex, ey, 0.0, -ey, ex, 0.0,
+            _, y1, y2, g, hess, conv = _minimise_points(quad, ex, ey, 0.0, -ey, ex, 0.0,
                                                         -ke * ex, -ke * ey, 1.0, 2, 0.0, 0.0,
                                                         take)
     else:
-        _, y1, y2, g, hess, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
+        _, y1, y2, g, hess, conv = _minimise(quad, area, ex, ey, 0.0, -ey, ex, 0.0,
                                              -ke * ex, -ke * ey, 1.0, 2, y1, y2, take)
         if not conv and (y1 != 0.0 or y2 != 0.0):
-            _, y1, y2, g, hess, conv = _minimise(verts, quad, area, ex, ey, 0.0, -ey, ex, 0.0,
+            _, y1, y2, g, hess, conv = _minimise(quad, area, ex, ey, 0.0, -ey, ex, 0.0,
                                                  -ke * ex, -ke * ey, 1.0, 2, 0.0, 0.0, take)
     vx = ex - y1 * ey - y2 * ke * ex
     vy = ey + y1 * ex - y2 * ke * ey
@@ -594,7 +594,7 @@ def _scaled_hessian(hess, scale):
 
 
 @jit_inline
-def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
+def _minpower_twist(quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
                     model, take, points=False):
     """Minpower twist, force and mode (see ``_contact_twist``), plus P's
     gradient and Hessian at the twist returned, for the next warm start;
@@ -606,7 +606,7 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
         # sliding solution on the previous side whose slip opposes friction is
         # that answer. Otherwise fall through to the full rule.
         ex, ey = _cone_edge(nx, ny, mu, hint)
-        vx, vy, om, g, hess, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx,
+        vx, vy, om, g, hess, conv = _slide_solve(quad, area, cx, cy, ex, ey, wvx,
                                                  wvy, wom, model, take, points)
         scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
         if scale > 0.0:
@@ -615,7 +615,7 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
                 return (TWIST_OK, vx, vy, om, g[0], g[1], hint, g,
                         _scaled_hessian(hess, scale))
     if mu > 0.0:
-        vx, vy, om, g, hess, conv = _stick_solve(verts, quad, area, cx, cy, vpx, vpy, wom,
+        vx, vy, om, g, hess, conv = _stick_solve(quad, area, cx, cy, vpx, vpy, wom,
                                                  model, take, points)
         side = _cone_side(g[0], g[1], nx, ny, mu)
         if side == STICK:
@@ -628,7 +628,7 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
         side = SLIDE_POS
         vx, vy, om = wvx, wvy, wom
     ex, ey = _cone_edge(nx, ny, mu, side)
-    vx, vy, om, g, hess, conv = _slide_solve(verts, quad, area, cx, cy, ex, ey, vx, vy, om,
+    vx, vy, om, g, hess, conv = _slide_solve(quad, area, cx, cy, ex, ey, vx, vy, om,
                                              model, take, points)
     scale = _push_scale(vx, vy, om, cx, cy, nx, ny, vpx, vpy)
     if scale <= 0.0:
@@ -638,12 +638,12 @@ def _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, w
 
 
 @jit
-def _minpower_twist_points(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
+def _minpower_twist_points(quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
                            model, take):
     """``_minpower_twist`` over the point support in ``quad``: the same code,
     compiled as a function of its own so that the uniform model's callers,
     which inline ``_minpower_twist``, keep their code (and speed) as before."""
-    return _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
+    return _minpower_twist(quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint,
                            model, take, True)
 
 
@@ -665,17 +665,17 @@ def _tip_twist_for_line(cx, cy, fx, fy):
 
 
 @jit
-def _power_balance_force(verts, quad, area, vx, vy, om, cx, cy, fx, fy):
+def _power_balance_force(quad, area, vx, vy, om, cx, cy, fx, fy):
     """Scale the unit force direction ``f`` so the pin's power ``f . u(c)``
     equals the belt's dissipation ``P`` of the twist (uniform pressure)."""
     ucf = (vx - om * cy) * fx + (vy + om * cx) * fy
-    p = _power(verts, quad, area, vx, vy, om)[0]
+    p = _power(quad, area, vx, vy, om)[0]
     k = p / ucf if ucf > 0.0 else 0.0
     return k * fx, k * fy
 
 
 @jit
-def _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu):
+def _tip_twist(quad, area, cx, cy, nx, ny, vpx, vpy, mu):
     # Sticking: the COR lies on the line through c perpendicular to v_p
     # (r = c + lam t_v, t_v = z x v_p / |v_p|) and is the tip for a line
     # through c iff c . r = -a^2, which fixes lam in closed form.
@@ -704,7 +704,7 @@ def _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu):
         vx, vy, om = k * vx, k * vy, k * om
     side = _cone_side(fx, fy, nx, ny, mu)
     if side == STICK and mu > 0.0:
-        fx, fy = _power_balance_force(verts, quad, area, vx, vy, om, cx, cy, fx, fy)
+        fx, fy = _power_balance_force(quad, area, vx, vy, om, cx, cy, fx, fy)
         return TWIST_OK, vx, vy, om, fx, fy, STICK
     if mu == 0.0:
         side = SLIDE_POS
@@ -714,7 +714,7 @@ def _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu):
     if scale <= 0.0:
         return TWIST_NO_PUSH, 0.0, 0.0, 0.0, 0.0, 0.0, side
     vx, vy, om = scale * vx, scale * vy, scale * om
-    fx, fy = _power_balance_force(verts, quad, area, vx, vy, om, cx, cy, ex, ey)
+    fx, fy = _power_balance_force(quad, area, vx, vy, om, cx, cy, ex, ey)
     return TWIST_OK, vx, vy, om, fx, fy, side
 
 
@@ -748,7 +748,7 @@ def _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max):
 
 
 @jit
-def _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
+def _continued_slide(model, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
                      wvx, wvy, wom, side, p_model, take):
     """Sliding twist on cone side ``side`` continued past separation.
 
@@ -777,10 +777,10 @@ def _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, 
     """
     ex, ey = _cone_edge(nx, ny, mu, side)
     if model == MINPOWER:
-        vx, vy, om, _, _, _ = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
+        vx, vy, om, _, _, _ = _slide_solve(quad, area, cx, cy, ex, ey, wvx, wvy, wom,
                                            p_model, take)
     elif model == MINPOWER_POINTS:
-        vx, vy, om, _, _, _ = _slide_solve(verts, quad, area, cx, cy, ex, ey, wvx, wvy, wom,
+        vx, vy, om, _, _, _ = _slide_solve(quad, area, cx, cy, ex, ey, wvx, wvy, wom,
                                            p_model, take, True)
     elif model == TIP:
         vx, vy, om = _tip_twist_for_line(cx, cy, ex, ey)
@@ -794,7 +794,7 @@ def _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, 
 
 
 @jit
-def _contact_twist(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
+def _contact_twist(model, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu,
                    wvx, wvy, wom, hint):
     """Twist and pin force for one contact under ``model`` (see module doc).
 
@@ -807,13 +807,13 @@ def _contact_twist(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx, vpy, mu
     if vpx * nx + vpy * ny <= 0.0:
         return TWIST_OK, 0.0, 0.0, 0.0, 0.0, 0.0, SEPARATE
     if model == MINPOWER:
-        res = _minpower_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom,
+        res = _minpower_twist(quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom,
                               hint, NO_MODEL, _DEC_TAKE)
         return res[0], res[1], res[2], res[3], res[4], res[5], res[6]
     if model == MINPOWER_POINTS:
-        res = _minpower_twist_points(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy,
+        res = _minpower_twist_points(quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy,
                                      wom, hint, NO_MODEL, _DEC_TAKE)
         return res[0], res[1], res[2], res[3], res[4], res[5], res[6]
     if model == TIP:
-        return _tip_twist(verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu)
+        return _tip_twist(quad, area, cx, cy, nx, ny, vpx, vpy, mu)
     return _ellipsoid_twist(cx, cy, nx, ny, vpx, vpy, mu, m_max)

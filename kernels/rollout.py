@@ -49,12 +49,12 @@ import math
 import numpy as np
 
 from ._numba import jit, jit_inline
-from .geometry import (EDGE, VERTEX, _is_convex, _normalise, _other_contact_gap,
-                       _ray_first_contact)
+from .geometry import (EDGE, VERTEX, _is_convex, _keyhole, _normalise_loops,
+                       _other_contact_gap, _ray_first_contact)
 from .models import (_DEC_TAKE, MINPOWER, MINPOWER_POINTS, NO_MODEL, SEPARATE, SLIDE_NEG,
                      SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide, _minpower_twist,
                      _minpower_twist_points)
-from .support import _fan_quadrature, _max_moment
+from .support import _fan_quadrature, _max_moment, _table_sizes
 
 OK = 0
 MISS = 1
@@ -143,16 +143,41 @@ def _solve_take(tol):
 
 @jit
 def _prepare(xy):
-    """Normalise a vertex list for rollouts.
+    """Normalise a solid part's vertex list for rollouts (``_prepare_loops``
+    with one loop)."""
+    starts = np.empty(2, dtype=np.int64)
+    starts[0] = 0
+    starts[1] = xy.shape[0]
+    return _prepare_loops(xy, starts)
 
-    Returns ``(verts, area, a, quad, m_max, convex)`` with ``verts`` counter-
-    clockwise, centred and scaled to ``a = 1`` (area and m_max in those units).
+
+@jit
+def _prepare_loops(xy, starts):
+    """Normalise a part with holes for rollouts.
+
+    Parameters
+    ----------
+    xy : ``(N, 2)`` vertices of the outline, then of each hole, in either
+        winding (checked simple, holes strictly inside the outline and apart).
+    starts : ``(L + 1,)`` int64 offsets of the loops in ``xy``: the outline
+        is ``xy[starts[0]:starts[1]]``, hole ``k`` ``xy[starts[k]:starts[k + 1]]``.
+
+    Returns
+    -------
+    ``(verts, area, a, quad, m_max, convex)`` with ``verts`` the outline
+    (what a pin touches) counter-clockwise, centred on the material's area
+    centroid and scaled to ``a = 1``; ``area`` the material's area and
+    ``m_max`` its largest support moment in those units; ``quad`` the support
+    table (``support._fan_quadrature``) of the material, holes left out
+    (``geometry._keyhole``).
     """
-    verts, area, a = _normalise(xy)
-    verts = verts / a
+    loops, area, a = _normalise_loops(xy, starts)
+    n = starts[1] - starts[0]
+    verts = loops[:n] / a
+    material = _keyhole(loops, starts) / a
     area = area / (a * a)
-    quad = _fan_quadrature(verts)
-    return verts, area, a, quad, _max_moment(verts, area), _is_convex(verts)
+    quad = _fan_quadrature(material)
+    return verts, area, a, quad, _max_moment(material, area), _is_convex(verts)
 
 
 @jit
@@ -301,23 +326,23 @@ def _derivative(verts, quad, prm, kind, idx, y, sp, warm, out):
             # sliding contact (see models._continued_slide); the mode stays
             # SEPARATE, so a step that starts here still ends the contact.
             wvx, wvy, wom, p_model = _warm_start(warm, sp)
-            vx, vy, om = _continued_slide(model, verts, quad, area, m_max, cx, cy, nx, ny, vpx,
+            vx, vy, om = _continued_slide(model, quad, area, m_max, cx, cy, nx, ny, vpx,
                                           vpy, mu, wvx, wvy, wom, hint, p_model, take)
     elif model == MINPOWER or model == MINPOWER_POINTS:
         wvx, wvy, wom, p_model = _warm_start(warm, sp)
         if model == MINPOWER:
             st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist(
-                verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model,
+                quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model,
                 take)
         else:
             st, vx, vy, om, fx, fy, mode, g, hess = _minpower_twist_points(
-                verts, quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model,
+                quad, area, cx, cy, nx, ny, vpx, vpy, mu, wvx, wvy, wom, hint, p_model,
                 take)
         if st == TWIST_OK:
             _remember(warm, sp, vx, vy, om, mode, g, hess)
     else:
         # The closed-form models need no warm start: keep the mode only.
-        st, vx, vy, om, fx, fy, mode = _contact_twist(model, verts, quad, area, m_max, cx, cy,
+        st, vx, vy, om, fx, fy, mode = _contact_twist(model, quad, area, m_max, cx, cy,
                                                       nx, ny, vpx, vpy, mu, 0.0, 0.0, 0.0, hint)
         if st == TWIST_OK:
             warm[_WARM_MODE] = mode
@@ -624,12 +649,12 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
         ``trajectory`` rows ``(s, x, y, theta)`` (theta unwrapped, radians) and
         ``force`` rows ``(s, f_x, f_y)`` (force on the pin, units of mu_s m g);
         both empty unless ``record``. A rollout that uses up the step budget
-        ``max_steps_for(len(verts))`` ends ``TRUNCATED`` with reason
+        ``max_steps_for`` of the support polygon's size ends ``TRUNCATED`` with reason
         ``TRUNC_STEP_BUDGET``.
     """
     res = _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d,
                           v_pin, max_travel, ds_max, tol, record,
-                          max_steps_for(verts.shape[0]))
+                          max_steps_for(_table_sizes(quad)[1]))
     return res[0], res[1], res[2], res[3], res[4], res[5], res[6], res[7], res[8]
 
 

@@ -102,11 +102,17 @@ def _edge_support(px, py, r1, i1, qx, qy, r2, i2, ex, ey):
 
 
 @jit
-def _support_sum(verts, quad, rx, ry):
-    """E(r), G(r), N(r) of the counter-clockwise polygon ``verts``, with the
-    edges' unit directions read from the last ``n`` rows of ``quad`` (as
-    ``_fan_quadrature`` builds it), or computed here if ``quad`` has fewer
-    than ``n`` rows.
+def _table_sizes(quad):
+    """``(F, S)``: the number of quadrature (or support point) rows of a
+    support table and the number of vertices of its support polygon (its
+    last row; see ``_fan_quadrature``)."""
+    return int(quad[quad.shape[0] - 1, 0]), int(quad[quad.shape[0] - 1, 1])
+
+
+@jit
+def _support_sum(quad, rx, ry):
+    """E(r), G(r), N(r) of the support polygon of the table ``quad`` (see
+    ``_fan_quadrature``: its vertex positions and edges' unit directions).
 
     Returns ``(E, Gx, Gy, Nxx, Nxy, Nyy)``.
 
@@ -116,28 +122,25 @@ def _support_sum(verts, quad, rx, ry):
     and, only for an edge end behind the foot of the perpendicular, one
     division (see ``_edge_support``). The unit directions do not depend on
     r, so the prepared table saves a square root and a division per edge.
+    The edges are signed: the outline counter-clockwise, holes clockwise,
+    so the sum is the integral over the material (module notes).
     """
-    n = verts.shape[0]
-    base = quad.shape[0] - n
+    f, n = _table_sizes(quad)
+    pos = f
+    base = f + n
     e_val = gx = gy = nxx = nxy = nyy = 0.0
-    x0, y0 = verts[0, 0] - rx, verts[0, 1] - ry
+    x0, y0 = quad[pos, 0] - rx, quad[pos, 1] - ry
     r0 = math.sqrt(x0 * x0 + y0 * y0)
     i0 = 1.0 / r0
     px, py, r1, i1 = x0, y0, r0, i0
     for j in range(n):
         if j + 1 < n:
-            qx, qy = verts[j + 1, 0] - rx, verts[j + 1, 1] - ry
+            qx, qy = quad[pos + j + 1, 0] - rx, quad[pos + j + 1, 1] - ry
             r2 = math.sqrt(qx * qx + qy * qy)
             i2 = 1.0 / r2
         else:
             qx, qy, r2, i2 = x0, y0, r0, i0
-        if base >= 0:
-            ex, ey = quad[base + j, 0], quad[base + j, 1]
-        else:
-            ex, ey = qx - px, qy - py
-            inv = 1.0 / math.sqrt(ex * ex + ey * ey)
-            ex *= inv
-            ey *= inv
+        ex, ey = quad[base + j, 0], quad[base + j, 1]
         a0, a1, a2, a3, a4, a5 = _edge_support(px, py, r1, i1, qx, qy, r2, i2, ex, ey)
         e_val += a0
         gx += a1
@@ -151,29 +154,40 @@ def _support_sum(verts, quad, rx, ry):
 
 @jit
 def _support(verts, rx, ry):
-    """E(r), G(r) and N(r) of the counter-clockwise polygon ``verts``.
+    """E(r), G(r) and N(r) of the polygon ``verts`` (counter-clockwise; a
+    keyhole polygon of ``geometry._keyhole`` for a part with holes).
 
     Returns ``(E, Gx, Gy, Nxx, Nxy, Nyy)``.
     """
-    return _support_sum(verts, verts[:0], rx, ry)
+    return _support_sum(_fan_quadrature(verts), rx, ry)
 
 
 @jit
 def _fan_quadrature(verts):
-    """Collapsed Gauss-Legendre rule over the centroid fan of ``verts``, and
-    the edges' unit directions.
+    """The support table of the polygon ``verts``: a collapsed
+    Gauss-Legendre rule over its centroid fan, its vertices and its edges'
+    unit directions.
 
-    Returns an ``(n g^2 + n, 3)`` array (``g = _GL_N``): rows of ``(x, y,
-    weight)`` with signed weights, so the rule integrates smooth functions
-    over non-convex polygons too, then one row ``(e_x, e_y, 0)`` per edge
-    ``j`` (vertex ``j`` to ``j + 1``), unit direction, weight zero, so a sum
-    over all rows is still the quadrature. ``_power`` reads the directions
-    from there (see ``_support_sum``) instead of normalising every edge in
-    every evaluation.
+    Returns an ``(F + 2 n + 1, 3)`` array (``F = n g^2``, ``g = _GL_N``):
+
+    - ``F`` rows ``(x, y, weight)`` with signed weights, so the rule
+      integrates smooth functions over non-convex polygons, and over a
+      keyhole polygon (``_keyhole``) the material without its holes;
+    - ``n`` rows ``(x_j, y_j, 0)``: the vertices;
+    - ``n`` rows ``(e_x, e_y, 0)``: the unit direction of edge ``j``
+      (vertex ``j`` to ``j + 1``);
+    - one row ``(F, n, 0)`` that says so (``_table_sizes``).
+
+    The weights after row ``F`` are zero, so a sum over all rows but the
+    last is still the quadrature. ``_power`` reads the vertices and
+    directions from here (see ``_support_sum``) instead of normalising every
+    edge in every evaluation. A point support replaces the first ``F`` rows
+    by its points and ``F`` by their count (``maps.simulate``).
     """
     n = verts.shape[0]
     g = _GL_X.shape[0]
-    out = np.empty((n * g * g + n, 3))
+    f = n * g * g
+    out = np.empty((f + 2 * n + 1, 3))
     m = 0
     for j in range(n):
         k = (j + 1) % n
@@ -192,14 +206,34 @@ def _fan_quadrature(verts):
         k = (j + 1) % n
         ex, ey = verts[k, 0] - verts[j, 0], verts[k, 1] - verts[j, 1]
         length = math.sqrt(ex * ex + ey * ey)
-        out[m + j, 0] = ex / length
-        out[m + j, 1] = ey / length
-        out[m + j, 2] = 0.0
+        out[f + j, 0] = verts[j, 0]
+        out[f + j, 1] = verts[j, 1]
+        out[f + j, 2] = 0.0
+        out[f + n + j, 0] = ex / length
+        out[f + n + j, 1] = ey / length
+        out[f + n + j, 2] = 0.0
+    out[f + 2 * n, 0] = f
+    out[f + 2 * n, 1] = n
+    out[f + 2 * n, 2] = 0.0
     return out
 
 
 @jit
-def _power(verts, quad, area, vx, vy, om):
+def _point_table(quad, pts):
+    """The support table ``quad`` with its quadrature rows replaced by the
+    point support ``pts`` (``(K, 3)`` rows ``(x, y, w)``, units of a,
+    weights summing to 1): what ``MINPOWER_POINTS`` rolls on."""
+    f, n = _table_sizes(quad)
+    k = pts.shape[0]
+    out = np.empty((k + 2 * n + 1, 3))
+    out[:k] = pts
+    out[k:] = quad[f:]
+    out[k + 2 * n, 0] = k
+    return out
+
+
+@jit
+def _power(quad, area, vx, vy, om):
     """Belt power P(xi), its gradient and Hessian for the twist ``(vx, vy, om)``.
 
     Units: ``mu_s m g`` times speed. The gradient's first two entries are the
@@ -211,7 +245,7 @@ def _power(verts, quad, area, vx, vy, om):
         # Rotation about r = z x v / omega within _R_FAR: closed forms.
         inv_om = 1.0 / om
         rx, ry = -vy * inv_om, vx * inv_om
-        e_val, gx, gy, nxx, nxy, nyy = _support_sum(verts, quad, rx, ry)
+        e_val, gx, gy, nxx, nxy, nyy = _support_sum(quad, rx, ry)
         s = 1.0 if om > 0.0 else -1.0
         p_val = abs(om) * e_val / area
         f = s / area
@@ -226,7 +260,7 @@ def _power(verts, quad, area, vx, vy, om):
                 k * (px * npx + py * npy))
     p_val = g0 = g1 = g2 = 0.0
     h00 = h01 = h02 = h11 = h12 = h22 = 0.0
-    for i in range(quad.shape[0] - verts.shape[0]):  # the last n rows are edges
+    for i in range(_table_sizes(quad)[0]):  # the quadrature rows
         wx, wy, wt = quad[i, 0], quad[i, 1], quad[i, 2]
         ux = vx - om * wy
         uy = vy + om * wx

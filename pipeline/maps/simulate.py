@@ -19,6 +19,7 @@ import xarray as xr
 from kernels.batch import _rollout_grid, blocks_for
 from kernels.points import _rollout_points
 from kernels.models import MINPOWER_POINTS, MODEL_NAMES
+from kernels.support import _point_table
 from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
                              _rollout, max_steps_for)
 
@@ -92,8 +93,8 @@ def resolve_support(part: Part, support, model: str = "minpower") -> Support | N
 def _kernel_part(part: Part, model: str, support: Support | None):
     """The arrays a rollout kernel takes for ``part`` (``Part.prepared``) and
     the kernel's model code; for a point support the ``quad`` array holds
-    the points in units of a, weights summing to 1, before the edge
-    directions (see ``kernels.models``), and the code is ``MINPOWER_POINTS``."""
+    the points in units of a, weights summing to 1, in place of its
+    quadrature rows (``kernels.support._point_table``), and the code is ``MINPOWER_POINTS``."""
     prep = part.prepared()
     if support is None:
         return prep, MODELS.index(model)
@@ -101,7 +102,7 @@ def _kernel_part(part: Part, model: str, support: Support | None):
     # The kernel centres the outline again (to rounding): move the points with it.
     shift = np.asarray(part.vertices).mean(axis=0) - (verts * a).mean(axis=0)
     rows = np.column_stack([(support.points - shift) / a, support.weights])
-    pts = np.ascontiguousarray(np.vstack([rows, quad[-verts.shape[0]:]]))
+    pts = _point_table(quad, np.ascontiguousarray(rows))
     return (verts, area, a, pts, m_max, convex), MINPOWER_POINTS
 
 
@@ -302,7 +303,7 @@ def compute_map(part: Part, theta_i, d, mu_c: float, pin_radius: float, model: s
         prep, code = _kernel_part(part, model, sup)
         out = cuda_grid()(
             *prep, code, float(mu_c), float(pin_radius), np.radians(th), dd,
-            float(v_pin), cap, float(ds_max), float(tol), max_steps_for(prep[0].shape[0]))
+            float(v_pin), cap, float(ds_max), float(tol), max_steps_for(int(prep[3][-1, 1])))
     elif dynamic:
         out = _dynamic_grid(part, mu_c, pin_radius, th, dd, v_pin, fr, belt_speed, cap, threads)
     else:
