@@ -209,7 +209,7 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
         raise PinfeedError(f"trials must be a whole number >= 1, got {trials!r}")
     result = as_plan_file(result)
     chosen, mu_c, entry = pick_tight_plan(result, plan, mu_text)
-    part = Part.from_vertices(result.part["vertices"], name=result.name)
+    part = Part.from_dict(result.part, name=result.name)
     perturb = perturbation_from_verify(config.get("verify", {}))
     # A tight-only plan file keeps the resting states per friction entry.
     stored_states = entry.initial_states or result.initial_states or {}

@@ -160,7 +160,9 @@ def _moving_figure(part, still, panes, stations, heights, speeds, pin_radius):
     """A figure showing the still one as an image, and ``draw(b)`` that poses the
     moving artists (parts, moving pins, belt marks, notes, clock) at belt travel b."""
     import matplotlib.pyplot as plt
-    from matplotlib.patches import Circle, Polygon, Rectangle
+    from matplotlib.patches import Circle, Rectangle
+
+    from pipeline.present.figures.outline import PartPatch
     a = part.a
     w, h = still.canvas.get_width_height()
     image = np.asarray(still.canvas.buffer_rgba()).copy()
@@ -177,7 +179,7 @@ def _moving_figure(part, still, panes, stations, heights, speeds, pin_radius):
         (x0, y0), (x1, y1) = ax.bbox.get_points()
         clip = Rectangle((x0, y0), x1 - x0, y1 - y0, transform=bg.transData, visible=False)
         bg.add_patch(clip)
-        body = Polygon(np.zeros((3, 2)), closed=True, fc="tab:blue", ec="k", alpha=0.7, zorder=2)
+        body = PartPatch(part, to=to_px, fc="tab:blue", ec="k", alpha=0.7, zorder=2)
         bg.add_patch(body)
         body.set_clip_path(clip)
         pins = {}
@@ -197,7 +199,7 @@ def _moving_figure(part, still, panes, stations, heights, speeds, pin_radius):
         clock.set_text(f"belt travel {b:6.1f} mm")
         for lane, to_px, body, pins, marks, note, lo, x_lo, x_hi in movers:
             x, y, th = lane.pose(b)
-            body.set_xy(to_px.transform(rotated(part.vertices, th) + np.array([x, y])))
+            body.set_pose(th, x, y)
             for k, pin in pins.items():
                 pin.center = tuple(to_px.transform((stations[k], pin_height(
                     lane, k, b, heights[k], speeds[k], stations[k]))))
@@ -352,12 +354,12 @@ def animate_stored(result, config: dict, out, plan_index=None, frames: int = 120
     result = as_plan_file(result)
     if layout is not None:
         inputs = layout_inputs(result, layout)
-        part = Part.from_vertices(result.part["vertices"], name=result.name)
+        part = Part.from_dict(result.part, name=result.name)
         done = animate_layout(part, layout, inputs["states"], inputs["mu_c"], out, frames=frames, fps=fps,
                               what=f"{inputs['what']}, pins {' → '.join(inputs['labels'])}")
         return {**done, **inputs}
     inputs = plan_inputs(result, plan_index, config)
-    part = Part.from_vertices(result.part["vertices"], name=result.name)
+    part = Part.from_dict(result.part, name=result.name)
     done = animate_plan(part, inputs["heights"], inputs["speeds"], inputs["states"], inputs["mu_c"],
                         inputs["model"], inputs["pin_radius"], out, labels=inputs["labels"],
                         frames=frames, fps=fps,
@@ -460,9 +462,10 @@ def station_figure(scene: StationScene, title: str) -> dict:
     ``parts`` the part polygons (part k first), ``draw(b)`` poses the parts at
     belt travel ``b`` and returns the artists it changed."""
     import matplotlib.pyplot as plt
-    from matplotlib.patches import Circle, Polygon, Rectangle
+    from matplotlib.patches import Circle, Rectangle
 
     from pipeline.present.figures import save_figure  # noqa: F401 (selects the Agg backend)
+    from pipeline.present.figures.outline import PartPatch
     part, a = scene.part, scene.part.a
     x_lo = -scene.entry - 1.5 * a
     x_hi = max([float(ln.x[-1]) for ln in scene.lanes]
@@ -483,8 +486,8 @@ def station_figure(scene: StationScene, title: str) -> dict:
         ax.axvline(x, color="tab:red", lw=0.4, ls=":", zorder=0)
         labels.append(label_above(ax, x, f"{row['label']}: x {x:.0f}, y {y:g} mm", fontsize=7,
                                   color="tab:red"))
-    parts = [ax.add_patch(Polygon(np.zeros((3, 2)), closed=True, fc=f"C{k % len(scene.lanes)}", ec="k",
-                                  alpha=0.75, zorder=2)) for k in range(scene.n_parts)]
+    parts = [ax.add_patch(PartPatch(part, fc=f"C{k % len(scene.lanes)}", ec="k", alpha=0.75, zorder=2))
+             for k in range(scene.n_parts)]
     marks, = ax.plot([], [], "|", color="0.6", ms=5, zorder=1)
     clock = ax.text(0.005, 0.98, "", transform=ax.transAxes, ha="left", va="top", fontsize=8,
                     family="monospace")
@@ -497,7 +500,7 @@ def station_figure(scene: StationScene, title: str) -> dict:
 
     def draw(b):
         for (k, _, x, y, th), body in zip(scene.part_poses(b), parts):
-            body.set_xy(rotated(part.vertices, th) + np.array([x, y]))
+            body.set_pose(th, x, y)
         ticks = np.arange(x_lo + b % (0.5 * a), x_hi, 0.5 * a)  # the belt's texture moves with it
         marks.set_data(ticks, np.full_like(ticks, scene.belt_y[0] + 0.1 * a))
         clock.set_text(f"belt travel {b:6.1f} mm")

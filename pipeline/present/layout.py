@@ -326,19 +326,26 @@ def _fence_end(part: Part, lanes: list[Lane], pin_radius: float) -> float:
 def _drawing(part, states, nominal_lanes, stations, pitch, entry, pin_radius, margin) -> dict:
     """Outlines to draw: each resting state at the entry (one pitch apart,
     nearest the pins first) and each state's nominal exit pose, clear of the
-    last pin."""
+    last pin; each entry's ``holes`` (a part with holes only) are its holes at
+    the same pose."""
     entry_parts, exit_parts = [], []
+
+    def shape(x, y, theta):  # the outline, and the holes of a part with holes, at a pose
+        out = {"outline": outlines(part.vertices, [x], [y], [theta])[0].tolist()}
+        if part.has_holes:
+            out["holes"] = [outlines(h, [x], [y], [theta])[0].tolist() for h in part.holes]
+        return out
+
     for k, ((label, (theta, y_c)), lane) in enumerate(zip(states.items(), nominal_lanes)):
         x = -entry - k * pitch
         entry_parts.append({"state": label, "x_mm": x, "y_mm": float(y_c), "theta_deg": float(theta) % 360,
-                            "outline": outlines(part.vertices, [x], [y_c], [theta])[0].tolist()})
+                            **shape(x, y_c, theta)})
         x_end, y_end, th_end = (float(v) for v in (lane.x[-1], lane.y[-1], lane.theta[-1]))
         poly = rotated(part.vertices, th_end)
         clear_x = stations[-1] + pin_radius + margin - float(poly[:, 0].min())
         x_exit = max(x_end, clear_x) + k * pitch
         exit_parts.append({"state": label, "x_mm": x_exit, "y_mm": y_end, "theta_deg": th_end % 360,
-                           "outcome": lane.outcome,
-                           "outline": outlines(part.vertices, [x_exit], [y_end], [th_end])[0].tolist()})
+                           "outcome": lane.outcome, **shape(x_exit, y_end, th_end)})
     return {"entry_parts": entry_parts, "exit_parts": exit_parts}
 
 
@@ -371,7 +378,7 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})
     result = as_plan_file(result)
     plan, mu_c, states = _fixed_pin_plan(result, plan_number, mu_text)
-    part = Part.from_vertices(result.part["vertices"], name=result.name)
+    part = Part.from_dict(result.part, name=result.name)
     pin_radius = float(result.extra.get("pin_radius", config["sweep"]["pin_radius"]))
     mu_s = float(cfg["mu_s"] if mu_s is None else mu_s)
     heights = [float(h) for h in plan.pin_heights_mm]

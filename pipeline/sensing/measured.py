@@ -133,7 +133,7 @@ def _part(config, part_name, root, catalog=None):
             path = root / kind / f"{part_name}.json"
             if path.is_file():
                 stored = read_json(path)["part"]
-                return Part.from_vertices(stored["vertices"], name=stored["name"]), None
+                return Part.from_dict(stored), None
         raise
 
 

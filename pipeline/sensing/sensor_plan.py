@@ -312,7 +312,7 @@ def sense_part(plan_path, config: dict, log=print, friction=None) -> dict:
     sc, sweep = config["sensing"], config["sweep"]
     stored = load_plan(plan_path)
     entry = tight_entry(stored, friction)
-    part = Part.from_vertices(stored.part["vertices"], name=stored.name)
+    part = Part.from_dict(stored.part, name=stored.name)
     model = stored.model if stored.model is not None else config["planner"]["model"]
     sensor = Sensor.from_config(sc["sensor"])
     res = plan_with_sensor(part, entry.to_dict(), sweep["pin_radius"], model, sensor, trials=sc["trials"],

@@ -118,7 +118,7 @@ def verify_part(plan_result: dict, config: dict) -> dict:
     result + "kind"]}``."""
     name = plan_result["part"]["name"]
     out = {"part": name, "checks": [], **provenance_attrs()}
-    part = Part.from_vertices(plan_result["part"]["vertices"], name=name)
+    part = Part.from_dict(plan_result["part"], name=name)
     states = {k: (v["theta"], v["y_c"]) for k, v in plan_result["initial_states"].items()}
     radius, kernel = config["sweep"]["pin_radius"], config["sweep"].get("kernel")
     for kind, plan in plans_to_check(plan_result).items():

@@ -30,7 +30,7 @@ def nominal_paths(plan_result: dict, config: dict, plan: dict | None = None, pin
     """Unperturbed rollouts of a plan (default: the best): (theta, y_c) before and after each pin;
     ``pins`` (label -> mm), ``speeds`` (label -> v_pin / v_b) and ``mu_c`` default to the
     file's tables and paper mode's friction."""
-    part = Part.from_vertices(plan_result["part"]["vertices"], name=plan_result["part"]["name"])
+    part = Part.from_dict(plan_result["part"])
     best = plan or plan_result["plans"][0]
     pins = plan_result["pins"] if pins is None else pins
     speeds = plan_result.get("pin_speeds", {}) if speeds is None else speeds
@@ -141,7 +141,7 @@ def _sequence_figure(config, res, plan, what, path):
             why = "no plan with dynamic pins beats the fixed pins (or none allowed)"
         placeholder(path, f"{name}, {what}: {why}")
         return
-    part = Part.from_vertices(res["part"]["vertices"], name=name)
+    part = Part.from_dict(res["part"], name=name)
     pins, speeds, mu_c = res["pins"], res.get("pin_speeds", {}), None
     if plan.get("pin_heights_mm") is not None:  # a tight plan: its own heights, speeds and friction
         pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
@@ -160,7 +160,7 @@ def _carried_figure(config, res, path):
         placeholder(path, f"{name}: no recommended tight plan" + (f" ({tight.warning})" if tight else ""))
         return
     plan = tight.recommended.to_dict()
-    part = Part.from_vertices(res["part"]["vertices"], name=name)
+    part = Part.from_dict(res["part"], name=name)
     starts = {k: (v["theta"], v["y_c"]) for k, v in res["initial_states"].items()}
     replays = replayed_paths(part, plan, starts, tight.mu_c, config["sweep"]["pin_radius"], res["model"],
                              config.get("verify", {}), kernel=config["sweep"].get("kernel"),
@@ -172,7 +172,7 @@ def _carried_figure(config, res, path):
 
 def outline_figure(plan_result: dict, config: dict, out) -> Path:
     """The outline figure of a planned part (from its plan JSON)."""
-    part = Part.from_vertices(plan_result["part"]["vertices"], name=plan_result["part"]["name"])
+    part = Part.from_dict(plan_result["part"])
     return plot_outline(part, out, source=config_part_source(config, part.name))
 
 

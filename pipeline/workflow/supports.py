@@ -28,7 +28,7 @@ def support_part(plan_path, config: dict, out, figure, progress=print) -> dict:
     ``out`` (with provenance) and the overlaid maps (swept friction nearest
     the planner's nominal one, the ``figures.d`` panels) to ``figure``."""
     stored = validate_plan_file(plan_path)
-    part = Part.from_vertices(stored["part"]["vertices"], name=stored["part"]["name"])
+    part = Part.from_dict(stored["part"])
     uniform = (stored.get("tight") or [None])[0]
     family = config["support_study"]["family"]
     result = support_study(part, config, family, uniform, progress=progress)

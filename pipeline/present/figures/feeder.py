@@ -49,12 +49,14 @@ def title_lines(layout: dict) -> list[str]:
 def drawing_items(layout: dict) -> dict:
     """Everything to draw, in mm: ``belt`` and ``fence`` segments, ``pins``
     (centre, radius, label), ``dims`` (``(p1, p2, offset point, text, angle)``),
-    ``parts`` (closed outlines), ``arrow`` (tail, head), ``title`` (origin,
-    lines), ``extent`` (x_lo, x_hi, y_lo, y_hi)."""
+    ``parts`` (closed outlines), ``holes`` (per part, its holes' closed
+    outlines: none for a solid part), ``arrow`` (tail, head), ``title``
+    (origin, lines), ``extent`` (x_lo, x_hi, y_lo, y_hi)."""
     stations = layout["stations"]
     y_lo, y_hi = layout["belt_y_mm"]
-    parts = [np.asarray(p["outline"], float) for key in ("entry_parts", "exit_parts")
-             for p in layout["drawing"][key]]
+    drawn = [p for key in ("entry_parts", "exit_parts") for p in layout["drawing"][key]]
+    parts = [np.asarray(p["outline"], float) for p in drawn]
+    holes = [[np.asarray(h, float) for h in p.get("holes") or ()] for p in drawn]
     xs = np.concatenate([p[:, 0] for p in parts] + [[s["x_mm"] for s in stations]])
     x_lo, x_hi = float(xs.min()) - 15.0, float(xs.max()) + 15.0
     pin_r = max(s["radius_mm"] for s in stations)
@@ -87,6 +89,7 @@ def drawing_items(layout: dict) -> dict:
                   (s["x_mm"], label_y0 + row * (k + 1))) for k, s in enumerate(stations)],
         "dims": dims,
         "parts": parts,
+        "holes": holes,
         "arrow": ((x_lo + 5.0, arrow_y), (x_lo + 35.0, arrow_y)),
         # The title block's top right corner, under the belt and its dimensions.
         "title": ((x_hi, y_lo - 16.0), title_lines(layout)),
@@ -120,9 +123,10 @@ def draw_feeder(layout: dict, out) -> Path:
 def feeder_figure(layout: dict):
     """The matplotlib figure of the drawing; the layout's warnings above it, in red."""
     import matplotlib.pyplot as plt
-    from matplotlib.patches import Circle, Polygon
+    from matplotlib.patches import Circle, PathPatch
 
     from pipeline.present.figures import save_figure  # noqa: F401 (selects the Agg backend)
+    from pipeline.present.figures.outline import loops_path
     items = drawing_items(layout)
     x0, x1, y0, y1 = items["extent"]
     width = DRAWING_WIDTH_IN
@@ -133,8 +137,8 @@ def feeder_figure(layout: dict):
     for (a, b) in items["fence"]:
         ax.plot([a[0], b[0]], [a[1], b[1]], color="k", lw=3.0)
         ax.text(a[0] + 2, a[1] - 1.0, "fence", fontsize=7, va="top")
-    for k, poly in enumerate(items["parts"]):
-        ax.add_patch(Polygon(poly, closed=True, fc="tab:blue", ec="k", alpha=0.35, lw=0.8))
+    for poly, holes in zip(items["parts"], items["holes"]):  # holes left empty
+        ax.add_patch(PathPatch(loops_path([poly, *holes]), fc="tab:blue", ec="k", alpha=0.35, lw=0.8))
     for centre, r, label, at in items["pins"]:
         ax.add_patch(Circle(centre, r, color="tab:red", zorder=3))
         ax.plot([centre[0], at[0]], [centre[1] + r, at[1]], color="tab:red", lw=0.4, ls=":")
@@ -171,7 +175,8 @@ def feeder_figure(layout: dict):
 
 def write_dxf(layout: dict, out) -> Path:
     """The drawing as a DXF (R2010, millimetres), written atomically: a CIRCLE
-    per pin at its station, each part outline a closed LWPOLYLINE on PARTS."""
+    per pin at its station, each part outline (and each hole of a part with
+    holes) a closed LWPOLYLINE on PARTS."""
     import ezdxf
     items = drawing_items(layout)
     doc = ezdxf.new("R2010", setup=True)
@@ -194,7 +199,7 @@ def write_dxf(layout: dict, out) -> Path:
                                  dxfattribs={"layer": "DIMENSIONS"},
                                  override={"dimtxt": TEXT_MM * 0.7, "dimasz": 2.0})
         dim.render()
-    for poly in items["parts"]:
+    for poly in items["parts"] + [h for holes in items["holes"] for h in holes]:
         msp.add_lwpolyline([tuple(p) for p in poly], close=True, dxfattribs={"layer": "PARTS"})
     tail, head = items["arrow"]
     msp.add_line(tail, head, dxfattribs={"layer": "BELT"})

@@ -92,7 +92,7 @@ def sensing_figures(result: dict, out_profiles, out_scores) -> tuple[Path, Path]
     """Both figures for a stored sensing result (``RESULTS/sensing/NAME.json``)."""
     from pipeline.parts.part import Part
     from pipeline.sensing.profiles import PERTURB_DEFAULTS, reference_profiles, synthetic_measurement
-    part = Part.from_vertices(result["part"]["vertices"], name=result["part"]["name"])
+    part = Part.from_dict(result["part"])
     name = part.name
     if not result.get("found"):
         from pipeline.present.figures import placeholder

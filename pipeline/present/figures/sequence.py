@@ -8,20 +8,14 @@ labels never cover a part; each pose's orientation is written under it.
 """
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-import numpy as np
-from matplotlib.patches import Circle, Polygon
+from matplotlib.patches import Circle
 
 from pipeline.planning.arcs import format_arcs
 from pipeline.present.figures import save_figure
-
-
-def _pose(vertices, theta_deg, x, y):
-    c, s = math.cos(math.radians(theta_deg)), math.sin(math.radians(theta_deg))
-    return vertices @ np.array([[c, s], [-s, c]]) + np.array([x, y])
+from pipeline.present.figures.outline import PartPatch, posed
 
 
 def pin_label(label: str, height: float, speed: float | None = None) -> str:
@@ -80,11 +74,11 @@ def _draw_row(ax, part, path, seq, pins, speeds, pin_radius, spacing):
     ax.text(-1.25 * a, 0.0, "fence", fontsize=7, va="bottom", ha="left")
     for k, (theta, y) in enumerate(path):
         x = k * spacing
-        ax.add_patch(Polygon(_pose(part.vertices, theta, x, y), closed=True, fc="tab:blue" if k else "0.8",
-                             ec="k", alpha=0.6 if k else 0.9))
+        ax.add_patch(PartPatch(part, theta, x, y, fc="tab:blue" if k else "0.8", ec="k",
+                               alpha=0.6 if k else 0.9))
         ax.plot([x], [y], "k+", ms=5)
         # Below the pose and the fence line: never on the part or the fence.
-        bottom = min(_pose(part.vertices, theta, x, y)[:, 1].min(), 0.0)
+        bottom = min(posed(part.vertices, theta, x, y)[:, 1].min(), 0.0)
         ax.text(x, bottom - 0.08 * a, rf"$\theta$ = {theta % 360:.0f}°", ha="center", va="top",
                 fontsize=7, bbox=dict(fc="white", ec="none", pad=0.5, alpha=0.85))
     for k, pin in enumerate(seq):
