@@ -52,7 +52,7 @@ def solve(model, part, c, n, vp, mu, warm=None, hint=STICK):
     """``_contact_twist`` with numpy in/out: (status, xi, f, mode)."""
     if warm is None:
         warm = (vp[0], vp[1], 0.0)
-    res = _contact_twist(model, part.verts, part.quad, part.area, part.m_max,
+    res = _contact_twist(model, part.quad, part.area, part.m_max,
                          float(c[0]), float(c[1]), float(n[0]), float(n[1]),
                          float(vp[0]), float(vp[1]), float(mu),
                          float(warm[0]), float(warm[1]), float(warm[2]), int(hint))
@@ -225,7 +225,7 @@ def test_minpower_stick_converges_from_any_warm_start(case):
     b = np.array([c[1], -c[0], 1.0])
     oms = []
     for warm in warms:
-        vx, vy, om, _g, _h, _conv = _stick_solve(verts, quad, area, c[0], c[1], vp[0], vp[1],
+        vx, vy, om, _g, _h, _conv = _stick_solve(quad, area, c[0], c[1], vp[0], vp[1],
                                                  float(warm), NO_MODEL, _DEC_TAKE)
         _, g_ref, _ = ref.power_ref(verts, vx, vy, om, derivatives=True)
         assert abs(g_ref @ b) <= 1e-10, (
@@ -255,7 +255,7 @@ def test_minpower_stick_independent_of_warm_start():
         al = rng.uniform(-1.45, 1.45)
         vp = math.cos(al) * n + math.sin(al) * tangent(n)
         warms = (0.0, rng.normal(), rng.normal() * 0.01)
-        oms = [_stick_solve(part.verts, part.quad, part.area, c[0], c[1], vp[0], vp[1], w,
+        oms = [_stick_solve(part.quad, part.area, c[0], c[1], vp[0], vp[1], w,
                             NO_MODEL, _DEC_TAKE)[2] for w in warms]
         spread = max(oms) - min(oms)
         if spread > worst[0]:
@@ -345,7 +345,7 @@ def test_sliding_side_follows_sticking_force_when_it_pulls(case, mu):
     """Spec: the sliding side is the sign of the sticking force's f.t, also
     when f.n <= 0 (the sticking solution would need the pin to pull)."""
     part, c, n, vp, _ = case
-    vx, vy, om, g, _, _ = _stick_solve(part.verts, part.quad, part.area,
+    vx, vy, om, g, _, _ = _stick_solve(part.quad, part.area,
                                        c[0], c[1], vp[0], vp[1], 0.0, NO_MODEL, _DEC_TAKE)
     f_s = np.array([g[0], g[1]])
     assume(f_s @ n <= 0.0)

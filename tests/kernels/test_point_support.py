@@ -26,6 +26,7 @@ from conftest import fewer_examples
 from kernels.models import (_DEC_TAKE, MINPOWER_POINTS, NO_MODEL, SLIDE_NEG, SLIDE_POS, STICK,
                             TWIST_OK, _contact_twist, _slide_solve, _stick_solve)
 from kernels.rollout import _prepare
+from kernels.support import _point_table
 
 TRIANGLE = np.array([(0.0, 0.0), (60.0, 0.0), (15.0, 35.0)])
 
@@ -105,18 +106,18 @@ def support_quad(verts, pts, w):
     n = verts.shape[0]
     _, _, _, quad, _, _ = _prepare(np.ascontiguousarray(verts * 1.0))
     rows = np.column_stack([pts, w / np.sum(w)])
-    return np.ascontiguousarray(np.vstack([rows, quad[-n:]]))
+    return _point_table(quad, np.ascontiguousarray(rows))
 
 
 def k_stick(verts, q, c, vp, warm=0.0):
-    vx, vy, om, g, hess, conv = _stick_solve(verts, q, 1.0, float(c[0]), float(c[1]),
+    vx, vy, om, g, hess, conv = _stick_solve(q, 1.0, float(c[0]), float(c[1]),
                                              float(vp[0]), float(vp[1]), float(warm), NO_MODEL,
                                              _DEC_TAKE, True)
     return np.array([vx, vy, om]), np.array(g), conv
 
 
 def k_slide(verts, q, c, e, warm=(0.0, 0.0, 0.0)):
-    vx, vy, om, g, hess, conv = _slide_solve(verts, q, 1.0, float(c[0]), float(c[1]),
+    vx, vy, om, g, hess, conv = _slide_solve(q, 1.0, float(c[0]), float(c[1]),
                                              float(e[0]), float(e[1]), *map(float, warm),
                                              NO_MODEL, _DEC_TAKE, True)
     return np.array([vx, vy, om]), np.array(g), conv
@@ -316,7 +317,7 @@ def test_contact_model_force_and_mode(case, mu):
     pin not penetrating (n . u(c) = n . v_p), the slip against friction."""
     verts, pts, w, c, n, _, vp = case
     q = support_quad(verts, pts, w)
-    st_, vx, vy, om, fx, fy, mode = _contact_twist(MINPOWER_POINTS, verts, q, 1.0, 1.0,
+    st_, vx, vy, om, fx, fy, mode = _contact_twist(MINPOWER_POINTS, q, 1.0, 1.0,
                                                   c[0], c[1], n[0], n[1], vp[0], vp[1], mu,
                                                   0.0, 0.0, 0.0, STICK)
     if st_ != TWIST_OK:

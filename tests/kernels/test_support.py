@@ -276,7 +276,7 @@ def test_fan_quadrature_exact_for_low_degree_polynomials(xy):
 
 
 def kernel_power(verts, quad, area, xi):
-    res = _power(verts, quad, area, float(xi[0]), float(xi[1]), float(xi[2]))
+    res = _power(quad, area, float(xi[0]), float(xi[1]), float(xi[2]))
     g = np.array(res[1:4])
     h = np.array([[res[4], res[5], res[6]], [res[5], res[7], res[8]], [res[6], res[8], res[9]]])
     return res[0], g, h

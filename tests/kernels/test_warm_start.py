@@ -49,7 +49,7 @@ def model_of(xi, g, hess):
 
 
 def stick(verts, quad, area, c, vp, warm_om, model, take):
-    vx, vy, om, g, hess, _ = _stick_solve(verts, quad, area, float(c[0]), float(c[1]),
+    vx, vy, om, g, hess, _ = _stick_solve(quad, area, float(c[0]), float(c[1]),
                                           float(vp[0]), float(vp[1]), float(warm_om), model,
                                           float(take))
     return np.array([vx, vy, om]), np.array(g), np.array(hess)
@@ -59,7 +59,7 @@ def slide(verts, quad, area, c, n, vp, mu, side, warm, model, take):
     """Sliding twist on the physical scale (``n . u(c) = n . v_p``), its
     gradient and Hessian (as ``models._minpower_twist`` returns them)."""
     ex, ey = _cone_edge(float(n[0]), float(n[1]), mu, side)
-    vx, vy, om, g, hess, _ = _slide_solve(verts, quad, area, float(c[0]), float(c[1]), ex, ey,
+    vx, vy, om, g, hess, _ = _slide_solve(quad, area, float(c[0]), float(c[1]), ex, ey,
                                           float(warm[0]), float(warm[1]), float(warm[2]),
                                           model, float(take))
     scale = _push_scale(vx, vy, om, float(c[0]), float(c[1]), float(n[0]), float(n[1]),
@@ -135,7 +135,7 @@ def test_model_step_on_a_twist_of_any_sign(scale):
     ex, ey = _cone_edge(float(n[0]), float(n[1]), mu, side)
 
     def family_twist(c, start, model, take):
-        vx, vy, om, *_ = _slide_solve(verts, quad, area, float(c[0]), float(c[1]), ex, ey,
+        vx, vy, om, *_ = _slide_solve(quad, area, float(c[0]), float(c[1]), ex, ey,
                                       *map(float, start), model, float(take))
         return np.array([vx, vy, om])
 
