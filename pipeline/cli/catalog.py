@@ -53,6 +53,8 @@ def cmd_catalog_show(args):
     e0 = entries[0]
     info = {k: e0[k] for k in ("family", "part_id", "part_name", "part_vertices", "pin_radius",
                                "d", "theta_step", "config_hash", "pinfeed_version", "git_commit")}
+    if e0.get("part_holes"):
+        info["part_holes"] = e0["part_holes"]
     info["shards"] = [dict({k: e[k] for k in ("model", "mu_c", "file", "sha256", "created")},
                            v_pin=e.get("v_pin", 0.0), support=e.get("support", "uniform"))
                       for e in sorted(entries, key=lambda e: (e["model"], e["mu_c"], e.get("v_pin", 0.0),
@@ -62,6 +64,8 @@ def cmd_catalog_show(args):
         return
     print(f"part {info['part_id']} (family {info['family']})")
     print("vertices (body frame, mm): " + " ".join(f"{x:.3f},{y:.3f}" for x, y in info["part_vertices"]))
+    for k, hole in enumerate(info.get("part_holes", []), start=1):
+        print(f"hole {k} (body frame, mm): " + " ".join(f"{x:.3f},{y:.3f}" for x, y in hole))
     print(f"pin radius {info['pin_radius']:g} mm; theta step {info['theta_step']:g} deg; "
           f"d = {', '.join(f'{d:g}' for d in info['d'])}")
     print(f"made by pinfeed {info['pinfeed_version']} ({info['git_commit']}), config {info['config_hash']}")

@@ -19,6 +19,12 @@ PAPER_D = [-0.9, -0.8, -0.7, -0.6, -0.5, -0.4, -0.3, -0.2, -0.1,
 DEFAULT_TRIANGLE = "0,0 60,0 15,35"
 
 
+def _holes_note(part) -> str:
+    """`` (2 holes)`` for a part with holes, else nothing."""
+    n = len(part.holes)
+    return f" ({n} hole{'s' if n > 1 else ''})" if n else ""
+
+
 def cmd_rollout(args):
     """Roll a part past one pin (see :func:`pipeline.workflow.commands.rollout_rows`)."""
     from pipeline.workflow.commands import rollout_belt, rollout_rows
@@ -32,7 +38,7 @@ def cmd_rollout(args):
         return
     speed = f"  belt {args.belt_speed:g} mm/s  mu_s = {args.mu_s:g}" if belt else ""
     support = f"  support {args.support}" if args.support else ""
-    print(f"part {part.id}  a = {part.a:.3f} mm  model {args.model}  mu_c = {args.mu_c:g}  "
+    print(f"part {part.id}{_holes_note(part)}  a = {part.a:.3f} mm  model {args.model}  mu_c = {args.mu_c:g}  "
           f"pin radius {args.pin_radius:g} mm  d = {args.d:+g}{speed}{support}")
     print(f"{'theta_i':>8} {'status':>9} {'theta_f':>9} {'dy (mm)':>9} {'travel':>8} "
           f"{'changes':>7} {'peak F':>7}")

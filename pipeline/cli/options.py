@@ -1,6 +1,6 @@
 """Option groups and helpers the ``pinfeed`` verbs share, defined once.
 
-* the part: ``--vertices`` or a CAD ``--outline`` (with ``--layer``, ``--id``,
+* the part: ``--vertices`` (with ``--hole``) or a CAD ``--outline`` (with ``--layer``, ``--id``,
   ``--units``, ``--join-tol``, ``--flatten-tol``) and ``--name``
   (:func:`add_outline_args`, read back by :func:`part_from_args`);
 * the physics of one pin: friction, pin radius, contact model, pin speed and
@@ -55,8 +55,9 @@ def parse_values(text: str, what: str) -> np.ndarray:
 
 
 def part_from_args(args):
-    """The part of ``--vertices`` or ``--outline`` (saying how many vertices a CAD outline gave)."""
-    from pipeline.parts.part import Part, parse_vertices
+    """The part of ``--vertices`` (with its ``--hole`` loops) or ``--outline``
+    (saying how many vertices and holes a CAD outline gave)."""
+    from pipeline.parts.part import Part, parse_holes, parse_vertices
     if getattr(args, "outline", None):
         from pipeline.parts.outlines import read_outline
         out = read_outline(args.outline, layer=args.layer, id=args.id, flatten_tol=args.flatten_tol,
@@ -64,11 +65,15 @@ def part_from_args(args):
         print(f"outline {out.describe()}", file=sys.stderr)
         for line in out.warnings():
             print(f"pinfeed: warning: {line}", file=sys.stderr)
+        if getattr(args, "hole", None):
+            raise PinfeedError("--hole goes with --vertices; an --outline file brings its own holes "
+                               "(closed loops inside the outline)")
         name = args.name or re.sub(r"[^A-Za-z0-9_]", "_", Path(args.outline).stem) or "part"
-        return Part.from_vertices(out.vertices, name=name)
+        return Part.from_vertices(out.vertices, name=name, holes=out.holes)
     if any(getattr(args, k, None) is not None for k in ("layer", "id", "units", "join_tol")):
         raise PinfeedError("--layer, --id, --units and --join-tol apply to an --outline file")
-    return Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part")
+    return Part.from_vertices(parse_vertices(args.vertices), name=args.name or "part",
+                              holes=parse_holes(getattr(args, "hole", None)))
 
 
 def plan_part_arg(args, config):
@@ -84,9 +89,12 @@ def add_outline_args(p, required=True):
     g = p.add_mutually_exclusive_group(required=required)
     g.add_argument("--vertices", help='part outline "x0,y0 x1,y1 ..." (mm)')
     g.add_argument("--outline", metavar="FILE",
-                   help="or a CAD outline: a .dxf or .svg file; its pieces are joined into closed loops "
-                   "and the largest is the part (the others are reported). Holes are refused (not "
-                   "modelled): put them on another layer and pick the outline with --layer")
+                   help="or a CAD outline: a .dxf or .svg file; its pieces are joined into closed loops, "
+                   "the largest is the part's outline and the closed loops inside it are its holes "
+                   "(loops outside it are reported and left out)")
+    p.add_argument("--hole", action="append", default=None, metavar="VERTICES",
+                   help='a hole of a --vertices part, "x0,y0 x1,y1 ..." (mm, the outline\'s frame), '
+                   "strictly inside the outline and apart from other holes; repeat for each hole")
     p.add_argument("--layer", default=None, metavar="NAME",
                    help="DXF layer of the outline (when the file holds several)")
     p.add_argument("--id", default=None, help="SVG element id or DXF entity handle of the outline")

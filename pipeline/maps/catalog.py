@@ -42,6 +42,7 @@ import xarray as xr
 from pipeline.checks import schema_problem
 from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_json
+from pipeline.parts.part import Part
 from pipeline.parts.support import support_key
 
 INDEX_NAME = "index.json"
@@ -73,6 +74,9 @@ INDEX_SCHEMA = {
                 "family": _STR, "part_id": _STR, "part_name": _STR, "model": _STR,
                 "part_vertices": {"type": "array", "minItems": 3,
                                   "items": {"type": "array", "minItems": 2, "maxItems": 2, "items": _NUM}},
+                "part_holes": {"type": "array", "items": {
+                    "type": "array", "minItems": 3,
+                    "items": {"type": "array", "minItems": 2, "maxItems": 2, "items": _NUM}}},
                 "mu_c": _NUM, "pin_radius": _NUM, "v_pin": _NUM, "theta_step": _NUM,
                 "support": _STR, "support_key": _STR,
                 "d": {"type": "array", "items": _NUM},
@@ -81,6 +85,13 @@ INDEX_SCHEMA = {
         }},
     },
 }
+
+
+def entry_part(entry: dict) -> Part:
+    """The :class:`~pipeline.parts.part.Part` an index entry describes (its
+    outline and, for a part with holes, ``part_holes``)."""
+    return Part.from_vertices(entry["part_vertices"], name=entry["part_name"],
+                              holes=entry.get("part_holes") or ())
 
 
 def _sha256(path: Path) -> str:
@@ -142,6 +153,7 @@ def _entry(root: Path, path: Path, attrs: dict, d: list, n_theta: int) -> dict:
     """The index entry of a readable shard (see :func:`entry_from_file`)."""
     support = _check_support_attrs(path, attrs)
     verts = np.asarray(attrs["part_vertices"], float).reshape(-1, 2).tolist()
+    holes = {"part_holes": [h.tolist() for h in Part.holes_from_attrs(attrs)]} if "part_holes" in attrs else {}
     return {
         "file": path.relative_to(root).as_posix(),
         "sha256": _sha256(path),
@@ -151,6 +163,7 @@ def _entry(root: Path, path: Path, attrs: dict, d: list, n_theta: int) -> dict:
         "part_id": str(attrs["part_id"]),
         "part_name": str(attrs["part_name"]),
         "part_vertices": verts,
+        **holes,
         "model": str(attrs["model"]),
         "mu_c": float(attrs["mu_c"]),
         "pin_radius": float(attrs["pin_radius"]),

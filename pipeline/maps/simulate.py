@@ -139,6 +139,7 @@ def _common_attrs(part, model, mu_c, pin_radius, v_pin, ds_max, tol, length_unit
         "part_name": part.name,
         "part_id": part.id,
         "part_vertices": np.asarray(part.vertices).ravel(),
+        **part.hole_attrs(),
         "part_a": part.a,
         "model": model,
         "mu_c": float(mu_c),

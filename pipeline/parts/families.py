@@ -47,18 +47,19 @@ def _l_shape(g):
                [(0, 0), (w, 0), (w, t), (t, t), (t, h), (0, h)])
 
 
-def _explicit_vertices(family: str, p: dict):
-    """An explicit part's vertices, or its CAD outline's (``outline: FILE``; the
-    config loader has made a relative path absolute)."""
+def _explicit_loops(family: str, p: dict):
+    """An explicit part's vertices and holes, or its CAD outline's
+    (``outline: FILE``; the config loader has made a relative path absolute)."""
     if "outline" not in p:
-        return p["vertices"]
+        return p["vertices"], p.get("holes", [])
     from pipeline.parts.outlines import read_outline
     try:
-        return read_outline(p["outline"], layer=p.get("layer"), id=p.get("id"),
-                            flatten_tol=p.get("flatten_tol", 0.05), units=p.get("units"),
-                            join_tol=p.get("join_tol")).vertices
+        out = read_outline(p["outline"], layer=p.get("layer"), id=p.get("id"),
+                           flatten_tol=p.get("flatten_tol", 0.05), units=p.get("units"),
+                           join_tol=p.get("join_tol"))
     except PinfeedError as exc:
         raise PinfeedError(f"family {family}, part {p['name']}: {exc}") from None
+    return out.vertices, out.holes
 
 
 GENERATORS = {
@@ -71,7 +72,7 @@ GENERATORS = {
 
 def family_parts(name: str, spec: dict) -> list[Part]:
     """All parts of one family, validated; raises :class:`PinfeedError` naming the part."""
-    outlines = [(p["name"], _explicit_vertices(name, p)) for p in spec.get("parts", [])]
+    outlines = [(p["name"], *_explicit_loops(name, p)) for p in spec.get("parts", [])]
     for g in spec.get("generators", []):
         kind = g.get("kind")
         if kind not in GENERATORS:
@@ -81,14 +82,14 @@ def family_parts(name: str, spec: dict) -> list[Part]:
         missing = [k for k in required if k not in g]
         if missing:
             raise PinfeedError(f"family {name}: generator {kind} needs {', '.join(missing)}")
-        outlines.extend(fn(g))
+        outlines.extend((pname, verts, []) for pname, verts in fn(g))
     parts, seen = [], set()
-    for pname, verts in outlines:
+    for pname, verts, holes in outlines:
         if pname in seen:
             raise PinfeedError(f"family {name}: two parts are named {pname!r}; give each a unique name")
         seen.add(pname)
         try:
-            parts.append(Part.from_vertices(verts, name=pname))
+            parts.append(Part.from_vertices(verts, name=pname, holes=holes))
         except PolygonError as exc:
             raise PinfeedError(f"family {name}, part {pname}: {exc}") from None
     if not parts:

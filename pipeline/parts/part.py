@@ -237,6 +237,24 @@ class Part:
         """Whether the part has holes."""
         return bool(self.holes)
 
+    def hole_attrs(self) -> dict:
+        """File attributes of the holes (none for a solid part, whose stored
+        files stay as they were): ``part_holes``, every hole's vertices one
+        after the other, flattened, and ``part_hole_sizes``, their counts."""
+        if not self.holes:
+            return {}
+        return {"part_holes": np.vstack(self.holes).ravel(),
+                "part_hole_sizes": np.array([len(h) for h in self.holes], dtype=np.int64)}
+
+    @staticmethod
+    def holes_from_attrs(attrs) -> list[np.ndarray]:
+        """The holes that :meth:`hole_attrs` stored (``[]`` when none)."""
+        if "part_holes" not in attrs:
+            return []
+        flat = np.asarray(attrs["part_holes"], dtype=np.float64).reshape(-1, 2)
+        ends = np.cumsum(np.atleast_1d(np.asarray(attrs["part_hole_sizes"], dtype=np.int64)))
+        return np.split(flat, ends[:-1])
+
     def loops(self) -> tuple[np.ndarray, np.ndarray]:
         """The outline and holes as one ``(N, 2)`` array and the int64 loop
         offsets the kernels take (``kernels.rollout._prepare_loops``)."""

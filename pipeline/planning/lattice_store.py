@@ -157,7 +157,8 @@ def save_lattice(root, lattice: OutcomeLattice) -> Path | None:
                                                               "long_name": "centroid displacement across the belt"}),
         },
         attrs={"kind": "refinement", "part_id": lattice.part.id, "part_name": lattice.part.name,
-               "part_vertices": np.asarray(lattice.part.vertices).ravel(), "model": lattice.model,
+               "part_vertices": np.asarray(lattice.part.vertices).ravel(), **lattice.part.hole_attrs(),
+               "model": lattice.model,
                "v_pin": float(lattice.v_pin), **_settings(lattice), **provenance_attrs()},
     )
     where = (lattice.part, lattice.model, lattice.v_pin, lattice.belt_speed, lattice.mu_s)

@@ -34,7 +34,7 @@ import numpy as np
 from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from pipeline.errors import PinfeedError
-from pipeline.maps.catalog import Catalog
+from pipeline.maps.catalog import Catalog, entry_part
 from pipeline.parts.families import config_part_id
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
@@ -352,7 +352,7 @@ def _dedupe(states):
 def catalog_part(cat: Catalog, name: str) -> Part:
     """The :class:`Part` stored in the catalog under ``name`` (id or name)."""
     e = cat.entries_for(name)[0]
-    return Part.from_vertices(e["part_vertices"], name=e["part_name"])
+    return entry_part(e)
 
 
 def build_planner(cat: Catalog, name: str, config: dict, dynamic: bool = True):

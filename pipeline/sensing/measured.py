@@ -14,7 +14,7 @@ import math
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
-from pipeline.maps.catalog import Catalog
+from pipeline.maps.catalog import Catalog, entry_part
 from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_id
 from pipeline.parts.part import Part
@@ -127,7 +127,7 @@ def _part(config, part_name, root, catalog=None):
         if wanted != part_name and not any(e["part_id"] == wanted for e in cat.entries):
             wanted = part_name  # the config's outline is not stored: use what the catalog has
         entry = cat.entries_for(wanted)[0]  # unknown part: says how to list them
-        return Part.from_vertices(entry["part_vertices"], name=entry["part_name"]), float(entry["pin_radius"])
+        return entry_part(entry), float(entry["pin_radius"])
     except PinfeedError:
         for kind in ("sensing", "plans"):
             path = root / kind / f"{part_name}.json"

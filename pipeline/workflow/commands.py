@@ -10,7 +10,7 @@ import copy
 import math
 
 from pipeline.errors import PinfeedError
-from pipeline.maps.catalog import Catalog
+from pipeline.maps.catalog import Catalog, entry_part
 from pipeline.parts.families import family_parts
 from pipeline.parts.part import Part
 from pipeline.planning.orient import check_tolerance
@@ -91,7 +91,7 @@ def named_part(config: dict, name: str | None) -> Part:
         return found[0]
     cat = Catalog.open(config["catalog_dir"])
     e = cat.entries_for(name)[0]  # raises 'unknown part' with the known names
-    return Part.from_vertices(e["part_vertices"], name=e["part_name"])
+    return entry_part(e)
 
 
 def plan_tight_only(part: Part, config: dict, progress=None) -> dict:
