@@ -1,38 +1,66 @@
-"""Part outlines from CAD files: DXF (ezdxf) and SVG (svgelements).
+"""Part outlines from CAD files: DXF (ezdxf) and SVG (svgelements), with holes.
 
 A drawing may hold loose LINE/ARC pieces in any order and direction,
-polylines with bulges, circles, ellipses, splines, paths, polygons and rects.
+polylines with bulges (LWPOLYLINE, or R12's POLYLINE), circles, ellipses,
+splines, block references (INSERT, nested too), paths, polygons and rects.
 Every curve is flattened to a polygon whose chords stay within a chordal
 tolerance of the curve: ``flatten_tol`` mm when given, else 0.05 mm or a
 fixed fraction (:data:`FLATTEN_FRACTION`) of the drawing's diagonal, whichever
 is larger, so that a large drawing (or one in the wrong units) still gets a
-modest vertex count; duplicate pieces are dropped; pieces whose
-ends lie within ``join_tol`` (drawing units; default 1e-4 of the drawing's
-size) are joined end to end into closed loops. The largest closed loop is the
-part (or the loop picked by ``layer`` / ``id``); the loops and open chains
-left out are reported. A loop inside the outline is a hole: refused, because
-no pressure acts under a hole, which moves the centroid and changes the
-support integrals (spec section 2) that the kernels compute for a solid
-polygon.
+modest vertex count; duplicate pieces are dropped; pieces whose ends lie
+within ``join_tol`` (drawing units; default 1e-4 of the drawing's size) are
+joined end to end into closed loops.
+
+Layers (DXF). Pieces are joined layer by layer: construction lines on another
+layer never become part of the outline. The largest closed loop is the part's
+outline (the layer whose largest loop is largest is the part's layer), or the
+loop picked by ``id``: a DXF entity handle (an INSERT's handle for what its
+block holds) or an SVG element id, naming any piece of the loop. ``layer``
+restricts everything to one layer. Only when no layer closes on its own are
+the pieces of several layers joined, and the outline says which layers it
+joined. An entity of a block on layer 0 takes the layer of its INSERT (CAD's
+rule). Pieces in a dashed linetype (CENTER, DASHED, HIDDEN, ...) or on a layer
+named for construction, centre lines or dimensions are construction geometry:
+joined only among themselves, never a hole, and the outline only when nothing
+else closes.
+
+Holes. A closed loop strictly inside the outline is a hole: a loop of the
+outline's layer, or one closed on its own on another layer (a "HOLES" layer).
+The belt presses on the material only, so the area, centroid and ``a`` are
+those of the outline minus its holes (:class:`pipeline.parts.part.Part`); pins
+touch the outline only. Holes are checked by
+:func:`pipeline.parts.part.check_holes`. Refused, in one line naming the loops
+and the way out: loops that cross each other, a hole touching the outline (an
+opening to the outline is a notch: draw it as part of the outline), and a loop
+inside a hole (an island: a part of its own). Loops outside the outline and
+open chains are left out and reported.
+
+Drawing frames. A sheet border is usually a drawing's largest loop. It is left
+out (with everything on its layer, and said so) when it is an axis-aligned
+rectangle around all other geometry, holds closed loops of other layers, and
+its layer is named as a frame (TITLE, BORDER, FRAME, SHEET, RAHMEN, ...) or
+holds TEXT outside the other layers' geometry (a title block).
 
 Units are said out loud (:meth:`Outline.describe`): a DXF's ``$INSUNITS``
-(unitless: mm), an SVG's width/height over its viewBox (no physical size: CSS
-pixels, 96 per inch), or ``units`` given by the user. Conversion factors are
-exact (25.4 mm per inch), so one shape gives one part id from DXF and SVG.
-SVG's y axis points down; it is flipped so the part looks as it does in the
-viewer (a mirrored part would be a different part).
+(unitless, as every R12 file: mm), an SVG's width/height over its viewBox (no
+physical size: CSS pixels, 96 per inch; 90 per inch in a file of Inkscape
+before 0.92, which its ``inkscape:version`` tells), or ``units`` given by the
+user. Conversion factors are exact (25.4 mm per inch), so one shape gives one
+part id from DXF and SVG. SVG's y axis points down; it is flipped so the part
+looks as it does in the viewer (a mirrored part would be a different part).
 """
 from __future__ import annotations
 
 import math
 import re
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from pipeline.errors import PinfeedError
-from pipeline.parts.part import PolygonError, check_outline
+from pipeline.parts.part import Part, PolygonError, check_holes, check_outline
 
 DEFAULT_FLATTEN_TOL = 0.05  # mm: the default chordal tolerance of a drawing up to 100 mm across
 FLATTEN_FRACTION = 5e-4  # of the drawing's diagonal: the default chordal tolerance of a larger one
@@ -42,13 +70,22 @@ JOIN_TOL_FRACTION = 1e-4  # default join tolerance, as a fraction of the drawing
 # svgelements' mm is 1.00000054 of the CSS one).
 MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
 _SVG_MM = dict(MM_PER_UNIT, pt=25.4 / 72, pc=25.4 / 6, px=25.4 / 96, q=0.25)
+OLD_INKSCAPE_PX_PER_IN = 90.0  # Inkscape before 0.92 drew 90 pixels per inch, not CSS's 96
 _DXF_UNITS = {1: "in", 2: "ft", 4: "mm", 5: "cm", 6: "m", 9: "mil", 10: "yd", 13: "um", 14: "dm"}
 _DXF_MM = dict(MM_PER_UNIT, ft=304.8, mil=0.0254, yd=914.4, um=1e-3, dm=100.0)
 SIZE_WARN_MM = (2.0, 2000.0)  # a part outside this many mm across gets a units warning
+_DXF_CURVES = {"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE"}
+_DXF_TEXTS = {"TEXT", "MTEXT", "ATTRIB"}
+# Layer names that mark a drawing frame (sheet border, title block).
+FRAME_LAYER = re.compile(r"title|titel|border|frame|rahmen|sheet|blatt|schriftfeld|cartouche", re.I)
+# Layer names that mark construction geometry, centre lines or dimensions.
+CONSTRUCTION_LAYER = re.compile(r"constr|hilfs|center|centre|mittel|axis|achse|defpoints|dimension|^dims?$"
+                                r"|^dims?[ _-]|bema(ss|ß)|hidden|verdeckt", re.I)
+_SOLID_LINETYPES = {"", "CONTINUOUS", "BYLAYER", "BYBLOCK"}
 
 
 class OutlineError(PinfeedError):
-    """The CAD file does not give one closed, simple outline without holes."""
+    """The CAD file does not give one closed, simple outline with valid holes."""
 
 
 @dataclass
@@ -62,37 +99,72 @@ class Units:
 
 @dataclass
 class Outline:
-    """A part outline read from a CAD file (vertices in mm, drawing frame, y up)."""
+    """A part outline read from a CAD file (vertices in mm, drawing frame, y up),
+    and its holes (each an ``(m, 2)`` array in mm, same frame)."""
 
     vertices: np.ndarray
     source: str  # the file
-    name: str  # which loop: layer/handle (DXF) or element id (SVG)
+    name: str  # which loop: entity and layer (DXF) or element id (SVG)
     flatten_tol: float
     units: Units = field(default_factory=lambda: Units("mm", "default", 1.0))
     left_out: list = field(default_factory=list)  # loops and open chains not used, described
+    holes: list = field(default_factory=list)  # (m, 2) float arrays, mm
+    hole_names: list = field(default_factory=list)  # which loop each hole is
+    hole_layers: list = field(default_factory=list)  # each hole's DXF layer (None: SVG, or several)
+    layer: str | None = None  # the outline's DXF layer (None: SVG, or joined across layers)
+    joined_layers: list = field(default_factory=list)  # the layers an outline joined across, if several
+    _a: float | None = field(default=None, repr=False, compare=False)
 
     @property
     def n_vertices(self) -> int:
-        """Number of vertices after flattening."""
+        """Number of vertices of the outline after flattening (holes not counted)."""
         return int(self.vertices.shape[0])
+
+    def part(self, name: str = "part") -> Part:
+        """The part: the outline with its holes (``Part.from_vertices``)."""
+        return Part.from_vertices(self.vertices, name=name, holes=self.holes)
+
+    @property
+    def a(self) -> float:
+        """Distance from the material's centroid (outline minus holes) to the farthest vertex, mm."""
+        if self._a is None:
+            self._a = self.part().a
+        return self._a
 
     @property
     def size_mm(self) -> tuple:
-        """Bounding box width and height, and ``a`` (area centroid to farthest vertex), in mm."""
+        """Bounding box width and height, and ``a`` (the material's area centroid
+        to the farthest vertex of the outline), in mm."""
         w, h = np.ptp(self.vertices, axis=0)
-        return float(w), float(h), float(np.max(np.hypot(*(self.vertices - _centroid(self.vertices)).T)))
+        return float(w), float(h), float(self.a)
 
     def describe(self) -> str:
-        """One line: the loop, its vertex count, units (whence, scale) and size in mm."""
+        """One line: the loop, its vertex count, units (whence, scale), size in
+        mm, and, where there are any, the holes (how many, their vertices, the
+        layers other than the outline's they came from) and the layers joined."""
         w, h, a = self.size_mm
         u = self.units
-        return (f"{self.source}: {self.name}, flattened to {self.n_vertices} vertices "
+        line = (f"{self.source}: {self.name}, flattened to {self.n_vertices} vertices "
                 f"(chordal tolerance {self.flatten_tol:g} mm); units {u.name} from {u.source}, "
                 f"{u.scale:g} mm per unit; size {w:.4g} x {h:.4g} mm, a = {a:.4g} mm")
+        if self.holes:
+            k = len(self.holes)
+            elsewhere = Counter(ly for ly in self.hole_layers if ly is not None and ly != self.layer)
+            where = "".join(f"; {n} on layer {ly}" for ly, n in sorted(elsewhere.items()))
+            line += (f", {k} hole{'s' if k != 1 else ''} "
+                     f"({sum(len(hole) for hole in self.holes)} vertices{where})")
+        if self.joined_layers:
+            line += f"; joined across layers {', '.join(self.joined_layers)}"
+        return line
 
     def warnings(self) -> list[str]:
-        """Lines worth a warning: loops left out, and a size that suggests wrong units."""
+        """Lines worth a warning: loops left out, an outline joined across layers,
+        and a size that suggests wrong units."""
         out = [f"{self.source}: left out {item}" for item in self.left_out]
+        if self.joined_layers:
+            out.append(f"{self.source}: the outline joins pieces of layers {', '.join(self.joined_layers)} "
+                       f"(no layer closes on its own); if some are construction lines, draw the outline "
+                       f"closed on one layer and pick it with --layer NAME")
         across = max(self.size_mm[:2])
         if not SIZE_WARN_MM[0] <= across <= SIZE_WARN_MM[1]:
             out.append(f"{self.source}: the part is {across:.4g} mm across (units {self.units.name} from "
@@ -102,22 +174,84 @@ class Outline:
 
 @dataclass
 class _Piece:
-    """A flattened, possibly open, polyline from one drawing entity (drawing units)."""
+    """A flattened, possibly open, polyline from one drawing entity, or joined
+    from several (drawing units)."""
 
     points: np.ndarray  # (n, 2)
     name: str
     closed: bool
+    layer: str | None = None  # DXF layer (None: SVG, or a chain across layers)
+    pick: str | None = None  # what --id names: DXF handle (the top INSERT's in a block), SVG element id
+    construction: str = ""  # why it is construction geometry ("linetype CENTER"), "" when not
+    members: tuple = ()  # the drawn pieces a loop or chain was joined from
+
+    @property
+    def parts(self) -> tuple:
+        """The drawn pieces this one is made of."""
+        return self.members or (self,)
+
+    @property
+    def layers(self) -> list:
+        """The DXF layers of its drawn pieces, sorted."""
+        return sorted({m.layer for m in self.parts if m.layer is not None})
+
+
+@dataclass
+class _Drawing:
+    """What advice and messages need to know of the file read."""
+
+    path: Path
+    unit: Units
+    svg: bool
+    layers: list  # DXF layers of the pieces read (empty for SVG)
+    id: str | None
+
+    def option(self, loop: _Piece, other: _Piece | None = None) -> str:
+        """The option that picks ``loop`` as the outline, as fits the file:
+        ``--id`` for an SVG (element id) or a DXF on one layer (entity handle),
+        ``--layer`` for a DXF of several layers (``--id`` still where ``other``
+        is on the same layer, or --id is in use)."""
+        if self.svg:
+            return f"--id {loop.pick}" if loop.pick else "--id (give the element an id)"
+        several = len(self.layers) > 1 and self.id is None
+        if several and loop.layer is not None and (other is None or other.layer != loop.layer):
+            return f"--layer {loop.layer}"
+        return f"--id {loop.pick}"
+
+    def pick(self, loop: _Piece | None, other: _Piece | None = None) -> str:
+        """Advice: how to pick ``loop`` (None: an outline not known) as the outline."""
+        if loop is None:
+            if self.svg:
+                return "pick the outline with --id ELEMENT_ID (give it an id in the SVG)"
+            if len(self.layers) > 1 and self.id is None:
+                return f"pick the outline's layer with --layer NAME (layers {', '.join(self.layers)})"
+            return "pick the outline with --id HANDLE (an entity handle of it)"
+        option = self.option(loop, other)
+        if option.startswith("--layer"):
+            return f"pick the outline's layer with {option}"
+        return f"pick the outline with {option}"
 
 
 def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa: A002 (CLI's --id)
                  flatten_tol: float | None = None, units: str | None = None,
                  join_tol: float | None = None) -> Outline:
-    """The part outline in ``path`` (.dxf or .svg).
+    """The part outline in ``path`` (.dxf or .svg), with its holes.
+
+    Pieces are joined into closed loops layer by layer (across layers only when
+    no layer closes on its own); the largest closed loop, leaving out a drawing
+    frame and construction geometry, is the outline, or the loop that ``id``
+    names; closed loops strictly inside it are its holes (from its own layer or
+    closed on another); loops outside it and open chains are reported in
+    ``left_out``. See the module docstring for the rules.
 
     Parameters
     ----------
-    layer, id : pick the outline by DXF layer, or by SVG element id / DXF
-        entity handle; otherwise the largest closed loop is the outline.
+    layer : read only this DXF layer (outline and holes).
+    id : the outline is the loop holding this SVG element id or DXF entity
+        handle (an INSERT's handle for the entities of its block), its holes
+        the loops inside it as above, and loops across it are left out, not
+        refused (the user chose); otherwise the largest closed loop is the
+        outline.
     flatten_tol : chordal tolerance for curves, mm (``None``: :data:`DEFAULT_FLATTEN_TOL`
         or :data:`FLATTEN_FRACTION` of the drawing's diagonal, whichever is larger,
         which keeps the vertex count of a large drawing modest).
@@ -128,34 +262,77 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
     Raises
     ------
     OutlineError
-        No closed loop, a hole, loops that cross, a self-intersection, or a
-        file that cannot be read: one line naming the problem and the way out.
+        No closed loop, loops that cross or touch, a loop inside a hole, a
+        self-intersection, too many vertices, or a file that cannot be read:
+        one line naming the problem and the way out.
     """
     path = Path(path)
     _check_options(flatten_tol, units, join_tol)
     if not path.is_file():
         raise OutlineError(f"no outline file at {path}")
     suffix = path.suffix.lower()
+    texts = []
     if suffix == ".dxf":
-        pieces, unit, tol_mm = _dxf_pieces(path, layer, id, flatten_tol, units)
+        pieces, unit, tol_mm, texts = _dxf_pieces(path, layer, flatten_tol, units)
     elif suffix == ".svg":
         if layer is not None:
             raise OutlineError(f"{path}: --layer picks a DXF layer; pick an SVG element with --id")
-        pieces, unit, tol_mm = _svg_pieces(path, id, flatten_tol, units)
+        pieces, unit, tol_mm = _svg_pieces(path, flatten_tol, units)
     else:
         raise OutlineError(f"{path}: unknown outline format {suffix or '(none)'}; give a .dxf or .svg file")
+    on = f" on layer {layer!r}" if layer else ""
     if not pieces:
-        which = f" on layer {layer!r}" if layer else (f" with id {id!r}" if id else "")
-        raise OutlineError(f"{path}: no lines, arcs, polylines or shapes{which}")
+        raise OutlineError(f"{path}: no lines, arcs, polylines or shapes{on}")
+    if id is not None and not any(_names_id(p, id) for p in pieces):
+        raise OutlineError(f"{path}: no lines, arcs, polylines or shapes with id {id!r}{on}; give the "
+                           f"{'element id' if suffix == '.svg' else 'entity handle'} of a piece of the outline")
+    drawing = _Drawing(path, unit, suffix == ".svg", sorted({p.layer for p in pieces if p.layer is not None}), id)
     tol = join_tol if join_tol is not None else JOIN_TOL_FRACTION * _extent(pieces)
-    loops, chains = _join(_unique(pieces, tol), tol)
-    loop, left_out = _choose(loops, chains, path, unit)
+    outer, holes, left_out, joined = _choose(pieces, texts, tol, drawing)
+    xy, hole_xy = _checked(outer, holes, drawing, tol_mm)
+    return Outline(vertices=xy, source=str(path), name=outer.name, flatten_tol=float(tol_mm), units=unit,
+                   left_out=left_out, holes=hole_xy, hole_names=[h.name for h in holes],
+                   hole_layers=[h.layer for h in holes], layer=outer.layer, joined_layers=joined)
+
+
+def _names_id(piece: _Piece, want) -> bool:
+    """Whether ``--id want`` names this drawn piece (DXF handles in any case)."""
+    if piece.pick is None:
+        return False
+    return piece.pick == str(want) or (piece.layer is not None and piece.pick.upper() == str(want).upper())
+
+
+def _checked(outer: _Piece, holes: list, drawing: _Drawing, tol_mm: float):
+    """The outline and holes in mm, checked as a part's (one-line errors naming the loops)."""
+    path, scale = drawing.path, drawing.unit.scale
     try:
-        xy = check_outline(loop.points * unit.scale)
+        xy = check_outline(outer.points * scale)
     except PolygonError as exc:
-        raise OutlineError(f"{path}: outline {loop.name}: {exc}") from None
-    return Outline(vertices=xy, source=str(path), name=loop.name, flatten_tol=float(tol_mm),
-                   units=unit, left_out=left_out)
+        raise OutlineError(f"{path}: outline {outer.name}: {_with_flatten_advice(exc, tol_mm)}") from None
+    hole_xy = [h.points * scale for h in holes]
+    try:
+        hole_xy = check_holes(xy, hole_xy)
+    except PolygonError as exc:
+        text = str(exc)
+        head, sep, tail = text.partition(";")
+        head = re.sub(r"\bhole (\d+)", lambda m: f"hole {holes[int(m.group(1)) - 1].name}", head)
+        head = head.replace("the outline", f"the outline {outer.name}")
+        raise OutlineError(f"{path}: {head}{sep}{_with_flatten_advice(tail, tol_mm)}") from None
+    try:
+        Part.from_vertices(xy, holes=hole_xy)
+    except PolygonError as exc:
+        raise OutlineError(f"{path}: outline {outer.name}"
+                           f"{f' and {len(holes)} holes' if holes else ''}: "
+                           f"{_with_flatten_advice(exc, tol_mm)}") from None
+    return xy, hole_xy
+
+
+def _with_flatten_advice(exc, tol_mm: float) -> str:
+    """The message, with the way out of a vertex count over the limit: a coarser flattening."""
+    text = str(exc)
+    if "more than the limit" in text:
+        text += f", or raise --flatten-tol (now {tol_mm:g} mm)"
+    return text
 
 
 def _check_options(flatten_tol, units, join_tol) -> None:
@@ -201,8 +378,9 @@ def _dxf_units(doc, override) -> Units:
                  units.conversion_factor(code, units.MM))
 
 
-def _dxf_pieces(path: Path, layer, handle, flatten_tol, override) -> tuple[list[_Piece], Units, float]:
-    """The flattened pieces of a DXF's chosen entities, their units and the chordal tolerance (mm)."""
+def _dxf_pieces(path: Path, layer, flatten_tol, override):
+    """The flattened pieces of a DXF's entities (on ``layer`` when given), their
+    units, the chordal tolerance (mm), and the TEXT positions ``(x, y, layer)``."""
     import ezdxf
     from ezdxf import path as ezpath
     try:
@@ -210,44 +388,111 @@ def _dxf_pieces(path: Path, layer, handle, flatten_tol, override) -> tuple[list[
     except (OSError, ezdxf.DXFStructureError, UnicodeDecodeError) as exc:
         raise OutlineError(f"{path} is not a readable DXF file: {exc}".splitlines()[0]) from None
     unit = _dxf_units(doc, override)
-    kinds = {"LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE", "LWPOLYLINE", "POLYLINE"}
-    chosen = [(e, ezpath.make_path(e)) for e in _dxf_entities(doc.modelspace())
-              if e.dxftype() in kinds and (layer is None or e.dxf.layer == layer)
-              and (handle is None or e.dxf.handle.upper() == str(handle).upper())]
-    box = ezpath.bbox([p for _, p in chosen], fast=True) if chosen else None
+    chosen, texts = [], []
+    for e, where, on_layer, pick, linetype in _dxf_entities(doc):
+        if layer is not None and on_layer != layer:
+            continue
+        kind = e.dxftype()
+        if kind in _DXF_TEXTS:
+            at = e.dxf.get("insert")
+            if at is not None:
+                texts.append((float(at.x), float(at.y), on_layer))
+        elif kind in _DXF_CURVES:
+            chosen.append((e, ezpath.make_path(e), where, on_layer, pick, linetype))
+    box = ezpath.bbox([c[1] for c in chosen], fast=True) if chosen else None
     diagonal = float(np.hypot(box.size.x, box.size.y)) if box is not None and box.has_data else 0.0
     tol = _chordal_tolerance(flatten_tol, diagonal, unit.scale)
     pieces = []
-    for e, curve in chosen:
-        # ezdxf flattens with a maximum chord-to-curve distance: the chordal tolerance.
-        pts = np.array([(v.x, v.y) for v in curve.flattening(distance=tol)], dtype=float)
+    for e, curve, where, on_layer, pick, linetype in chosen:
+        kind = e.dxftype()
+        # ezdxf flattens with a maximum chord-to-curve distance: the chordal tolerance. A SPLINE
+        # from its own NURBS (a rational one, as CAD writes a circle, becomes hundreds of points
+        # through the path's cubic curves).
+        flat = e.construction_tool().flattening(tol, segments=4) if kind == "SPLINE" \
+            else curve.flattening(distance=tol)
+        pts = np.array([(v.x, v.y) for v in flat], dtype=float)
         if len(pts) < 2:
             continue
-        kind = e.dxftype()
         closed = bool(getattr(e, "closed", False) or getattr(e, "is_closed", False)) or kind == "CIRCLE"
-        pieces.append(_Piece(pts, f"{kind} {e.dxf.handle} on layer {e.dxf.layer}", closed))
-    return pieces, unit, tol * unit.scale
+        pieces.append(_Piece(pts, f"{kind} {where} on layer {on_layer}", closed, layer=on_layer, pick=pick,
+                             construction=_construction(on_layer, linetype)))
+    return pieces, unit, tol * unit.scale, texts
 
 
-def _dxf_entities(space):
-    """The entities of a layout, with block references (INSERT) exploded in place."""
-    for e in space:
-        if e.dxftype() == "INSERT":
-            yield from e.virtual_entities()
-        else:
-            yield e
+def _dxf_entities(doc):
+    """``(entity, where, layer, pick, linetype)`` for the modelspace's entities,
+    block references (INSERT) exploded in place, nested ones too: ``where`` is
+    the handle, or ``"in block B (INSERT 2F)"`` for a block's entity (which has
+    none); ``layer`` the effective layer (an entity of a block on layer 0 takes
+    its INSERT's); ``pick`` the handle ``--id`` names (the top INSERT's);
+    ``linetype`` the effective linetype (BYLAYER and BYBLOCK resolved)."""
+    for e in doc.modelspace():
+        yield from _explode(e, doc, (), None, None, None)
+
+
+def _explode(e, doc, blocks, parent_layer, pick, parent_linetype):
+    own = e.dxf.get("layer", "0") or "0"
+    layer = parent_layer if parent_layer is not None and own == "0" else own
+    linetype = _linetype(e, layer, doc, parent_linetype)
+    if not blocks:
+        pick, where = str(e.dxf.handle), str(e.dxf.handle)
+    else:
+        where = "in " + " in ".join(f"block {b}" for b in reversed(blocks)) + f" (INSERT {pick})"
+    if e.dxftype() != "INSERT":
+        yield e, where, layer, pick, linetype
+        return
+    name = e.dxf.name
+    for attrib in e.attribs:  # a title block's fields: only where they stand matters
+        own_attrib = attrib.dxf.get("layer", "0") or "0"
+        yield attrib, where, layer if own_attrib == "0" else own_attrib, pick, linetype
+    if name in blocks:  # a block that holds itself: drawn once
+        return
+    for v in e.virtual_entities():
+        yield from _explode(v, doc, blocks + (name,), layer, pick, linetype)
+
+
+def _linetype(e, layer: str, doc, inherited) -> str:
+    """The linetype an entity is drawn in: its own, its layer's (BYLAYER) or its INSERT's (BYBLOCK)."""
+    lt = str(e.dxf.get("linetype", "BYLAYER") or "BYLAYER")
+    if lt.upper() == "BYBLOCK":
+        return inherited or "CONTINUOUS"
+    if lt.upper() == "BYLAYER":
+        return str(doc.layers.get(layer).dxf.linetype) if doc.layers.has_entry(layer) else "CONTINUOUS"
+    return lt
+
+
+def _construction(layer: str, linetype: str) -> str:
+    """Why a piece is construction geometry (a dashed linetype, a layer named so), or ""."""
+    if linetype.upper() not in _SOLID_LINETYPES:
+        return f"linetype {linetype}"
+    if CONSTRUCTION_LAYER.search(layer):
+        return f"layer {layer}"
+    return ""
 
 
 # ---------------------------------------------------------------------- SVG
 
 
-def _svg_length_mm(text) -> float | None:
-    """An SVG width/height in mm, or None when it is missing, relative or unitless."""
+def _inkscape_version(svg) -> tuple[str, tuple[int, int]] | None:
+    """The ``inkscape:version`` of the root element ("0.48.4 r9939": ("0.48", (0, 48))), or None."""
+    text = svg.values.get("{http://www.inkscape.org/namespaces/inkscape}version") \
+        or svg.values.get("inkscape:version")
+    m = re.match(r"\s*(\d+)\.(\d+)", str(text or ""))
+    return (f"{m.group(1)}.{m.group(2)}", (int(m.group(1)), int(m.group(2)))) if m else None
+
+
+def _svg_length_mm(text, px_mm: float = _SVG_MM["px"]) -> float | None:
+    """An SVG width/height in mm (a unitless one in pixels of ``px_mm``), or None
+    when it is missing or relative."""
     m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-zA-Z]*)\s*", str(text or ""))
-    if not m or m.group(2).lower() not in _SVG_MM:
+    if not m:
+        return None
+    unit = m.group(2).lower()
+    factor = px_mm if unit in ("", "px") else _SVG_MM.get(unit)
+    if factor is None:
         return None
     try:
-        return float(m.group(1)) * _SVG_MM[m.group(2).lower()]
+        return float(m.group(1)) * factor
     except ValueError:
         return None
 
@@ -257,29 +502,38 @@ def _svg_units(svg, override) -> tuple[Units, float]:
 
     svgelements has already scaled user units by the viewBox and its own
     (inexact) unit factors; the factor undoes that so the drawing units are
-    the viewBox's user units, which are then scaled exactly."""
+    the viewBox's user units, which are then scaled exactly. A pixel is 1/96
+    inch (CSS), or 1/90 in a file of Inkscape before 0.92."""
+    inkscape = _inkscape_version(svg)
+    if inkscape is not None and inkscape[1] < (0, 92):
+        px_mm, px_said = 25.4 / OLD_INKSCAPE_PX_PER_IN, f"Inkscape {inkscape[0]} file: 90 px per inch"
+    else:
+        px_mm, px_said = _SVG_MM["px"], "CSS pixels, 96 per inch"
     vb = svg.viewbox
+    width, height = svg.values.get("width"), svg.values.get("height")
     if vb is None or not vb.width or not vb.height:
-        px_per_user, user_mm = 1.0, None  # user units are CSS pixels
+        px_per_user, user_mm = 1.0, None  # user units are pixels
     else:
         # preserveAspectRatio "meet" (the default): the smaller scale wins.
         px_per_user = min(svg.width / vb.width, svg.height / vb.height)
-        w, h = _svg_length_mm(svg.values.get("width")), _svg_length_mm(svg.values.get("height"))
+        w, h = _svg_length_mm(width, px_mm), _svg_length_mm(height, px_mm)
         sizes = [s for s in (w and w / vb.width, h and h / vb.height) if s]
         user_mm = min(sizes) if sizes else None
     if override is not None:
         return Units(override, "--units", MM_PER_UNIT[override]), 1.0 / px_per_user
     if user_mm is None:
-        return Units("px", "SVG user units (no physical width over a viewBox: CSS pixels, 96 per inch)",
-                     _SVG_MM["px"]), 1.0 / px_per_user
-    name = next((n for n, f in MM_PER_UNIT.items() if math.isclose(f, user_mm, rel_tol=1e-12)),
+        return Units("px", f"SVG user units ({px_said}; no physical width over a viewBox)", px_mm), \
+            1.0 / px_per_user
+    in_px = any(re.fullmatch(r"\s*[0-9.eE+-]+\s*(px)?\s*", str(t or ""), re.I) for t in (width, height))
+    names = dict(MM_PER_UNIT, px=px_mm)
+    name = next((n for n, f in names.items() if math.isclose(f, user_mm, rel_tol=1e-12)),
                 f"user units of {user_mm:g} mm")
-    return Units(name, f"SVG width/viewBox ({svg.values.get('width')} over {vb.width:g} user units)",
-                 user_mm), 1.0 / px_per_user
+    return Units(name, f"SVG width/viewBox ({width} over {vb.width:g} user units"
+                       f"{'; ' + px_said if in_px else ''})", user_mm), 1.0 / px_per_user
 
 
-def _svg_pieces(path: Path, want_id, flatten_tol, override) -> tuple[list[_Piece], Units, float]:
-    """The flattened pieces of an SVG's chosen shapes, their units and the chordal tolerance (mm)."""
+def _svg_pieces(path: Path, flatten_tol, override) -> tuple[list[_Piece], Units, float]:
+    """The flattened pieces of an SVG's shapes, their units and the chordal tolerance (mm)."""
     import svgelements as se
     try:
         svg = se.SVG.parse(str(path), ppi=96.0)  # transforms and viewBox applied
@@ -292,20 +546,19 @@ def _svg_pieces(path: Path, want_id, flatten_tol, override) -> tuple[list[_Piece
         if not isinstance(el, se.Shape) or isinstance(el, se.Group):
             continue
         eid = el.values.get("id") or el.id
-        if want_id is not None and eid != want_id:
-            continue
         label = f"<{type(el).__name__.lower()} id={eid!r}>" if eid else f"{type(el).__name__.lower()} #{k}"
         shape = se.Path(el)
         shape.reify()  # bake the transform into the coordinates
-        chosen.append((label, shape))
-    tol_px = _chordal_tolerance(flatten_tol, _svg_diagonal(s for _, s in chosen) * user_per_px,
+        chosen.append((label, eid, shape))
+    tol_px = _chordal_tolerance(flatten_tol, _svg_diagonal(s for _, _, s in chosen) * user_per_px,
                                 unit.scale) / user_per_px
     pieces = []
-    for label, shape in chosen:
+    for label, eid, shape in chosen:
         subs = [(sub, closed) for sub, closed in _subpaths(shape, tol_px) if len(sub) >= 2]
         for i, (sub, closed) in enumerate(subs, start=1):
             pts = np.array(sub, dtype=float) * flip
-            pieces.append(_Piece(pts, label + (f" subpath {i}" if len(subs) > 1 else ""), closed))
+            pieces.append(_Piece(pts, label + (f" subpath {i}" if len(subs) > 1 else ""), closed,
+                                 pick=str(eid) if eid else None))
     return pieces, unit, tol_px * user_per_px * unit.scale
 
 
@@ -388,6 +641,16 @@ def _same(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
     return bool(np.all(np.hypot(*(a - b).T) <= tol) or np.all(np.hypot(*(a - b[::-1]).T) <= tol))
 
 
+def _joined(points, members: list, closed: bool) -> _Piece:
+    """A loop or chain of the drawn pieces ``members``."""
+    first = members[0]
+    name = first.name if len(members) == 1 else f"chain of {len(members)} pieces from {first.name}"
+    layers = {m.layer for m in members}
+    return _Piece(points, name, closed, layer=first.layer if len(layers) == 1 else None, pick=first.pick,
+                  construction=first.construction if all(m.construction for m in members) else "",
+                  members=tuple(members))
+
+
 def _join(pieces: list[_Piece], tol: float) -> tuple[list[_Piece], list[_Piece]]:
     """Closed loops and open chains from the pieces: closed ones as they are,
     open ones chained end to end (either direction, any order) wherever an end
@@ -396,25 +659,24 @@ def _join(pieces: list[_Piece], tol: float) -> tuple[list[_Piece], list[_Piece]]
     for p in pieces:
         gap = np.hypot(*(p.points[-1] - p.points[0]))
         if p.closed or (len(p.points) > 2 and gap <= tol):
-            loops.append(_Piece(_dedupe(p.points, tol), p.name, True))
+            loops.append(_joined(_dedupe(p.points, tol), [p], True))
         elif np.max(np.ptp(p.points, axis=0)) > tol:  # a zero-length LINE joins nothing
             open_.append(p)
     chains = []
     while open_:
         first = open_.pop(0)
-        pts, names = first.points, [first.name]
-        pts = _grow(pts, names, open_, tol)
+        pts, members = first.points, [first]
+        pts = _grow(pts, members, open_, tol)
         if np.hypot(*(pts[-1] - pts[0])) > tol:  # a dead end: grow the start too
-            pts = _grow(pts[::-1], names, open_, tol)[::-1]
-        name = names[0] if len(names) == 1 else f"chain of {len(names)} pieces from {names[0]}"
+            pts = _grow(pts[::-1], members, open_, tol)[::-1]
         closed = np.hypot(*(pts[-1] - pts[0])) <= tol and len(pts) > 2
-        (loops if closed else chains).append(_Piece(_dedupe(pts, tol) if closed else pts, name, closed))
+        (loops if closed else chains).append(_joined(_dedupe(pts, tol) if closed else pts, members, closed))
     return loops, chains
 
 
-def _grow(pts, names, open_, tol):
+def _grow(pts, members, open_, tol):
     """``pts`` extended at its end by the pieces of ``open_`` that chain on
-    (taken out of ``open_``, their names appended to ``names``)."""
+    (taken out of ``open_``, appended to ``members``)."""
     while np.hypot(*(pts[-1] - pts[0])) > tol:
         k, reverse = _next_piece(open_, pts[-1], tol)
         if k is None:
@@ -422,7 +684,7 @@ def _grow(pts, names, open_, tol):
         piece = open_.pop(k)  # by index: pieces hold arrays, so list.remove would compare them
         more = piece.points[::-1] if reverse else piece.points
         pts = np.vstack([pts, more[1:]])
-        names.append(piece.name)
+        members.append(piece)
     return pts
 
 
@@ -445,14 +707,8 @@ def _signed_area(xy) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
 
 
-def _centroid(xy) -> np.ndarray:
-    """Area centroid of a simple polygon (after centring, for precision)."""
-    c0 = xy.mean(axis=0)
-    x, y = (xy - c0).T
-    xn, yn = np.roll(x, -1), np.roll(y, -1)
-    cross = x * yn - xn * y
-    area = 0.5 * cross.sum()
-    return c0 + np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6.0 * area)
+def _area(piece: _Piece) -> float:
+    return abs(_signed_area(piece.points))
 
 
 def _inside(pt, poly) -> bool:
@@ -464,48 +720,209 @@ def _inside(pt, poly) -> bool:
     return bool(np.count_nonzero(crosses) % 2)
 
 
+def _inside_all(points, poly) -> np.ndarray:
+    """Whether each of ``points`` lies inside ``poly`` (even-odd)."""
+    return np.array([_inside(pt, poly) for pt in points])
+
+
 def _diagonal(xy) -> float:
     return float(np.hypot(*np.ptp(xy, axis=0)))
 
 
-def _choose(loops: list[_Piece], chains: list[_Piece], path: Path, unit: Units) -> tuple[_Piece, list]:
-    """The largest closed loop and descriptions of what was left out; an error
-    for holes, crossing loops, or an open chain that looks like the outline."""
-    loops = sorted((lp for lp in loops if len(lp.points) >= 3),
-                   key=lambda lp: -abs(_signed_area(lp.points)))
-    chains = sorted(chains, key=lambda c: -_diagonal(c.points))
-    # A lone straight line (a centre line, a dimension) is never an outline left open.
-    could_be_outlines = [c for c in chains if len(c.points) > 2]
-    if could_be_outlines and (not loops or _diagonal(could_be_outlines[0].points) > _diagonal(loops[0].points)):
-        raise _open_error(could_be_outlines[0], path, unit)
-    if chains and not loops:
-        raise _open_error(chains[0], path, unit)
-    if not loops:
-        raise OutlineError(f"{path}: no closed outline with an area")
-    outer = loops[0]
-    inside = {id(lp): [_inside(pt, outer.points) for pt in lp.points] for lp in loops[1:]}
-    crossing = [lp for lp in loops[1:] if any(inside[id(lp)]) and not all(inside[id(lp)])]
-    if crossing:
-        raise OutlineError(f"{path}: outlines {outer.name} and {crossing[0].name} cross each other; "
-                           f"draw the part as one closed outline, or pick one with --layer/--id")
-    holes = [lp for lp in loops[1:] if all(inside[id(lp)])]
-    if holes:
-        raise OutlineError(
-            f"{path}: outline {outer.name} has {len(holes)} hole(s) ({', '.join(h.name for h in holes[:3])}"
-            f"{' ...' if len(holes) > 3 else ''}); parts with holes are not supported (no pressure acts "
-            f"under a hole, which moves the centroid and the support integrals): put the holes on another "
-            f"layer and pick the outline with --layer, or delete them to plan the part as if solid")
-    left = [f"closed loop {lp.name} (area {abs(_signed_area(lp.points)) * unit.scale ** 2:.4g} mm^2)"
-            for lp in loops[1:]]
-    left += [f"open chain {c.name} (ends {np.hypot(*(c.points[-1] - c.points[0])) * unit.scale:.4g} mm "
-             f"apart)" for c in chains]
-    return outer, left
+def _groups(pieces: list[_Piece]) -> dict:
+    """The pieces by (layer, construction or not), in the order drawn."""
+    out = {}
+    for p in pieces:
+        out.setdefault((p.layer, bool(p.construction)), []).append(p)
+    return out
 
 
-def _open_error(chain: _Piece, path: Path, unit: Units) -> OutlineError:
-    end = chain.points[-1] * unit.scale
-    gap = np.hypot(*(chain.points[-1] - chain.points[0])) * unit.scale
-    return OutlineError(
-        f"{path}: open outline: {chain.name} ends at ({end[0]:.3f}, {end[1]:.3f}) mm, {gap:.3f} mm from "
-        f"its start; close the outline in the drawing, raise --join-tol (drawing units) over the gaps, "
-        f"or pick the outline with --layer/--id")
+def _loops_and_chains(pieces, tol):
+    """The loops (of 3 points or more) and the chains of the pieces, joined
+    group by group (a layer's pieces, its construction pieces apart)."""
+    loops, chains = [], []
+    for group in _groups(pieces).values():
+        lp, ch = _join(_unique(group, tol), tol)
+        loops += lp
+        chains += ch
+    return [lp for lp in loops if len(lp.points) >= 3], chains
+
+
+def _choose(pieces: list[_Piece], texts: list, tol: float, drawing: _Drawing):
+    """The outline, its holes, descriptions of what was left out, and the
+    layers the outline joined across (when several); an error for crossing
+    loops, an island, or an open chain that looks like the outline."""
+    if all(p.construction for p in pieces):  # all dashed, or on a construction layer: take it as drawn
+        pieces = [_Piece(p.points, p.name, p.closed, p.layer, p.pick) for p in pieces]
+    loops, chains = _loops_and_chains(pieces, tol)
+    joined = []
+    plain = [p for p in pieces if not p.construction]
+    if not any(not lp.construction for lp in loops) and len({p.layer for p in plain}) > 1:
+        # No layer closes on its own: join the layers' pieces (never construction geometry).
+        mixed, mixed_chains = _join(_unique(plain, tol), tol)
+        mixed = [lp for lp in mixed if len(lp.points) >= 3]
+        if mixed:
+            loops = [lp for lp in loops if lp.construction] + mixed
+            chains = [c for c in chains if c.construction] + mixed_chains
+    loops.sort(key=lambda lp: -_area(lp))
+    chains.sort(key=lambda c: -_diagonal(c.points))
+    frame, left = None, []
+    if drawing.id is not None:
+        mine = [lp for lp in loops if any(_names_id(m, drawing.id) for m in lp.parts)]
+        if not mine:
+            chain = next((c for c in chains if any(_names_id(m, drawing.id) for m in c.parts)), None)
+            if chain is None:
+                raise OutlineError(f"{drawing.path}: the piece with id {drawing.id!r} has no length or repeats "
+                                   f"another piece; give the id of another piece of the outline")
+            raise _open_error(chain, pieces, tol, drawing, None)
+        outer = mine[0]
+    else:
+        frame = _frame(loops, pieces, texts, tol, drawing)
+        if frame is not None:
+            left.append(frame[1])
+            loops = [lp for lp in loops if lp.layer != frame[0]]
+            chains = [c for c in chains if c.layer != frame[0]]
+        candidates = [lp for lp in loops if not lp.construction] or loops
+        plain_chains = [c for c in chains if not c.construction]
+        # A lone straight line (a centre line, a dimension) is never an outline left open.
+        could_be = [c for c in plain_chains if len(c.points) > 2]
+        if could_be and (not candidates or _diagonal(could_be[0].points) > _diagonal(candidates[0].points)):
+            raise _open_error(could_be[0], pieces, tol, drawing, candidates[0] if candidates else None)
+        if not candidates:
+            if plain_chains or chains:
+                raise _open_error((plain_chains or chains)[0], pieces, tol, drawing, None)
+            raise OutlineError(f"{drawing.path}: no closed outline with an area")
+        outer = candidates[0]
+    if len(outer.layers) > 1:
+        joined = outer.layers
+    holes, left_loops = _holes(outer, [lp for lp in loops if lp is not outer], drawing)
+    left += left_loops
+    scale = drawing.unit.scale
+    for c in chains:
+        gap = np.hypot(*(c.points[-1] - c.points[0])) * scale
+        note = f"; construction geometry, {c.construction}" if c.construction else ""
+        if not c.construction and outer.layer is not None and c.layer == outer.layer and len(drawing.layers) > 1:
+            bridge = _bridge(c, pieces, tol)
+            if bridge:
+                note = (f"; {bridge}: draw it closed on layer {c.layer}, or read layer {c.layer} alone "
+                        f"with --layer {c.layer}")
+        left.append(f"open chain {c.name} (ends {gap:.4g} mm apart{note})")
+    return outer, holes, left, joined
+
+
+def _holes(outer: _Piece, others: list, drawing: _Drawing):
+    """The loops strictly inside ``outer`` that are holes, and descriptions of
+    the loops left out; an error for a loop across the outline or inside a hole."""
+    scale, path = drawing.unit.scale, drawing.path
+    holes, left = [], []
+    for lp in others:
+        inside = _inside_all(lp.points, outer.points)
+        area = f"area {_area(lp) * scale ** 2:.4g} mm^2"
+        if lp.construction:
+            where = "inside" if inside.all() else ("outside" if not inside.any() else "across")
+            left.append(f"closed loop {lp.name} ({area}; {lp.construction}: construction geometry, "
+                        f"{where} the outline, never a hole)")
+        elif inside.all():
+            holes.append(lp)
+        elif not inside.any():
+            left.append(f"closed loop {lp.name} ({area}; to plan it instead: {drawing.option(lp, outer)})")
+        elif drawing.id is not None:
+            left.append(f"closed loop {lp.name} ({area}; across the outline that --id {drawing.id} picked)")
+        else:
+            raise OutlineError(
+                f"{path}: outlines {outer.name} and {lp.name} cross each other or touch; a hole must lie "
+                f"strictly inside the outline (an opening to the outline is a notch: draw it as part of the "
+                f"outline), else draw the part as one closed outline, or {drawing.pick(outer, lp)}")
+    for j, hole in enumerate(holes):
+        for k, other in enumerate(holes):
+            if k != j and _inside_all(hole.points, other.points).all():
+                way = (f"pick the outline's layer with --layer {outer.layer} to leave layer {hole.layer} out"
+                       if outer.layer is not None and hole.layer != outer.layer and len(drawing.layers) > 1
+                       else "delete it from this drawing")
+                raise OutlineError(
+                    f"{path}: {hole.name} lies inside the hole {other.name} of outline {outer.name} (an island: "
+                    f"a separate part); plan it as a part of its own (--id {hole.pick}), or {way}")
+    return holes, left
+
+
+def _is_box(xy: np.ndarray, tol: float) -> bool:
+    """Whether the polygon is an axis-aligned rectangle (its edges axis-parallel, its area its box's)."""
+    edges = np.roll(xy, -1, axis=0) - xy
+    if not np.all(np.min(np.abs(edges), axis=1) <= tol):
+        return False
+    w, h = np.ptp(xy, axis=0)
+    return math.isclose(abs(_signed_area(xy)), w * h, rel_tol=1e-6)
+
+
+def _frame(loops: list, pieces: list, texts: list, tol: float, drawing: _Drawing):
+    """``(layer, description)`` of a drawing frame, or None: the largest loop,
+    when it is an axis-aligned rectangle around all other geometry holding
+    closed loops of other layers, on a layer named as a frame or holding TEXT
+    outside the other layers' geometry (a title block)."""
+    if not loops or drawing.svg or len(drawing.layers) < 2:
+        return None
+    big = loops[0]
+    layer = big.layer
+    if layer is None or not _is_box(big.points, tol):
+        return None
+    others = [p for p in pieces if p.layer != layer]
+    if not others or not any(lp.layer != layer and not lp.construction for lp in loops):
+        return None
+    lo, hi = big.points.min(axis=0) - tol, big.points.max(axis=0) + tol
+    pts = np.vstack([p.points for p in others])
+    if not np.all((pts >= lo) & (pts <= hi)):
+        return None
+    olo, ohi = pts.min(axis=0), pts.max(axis=0)
+    title = [t for t in texts if t[2] == layer and lo[0] <= t[0] <= hi[0] and lo[1] <= t[1] <= hi[1]
+             and not (olo[0] <= t[0] <= ohi[0] and olo[1] <= t[1] <= ohi[1])]
+    named = FRAME_LAYER.search(layer)
+    if not (named or title):
+        return None
+    w, h = np.ptp(big.points, axis=0) * drawing.unit.scale
+    n = sum(p.layer == layer for p in pieces)
+    why = "a layer named as a frame" if named else f"{len(title)} text(s) outside the part, a title block"
+    return layer, (f"drawing frame on layer {layer}: {big.name}, a {w:.4g} x {h:.4g} mm rectangle around "
+                   f"everything else ({why}), and the other {n - 1} piece(s) of the layer; if it is the part, "
+                   f"read layer {layer} alone with --layer {layer}")
+
+
+def _bridge(chain: _Piece, pieces: list, tol: float) -> str:
+    """When ``chain`` would close only through pieces of other layers or
+    construction geometry: what closes it and why that is not joined; else ""."""
+    loops, _ = _join(_unique(pieces, tol), tol)
+    mine = {id(m) for m in chain.parts}
+    for lp in loops:
+        if not any(id(m) in mine for m in lp.parts):
+            continue
+        foreign = [m for m in lp.parts if id(m) not in mine and (m.layer != chain.layer or m.construction)]
+        if not foreign:
+            continue
+        names = ", ".join(m.name.split(" on layer ")[0] for m in foreign[:3])
+        names += " ..." if len(foreign) > 3 else ""
+        layers = ", ".join(sorted({m.layer for m in foreign if m.layer is not None}))
+        why = ("construction geometry, never joined into an outline" if all(m.construction for m in foreign)
+               else "layers are joined only when none closes on its own")
+        return f"it closes only through {names} on layer {layers} ({why})"
+    return ""
+
+
+def _open_error(chain: _Piece, pieces: list, tol: float, drawing: _Drawing,
+                closed: _Piece | None) -> OutlineError:
+    """The error for an open outline: where it ends, what would close it, and the ways out
+    (``closed``: a closed loop the user might pick instead)."""
+    scale = drawing.unit.scale
+    end = chain.points[-1] * scale
+    gap = np.hypot(*(chain.points[-1] - chain.points[0])) * scale
+    head = (f"{drawing.path}: open outline: {chain.name} ends at ({end[0]:.3f}, {end[1]:.3f}) mm, {gap:.3f} mm "
+            f"from its start")
+    if closed is not None:
+        pick = f"or take the closed loop {closed.name} instead: {drawing.pick(closed, chain)}"
+    elif drawing.id is not None:
+        pick = "or give --id of a piece of a closed loop"
+    else:
+        pick = f"or {drawing.pick(None)}"
+    bridge = _bridge(chain, pieces, tol) if chain.layer is not None else ""
+    if bridge:
+        return OutlineError(f"{head}; {bridge}; draw it closed on layer {chain.layer}, {pick}")
+    return OutlineError(f"{head}; close the outline in the drawing, raise --join-tol (drawing units) over the "
+                        f"gaps, {pick}")

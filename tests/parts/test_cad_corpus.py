@@ -265,8 +265,17 @@ def test_bad_outlines_are_one_line_errors(tmp_path, capsys):
         _slot_issue(msp)
         msp.add_circle((SL / 2, 0), 3, dxfattribs={"layer": "HOLES"})
     path = dxf_file(tmp_path / "washer.dxf", washer)
-    _one_line_error(capsys, _rollout_args(path), "1 hole(s)", "CIRCLE", "not supported", "--layer")
-    code, _, err = run_cli(capsys, _rollout_args(path, "--layer", "0"))  # the way out works
+    out = read_outline(path)  # a hole on another layer is a hole (issue: parts with holes)
+    assert len(out.holes) == 1 and out.hole_names[0].startswith("CIRCLE") and "1 on layer HOLES" in out.describe()
+    assert not read_outline(path, layer="0").holes  # --layer reads one layer alone
+
+    def island(msp):  # a disc in the hole: a separate part
+        washer(msp)
+        msp.add_circle((SL / 2, 0), 1, dxfattribs={"layer": "HOLES"})
+    island_path = dxf_file(tmp_path / "island.dxf", island)
+    _one_line_error(capsys, _rollout_args(island_path), "an island", "CIRCLE", "part of its own",
+                    "--layer 0")
+    code, _, err = run_cli(capsys, _rollout_args(island_path, "--layer", "0"))  # the way out works
     assert code == 0 and "chain of 4 pieces" in err
 
     def gapped(msp):  # the L in two open polylines, 0.05 mm apart at (0, 0)

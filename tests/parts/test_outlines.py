@@ -129,12 +129,21 @@ def test_self_intersection(tmp_path):
         read_outline(dxf_file(tmp_path / "bow.dxf", build))
 
 
-def test_hole_is_refused(tmp_path):
+def test_hole_reads_as_a_hole(tmp_path):
     def build(msp):
         _bracket(msp)
         msp.add_circle((5, 5), 2)
-    with pytest.raises(OutlineError, match=r"1 hole\(s\).*not supported.*--layer"):
-        read_outline(dxf_file(tmp_path / "hole.dxf", build))
+    out = read_outline(dxf_file(tmp_path / "hole.dxf", build), flatten_tol=0.01)
+    (hole,) = out.holes
+    assert out.n_vertices == 6 and out.hole_names[0].startswith("CIRCLE") and "1 hole (" in out.describe()
+    # The flattened circle is inscribed: short of the true area by under its length times the tolerance.
+    assert 0 < math.pi * 4 - _area(hole) <= 2 * math.pi * 2 * 0.01
+    part = out.part("bracket")
+    assert part.area == pytest.approx(900 - _area(hole)) and part.has_holes
+    # The material's centroid: the L's (65/3, 35/3) less the hole's (5, 5), weighted by area.
+    c = (np.array([65 / 3, 35 / 3]) * 900 - np.array([5.0, 5.0]) * _area(hole)) / part.area
+    corners = np.array([(0, 0), (60, 0), (60, 10), (10, 10), (10, 40), (0, 40)])
+    assert out.a == part.a == pytest.approx(np.max(np.hypot(*(corners - c).T)), rel=1e-12)
 
 
 def test_bad_inputs(tmp_path):
@@ -182,11 +191,15 @@ def test_cli_rollout_from_outline(tmp_path, capsys):
     assert capsys.readouterr().err.startswith("pinfeed: error: no outline file")
 
 
-def test_svg_hole_is_refused_and_named(tmp_path):
+def test_svg_hole_reads_and_is_named(tmp_path):
     body = '<path id="ring" fill-rule="evenodd" d="M0,0 H40 V40 H0 Z M10,10 H20 V20 H10 Z"/>'
-    with pytest.raises(OutlineError, match=r"outline <path id='ring'> subpath 1 has 1 hole\(s\) "
-                                           r"\(<path id='ring'> subpath 2\)"):
-        read_outline(_svg(tmp_path / "ring.svg", body))
+    out = read_outline(_svg(tmp_path / "ring.svg", body))
+    assert out.name == "<path id='ring'> subpath 1" and out.hole_names == ["<path id='ring'> subpath 2"]
+    assert "1 hole (4 vertices)" in out.describe()
+    # Material: the 40 x 40 square less the 10 x 10 one, centroid (20.333, 20.333) in SVG's frame
+    # (y down); the farthest corner is the square's (0, 0), flipped or not.
+    c = (1600 * 20 - 100 * 15) / 1500
+    assert out.part().area == pytest.approx(1500) and out.a == pytest.approx(c * math.sqrt(2), rel=1e-12)
 
 
 @pytest.mark.parametrize("part, message", [
