@@ -88,8 +88,8 @@ BRACKET_HOLES = [_circle((8, 32), 3.25), _circle((42, 32), 3.25), _slot((18, 14)
 BRACKET_CORNERS = [(0, 0), (50, 0), (50, 40), (0, 40)]
 
 
-@pytest.mark.parametrize("path", [CAD / "holed_bracket.dxf", TUTORIAL])
-def test_holed_bracket(path):
+def test_holed_bracket():
+    path = CAD / "holed_bracket.dxf"
     out = read_outline(path, flatten_tol=TOL)
     assert out.n_vertices == 4 and out.layer == "OUTLINE" and not out.left_out
     assert sorted(out.hole_layers) == ["HOLES", "HOLES", "OUTLINE"] and "2 on layer HOLES" in out.describe()
@@ -97,8 +97,29 @@ def test_holed_bracket(path):
     _check_part(out, BRACKET, BRACKET_HOLES, BRACKET_CORNERS, 3)
 
 
+GUSSET_CORNERS = [(0, 0), (50, 0), (50, 6), (6, 40), (0, 40)]
+
+
+def _polygon(xy):
+    """(area, centroid, 0) of a simple polygon (the shoelace sums)."""
+    xy = np.asarray(xy, float)
+    x, y = xy[:, 0], xy[:, 1]
+    xn, yn = np.roll(x, -1), np.roll(y, -1)
+    cross = x * yn - xn * y
+    area = 0.5 * cross.sum()
+    return abs(area), np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6 * area), 0.0
+
+
+@pytest.mark.parametrize("path", [CAD / "gusset_bracket.dxf", TUTORIAL])
+def test_gusset_bracket_of_the_tutorial(path):
+    out = read_outline(path, flatten_tol=TOL)
+    assert out.n_vertices == 5 and out.layer == "PART" and not out.left_out
+    holes = [_circle((8, 8), 3.25), _circle((8, 30), 3.25), _slot((20, 10), (32, 10), 3.25)]
+    _check_part(out, _polygon(GUSSET_CORNERS), holes, GUSSET_CORNERS, 3)
+
+
 def test_tutorial_bracket_is_the_corpus_one():
-    assert TUTORIAL.read_bytes() == (CAD / "holed_bracket.dxf").read_bytes()
+    assert TUTORIAL.read_bytes() == (CAD / "gusset_bracket.dxf").read_bytes()
 
 
 def test_inkscape1_bracket_is_the_dxf_bracket():

@@ -1,4 +1,4 @@
-"""Write the CAD corpus of tests/data/cad (and docs/tutorials/holed_bracket.dxf).
+"""Write the CAD corpus of tests/data/cad (and docs/tutorials/holed_bracket.dxf, its gusset bracket).
 
 The files are committed; this script rewrites them byte for byte (ezdxf's fixed
 metadata for testing: no time stamps or GUIDs; a fixed hash seed, as ezdxf
@@ -24,7 +24,7 @@ import ezdxf
 from ezdxf.math import rational_bspline_from_arc
 
 HERE = Path(__file__).resolve().parent
-TUTORIAL = HERE.parents[2] / "docs" / "tutorials" / "holed_bracket.dxf"
+TUTORIAL = HERE.parents[2] / "docs" / "tutorials" / "holed_bracket.dxf"  # the gusset bracket
 
 
 def _new(version, insunits=4, linetypes=False):
@@ -59,6 +59,26 @@ def holed_bracket():
     msp.add_arc((18, 14), 3.5, 90, 270, dxfattribs=o)
     msp.add_circle((8, 32), 3.25, dxfattribs=h)
     msp.add_circle((42, 32), 3.25, dxfattribs=h)
+    return doc
+
+
+def gusset_bracket():
+    """A 50 x 40 mm gusset bracket, the own-part tutorial's holed part (drawn
+    as AutoCAD 2000+ writes it), DXF 2010, all on layer PART.
+
+    The outline a closed LWPOLYLINE (0, 0), (50, 0), (50, 6), (6, 40), (0, 40):
+    a right triangle with its two sharp tips cut. Two mounting holes, CIRCLEs
+    of diameter 6.5 at (8, 8) and (8, 30); a slot, a closed LWPOLYLINE with
+    two half-circle bulges, centres (20, 10) and (32, 10), radius 3.25.
+    """
+    doc = _new("R2010")
+    msp = doc.modelspace()
+    part = _layer(doc, "PART")
+    msp.add_lwpolyline([(0, 0), (50, 0), (50, 6), (6, 40), (0, 40)], close=True, dxfattribs=part)
+    msp.add_circle((8, 8), 3.25, dxfattribs=part)
+    msp.add_circle((8, 30), 3.25, dxfattribs=part)
+    msp.add_lwpolyline([(20, 6.75, 0, 0, 0), (32, 6.75, 0, 0, 1), (32, 13.25, 0, 0, 0),
+                        (20, 13.25, 0, 0, 1)], format="xyseb", close=True, dxfattribs=part)
     return doc
 
 
@@ -205,6 +225,7 @@ def notch_r12():
 
 DXF = {
     "holed_bracket.dxf": holed_bracket,
+    "gusset_bracket.dxf": gusset_bracket,
     "plate_offcentre_r12.dxf": plate_offcentre_r12,
     "lever_r2000.dxf": lever_r2000,
     "construction_r2010.dxf": construction_r2010,
@@ -326,7 +347,7 @@ SVG = {
 
 
 def write(out: Path = HERE, tutorial: bool = True) -> list[Path]:
-    """Write every corpus file into ``out`` (and the tutorial's copy of the bracket); the paths."""
+    """Write every corpus file into ``out`` (and the tutorial's copy of the gusset bracket); the paths."""
     ezdxf.options.write_fixed_meta_data_for_testing = True  # no time stamps, no GUIDs: reproducible
     out.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -337,7 +358,7 @@ def write(out: Path = HERE, tutorial: bool = True) -> list[Path]:
         (out / name).write_text(build())
         paths.append(out / name)
     if tutorial:
-        shutil.copyfile(out / "holed_bracket.dxf", TUTORIAL)
+        shutil.copyfile(out / "gusset_bracket.dxf", TUTORIAL)
     return paths
 
 
