@@ -498,10 +498,15 @@ def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
 
 def final_sets_warning(plan: dict) -> list[str]:
     """A warning (a list of none or one line) when a laid-out plan leaves the parts in
-    several final orientation sets: such a feeder does not orient them fully."""
+    several final orientation sets: such a feeder does not orient them fully. A
+    plan whose verification says it orients (its trials end in one set within
+    the tolerance, though the claim names several narrower ones) gets none."""
     from pipeline.planning.arcs import format_arcs
     n = plan.get("n_final_sets") or len(plan.get("final_sets") or ())
-    if n <= 1:
+    orientation = (plan.get("verification") or {}).get("orientation") or {}
+    if n <= 1 or orientation.get("orients"):
+        # Claimed sets that the verified trials show to lie in one set of the
+        # tolerance's width are one orientation to the user.
         return []
     return [f"plan {plan['number']} leaves {n} final orientation sets ({format_arcs(plan['final_sets'])}): "
             f"parts leave this feeder in more than one orientation"]

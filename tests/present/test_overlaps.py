@@ -55,6 +55,11 @@ def test_several_final_sets_are_a_warning_drawn_in_red():
     assert warning == ["plan 2 leaves 2 final orientation sets (20.0-25.0 deg, 130.0-134.0 deg): parts "
                        "leave this feeder in more than one orientation"]
     assert final_sets_warning(dict(layout["plan"], n_final_sets=1)) == []
+    # Two claimed sets that the verified trials find in one set within the tolerance: no warning.
+    verified = {"orientation": {"orients": True, "width_deg": 7.3, "tolerance_deg": 10.0}}
+    assert final_sets_warning(dict(layout["plan"], verification=verified)) == []
+    verified["orientation"]["orients"] = False
+    assert final_sets_warning(dict(layout["plan"], verification=verified)) == warning
     fig = feeder_figure(_layout(warning))
     try:
         red = [t for t in fig.findobj(lambda a: hasattr(a, "get_text") and "final orientation sets" in a.get_text())]
