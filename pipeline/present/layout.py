@@ -401,7 +401,8 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
                    "pins": list(plan.pins), "pin_heights_mm": heights,
                    "final_sets": [s.to_dict() for s in plan.final_sets],
                    "n_final_sets": plan.n_final_sets}
-    out["warnings"] = warnings + final_sets_warning(out["plan"])
+    verified = plan.verification.to_dict() if plan.verification else None
+    out["warnings"] = warnings + final_sets_warning(dict(out["plan"], verification=verified))
     _family_assumption(out, result)
     out["method"]["belt_speed"] = source
     out["method"]["throughput"] = "60 x belt speed / pitch" if belt_speed else "none: no belt speed"
