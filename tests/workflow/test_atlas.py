@@ -1,5 +1,6 @@
-"""The feedability atlas (issue 23): its rows against the plan files they
-summarise, its CSV against its JSON, ``pinfeed atlas``, and planner.parts
+"""The feedability atlas: its rows against the plan files they summarise
+(a part with holes among them), its CSV against its JSON, ``pinfeed atlas``,
+the report's grid (thumbnails of every part, holes drawn), and planner.parts
 naming families, ``all`` and bad names."""
 import copy
 import csv
@@ -17,7 +18,9 @@ from pipeline.workflow.atlas import COLUMNS, build_atlas, write_atlas
 from pipeline.workflow.commands import plan_tight_only
 
 PARTS = {"right_triangle": [[0, 0], [50, 0], [0, 30]],
-         "flat_bar": [[0, 0], [60, 0], [60, 12], [0, 12]]}
+         "flat_bar": [[0, 0], [60, 0], [60, 12], [0, 12]],
+         "holed_gusset": [[0, 0], [50, 0], [50, 6], [6, 40], [0, 40]]}
+HOLES = {"holed_gusset": [[[5, 5], [11, 5], [11, 11], [5, 11]], [[17, 7], [31, 7], [31, 12], [17, 12]]]}
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +37,8 @@ def planned(tmp_path_factory):
     paths = []
     for name, vertices in PARTS.items():
         path = root / "plans" / f"{name}.json"
-        write_json(plan_tight_only(Part.from_vertices(vertices, name=name), config), path)
+        part = Part.from_vertices(vertices, name=name, holes=HOLES.get(name, ()))
+        write_json(plan_tight_only(part, config), path)
         paths.append(path)
     speed = write_json({"part": "right_triangle", "speed_limit_mm_s": 210.0}, root / "speed" / "right_triangle.json")
     layout = write_json({"part": "right_triangle", "belt_speed_mm_s": 168.0, "throughput_per_min": 55.5},
