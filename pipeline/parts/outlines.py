@@ -271,15 +271,7 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
     if not path.is_file():
         raise OutlineError(f"no outline file at {path}")
     suffix = path.suffix.lower()
-    texts = []
-    if suffix == ".dxf":
-        pieces, unit, tol_mm, texts = _dxf_pieces(path, layer, flatten_tol, units)
-    elif suffix == ".svg":
-        if layer is not None:
-            raise OutlineError(f"{path}: --layer picks a DXF layer; pick an SVG element with --id")
-        pieces, unit, tol_mm = _svg_pieces(path, flatten_tol, units)
-    else:
-        raise OutlineError(f"{path}: unknown outline format {suffix or '(none)'}; give a .dxf or .svg file")
+    pieces, unit, tol_mm, texts = _pieces(path, suffix, layer, flatten_tol, units)
     on = f" on layer {layer!r}" if layer else ""
     if not pieces:
         raise OutlineError(f"{path}: no lines, arcs, polylines or shapes{on}")
@@ -333,6 +325,18 @@ def _with_flatten_advice(exc, tol_mm: float) -> str:
     if "more than the limit" in text:
         text += f", or raise --flatten-tol (now {tol_mm:g} mm)"
     return text
+
+
+def _pieces(path: Path, suffix: str, layer, flatten_tol, units):
+    """The drawing's flattened pieces, units, chordal tolerance (mm) and TEXT
+    positions (DXF; none for SVG), by file format."""
+    if suffix == ".dxf":
+        return _dxf_pieces(path, layer, flatten_tol, units)
+    if suffix == ".svg":
+        if layer is not None:
+            raise OutlineError(f"{path}: --layer picks a DXF layer; pick an SVG element with --id")
+        return (*_svg_pieces(path, flatten_tol, units), [])
+    raise OutlineError(f"{path}: unknown outline format {suffix or '(none)'}; give a .dxf or .svg file")
 
 
 def _check_options(flatten_tol, units, join_tol) -> None:
