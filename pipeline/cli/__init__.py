@@ -10,7 +10,8 @@ One module per verb or group of verbs, each building its own parsers:
 module          verbs
 ==============  =======================================================
 ``maps``        ``rollout``, ``map``, ``plot-map``, ``demo``
-``plans``       ``sweep``, ``plan``, ``atlas`` (``plan_text`` prints plans)
+``plans``       ``sweep``, ``plan``, ``atlas`` (``plan_text`` prints plans,
+                ``next_steps`` what to run after one)
 ``catalog``     ``catalog index|list|show|query|plot``
 ``sense``       ``sense classify``
 ``support``     ``support fit``
@@ -19,8 +20,8 @@ module          verbs
 ==============  =======================================================
 
 :func:`build_parser` returns the whole parser (the manual's command reference
-is generated from it); :func:`main` runs it, with shell completion by
-argcomplete when the shell asks.
+is generated from it; ``pinfeed --version`` prints ``pipeline.__version__``);
+:func:`main` runs it, with shell completion by argcomplete when the shell asks.
 """
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ import argparse
 import re
 import sys
 
+from pipeline import __version__
 from pipeline.cli import catalog, feeder, maps, plans, sense, support
 from pipeline.cli.maps import DEFAULT_TRIANGLE, PAPER_D
 from pipeline.cli.options import parse_values
@@ -69,6 +71,8 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``pinfeed`` argument parser, one subcommand per command."""
     parser = PinfeedParser(prog="pinfeed", description="pinfeed: design part feeders that orient flat parts "
                            "on a conveyor with overhead pins.")
+    parser.add_argument("--version", action="version", version=f"pinfeed {__version__}",
+                        help="print the version of pinfeed and exit")
     sub = parser.add_subparsers(dest="command", required=True)
     maps.add_map_commands(sub)
     plans.add_sweep_plan_commands(sub)

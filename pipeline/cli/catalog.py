@@ -134,17 +134,18 @@ def add_catalog_commands(sub) -> None:
 
     catalog_parser("index", "rebuild the index from the shards on disk", cmd_catalog_index)
     q = catalog_parser("list", "list the parts stored", cmd_catalog_list)
-    add_json_option(q)
+    add_json_option(q, "print the parts as a JSON list instead of a table")
     q = catalog_parser("show", "everything stored about one part", cmd_catalog_show)
     q.add_argument("part", help="part name or id")
     q.add_argument("--support", default=None, metavar="SPEC",
                    help="only the shards of this support (its text or file key); default: every support")
-    add_json_option(q)
+    add_json_option(q, "print the part and its shards as JSON instead of text")
     for name, func, help_text in (("query", cmd_catalog_query, "maps of one part, model, friction, d"),
                                   ("plot", cmd_catalog_plot, "draw stored maps like the paper's Table 1")):
         q = catalog_parser(name, help_text, func)
         q.add_argument("--part", required=True, help="part name or id")
-        q.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"])
+        q.add_argument("--model", default="minpower", choices=["minpower", "tip", "ellipsoid"],
+                       help="contact model of the maps (default minpower)")
         q.add_argument("--mu-c", type=float, default=None, help="friction (nearest/bracketing stored value)")
         q.add_argument("--d", default=None, help="contact parameter(s): 'a,b' or 'start:stop:step'")
         q.add_argument("--method", default="nearest", choices=["nearest", "bracket"],
@@ -157,7 +158,7 @@ def add_catalog_commands(sub) -> None:
         if name == "query":
             q.add_argument("--theta-i", default=None,
                            help="only these initial orientations (nearest stored)")
-            add_json_option(q)
+            add_json_option(q, "print the selection and its rows as JSON instead of a table")
         else:
             q.add_argument("--out", required=True, help="image file (.png, .pdf, .svg)")
             q.add_argument("--bands", default=None, metavar="T,C",

@@ -153,7 +153,7 @@ def add_stored_plan_commands(sub) -> None:
                         "with the plan, else the config's speed.trials); other settings recompute it")
     add_config_option(p)
     add_results_option(p)
-    add_json_option(p)
+    add_json_option(p, "print JSON instead of text")
     p.set_defaults(func=cmd_speed)
 
 

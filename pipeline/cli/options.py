@@ -152,8 +152,9 @@ def add_results_option(p, holding: str = "plans/") -> None:
                    "(default: the config's, RESULTS_DIR/NAME)")
 
 
-def add_json_option(p, help_text: str | None = None) -> None:
-    """``--json``: one JSON document on stdout instead of text (:func:`print_json`)."""
+def add_json_option(p, help_text: str = "print JSON instead of text") -> None:
+    """``--json``: one JSON document on stdout instead of text (:func:`print_json`),
+    with ``help_text`` saying what the document holds."""
     p.add_argument("--json", action="store_true", help=help_text)
 
 
