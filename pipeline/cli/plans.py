@@ -4,13 +4,17 @@
 one part (a named part, ``--vertices`` or a CAD ``--outline``), stores the plan
 and prints the commands that use it; ``atlas`` prints the feedability atlas
 the workflow made. How a plan reads for people is in
-:mod:`pipeline.cli.plan_text`.
+:mod:`pipeline.cli.plan_text`; what ``plan`` suggests next (the commands that
+use a plan that orients the part, or what may still orient it) in
+:mod:`pipeline.cli.next_steps`.
 """
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
+from pipeline.cli.next_steps import print_next_steps
 from pipeline.cli.options import (add_config_option, add_json_option, add_outline_args, parse_values,
                                   plan_part_arg, print_json)
 from pipeline.cli.plan_text import plan_json, print_plan_result
@@ -52,24 +56,15 @@ def cmd_plan(args, print_result=print_plan_result):
         print_json(plan_json(result, args.mode), default=float)
     else:
         print_result(result, part, config, args.mode)
-    _print_stored(result, out, config, args.config, sys.stderr if args.json else sys.stdout)
+    print_next_steps(result, out, config, args, plan_options(), sys.stderr if args.json else sys.stdout)
 
 
-def _print_stored(result, out, config, config_path, stream):
-    """Where the plan went and the commands that use it (``stream``: stderr with
-    ``--json``, which keeps stdout one JSON document)."""
-    from pipeline.workflow.commands import next_step_hints
-    if out is None:
-        print(f"not stored: the workflow stores {result['part']['name']}'s plan; give --out FILE.json "
-              f"to keep this one", file=stream)
-        return
-    print(f"stored the plan at {out}", file=stream)
-    hints = next_step_hints(result, out, config, config_path)
-    if hints:
-        print("next: " + "\n      ".join(hints), file=stream)
-    else:
-        print("(speed, layout and animate read RESULTS/plans/NAME.json: store it there to use them)",
-              file=stream)
+def plan_options() -> list:
+    """The option actions of the ``plan`` parser, in its order (the rerun commands
+    that ``plan`` suggests after a plan that does not orient the part repeat them)."""
+    sub = argparse.ArgumentParser().add_subparsers()
+    add_plan_commands(sub)
+    return [a for a in sub.choices["plan"]._actions if a.option_strings and a.dest != "help"]
 
 
 def _progress(message):
@@ -93,8 +88,8 @@ def cmd_atlas(args):
     if args.json:
         print_json(atlas)
         return
-    print(f"feedability atlas of config {atlas['config']}: tolerance {atlas['tolerance_deg']:g} deg, "
-          f"depth {atlas['depth']} ({path})")
+    print(f"feedability atlas of the config '{atlas['config']}' ({path}): tolerance "
+          f"{atlas['tolerance_deg']:g} deg, depth {atlas['depth']}")
     print(f"{'part':<18} {'outcome':<14} {'fixed':>5} {'moving':>6} {'sets':>4} {'width':>7} {'in set':>11} "
           f"{'limit':>7} {'parts/min':>9} {'plan s':>7}  plan")
     for r in atlas["rows"]:
@@ -169,7 +164,8 @@ def add_plan_commands(sub) -> None:
     p.add_argument("--out", default=None, help="store the plan JSON here (default: RESULTS/plans/NAME.json, "
                    "where speed, layout and animate look; a part the workflow plans is stored only "
                    "with --out)")
-    add_json_option(p)
+    add_json_option(p, "print a summary of the plans as one JSON document instead of text (where the "
+                    "plan is stored and the next steps go to stderr)")
     p.set_defaults(func=cmd_plan)
 
     p = sub.add_parser("atlas", help="the feedability atlas: which planned parts pins orient, with how "
