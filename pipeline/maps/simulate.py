@@ -157,7 +157,7 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
             trajectory: bool = False, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
             length_unit: str = "mm", belt_speed: float | None = None,
             mu_s: float = 0.5, support=None) -> xr.Dataset:
-    """One passage of ``part`` past one pin (spec section 4).
+    """One passage of ``part`` past one pin (see the manual's mechanics page, section 4).
 
     Parameters
     ----------
