@@ -4,6 +4,8 @@ from __future__ import annotations
 import os
 import shutil
 import sys
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _dist_version
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -17,6 +19,12 @@ shutil.rmtree(HERE / "gallery", ignore_errors=True)
 project = "pinfeed"
 author = "pinfeed developers"
 copyright = "2026, pinfeed developers"
+# The version of the installed package (pyproject.toml), shown in the header.
+try:
+    release = _dist_version("pinfeed")
+except PackageNotFoundError:        # docs built from a clone that is not installed
+    release = "0+unknown"
+version = ".".join(release.split(".")[:2])
 
 extensions = [
     "myst_parser",
@@ -47,7 +55,7 @@ smartquotes = False
 highlight_language = "text"   # usage lines and shell text are not Python
 
 html_theme = "furo"
-html_title = "pinfeed"
+html_title = f"pinfeed {release}"
 html_static_path: list[str] = []
 
 sphinx_gallery_conf = {
