@@ -16,6 +16,6 @@ from pipeline.present.figures.maps import map_figure
 
 part = Part.from_vertices([(0, 0), (60, 0), (15, 35)], name="asym_triangle")
 one_map = simulate.compute_map(part, theta_i=np.arange(0, 360, 3), d=[0.3], mu_c=0.15, pin_radius=3)
-print("theta_f from", float(one_map["theta_f"].min()), "to", float(one_map["theta_f"].max()), "deg")
+print(f"theta_f from {float(one_map['theta_f'].min()):.1f} to {float(one_map['theta_f'].max()):.1f} deg")
 fig = map_figure(one_map, ncols=1, bands=(5, 2))
 plt.show()

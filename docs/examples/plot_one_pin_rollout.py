@@ -17,7 +17,7 @@ fig, ax = plt.subplots(figsize=(6, 3.5))
 for theta_i in (0, 120, 240):
     one = simulate.rollout(part, theta_i=theta_i, d=0.3, mu_c=0.15, pin_radius=3,
                            trajectory=True)
-    print(theta_i, "->", float(one["theta_f"]), str(one["status"].values))
+    print(f"{theta_i} -> {float(one['theta_f']):.1f} deg", str(one["status"].values))
     s = one["traj_s"].values
     turn = one["traj_theta"].values - one["traj_theta"].values[0]
     ax.plot(s[: turn.size], turn, marker=".", label=f"theta_i = {theta_i} deg")

@@ -1,5 +1,13 @@
-"""Shared by the pin-sequence examples: coarse maps, the paper's planner, and
-the nominal path of every resting state through the best plan."""
+"""Coarse plans for the gallery: a part's maps on a coarse grid, the paper's
+fixed-pins planner on them, and the nominal path of every resting state
+through the best plan, drawn as the paper's pin-sequence figure.
+
+The gallery's pin-sequence examples (Fig. 2, Fig. 9, Table 2) call these, so
+a downloaded example needs only the installed package. ``make run`` plans on
+the full grid with the complete search instead.
+"""
+from __future__ import annotations
+
 import numpy as np
 
 from pipeline.maps import simulate
@@ -9,12 +17,13 @@ from pipeline.planning.settings import candidate_pins
 from pipeline.present.figures.sequence import sequence_figure
 
 MU_C, PIN_RADIUS, THRESHOLD_T, FACTOR_C = 0.15, 3.0, 5.0, 2.0
-D_VALUES = [d for d in np.round(np.arange(-0.9, 0.91, 0.1), 1) if d != 0]
+D_VALUES = [float(d) for d in np.round(np.arange(-0.9, 0.91, 0.1), 1) if d != 0]
 
 
-def best_plan(part, depth: int = 3, theta_step: float = 2.0):
-    """The paper planner's best fixed-pin plan of ``part`` on a coarse map grid:
-    ``(planner, candidate pins, plan dict)``."""
+def best_coarse_plan(part, depth: int = 3, theta_step: float = 2.0):
+    """The paper planner's best fixed-pin plan of ``part`` on maps with
+    ``theta_step``-degree steps of theta_i (friction ``MU_C``, pin radius
+    ``PIN_RADIUS``): returns ``(planner, candidate pins, plan dict)``."""
     maps = simulate.compute_map(part, theta_i=np.arange(0, 360, theta_step), d=D_VALUES,
                                 mu_c=MU_C, pin_radius=PIN_RADIUS)
     pins = candidate_pins(part, {"pins": "auto"})
@@ -22,10 +31,10 @@ def best_plan(part, depth: int = 3, theta_step: float = 2.0):
     return planner, pins, planner.search(depth, keep=1)[0].to_dict()
 
 
-def best_plan_figure(part, depth: int = 3, theta_step: float = 2.0):
-    """The best fixed-pin plan of ``part`` on a coarse map grid, drawn as the
-    paper's pin-sequence figure; returns ``(figure, plan dict)``."""
-    planner, pins, plan = best_plan(part, depth, theta_step)
+def best_coarse_plan_figure(part, depth: int = 3, theta_step: float = 2.0):
+    """:func:`best_coarse_plan` drawn as the paper's pin-sequence figure, one
+    row per resting state; returns ``(figure, plan dict)``."""
+    planner, pins, plan = best_coarse_plan(part, depth, theta_step)
     paths = {}
     for label, state in planner.initial_states().items():
         theta, y = state.arc[0], state.y_lo
