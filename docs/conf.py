@@ -2,7 +2,9 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
+import socket
 import sys
 from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as _dist_version
@@ -15,6 +17,9 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 # The gallery's pages are generated into docs/gallery/ by running the examples;
 # start from nothing so that a renamed or removed example leaves no stale page.
 shutil.rmtree(HERE / "gallery", ignore_errors=True)
+# Likewise the API reference's per-function pages (autosummary's stubs and the
+# gallery's back-references), generated into docs/reference/generated/.
+shutil.rmtree(HERE / "reference" / "generated", ignore_errors=True)
 
 project = "pinfeed"
 author = "pinfeed developers"
@@ -29,6 +34,8 @@ version = ".".join(release.split(".")[:2])
 extensions = [
     "myst_parser",
     "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
+    "sphinx.ext.intersphinx",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
     "sphinxarg.ext",
@@ -49,6 +56,38 @@ napoleon_use_ivar = True
 autodoc_typehints = "none"
 autodoc_member_order = "bysource"
 autodoc_default_options = {"members": True, "undoc-members": False}
+# One page per function and class of the API reference (docs/reference/api.md),
+# from the templates in docs/_templates/autosummary/ (each ends with the
+# gallery examples that use the object).
+autosummary_generate = True
+templates_path = ["_templates"]
+
+# Links to numpy, xarray and matplotlib. Their inventories (objects.inv) come
+# from the web: none of the installed packages ships one. Offline (no route
+# to numpy.org, or PINFEED_DOCS_OFFLINE=1) the mapping is left empty, so the
+# build, with warnings as errors, does not fail on a fetch; the types are then
+# shown as plain text. PINFEED_DOCS_OFFLINE=0 insists on the links.
+INTERSPHINX = {
+    "python": ("https://docs.python.org/3", None),
+    "numpy": ("https://numpy.org/doc/stable", None),
+    "xarray": ("https://docs.xarray.dev/en/stable", None),
+    "matplotlib": ("https://matplotlib.org/stable", None),
+}
+
+
+def _online(host: str = "numpy.org") -> bool:
+    flag = os.environ.get("PINFEED_DOCS_OFFLINE", "").strip()
+    if flag:
+        return flag == "0"
+    try:
+        socket.create_connection((host, 443), timeout=3).close()
+        return True
+    except OSError:
+        return False
+
+
+intersphinx_mapping = INTERSPHINX if _online() else {}
+intersphinx_timeout = 10
 
 # Keep quotes as typed: option values and shell text must stay copyable.
 smartquotes = False
@@ -69,4 +108,62 @@ sphinx_gallery_conf = {
     "image_scrapers": ("matplotlib",),
     "show_memory": False,
     "min_reported_time": 9999,
+    # Which pinfeed functions each example uses, for the "Examples using"
+    # list on every API page (the minigallery in the autosummary templates).
+    "doc_module": ("pipeline",),
+    "backreferences_dir": "reference/generated/backreferences",
 }
+
+# The docstrings list parameters and attributes NumPy-style but as
+# "name : what it is" (a description where NumPy puts a type). Napoleon would
+# print that description as the type, in italics; so before napoleon reads a
+# docstring, such a line becomes "name" with the description under it. A
+# real type ("float", "int, optional", "xarray.Dataset") is left alone.
+_FIELD_SECTIONS = {"parameters", "other parameters", "attributes", "keyword arguments", "args",
+                   "arguments"}
+_FIELD = re.compile(r"^(\s*)([\w*][\w*, ]*?) : (.+)$")
+_TYPE_WORDS = {"int", "float", "str", "bool", "bytes", "complex", "none", "optional", "list",
+               "dict", "tuple", "set", "of", "or", "array", "array-like", "ndarray", "sequence",
+               "iterable", "callable", "path", "mapping", "default", "object", "any"}
+
+
+def _is_type(text: str) -> bool:
+    tokens = [t for t in re.split(r"[\s,|\[\]()]+", text.strip()) if t]
+    return bool(tokens) and all(t.lower() in _TYPE_WORDS or "." in t.strip(".") or t[:1].isupper()
+                                for t in tokens) and not text.rstrip().endswith(".")
+
+
+def _description_fields(app, what, name, obj, options, lines):
+    if what in ("property", "attribute", "data"):
+        # Napoleon reads "text: more" on a property's first line as "type: description";
+        # these docstrings mean it as one sentence: start them with an empty comment.
+        if lines and ":" in lines[0]:
+            lines[:0] = ["..", ""]
+        return
+    section, indent, out = None, None, []
+    for i, line in enumerate(lines):
+        nxt = lines[i + 1] if i + 1 < len(lines) else ""
+        if nxt.strip() and set(nxt.strip()) == {"-"} and line.strip():
+            section = line.strip().lower()
+            indent = len(line) - len(line.lstrip())
+            out.append(line)
+            continue
+        if (section in _FIELD_SECTIONS and not line.strip() and nxt.strip()
+                and len(nxt) - len(nxt.lstrip()) == indent and not _FIELD.match(nxt)):
+            # A paragraph after the fields ends the section (napoleon: two blank lines).
+            out += ["", ""]
+            section = None
+            continue
+        m = _FIELD.match(line)
+        if (section in _FIELD_SECTIONS and m and len(m.group(1)) == indent
+                and not _is_type(m.group(3))):
+            out += [m.group(1) + m.group(2), m.group(1) + "    " + m.group(3)]
+        else:
+            out.append(line)
+    lines[:] = out
+
+
+def setup(app):
+    # Before napoleon's own handler (priority 500) turns the sections into fields.
+    app.connect("autodoc-process-docstring", _description_fields, priority=400)
+
