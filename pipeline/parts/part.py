@@ -295,7 +295,7 @@ class Part:
                                   holes=[h @ rot.T for h in self.holes])
 
     def stable_states(self) -> np.ndarray:
-        """Resting states against a fence along the belt (spec section 6).
+        """Resting states against a fence along the belt (see the manual's mechanics page, section 6).
 
         Returns rows ``(theta_deg, y_c)``: the orientation that puts a stable
         hull edge on the fence with the part on its ``+y`` side, and the
