@@ -13,12 +13,22 @@ Set-up, in SI units, in the belt frame (belt at rest, pin moving):
   ear-clipping triangulation (MuJoCo collides with the convex hull of a mesh,
   so a non-convex outline must be split), on a planar joint set (slide x,
   slide y, hinge z) through its centroid, with the mass and polar inertia of
-  the uniform outline and no gravity;
+  the uniform material and no gravity;
+- a part with holes: the mass properties are the material's (the outline's
+  shoelace sums less each hole's: area, centroid, polar inertia about the
+  material's centroid) and the support grid leaves the holes out, but the
+  collision prism is the outline's, holes filled: the pin comes from the
+  belt's edge side and touches the outline only (it cannot enter a closed
+  hole), so the pieces, the pin path, the feature book-keeping and the
+  passage's end test all take the outline alone, and a hole changes nothing
+  the pin can touch; the ``inertial`` element sets mass and inertia, so the
+  filled prism does not put mass into a hole (``inertiafromgeom`` is off);
 - belt friction is applied by hand as generalised forces: support points on a
-  2.5 mm grid inside the outline (about 150 for a 40-60 mm part), each loaded
-  ``mu_s m g / K``, force ``-N u / sqrt(|u|^2 + eps^2)`` with ``u`` the
-  point's velocity and ``eps = 0.2 mm/s`` (MuJoCo's own floor contacts lift
-  off while sliding in its soft contact model);
+  2.5 mm grid on the material (inside the outline and in no hole; about 150
+  for a 40-60 mm part), each loaded ``mu_s m g / K``, force
+  ``-N u / sqrt(|u|^2 + eps^2)`` with ``u`` the point's velocity and
+  ``eps = 0.2 mm/s`` (MuJoCo's own floor contacts lift off while sliding in
+  its soft contact model);
 - the pin is a sphere of radius ``r_pin`` at the prism's mid-plane (a cylinder
   against a mesh gives wrong normals at vertices) on a heavy body (1e5 kg) on
   a slide joint along the pin's path; its joint velocity is reset to the pin
@@ -76,6 +86,26 @@ def _mass_properties(xy):
     jo = (cr * (x * x + x * xn + xn * xn + y * y + y * yn + yn * yn)).sum() / 12.0
     j = jo - area * (cx * cx + cy * cy)
     return area, np.array([cx, cy]), j
+
+
+def _material_properties(outline, holes=()):
+    """Area, centroid and polar second moment about the centroid of the
+    material: the outline (counter-clockwise) less the holes, each hole's
+    shoelace sums taken with the opposite sign (any winding given). A solid
+    part: :func:`_mass_properties` of the outline, to the bit."""
+    if not len(holes):
+        return _mass_properties(np.asarray(outline, dtype=float))
+    area = jo = 0.0
+    first = np.zeros(2)
+    for k, loop in enumerate([outline, *holes]):
+        a_k, c_k, j_k = _mass_properties(np.asarray(loop, dtype=float))
+        sign = (1.0 if a_k > 0 else -1.0) * (1.0 if k == 0 else -1.0)
+        a_k = sign * a_k  # signed area of the loop as material (+) or hole (-)
+        area += a_k
+        first += a_k * c_k
+        jo += sign * j_k + a_k * float(c_k @ c_k)  # parallel axes: about the origin
+    com = first / area
+    return area, com, jo - area * float(com @ com)
 
 
 def _inside(xy, pts):
@@ -303,15 +333,19 @@ class _Passage:
 
 
 def _support(part, mass, mu_s, support=None):
-    """``(xy, a, izz, pts, load)``: the outline about its centroid (m), its
-    radius a (m), polar inertia (kg m^2), the support points (m, body frame:
-    a grid inside the outline, or the points of ``support``) and the belt's
-    friction load on each (N: ``mu_s m g`` shared evenly, or by weight)."""
+    """``(xy, a, izz, pts, load)``: the outline about the material's centroid
+    (m), its radius a (m), the material's polar inertia (kg m^2), the support
+    points (m, body frame: a grid on the material, or the points of
+    ``support``) and the belt's friction load on each (N: ``mu_s m g``
+    shared evenly, or by weight). Holes (``part.holes``) take out area,
+    inertia and grid points; the outline stays whole (module notes)."""
     xy_mm = np.asarray(part.vertices, dtype=float)
     if _mass_properties(xy_mm)[0] < 0:
         xy_mm = xy_mm[::-1].copy()
-    area, com, jpol = _mass_properties(xy_mm)
+    holes_mm = [np.asarray(h, dtype=float) for h in getattr(part, "holes", ())]
+    area, com, jpol = _material_properties(xy_mm, holes_mm)
     xy_mm = xy_mm - com
+    holes = [(h - com) / 1000.0 for h in holes_mm]
     a_mm = float(np.max(np.hypot(xy_mm[:, 0], xy_mm[:, 1])))
     xy = xy_mm / 1000.0
     a = a_mm / 1000.0
@@ -324,7 +358,10 @@ def _support(part, mass, mu_s, support=None):
     span = np.arange(-math.ceil(a / s), math.ceil(a / s) + 1) * s
     gx, gy = np.meshgrid(span, span)
     pts = np.column_stack([gx.ravel(), gy.ravel()])
-    pts = pts[_inside(xy, pts)]
+    keep = _inside(xy, pts)
+    for hole in holes:
+        keep &= ~_inside(hole, pts)
+    pts = pts[keep]
     load = mu_s * mass * G / len(pts)
     return xy, a, izz, pts, load
 

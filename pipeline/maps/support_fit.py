@@ -28,13 +28,15 @@ Method
   scored; from each of the ``refine`` best, a trust-region least-squares solver
   (``scipy.optimize.least_squares``, method ``trf``, the same soft-L1 loss,
   finite-difference Jacobian) moves the ``2K`` coordinates. While it
-  searches, a point outside the outline is moved to the outline's nearest
-  point and a layout that cannot balance the part keeps its nearest weights;
-  both pay a penalty residual of ``PENALTY_DEG_PER_MM`` per mm of the
-  violation, so the solver sees a continuous loss and walks back. One more
+  searches, a point off the material (outside the outline, or in a hole of
+  a part with holes) is moved to the nearest point of the material's edge
+  (the outline, or that hole's rim) and a layout that cannot balance the
+  part keeps its nearest weights; both pay a penalty residual of
+  ``PENALTY_DEG_PER_MM`` per mm of the violation, so the solver sees a
+  continuous loss and walks back. One more
   run starts from the best feasible layout so far with a fresh trust
   region; the answer is the best *feasible* layout any evaluation saw
-  (points inside the outline, centre of pressure at the centroid).
+  (points on the material, centre of pressure at the centroid).
   Gauss-Newton steps use the residuals' structure that a simplex search
   (Nelder-Mead, the first version) ignores: four to seven times fewer
   rollouts, and it converges where the simplex stalled short of the light
@@ -51,6 +53,7 @@ import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 from scipy import optimize
@@ -58,7 +61,7 @@ from scipy import optimize
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.parts.support import Support, boundary_distance, inside_outline, point_support
+from pipeline.parts.support import Support, material_distance, point_support
 
 COLUMNS = ("theta_i_deg", "d", "theta_f_deg")
 OPTIONAL = ("mu_c",)
@@ -177,15 +180,21 @@ def _soft_l1(r: np.ndarray) -> float:
     return float(np.sum(2.0 * (np.sqrt(1.0 + z * z) - 1.0)))
 
 
-def _into_outline(verts: np.ndarray, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``pts`` with each point outside the polygon ``verts`` moved to the
-    nearest point of its boundary, and how far each moved."""
-    out = ~inside_outline(verts, pts)
-    moved = np.where(out, boundary_distance(verts, pts), 0.0)
+def _into_outline(verts: np.ndarray, pts: np.ndarray, holes=()) -> tuple[np.ndarray, np.ndarray]:
+    """``pts`` with each point off the material (outside the polygon
+    ``verts``, or inside one of ``holes``) moved to the nearest point of the
+    material's edge, and how far each moved. The nearest edge point over
+    every loop is the right one: a point outside the outline is nearer the
+    outline than any hole inside it, a point in a hole nearer that hole's
+    rim than any other loop."""
+    on, dist = material_distance(SimpleNamespace(vertices=verts, holes=tuple(holes)), pts)
+    out = ~on
+    moved = np.where(out, dist, 0.0)
     if not out.any():
         return pts, moved
-    p0 = verts[None, :, :]
-    e = np.roll(verts, -1, axis=0)[None, :, :] - p0
+    loops = [np.asarray(verts, dtype=float)] + [np.asarray(h, dtype=float) for h in holes]
+    p0 = np.vstack(loops)[None, :, :]
+    e = np.vstack([np.roll(lp, -1, axis=0) - lp for lp in loops])[None, :, :]
     rel = pts[:, None, :] - p0
     t = np.clip(np.sum(rel * e, axis=2) / np.sum(e * e, axis=2), 0.0, 1.0)
     near = p0 + t[:, :, None] * e
@@ -216,6 +225,7 @@ class _Objective:
         self.part, self.pushes, self.pin_radius = part, pushes, float(pin_radius)
         self.mu = np.where(np.isnan(pushes.mu_c), mu_default, pushes.mu_c)
         self.verts = np.asarray(part.vertices, dtype=float)
+        self.holes = tuple(getattr(part, "holes", ()))
         self.evaluations = 0
         self.best_loss, self.best_flat = math.inf, None
 
@@ -228,7 +238,8 @@ class _Objective:
 
     def support_of(self, flat) -> Support | None:
         pts = np.asarray(flat, dtype=float).reshape(-1, 2)
-        if not np.all(inside_outline(self.verts, pts) | (boundary_distance(self.verts, pts) < 1e-9)):
+        on, dist = material_distance(self.part, pts)
+        if not np.all(on | (dist < 1e-9)):
             return None
         w = statics_weights(pts)
         if w is None:
@@ -252,7 +263,7 @@ class _Objective:
     def residual_vector(self, flat) -> np.ndarray:
         """The residuals of a layout and its penalty residuals, continuous across
         the feasible region's edge (see the module notes)."""
-        pts, moved = _into_outline(self.verts, np.asarray(flat, dtype=float).reshape(-1, 2))
+        pts, moved = _into_outline(self.verts, np.asarray(flat, dtype=float).reshape(-1, 2), self.holes)
         w = _nearest_weights(pts)
         off = w @ pts  # the centre of pressure's distance from the centroid
         support = point_support(self.part, pts, np.maximum(w, 0.0), kind="points", label="search")
@@ -264,7 +275,7 @@ class _Objective:
 
 
 def _random_layouts(part, k, n, seed) -> list[np.ndarray]:
-    """``n`` random layouts of ``k`` points in the outline that hold the centroid."""
+    """``n`` random layouts of ``k`` points on the material that hold the centroid."""
     from pipeline.parts.support_family import sample_tripods
     if k == 3:
         return [m.points.ravel() for m in sample_tripods(part, n, 0.0, seed)]
@@ -274,7 +285,7 @@ def _random_layouts(part, k, n, seed) -> list[np.ndarray]:
     out = []
     for _ in range(200 * n):
         pts = rng.uniform(lo, hi, (k, 2))
-        if np.all(inside_outline(verts, pts)) and statics_weights(pts) is not None:
+        if np.all(material_distance(part, pts)[0]) and statics_weights(pts) is not None:
             out.append(pts.ravel())
             if len(out) == n:
                 break

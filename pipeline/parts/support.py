@@ -25,6 +25,20 @@ A real part rests on a few high points (a burr, a warp, a boss). A
 points (equal sub-triangles of a triangulation): as they get finer, the
 point support's rollouts converge to the uniform ones (a test).
 
+Parts with holes: the belt presses on the material only, so every support
+point must lie on the material: inside the outline (or on it) and not inside
+a hole (a hole's rim is material; "on" is within ``INSIDE_TOL a``). A given
+point in a hole is a one-line error naming the point and the hole. The
+built supports follow: ``tripod`` takes outline hull vertices (material) and
+its statics about the origin, which is the material's centroid (the centre
+of mass; ``Part`` centres the material, not the outline); ``rim`` is the
+outline's rim only, not the holes' (a warped or burred plate rests on its
+outer edge, the part of it farthest from the centre of mass: a plate dished
+enough to lift its middle off the belt touches with the outer rim, and a
+hole's rim lies inside that, off the belt); :func:`filled_support`
+triangulates the material, holes left out (:func:`material_triangles`).
+A solid part's supports are the same, to the bit, as before holes.
+
 A point support of a rigid part in equilibrium has its centre of pressure
 (the weighted mean of its points) at the centre of mass; ``points`` takes
 the weights as given and :attr:`Support.pressure_offset` says how far off
@@ -44,7 +58,8 @@ from pipeline.errors import PinfeedError
 SUPPORT_KINDS = ("uniform", "points", "rim", "tripod")
 MAX_SUPPORT_POINTS = 4096  # a point support's solve costs O(K) per evaluation
 DEFAULT_RIM_POINTS = 64
-INSIDE_TOL = 1e-9  # a point this far outside the outline (units of a) is on it
+INSIDE_TOL = 1e-9  # a point this far outside the material (units of a) is on its edge
+MAX_CONFORM_ROUNDS = 60  # boundary splits that make a Delaunay triangulation hold the material's edges
 _SYNTAX = ('give "uniform", "points:x0,y0,w0 x1,y1,w1 ..." (part frame: centroid at the '
            'origin; w defaults to 1), "rim", "rim:N" or "tripod"')
 
@@ -125,6 +140,49 @@ def inside_outline(verts: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return np.sum(crosses & (px < xc), axis=1) % 2 == 1
 
 
+def material_distance(part, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(on, dist)`` for each point of ``xy`` (part frame): whether it is
+    on the material (inside the outline and in no hole, even-odd) and its
+    distance to the material's edge (the outline or a hole's rim, the
+    nearest). A solid part gives ``inside_outline`` and ``boundary_distance``
+    of the outline."""
+    verts = np.asarray(part.vertices, dtype=np.float64)
+    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    on = inside_outline(verts, xy)
+    dist = boundary_distance(verts, xy)
+    for hole in getattr(part, "holes", ()):
+        hole = np.asarray(hole, dtype=np.float64)
+        on &= ~inside_outline(hole, xy)
+        dist = np.minimum(dist, boundary_distance(hole, xy))
+    return on, dist
+
+
+def signed_material_distance(part, xy: np.ndarray) -> np.ndarray:
+    """Distance of each point of ``xy`` to the material's edge, positive on
+    the material, negative off it (outside the outline or in a hole)."""
+    on, dist = material_distance(part, xy)
+    return np.where(on, dist, -dist)
+
+
+def _off_material(part, xy: np.ndarray):
+    """The first point of ``xy`` off the material beyond ``INSIDE_TOL a`` as
+    ``(k, hole, gap)`` (``hole`` 0 for outside the outline, else the hole's
+    number from 1; ``gap`` how far off, mm), or ``None``."""
+    verts = np.asarray(part.vertices, dtype=np.float64)
+    tol = INSIDE_TOL * part.a
+    where = np.where(~inside_outline(verts, xy) & (boundary_distance(verts, xy) > tol), 0, -1)
+    for j, hole in enumerate(getattr(part, "holes", ()), start=1):
+        hole = np.asarray(hole, dtype=np.float64)
+        inside = inside_outline(hole, xy) & (boundary_distance(hole, xy) > tol)
+        where = np.where((where < 0) & inside, j, where)
+    bad = np.flatnonzero(where >= 0)
+    if not bad.size:
+        return None
+    k = int(bad[0])
+    loop = verts if where[k] == 0 else np.asarray(part.holes[where[k] - 1], dtype=np.float64)
+    return k, int(where[k]), float(boundary_distance(loop, xy[k:k + 1])[0])
+
+
 def point_support(part, points, weights=None, kind: str = "points",
                   label: str | None = None) -> Support:
     """A checked point support of ``part``.
@@ -133,7 +191,8 @@ def point_support(part, points, weights=None, kind: str = "points",
     ----------
     part : the :class:`~pipeline.parts.part.Part`.
     points : ``(K, 2)`` points in the part frame (centroid at the origin,
-        the part's length unit), inside the outline or on it.
+        the part's length unit) on the material: inside the outline or on
+        it, and not inside a hole (on a hole's rim is fine).
     weights : ``(K,)`` pressures >= 0, not all zero (default: all equal).
         They are normalised to sum 1; zero-weight points are dropped and
         points at the same place merged (the result lists the points sorted
@@ -143,9 +202,9 @@ def point_support(part, points, weights=None, kind: str = "points",
     Raises
     ------
     PinfeedError
-        One line naming the problem: no points, a point that is not finite or
-        lies outside the outline, a negative weight, all weights zero, too
-        many points.
+        One line naming the problem: no points, a point that is not finite,
+        lies outside the outline or in a hole (naming the point and the
+        hole), a negative weight, all weights zero, too many points.
     """
     xy = np.asarray(points, dtype=np.float64).reshape(-1, 2) if np.size(points) else np.zeros((0, 2))
     if xy.shape[0] == 0:
@@ -166,14 +225,16 @@ def point_support(part, points, weights=None, kind: str = "points",
     if not np.any(w > 0):
         raise PinfeedError(f"support {kind!r}: every weight is zero; give at least one "
                            f"positive weight")
-    verts = np.asarray(part.vertices, dtype=np.float64)
-    out = ~inside_outline(verts, xy) & (boundary_distance(verts, xy) > INSIDE_TOL * part.a)
-    if np.any(out):
-        k = int(np.argmax(out))
-        gap = float(boundary_distance(verts, xy[k:k + 1])[0])
-        raise PinfeedError(f"support point {k} ({xy[k, 0]:g}, {xy[k, 1]:g}) lies {gap:.3g} mm outside "
-                           f"the outline; support points are in the part frame (centroid at the "
-                           f"origin, drawing axes): move it inside")
+    off = _off_material(part, xy)
+    if off is not None:
+        k, hole, gap = off
+        if hole == 0:
+            raise PinfeedError(f"support point {k} ({xy[k, 0]:g}, {xy[k, 1]:g}) lies {gap:.3g} mm outside "
+                               f"the outline; support points are in the part frame (centroid at the "
+                               f"origin, drawing axes): move it inside")
+        raise PinfeedError(f"support point {k} ({xy[k, 0]:g}, {xy[k, 1]:g}) lies in hole {hole} of the "
+                           f"part ({gap:.3g} mm from its rim); give points on the material (part "
+                           f"frame: the material's centroid at the origin)")
     keep = w > 0
     xy, w = xy[keep], w[keep]
     uniq, inverse = np.unique(xy, axis=0, return_inverse=True)
@@ -186,7 +247,14 @@ def point_support(part, points, weights=None, kind: str = "points",
 
 def rim_support(part, n: int = DEFAULT_RIM_POINTS) -> Support:
     """Pressure on the outline only: ``n`` equal pieces of the boundary, each a
-    point at its midpoint weighted by its length (``rim:n``)."""
+    point at its midpoint weighted by its length (``rim:n``).
+
+    A part with holes: the outline's rim only, the holes' rims left out (a
+    plate warped or burred enough to rest on a rim rests on its outer one,
+    the edge farthest from its centre of mass; see the module docstring).
+    The centre of pressure is then the outline's perimeter centroid, which
+    need not be the material's centroid: :attr:`Support.pressure_offset`
+    says how far (as for any ``rim`` of an outline without symmetry)."""
     if not (isinstance(n, (int, np.integer)) and 3 <= n <= MAX_SUPPORT_POINTS):
         raise PinfeedError(f"rim support needs 3 to {MAX_SUPPORT_POINTS} points, got {n!r}")
     verts = np.asarray(part.vertices, dtype=np.float64)
@@ -222,7 +290,11 @@ def _hull(verts: np.ndarray) -> np.ndarray:
 
 def tripod_support(part) -> Support:
     """Three convex-hull vertices: the largest triangle that holds the centroid,
-    weighted by the centroid's barycentric coordinates (statics)."""
+    weighted by the centroid's barycentric coordinates (statics).
+
+    The hull is the outline's (its vertices are on the material, holes or
+    not); the centroid is the part frame's origin, the material's centroid
+    (``Part`` centres the outline minus the holes), which lies in the hull."""
     verts = np.asarray(part.vertices, dtype=np.float64)
     hull = verts[_hull(verts)]
     best, best_area = None, 0.0
@@ -274,15 +346,71 @@ def _ears(verts: np.ndarray) -> list:
     return tris
 
 
-def filled_support(part, n: int) -> Support:
-    """Points filling the area: each triangle of a triangulation cut into
-    ``n^2`` equal sub-triangles, one point at each sub-triangle's centroid
-    weighted by its area (the midpoint rule: the point support's integrals
-    approach the uniform ones as ``n`` grows)."""
+def material_triangles(part) -> np.ndarray:
+    """``(T, 3, 2)`` triangles that tile the material, counter-clockwise.
+
+    A solid part: the ear-clipping triangulation of its outline. A part with
+    holes: a Delaunay triangulation (``scipy.spatial.Delaunay``, which has
+    no constrained form; nor has ``matplotlib.tri``) of the loops' vertices,
+    made to conform to the material's edges by splitting each outline or hole
+    edge that is not a union of triangle edges at its midpoint and
+    triangulating again (at most ``MAX_CONFORM_ROUNDS`` rounds); then every
+    triangle lies wholly on the material or wholly off it, and those whose
+    centroid is on the material are kept. Their areas are checked to sum to
+    ``Part.area``.
+    """
     verts = np.asarray(part.vertices, dtype=np.float64)
+    if not getattr(part, "holes", ()):
+        return np.array([[verts[i], verts[j], verts[k]] for i, j, k in _ears(verts)])
+    from scipy.spatial import Delaunay
+
+    loops = [verts] + [np.asarray(h, dtype=np.float64) for h in part.holes]
+    for _ in range(MAX_CONFORM_ROUNDS):
+        pts = np.vstack(loops)
+        tri = Delaunay(pts)
+        simp = np.sort(tri.simplices, axis=1)
+        edges = set(map(tuple, np.vstack([simp[:, [0, 1]], simp[:, [1, 2]], simp[:, [0, 2]]]).tolist()))
+        split, start = [], 0
+        for loop in loops:
+            m = len(loop)
+            i = np.arange(m) + start
+            j = np.roll(i, -1)
+            present = np.array([(min(p, q), max(p, q)) in edges for p, q in zip(i.tolist(), j.tolist())])
+            split.append(~present)
+            start += m
+        if not any(s.any() for s in split) and len(tri.coplanar) == 0:
+            break
+        for k, (loop, miss) in enumerate(zip(loops, split)):
+            mid = 0.5 * (loop + np.roll(loop, -1, axis=0))
+            rows = np.empty((len(loop) + int(miss.sum()), 2))
+            at = np.arange(len(loop)) + np.concatenate([[0], np.cumsum(miss)[:-1]])
+            rows[at] = loop
+            rows[at[miss] + 1] = mid[miss]
+            loops[k] = rows
+    else:
+        raise PinfeedError(f"could not triangulate the material of part {part.name!r} "
+                           f"({MAX_CONFORM_ROUNDS} rounds of edge splits)")
+    corners = pts[tri.simplices]
+    cross = ((corners[:, 1, 0] - corners[:, 0, 0]) * (corners[:, 2, 1] - corners[:, 0, 1])
+             - (corners[:, 1, 1] - corners[:, 0, 1]) * (corners[:, 2, 0] - corners[:, 0, 0]))
+    corners = np.where((cross < 0)[:, None, None], corners[:, ::-1], corners)
+    on, _ = material_distance(part, corners.mean(axis=1))
+    out = corners[on & (np.abs(cross) > 0)]
+    area = 0.5 * np.abs(cross[on & (np.abs(cross) > 0)]).sum()
+    if not abs(area - part.area) <= 1e-9 * part.area:  # pragma: no cover - conforming means exact
+        raise PinfeedError(f"the triangulation of part {part.name!r} covers {area:.6g} mm^2 of its "
+                           f"{part.area:.6g} mm^2 of material")
+    return out
+
+
+def filled_support(part, n: int) -> Support:
+    """Points filling the material: each triangle of a triangulation
+    (:func:`material_triangles`: holes left out) cut into ``n^2`` equal
+    sub-triangles, one point at each sub-triangle's centroid weighted by its
+    area (the midpoint rule: the point support's integrals approach the
+    uniform ones as ``n`` grows)."""
     pts, wts = [], []
-    for i, j, k in _ears(verts):
-        a, b, c = verts[i], verts[j], verts[k]
+    for a, b, c in material_triangles(part):
         area = 0.5 * abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
         u, v = (b - a) / n, (c - a) / n
         for p in range(n):

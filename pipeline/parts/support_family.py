@@ -14,6 +14,10 @@ sampled and how its extremes are found is spec section 9
     triples kept when the centroid's barycentric weights are all at least
     ``MIN_LEG_WEIGHT``: statics puts the centre of pressure at the centre of
     mass, and a leg carrying almost nothing is a part about to tip).
+    A part with holes: the legs stand on the material, at least ``F a``
+    from every edge of it, the holes' rims as well as the outline (a rim is
+    an edge whichever loop it belongs to); candidate points in a hole or
+    nearer a hole's rim are dropped like those outside the outline.
 ``warp:AMP[:N][:seed=S]``
     Uniform pressure times ``1 + AMP q``: ``q`` a quadratic over the area
     (bowl ``x^2 + y^2``, saddles ``x^2 - y^2`` and ``2xy``) with its
@@ -21,7 +25,10 @@ sampled and how its extremes are found is spec section 9
     at the centroid, scaled to ``max |q| = 1``; ``0 < AMP <= 1`` keeps the
     pressure >= 0. Members: the dome (centre-heavy) and the dish (rim-heavy)
     first, then ``N - 2`` random mixes (default ``N = 8``). Each member is
-    a point support on ``WARP_FILL^2`` points per triangle of the outline.
+    a point support on ``WARP_FILL^2`` points per triangle of the outline
+    (of the material, holes left out, for a part with holes:
+    :func:`~pipeline.parts.support.filled_support`), so the modes, their
+    projections and the centre of pressure are the material's.
 ``SPEC; SPEC; ...``
     An explicit list: each item a family or a single support
     (``uniform``, ``tripod``, ``rim:N``, ``points:"x,y,w ..."``, where a
@@ -36,8 +43,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pipeline.errors import PinfeedError
-from pipeline.parts.support import (UNIFORM, Support, barycentric, boundary_distance, filled_support,
-                                    inside_outline, parse_support, point_support)
+from pipeline.parts.support import (UNIFORM, Support, barycentric, filled_support, material_distance,
+                                    parse_support, point_support)
 
 DEFAULT_TRIPODS = 12
 DEFAULT_INSET = 0.2  # of a
@@ -140,19 +147,23 @@ def _count(value: str, what: str, text: str) -> int:
 
 
 def sample_tripods(part, n: int, inset: float = DEFAULT_INSET, seed: int = 0) -> list[Support]:
-    """``n`` tripods of points at least ``inset * a`` inside the outline that
-    hold the centroid (weights by statics); see the module docstring."""
+    """``n`` tripods of points at least ``inset * a`` inside the outline (and
+    that far from any hole's rim) that hold the centroid (weights by
+    statics); see the module docstring."""
     if not 0.0 <= inset < 1.0:
         raise PinfeedError(f"tripod inset {inset:g} must be in [0, 1) (a share of a)")
     verts = np.asarray(part.vertices, dtype=np.float64)
     rng = np.random.default_rng([int(seed), 25])
     lo, hi = verts.min(axis=0), verts.max(axis=0)
     xy = rng.uniform(lo, hi, (_DRAWS, 2))
-    ok = inside_outline(verts, xy) & (boundary_distance(verts, xy) >= inset * part.a)
-    pool = xy[ok]
+    on, dist = material_distance(part, xy)  # a solid part: inside the outline, its edge
+    pool = xy[on & (dist >= inset * part.a)]
     if pool.shape[0] < 3:
-        raise PinfeedError(f"no point of the outline lies {inset:g} a ({inset * part.a:.3g} mm) from "
-                           f"its edge; lower the inset (tripods:N:inset=F)")
+        holed = bool(getattr(part, "holes", ()))
+        where = "the material" if holed else "the outline"
+        edges = "its edges (the outline and the holes' rims)" if holed else "its edge"
+        raise PinfeedError(f"no point of {where} lies {inset:g} a ({inset * part.a:.3g} mm) from "
+                           f"{edges}; lower the inset (tripods:N:inset=F)")
     out = []
     for _ in range(200 * n):
         tri = pool[rng.choice(pool.shape[0], 3, replace=False)]
@@ -244,7 +255,8 @@ def parse_support_family(text: str | None, part) -> SupportFamily:
     ------
     PinfeedError
         One line: an empty family, an unknown kind, a bad number, a member
-        outside the outline (from :func:`~pipeline.parts.support.point_support`).
+        outside the outline or in a hole (from
+        :func:`~pipeline.parts.support.point_support`).
     """
     if text is None or not str(text).strip():
         raise PinfeedError(f"the support family is empty; {_SYNTAX}")

@@ -8,7 +8,9 @@ orientations lie farthest outside the plan's set:
 
 * ``tripods:N[:inset=F]``: three leg positions (6 numbers) anywhere in the
   outline at least ``F a`` from its edge, weights by statics (the centroid's
-  barycentric coordinates), every leg carrying at least 5 %;
+  barycentric coordinates), every leg carrying at least 5 %; for a part with
+  holes, on the material and at least ``F a`` from every rim, holes' too
+  (as ``sample_tripods``): a start whose leg falls in a hole is dropped;
 * ``warp:AMP``: the three quadratic coefficients ``c`` of the pressure
   ``1 + AMP q``, ``q = c . modes`` kept within ``max |q| <= 1``;
 * any other item (``tripod``, ``rim:N``, ``points:...``, ``uniform``): every
@@ -40,13 +42,14 @@ import dataclasses
 import itertools
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 from scipy.optimize import minimize
 
 from pipeline.errors import PinfeedError
-from pipeline.parts.support import (Support, barycentric, boundary_distance, filled_support,
-                                    inside_outline, point_support)
+from pipeline.parts.support import (Support, barycentric, filled_support, material_distance,
+                                    point_support, signed_material_distance)
 from pipeline.parts.support_family import (DEFAULT_INSET, MIN_LEG_WEIGHT, WARP_FILL, SupportFamily,
                                            parse_support_family, warp_modes)
 from pipeline.planning import orient
@@ -71,7 +74,8 @@ _POOL = 20_000
 
 @dataclass
 class TripodSpace:
-    """Three legs in the outline at least ``inset a`` from its edge that hold the centroid."""
+    """Three legs on the material at least ``inset a`` from its edges (the
+    outline, and the holes' rims of a part with holes) that hold the centroid."""
 
     part: object
     inset: float
@@ -82,9 +86,7 @@ class TripodSpace:
     def violation(self, x: np.ndarray) -> float:
         """0 for a feasible tripod, else how far it is from one (mm-ish)."""
         legs = np.asarray(x, float).reshape(3, 2)
-        verts = np.asarray(self.part.vertices, float)
-        dist = boundary_distance(verts, legs)
-        signed = np.where(inside_outline(verts, legs), dist, -dist)
+        signed = signed_material_distance(self.part, legs)  # negative outside or in a hole
         bad = np.maximum(0.0, self.inset * self.part.a * (1 - 1e-9) - signed).sum()
         lam = _weights(legs, self.part.a)
         if lam is None:
@@ -109,8 +111,10 @@ class TripodSpace:
         the inset outline (corners and ``EDGE_POINTS`` points along each
         edge: where no corner triple holds the centroid, as on a rectangle,
         these are the extreme tripods), and the smallest leg triangles about
-        the centroid (three turns)."""
-        pts = inset_corners(np.asarray(self.part.vertices, float), self.inset * self.part.a)
+        the centroid (three turns). Starts with a leg off the material (in
+        a hole, or nearer its rim than the inset) are dropped."""
+        pts = inset_corners(np.asarray(self.part.vertices, float), self.inset * self.part.a,
+                            getattr(self.part, "holes", ()))
         out = [np.array(t).ravel() for t in itertools.combinations(pts, 3)]
         out = [x for x in out if self.violation(x) == 0.0]
         rim = [p + (q - p) * t for p, q in zip(pts, np.roll(pts, -1, axis=0))
@@ -126,11 +130,12 @@ class TripodSpace:
         return [x for x in out if self.violation(x) == 0.0]
 
     def random(self, rng, n: int) -> list[np.ndarray]:
-        """Up to ``n`` feasible tripods with legs uniform in the inset outline."""
+        """Up to ``n`` feasible tripods with legs uniform in the inset material."""
         verts = np.asarray(self.part.vertices, float)
         lo, hi = verts.min(axis=0), verts.max(axis=0)
         xy = rng.uniform(lo, hi, (_POOL, 2))
-        pool = xy[inside_outline(verts, xy) & (boundary_distance(verts, xy) >= self.inset * self.part.a)]
+        on, dist = material_distance(self.part, xy)
+        pool = xy[on & (dist >= self.inset * self.part.a)]
         out = []
         for _ in range(200 * n if pool.shape[0] >= 3 else 0):
             x = pool[rng.choice(pool.shape[0], 3, replace=False)].ravel()
@@ -146,7 +151,7 @@ class TripodSpace:
 
     def describe(self) -> str:
         """The space in words."""
-        return f"tripods {self.inset:g} a inside the outline"
+        return f"tripods {self.inset:g} a inside the {_where(self.part)}"
 
 
 @dataclass
@@ -203,6 +208,11 @@ class WarpSpace:
         return f"warps of amplitude up to {self.amplitude:g}"
 
 
+def _where(part) -> str:
+    """What a tripod's legs stand in, in words: the outline, or the material of a part with holes."""
+    return "material" if getattr(part, "holes", ()) else "outline"
+
+
 def _area(x: np.ndarray) -> float:
     """Twice the area of the leg triangle ``x`` (6 numbers)."""
     (ux, uy), (vx, vy) = x[2:4] - x[0:2], x[4:6] - x[0:2]
@@ -218,10 +228,14 @@ def _weights(legs: np.ndarray, a: float) -> np.ndarray | None:
     return barycentric(*legs)
 
 
-def inset_corners(verts: np.ndarray, distance: float) -> np.ndarray:
+def inset_corners(verts: np.ndarray, distance: float, holes=()) -> np.ndarray:
     """The corners of the outline moved inwards by ``distance`` along each
     corner's bisector (exact for a convex outline; a reflex corner's point is
-    kept only if it lies at least ``distance`` from every edge)."""
+    kept only if it lies at least ``distance`` from every edge).
+
+    ``holes``: the part's holes (part frame); a point in a hole or nearer a
+    hole's rim than ``distance`` is dropped as well (the legs stand on the
+    material, as far from a hole's rim as from the outline)."""
     n = verts.shape[0]
     out = []
     for i in range(n):
@@ -233,8 +247,8 @@ def inset_corners(verts: np.ndarray, distance: float) -> np.ndarray:
         half = math.acos(float(np.clip(u1 @ u2, -1.0, 1.0))) / 2.0
         out.append(p + bis / np.linalg.norm(bis) * distance / math.sin(half))
     pts = np.array(out).reshape(-1, 2)
-    ok = inside_outline(verts, pts) & (boundary_distance(verts, pts) >= distance * (1 - 1e-9))
-    return pts[ok]
+    on, dist = material_distance(SimpleNamespace(vertices=verts, holes=tuple(holes)), pts)
+    return pts[on & (dist >= distance * (1 - 1e-9))]
 
 
 @dataclass
@@ -271,7 +285,7 @@ def member_space(part, family) -> MemberSpace:
             if not (space.corners() or space.random(np.random.default_rng([0, 33]), 1)):
                 raise PinfeedError(
                     f"support family {item!r} has no member: no three points {space.inset:g} a "
-                    f"({space.inset * part.a:.3g} mm) inside the outline hold the centroid with every "
+                    f"({space.inset * part.a:.3g} mm) inside the {_where(part)} hold the centroid with every "
                     f"leg carrying >= {MIN_LEG_WEIGHT:.0%}; lower the inset (tripods:N:inset=F)")
             spaces.append(space)
         elif kind.strip() == "warp":
