@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: run unlock demo test bench clean docs
+.PHONY: run support-study unlock demo test bench clean docs
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -14,12 +14,21 @@ $(STAMP): pyproject.toml
 
 # The main job: the Snakemake workflow on the embedded default config
 # (config/config.yaml). Resumes an interrupted run; does nothing if up to date.
+# Shows one line per finished stage; Snakemake's own output goes to
+# logs/<config name>/snakemake-DATE-TIME.log (pipeline/workflow/console.py).
 # Ends by printing the path of the report (results/<config name>/report.html;
 # pipeline/workflow/runner.py prints it).
 # After a killed run it removes Snakemake's stale lock and temporary files
 # when no other run is alive (pipeline/workflow/runner.py), saying so in one line.
 run: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pipeline.workflow run --cores all --rerun-incomplete
+
+# The support-family study (rules/support.smk, config key support_study): not
+# part of `make run` (about an hour of CPU on the default config; see
+# docs/howto/support-family.md). Runs what it needs of `make run` first, then
+# writes results/<config name>/report_support.html (the report with the study).
+support-study: $(STAMP)
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pipeline.workflow run --cores all --rerun-incomplete support_study
 
 # Remove Snakemake's lock by hand (only when no other run is alive).
 unlock: $(STAMP)

@@ -8,6 +8,8 @@ rule catalog_index:
         index=f"{CATALOG}/index.json",
     log:
         "logs/catalog/index.log",
+    benchmark:
+        "logs/benchmark/catalog/index.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:

@@ -31,6 +31,8 @@ rule figures:
         settings=config["figures"],
     log:
         f"{LOGS}/figures.log",
+    benchmark:
+        f"{LOGS}/benchmark/figures.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:
@@ -45,6 +47,8 @@ rule outline:
                        category="Parts"),
     log:
         f"{LOGS}/outline/{{name}}.log",
+    benchmark:
+        f"{LOGS}/benchmark/outline/{{name}}.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:
@@ -64,38 +68,47 @@ rule animate:
         fps=config["figures"]["animation_fps"],
     log:
         f"{LOGS}/animate/{{name}}.log",
+    benchmark:
+        f"{LOGS}/benchmark/animate/{{name}}.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:
         "scripts/animate.py"
 
 
+# What the report reads: everything `make run` makes (the default target, rule
+# all). The support study (rules/support.smk) is not among it: it has its own
+# target and report (rule support_study, `make support-study`).
+REPORT_INPUTS = dict(
+    figures=rules.figures.output,
+    plans=rules.figures.input.plans,
+    verify=rules.figures.input.verify,
+    outlines=expand(rules.outline.output.outline, name=PLANNED),
+    animations=expand(rules.animate.output.animation, name=PLANNED),
+    # feeder layouts (rules/layout.smk): stations, pitch, throughput, drawings
+    layouts=expand(rules.layout.output.layout, name=PLANNED),
+    layout_drawings=expand(rules.layout.output.png, name=PLANNED),
+    # sensing (rules/sense.smk): results and figures of the sensed parts
+    sensing=expand(rules.sense.output.sensing, name=SENSED),
+    sensing_figures=expand(f"{RESULTS}/figures/{{kind}}_{{name}}.png",
+                           kind=("profiles", "scores"), name=SENSED),
+    # speed limit (rules/speed.smk): JSON and figure of every planned part
+    speed=expand(rules.speed.output.speed, name=PLANNED),
+    speed_figures=expand(rules.speed.output.figure, name=PLANNED),
+    # the feedability atlas (rules/atlas.smk), shown first
+    atlas=rules.atlas.output.json,
+)
+
+
 rule report:
     input:
-        rules.figures.output,
-        plans=rules.figures.input.plans,
-        verify=rules.figures.input.verify,
-        outlines=expand(rules.outline.output.outline, name=PLANNED),
-        animations=expand(rules.animate.output.animation, name=PLANNED),
-        # feeder layouts (rules/layout.smk): stations, pitch, throughput, drawings
-        layouts=expand(rules.layout.output.layout, name=PLANNED),
-        layout_drawings=expand(rules.layout.output.png, name=PLANNED),
-        # sensing (rules/sense.smk): results and figures of the sensed parts
-        sensing=expand(rules.sense.output.sensing, name=SENSED),
-        sensing_figures=expand(f"{RESULTS}/figures/{{kind}}_{{name}}.png",
-                               kind=("profiles", "scores"), name=SENSED),
-        # speed limit (rules/speed.smk): JSON and figure of every planned part
-        speed=expand(rules.speed.output.speed, name=PLANNED),
-        speed_figures=expand(rules.speed.output.figure, name=PLANNED),
-        # plans against the support family (rules/support.smk): JSON and overlaid maps
-        support=expand(rules.support.output.support, name=STUDIED),
-        support_figures=expand(rules.support.output.figure, name=STUDIED),
-        # the feedability atlas (rules/atlas.smk), shown first
-        atlas=rules.atlas.output.json,
+        **REPORT_INPUTS,
     output:
         report=f"{RESULTS}/report.html",
     log:
         f"{LOGS}/report.log",
+    benchmark:
+        f"{LOGS}/benchmark/report.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:

@@ -14,6 +14,8 @@ rule sense:
         sweep={k: config["sweep"][k] for k in ("pin_radius", "kernel")},
     log:
         f"{LOGS}/sense/{{name}}.log",
+    benchmark:
+        f"{LOGS}/benchmark/sense/{{name}}.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:
@@ -30,6 +32,8 @@ rule sensing_figures:
                       category="Sensing"),
     log:
         f"{LOGS}/sense/figures_{{name}}.log",
+    benchmark:
+        f"{LOGS}/benchmark/sensing_figures/{{name}}.tsv"
     conda:
         "envs/pinfeed.yaml"
     script:
