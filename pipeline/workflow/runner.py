@@ -12,8 +12,15 @@ jobs are planned, and recovery after a run was killed (``kill -9``).
    alive, it stops with one line naming its pid.
 3. It removes the temporary files of atomic writes a killed run left behind
    (``.NAME.XXXX.tmp``; the catalog never reads them anyway).
-4. It runs Snakemake and, when the run made the config's report, prints its
-   path (``report: .../results/NAME/report.html``).
+4. It runs Snakemake with its output to a log file
+   (``logs/NAME/snakemake-DATE-TIME.log``, the last 20 kept) and shows on the
+   terminal one line per finished stage, a live line on a terminal, and for a
+   failed job its rule, log and last lines (:mod:`pipeline.workflow.console`).
+   A dry run and Snakemake's listing options (``-n``, ``--list-rules``,
+   ``--summary``, ...) print Snakemake's own output instead.
+5. When the run made the config's report, it prints its path
+   (``report: .../results/NAME/report.html``; for the ``support_study``
+   target, ``report_support.html`` and one line per studied part).
 
 The Snakefile calls :func:`reconcile_catalog` while it loads, before
 Snakemake plans any job: Snakemake treats a missing intermediate file (a
@@ -35,6 +42,14 @@ from pipeline.errors import PinfeedError
 
 RUN_LOCK = Path(".snakemake") / "pinfeed-run.lock"
 SNAKEMAKE_LOCKS = Path(".snakemake") / "locks"
+KEEP_LOGS = 20  # Snakemake logs kept per config (logs/NAME/snakemake-*.log)
+# Snakemake options that run no job and print what a person asked to see:
+# their output goes to the terminal unchanged.
+PASS_THROUGH = {"-n", "--dry-run", "--dryrun", "--unlock", "--summary", "-S", "--detailed-summary",
+                "-D", "--lint", "--dag", "--rulegraph", "--filegraph", "--help", "-h", "--version",
+                "-v", "--print-compilation", "--cleanup-metadata", "--cleanup-shadow", "--containerize",
+                "--delete-all-output", "--delete-temp-output", "--archive", "--report", "--list-changes",
+                "--lc", "-l"}
 
 
 # ---------------------------------------------------------------- catalog against disk
@@ -160,16 +175,69 @@ def run(args: list[str]) -> int:
         if gone:
             print(f"pinfeed: removed {len(gone)} temporary file(s) a killed run left behind",
                   file=sys.stderr)
-        code = subprocess.call(["snakemake", *args])
-    if code == 0 and not {"-n", "--dry-run", "--dryrun"} & set(args):
+        if _passes_through(args):
+            return subprocess.call(["snakemake", *args])
+        from pipeline.workflow.console import follow
+        code = follow(["snakemake", *args], _snakemake_log(args), workdir=_workdir(args))
+    if code == 0:
         _print_report_path(args)
     return code
 
 
+def _passes_through(args: list[str]) -> bool:
+    """Whether Snakemake's own output is what the arguments ask for (a dry run, a listing)."""
+    return any(a in PASS_THROUGH or a.startswith("--list") or a.startswith("--generate-unit-tests")
+               for a in args)
+
+
+def _workdir(args: list[str]) -> Path:
+    """Snakemake's working folder: ``--directory``/``-d`` if given, else here."""
+    for flag in ("--directory", "-d"):
+        if flag in args and args.index(flag) + 1 < len(args):
+            return Path(args[args.index(flag) + 1])
+    return Path(".")
+
+
+def _snakemake_log(args: list[str]) -> Path:
+    """A new file for Snakemake's output, ``logs/NAME/snakemake-DATE-TIME.log``
+    in its working folder (NAME: the config's name); older ones beyond the
+    last :data:`KEEP_LOGS` are removed."""
+    import time
+    import yaml
+    from pipeline.config import config_name
+    path = _config_path(args)
+    try:
+        cfg = yaml.safe_load(path.read_text()) or {}
+    except (OSError, yaml.YAMLError):
+        cfg = {}
+    name = str(cfg.get("name") or config_name(path)) if isinstance(cfg, dict) else config_name(path)
+    folder = _workdir(args) / "logs" / name
+    old = sorted(folder.glob("snakemake-*.log"))
+    for stale in old[:max(0, len(old) - KEEP_LOGS + 1)]:
+        stale.unlink(missing_ok=True)
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    log = folder / f"snakemake-{stamp}.log"
+    k = 1
+    while log.exists():
+        k += 1
+        log = folder / f"snakemake-{stamp}-{k}.log"
+    return log
+
+
 def _print_report_path(args: list[str]) -> None:
-    """The path of the report a finished run made (none when its targets left it out)."""
+    """The path of the report a finished run made (none when its targets left it
+    out): ``report.html``, or for the ``support_study`` target ``report_support.html``
+    and the study's answer per part."""
     from pipeline.config import load_config, results_folder
-    report = results_folder(load_config(_config_path(args))) / "report.html"
+    results = results_folder(load_config(_config_path(args)))
+    if "support_study" in args:
+        from pipeline.maps.io import read_json
+        from pipeline.workflow.supports import support_summary_text
+        for path in sorted((results / "support").glob("*.json")):
+            print(f"support: {support_summary_text(read_json(path))}", flush=True)
+        report = results / "report_support.html"
+    else:
+        report = results / "report.html"
     if report.is_file():
         print(f"report: {report.resolve()}", flush=True)
 
