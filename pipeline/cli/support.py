@@ -91,7 +91,7 @@ def add_support_commands(sub) -> None:
     q.add_argument("--pin-radius", dest="pin_radius", type=float, default=3.0, help="pin radius, mm (default 3)")
     q.add_argument("--points", type=int, default=3, help="support points to fit, 3 to 12 (default 3)")
     q.add_argument("--starts", type=int, default=48, help="random layouts tried before refining (default 48)")
-    q.add_argument("--refine", type=int, default=4, help="best layouts refined by least squares (default 4)")
+    q.add_argument("--refine", type=int, default=8, help="best layouts refined by least squares (default 8)")
     q.add_argument("--seed", type=int, default=0, help="seed of the random layouts (default 0)")
     q.add_argument("--family", action="store_true",
                    help="return every support consistent with the pushes within their noise, as a "

@@ -301,7 +301,7 @@ def _least_squares(objective: _Objective, start, a: float):
 
 
 def fit_support(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: float, n_points: int = 3,
-                starts: int = 48, refine: int = 4, seed: int = 0) -> SupportFit:
+                starts: int = 48, refine: int = 8, seed: int = 0) -> SupportFit:
     """The ``n_points``-point support (statics weights) that best explains
     ``pushes`` (see the module notes); ``mu_c`` is used where a push gives none."""
     if not 3 <= int(n_points) <= 12:
@@ -397,7 +397,7 @@ def _spread_pick(flats: np.ndarray, n: int) -> list[int]:
 
 def fit_support_family(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: float,
                        noise_deg: float | None = None, n_points: int = 3, starts: int = 48,
-                       refine: int = 4, seed: int = 0, max_members: int = MAX_FAMILY) -> FamilyFit:
+                       refine: int = 8, seed: int = 0, max_members: int = MAX_FAMILY) -> FamilyFit:
     """The ``n_points``-point supports consistent with ``pushes`` within their noise.
 
     The fit of :func:`fit_support` is run, keeping every feasible layout it
