@@ -1,7 +1,8 @@
 """What ``make run`` shows on the terminal: Snakemake's own output goes to a log
 file, and the terminal gets one line per finished stage (a rule whose jobs
 are all done), with counts and the time since the start, plus, on a terminal,
-one live line saying what runs now::
+one live line saying what runs now (``[ 3:12] 40/82 jobs; running: plan 0/2,
+sweep_shard 38/60``)::
 
     pinfeed: 141 jobs on 2 cores; Snakemake's full log: logs/config/snakemake-20261126-100009.log
     [ 2:41] sweep_shard      60/60   map shards               2:33
@@ -213,11 +214,13 @@ class Progress:
 
     def status(self, seconds: float) -> str:
         """The live line: jobs done, and the stages running now with their counts."""
+        if not self._stats_seen:
+            return f"[{clock(seconds)}] Snakemake is building its job graph"
         now = sorted(set(self.running.values()) - TARGETS)
         doing = ", ".join(f"{r} {self.done.get(r, 0)}/{self.totals.get(r, '?')}" for r in now)
         done, total = self.steps
         total = total or sum(self.totals.values())
-        return f"[{clock(seconds)}] {done}/{total} jobs" + (f" · running: {doing}" if doing else "")
+        return f"[{clock(seconds)}] {done}/{total} jobs" + (f"; running: {doing}" if doing else "")
 
     def summary(self, code: int, seconds: float, log_path) -> list[str]:
         """The closing lines: done, nothing to do, or what failed and where to look."""
@@ -251,28 +254,30 @@ class Terminal:
     def __init__(self, stream=None, live: bool | None = None):
         self.stream = stream or sys.stdout
         self.live = self.stream.isatty() if live is None else live
-        self._shown = False
+        self._shown = ""  # the live line on screen
 
     def line(self, text: str) -> None:
         self._clear()
         print(text, file=self.stream, flush=True)
 
     def status(self, text: str) -> None:
-        if self.live:
-            width = max(20, _columns() - 1)
-            self.stream.write("\r\033[K" + text[:width])
+        """Show ``text`` as the live line (cut to the terminal's width); nothing
+        when the output is not a terminal."""
+        if self.live and text != self._shown:
+            self.stream.write("\r\033[K" + text[:_columns() - 1])
             self.stream.flush()
-            self._shown = True
+            self._shown = text
 
     def _clear(self) -> None:
         if self._shown:
             self.stream.write("\r\033[K")
-            self._shown = False
+            self._shown = ""
 
 
 def _columns() -> int:
+    """The terminal's width (100 where it says none)."""
     try:
-        return os.get_terminal_size().columns
+        return os.get_terminal_size().columns or 100
     except OSError:
         return 100
 

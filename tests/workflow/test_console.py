@@ -317,7 +317,8 @@ def test_one_line_per_finished_stage_with_counts_and_times():
 
 def test_the_live_line_names_what_runs():
     progress, _ = replay(SMALL_RUN.split("Finished jobid: 7 (Rule: plan)")[0])
-    assert progress.status(83) == "[ 1:23] 5/17 jobs · running: plan 0/1"
+    assert progress.status(83) == "[ 1:23] 5/17 jobs; running: plan 0/1"
+    assert Progress().status(2) == "[ 0:02] Snakemake is building its job graph"
 
 
 def test_a_default_run_fits_on_a_screen():
@@ -387,6 +388,7 @@ def test_the_terminal_keeps_one_live_line():
     out = io.StringIO()
     term = Terminal(out, live=True)
     term.status("[ 0:01] 0/3 jobs")
+    term.status("[ 0:01] 0/3 jobs")  # unchanged: not written again
     term.status("[ 0:02] 1/3 jobs")
     term.line("[ 0:02] a  1/1")
     assert out.getvalue() == "\r\x1b[K[ 0:01] 0/3 jobs\r\x1b[K[ 0:02] 1/3 jobs\r\x1b[K[ 0:02] a  1/1\n"
