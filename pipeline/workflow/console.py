@@ -101,6 +101,7 @@ class Progress:
     nothing_to_do: bool = False
     tail: list = field(default_factory=list)  # Snakemake's last lines, outside job listings
     _stamp: datetime | None = None
+    _in_header: bool = False
     _in_stats: bool = False
     _stats_seen: bool = False
     _job_rule: str | None = None
@@ -141,9 +142,12 @@ class Progress:
                 elif not self._stats_seen:
                     self.totals[parts[0]] = int(parts[1])
             return out
-        if self.start is None and (m := _DATE.match(line)):
-            self.start = datetime.strptime(m.group(1), "%Y-%m-%d %H:%M:%S")
+        if line.startswith("SNAKEMAKE") or (self._in_header and not line.startswith("Building DAG")):
+            self._in_header = True  # Snakemake's banner: date, versions, paths (no line of ours)
+            if self.start is None and (m := _DATE.match(line)):
+                self.start = datetime.strptime(m.group(1), "%Y-%m-%d %H:%M:%S")
             return out
+        self._in_header = False
         if m := _STAMP.match(line):
             self._stamp = datetime.strptime(m.group(1), "%a %b %d %H:%M:%S %Y")
             self.start = self.start or self._stamp  # no header: from the first job

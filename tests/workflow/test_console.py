@@ -366,6 +366,15 @@ def test_a_failure_without_a_log_shows_snakemakes_last_lines(tmp_path):
     assert "Shutting down" not in text and "Complete log" not in text
 
 
+def test_snakemakes_banner_is_not_among_the_last_lines():
+    banner = ("Assuming unrestricted shared filesystem usage.\n\nSNAKEMAKE\n=========\n"
+              "  Date: 2026-11-26 10:04:40\n  Snakemake version: 9.27.1\n  Command: snakemake x\n\n"
+              "Building DAG of jobs...\nWorkflowError:\nTarget rules may not contain wildcards.\n")
+    progress, lines = replay(banner)
+    assert progress.start == datetime(2026, 11, 26, 10, 4, 40)
+    assert progress.tail == ["Target rules may not contain wildcards."]
+
+
 def test_an_error_before_any_job_shows_snakemakes_last_lines():
     progress, lines = replay("Building DAG of jobs...\nPinfeedError in file /w/Snakefile, line 32:\n"
                              "config error at planner/depth: 0 is less than the minimum of 1\n"
