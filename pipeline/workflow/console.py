@@ -108,6 +108,7 @@ class Progress:
     _failure: Failure | None = None
 
     def elapsed(self, when: datetime | None = None) -> float:
+        """Seconds from the run's start to ``when`` (default: the last time stamp read)."""
         when = when or self._stamp
         if when is None or self.start is None:
             return 0.0
@@ -118,30 +119,11 @@ class Progress:
         line = line.rstrip("\n")
         out = []
         if self._failure is not None:
-            m_log, m_job = _ERR_LOG.match(line), _ERR_JOB.match(line)
-            if m_log:
-                self._failure.logs = [p.strip() for p in m_log.group(1).split(", ") if p.strip()]
-                return out
-            if m_job:
-                self._failure.jobid = m_job.group(1)
-                return out
-            if line.startswith((" ", "\t")):
+            if self._failure_detail(line):
                 return out
             out += self.close_failure()
         if self._in_stats:
-            parts = line.split()
-            if len(parts) == 2 and parts[1].isdigit():
-                if parts[0] == "total":
-                    self._in_stats = False
-                    if not self._stats_seen:
-                        self._stats_seen = True
-                        total = int(parts[1])
-                        cores = (f" on {self.cores} core{'s' if self.cores > 1 else ''}"
-                                 if self.cores else "")
-                        out.append(f"pinfeed: {total} jobs to run{cores}")
-                elif not self._stats_seen:
-                    self.totals[parts[0]] = int(parts[1])
-            return out
+            return out + self._stats_line(line)
         if line.startswith("SNAKEMAKE") or (self._in_header and not line.startswith("Building DAG")):
             self._in_header = True  # Snakemake's banner: date, versions, paths (no line of ours)
             if self.start is None and (m := _DATE.match(line)):
@@ -189,6 +171,33 @@ class Progress:
         if line.strip() and not _NOISE.match(line):
             self.tail = (self.tail + [line])[-ERROR_LINES:]
         return out
+
+    def _failure_detail(self, line: str) -> bool:
+        """Take a line that belongs to the failure being read (its log files,
+        its job id, an indented detail); False for the first line after it."""
+        m_log, m_job = _ERR_LOG.match(line), _ERR_JOB.match(line)
+        if m_log:
+            self._failure.logs = [p.strip() for p in m_log.group(1).split(", ") if p.strip()]
+        elif m_job:
+            self._failure.jobid = m_job.group(1)
+        return bool(m_log or m_job or line.startswith((" ", "\t")))
+
+    def _stats_line(self, line: str) -> list[str]:
+        """A line of Snakemake's job-stats table: the count per rule, and at
+        its total the one line saying how many jobs will run."""
+        parts = line.split()
+        if len(parts) != 2 or not parts[1].isdigit():
+            return []
+        if parts[0] != "total":
+            if not self._stats_seen:
+                self.totals[parts[0]] = int(parts[1])
+            return []
+        self._in_stats = False
+        if self._stats_seen:
+            return []
+        self._stats_seen = True
+        cores = f" on {self.cores} core{'s' if self.cores > 1 else ''}" if self.cores else ""
+        return [f"pinfeed: {int(parts[1])} jobs to run{cores}"]
 
     def close_failure(self) -> list[str]:
         """The terminal lines of the failure just read: its rule, its log files
@@ -261,6 +270,7 @@ class Terminal:
         self._shown = ""  # the live line on screen
 
     def line(self, text: str) -> None:
+        """Print ``text`` as a line of its own (clearing the live line first)."""
         self._clear()
         print(text, file=self.stream, flush=True)
 
