@@ -40,7 +40,14 @@ extensions = [
     "sphinxarg.ext",
     "sphinx_gallery.gen_gallery",
     "config_schema",
+    "matplotlib.sphinxext.plot_directive",
 ]
+# Diagrams drawn by code at build time (``.. plot::``): one PNG each, no source
+# link or format links under them.
+plot_formats = [("png", 150)]
+plot_html_show_source_link = False
+plot_html_show_formats = False
+plot_include_source = False
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 exclude_patterns = ["_build", "_ext", "examples/README.txt", "**/GALLERY_HEADER.rst"]
