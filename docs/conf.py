@@ -20,6 +20,15 @@ shutil.rmtree(HERE / "gallery", ignore_errors=True)
 # gallery's back-references), generated into docs/reference/generated/.
 shutil.rmtree(HERE / "reference" / "generated", ignore_errors=True)
 
+# The default config's plans, computed from this code (docs/_ext/default_run.py,
+# cached by a hash of the code): pages quote them as {{ plans.NAME.KEY }}
+# (e.g. {{ plans.asym_triangle.pins }}) and show the figures it writes into
+# docs/_generated/; nothing about the default plans is written by hand.
+import default_run  # noqa: E402
+
+DEFAULT_RUN = default_run.default_run()
+myst_substitutions = {"plans": DEFAULT_RUN["parts"]}
+
 project = "pinfeed"
 author = "pinfeed developers"
 copyright = "2026, pinfeed developers"
@@ -50,8 +59,8 @@ plot_html_show_formats = False
 plot_include_source = False
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
-exclude_patterns = ["_build", "_ext", "examples/README.txt", "**/GALLERY_HEADER.rst"]
-myst_enable_extensions = ["colon_fence", "deflist"]
+exclude_patterns = ["_build", "_ext", "_generated", "examples/README.txt", "**/GALLERY_HEADER.rst"]
+myst_enable_extensions = ["colon_fence", "deflist", "substitution"]
 myst_heading_anchors = 3
 suppress_warnings = ["config.cache"]  # the gallery's conf entries hold functions
 

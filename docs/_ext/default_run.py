@@ -1,0 +1,253 @@
+"""The default plans, as the manual shows them, computed by the docs build.
+
+Every number the manual gives about the default config's plans (the pins,
+the final set's width, the trials in it, the belt's speed limit, the belt
+speed, the throughput) and the figures of them (the front page's feeder
+drawing, a frame of the feeder's animation) come from this module, run at
+the start of each docs build by ``docs/conf.py``. Nothing about the default
+plans is copied by hand into a page: pages write ``{{ plans.asym_triangle.pins }}``
+(a MyST substitution) or include a generated file.
+
+For each part of ``planner.parts`` of the embedded default config it does
+what a user does after ``make run``, with the same functions:
+
+1. ``pinfeed plan --part NAME`` (the maps it needs are computed on the
+   fly into a scratch catalog: the same grid as the workflow's shards);
+2. the speed stage (``pipeline.workflow.speed.speed``: the speed limit);
+3. the layout stage (``pipeline.workflow.layout.layout``: stations, belt
+   speed, pitch, throughput, the drawing);
+4. a still of the laid-out feeder's animation (the parts in mid-stream),
+   and the recommended plan's pin-sequence figure (the part's nominal path
+   past the pins, as the report draws it);
+
+then the atlas of the parts (``pipeline.workflow.atlas.atlas``) and what
+``pinfeed atlas`` prints of it. The parts run side by side, one process each.
+
+The work takes a few minutes, so its results are kept in
+``docs/_generated/cache/KEY/``, where KEY hashes everything the results
+depend on: the source of ``pipeline/`` and ``kernels/``, ``config/``,
+``pyproject.toml``, this file, and the versions of Python, NumPy, Numba and
+SciPy. A build with the same key reuses them; any change to the code makes a
+new key, so the manual never shows results of other code. The files a page
+uses are copied to ``docs/_generated/`` (``default_run.json``,
+``feeder_NAME.png``, ``frame_NAME.png``, ``sequence_NAME.png``, ``atlas.txt``).
+
+The README cannot run code, so it shows a committed copy of the front-page
+drawing, ``docs/feeder_asym_triangle.png``, which records its plan in the
+PNG's ``pinfeed-plan`` text field; ``tests/docs/test_front_page.py`` fails
+when that plan differs from the one this build computed.
+``make readme-figure`` copies the fresh drawing there.
+
+Run by hand: ``python docs/_ext/default_run.py`` (all parts, prints the
+folder), or ``python docs/_ext/default_run.py part NAME FOLDER`` (one part).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+GENERATED = ROOT / "docs" / "_generated"
+SOURCES = (("pipeline", "*.py"), ("pipeline", "*.json"), ("kernels", "*.py"), ("config", "*.yaml"))
+#: The PNG text field holding the drawing's plan (pins, space-separated).
+PLAN_FIELD = "pinfeed-plan"
+
+
+def cache_key() -> str:
+    """Hash of everything the default plans depend on (see the module's notes)."""
+    import numba
+    import numpy
+    import scipy
+    digest = hashlib.sha256()
+    files = [p for folder, pattern in SOURCES for p in (ROOT / folder).rglob(pattern)]
+    files += [ROOT / "pyproject.toml", Path(__file__).resolve()]
+    for path in sorted(set(files)):
+        if "__pycache__" in path.parts:
+            continue
+        digest.update(str(path.relative_to(ROOT)).encode() + b"\0" + path.read_bytes() + b"\0")
+    versions = (platform.python_version(), numpy.__version__, numba.__version__, scipy.__version__)
+    digest.update(" ".join(versions).encode())
+    return digest.hexdigest()[:16]
+
+
+def default_run(log=print) -> dict:
+    """The default plans' summary (``default_run.json``), computing it unless the
+    cache holds it for this code, and the page files copied to ``docs/_generated/``."""
+    key = cache_key()
+    cached = GENERATED / "cache" / key
+    if not (cached / "default_run.json").is_file():
+        log(f"pinfeed docs: computing the default plans for the manual (cache key {key}); "
+            "this takes a few minutes once per code change")
+        start = time.monotonic()
+        _compute(cached)
+        log(f"pinfeed docs: default plans computed in {time.monotonic() - start:.0f} s")
+    summary = json.loads((cached / "default_run.json").read_text())
+    for name in ["default_run.json", "atlas.txt", *summary["figures"]]:
+        shutil.copyfile(cached / name, GENERATED / name)
+    return summary
+
+
+def _compute(target: Path) -> None:
+    """Plan, speed, layout and still of every default part (a process each), then
+    the atlas; written to a scratch folder and renamed to ``target`` at the end."""
+    from pipeline.config import load_config
+    names = list(load_config(None)["planner"]["parts"])
+    target.parent.mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix="work-", dir=target.parent))
+    env = dict(os.environ, PYTHONPATH=f"{ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
+               MPLBACKEND="Agg", NUMBA_NUM_THREADS="1")
+    jobs = [(name, subprocess.Popen([sys.executable, __file__, "part", name, str(work)], env=env, cwd=work,
+                                    stdout=open(work / f"{name}.log", "w"), stderr=subprocess.STDOUT))
+            for name in names]
+    for name, job in jobs:
+        if job.wait() != 0:
+            tail = "".join((work / f"{name}.log").read_text().splitlines(True)[-30:])
+            raise RuntimeError(f"computing the default plan of {name} for the manual failed "
+                               f"(log {work / f'{name}.log'}):\n{tail}")
+    _summarise(names, work)
+    shutil.rmtree(target, ignore_errors=True)
+    os.replace(work, target)
+
+
+def run_part(name: str, work: Path) -> None:
+    """Plan, speed limit, layout, drawing and animation still of one default part."""
+    import matplotlib.pyplot as plt
+
+    from pipeline.config import load_config
+    from pipeline.maps.io import write_json
+    from pipeline.present.animate import station_figure, station_scene, station_title
+    from pipeline.present.figures import text_problems
+    from pipeline.present.figures.feeder import feeder_figure
+    from pipeline.workflow.commands import named_part, plan_command, planner_settings
+    from pipeline.workflow.layout import layout
+    from pipeline.workflow.speed import speed
+    config = planner_settings(load_config(None), catalog=str(work / "catalog"))
+    part = named_part(config, name)
+    plan_path = work / "plans" / f"{name}.json"
+    plan_path.parent.mkdir(parents=True, exist_ok=True)
+    write_json(plan_command(part, config, "tight", progress=print), plan_path)
+    _sequence_png(part, plan_path, config, work / f"sequence_{name}.png")
+    speed(plan_path, config, work / "speed" / f"{name}.json", work / "speed" / f"{name}.png")
+    drawings = {k: work / f"layout_{name}.{k}" for k in ("dxf", "svg", "png")}
+    print(layout(plan_path, config, dict(drawings, json=work / f"layout_{name}.json")))
+    feeder = json.loads((work / f"layout_{name}.json").read_text())
+    if not feeder.get("stations"):
+        return
+    fig = feeder_figure(feeder)
+    _no_overlaps(fig, text_problems, f"the feeder drawing of {name}")
+    fig.savefig(work / f"feeder_{name}.png", dpi=110,
+                metadata={PLAN_FIELD: " ".join(feeder["plan"]["pins"]), "Software": "pinfeed"})
+    plt.close(fig)
+    states = {k: tuple(v) for k, v in part_states(plan_path).items()}
+    scene = station_scene(part, feeder, states, feeder["mu_c"])
+    still = station_figure(scene, station_title(name, scene, "the laid-out feeder"))
+    still["draw"](0.55 * scene.b_end)   # mid-stream: parts before, at and after the pins
+    _no_overlaps(still["fig"], text_problems, f"the animation still of {name}")
+    still["fig"].savefig(work / f"frame_{name}.png", dpi=110)
+    plt.close(still["fig"])
+
+
+def _sequence_png(part, plan_path: Path, config: dict, out: Path) -> None:
+    """The recommended plan as the report's pin-sequence figure: one row per
+    resting state, the part's nominal path past the pins (a rollout per pin and
+    state) at the middle of the planned friction range."""
+    import matplotlib.pyplot as plt
+
+    from pipeline.planning.settings import nominal_friction, parse_friction
+    from pipeline.present.figures import text_problems
+    from pipeline.present.figures.sequence import sequence_figure
+    from pipeline.workflow.report import nominal_paths
+    stored = json.loads(plan_path.read_text())
+    tight = stored["tight"][0]
+    plan = tight.get("recommended")
+    if not plan:
+        return
+    pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
+    speeds = {q: v for q, v in zip(plan["pins"], plan.get("pin_speeds") or ()) if v}
+    mu_c = nominal_friction(parse_friction(tight["mu_c"]))
+    paths = nominal_paths({"part": stored["part"], "initial_states": tight["initial_states"], "mu_c": mu_c,
+                           "model": stored["model"]}, config, plan, pins, speeds, mu_c)
+    fig = sequence_figure(part, plan, pins, paths, config["sweep"]["pin_radius"],
+                          f"{part.name}: recommended plan, nominal paths at $\\mu_c$ {mu_c:g} "
+                          f"(planned for {tight['mu_c']})", speeds=speeds)
+    _no_overlaps(fig, text_problems, f"the pin sequence of {part.name}")
+    fig.savefig(out, dpi=110, metadata={PLAN_FIELD: " ".join(plan["pins"]), "Software": "pinfeed"})
+    plt.close(fig)
+
+
+def part_states(plan_path: Path) -> dict:
+    """The stored plan's initial (resting) states: label -> (theta deg, y_c mm)."""
+    stored = json.loads(plan_path.read_text())["tight"][0]["initial_states"]
+    return {label: (s["theta"], s["y_c"]) for label, s in stored.items()}
+
+
+def _no_overlaps(fig, text_problems, what: str) -> None:
+    problems = text_problems(fig)
+    if problems:
+        raise RuntimeError(f"{what} has overlapping labels: {problems}")
+
+
+def _summarise(names: list[str], work: Path) -> None:
+    """The atlas of the parts, what ``pinfeed atlas`` prints, and default_run.json."""
+    from pipeline.config import load_config
+    from pipeline.provenance import provenance_attrs
+    from pipeline.workflow.atlas import atlas
+    config = load_config(None)
+    rows = atlas(config, [work / "plans" / f"{n}.json" for n in names],
+                 [work / "speed" / f"{n}.json" for n in names],
+                 [work / f"layout_{n}.json" for n in names], work / "atlas.json", work / "atlas.csv")
+    printed = subprocess.run([sys.executable, "-m", "pipeline.cli", "atlas", "--results", str(work)],
+                             capture_output=True, text=True, check=True, cwd=ROOT).stdout
+    (work / "atlas.txt").write_text(printed.replace(str(work), "results/config"))
+    parts = {row["part"]: _numbers(row, work) for row in rows["rows"]}
+    figures = sorted(p.name for p in work.glob("*.png") if p.name.startswith(("feeder_", "frame_", "sequence_")))
+    summary = {"what": "the default config's plans, computed by the docs build (docs/_ext/default_run.py)",
+               "provenance": provenance_attrs(), "machine": _machine(),
+               "parts": parts, "figures": figures}
+    (work / "default_run.json").write_text(json.dumps(summary, indent=1, sort_keys=True, default=float))
+
+
+def _numbers(row: dict, work: Path) -> dict:
+    """The numbers a page may quote of one part, formatted as pages show them."""
+    feeder = json.loads((work / f"layout_{row['part']}.json").read_text())
+    stations = feeder.get("stations") or []
+
+    def fmt(value, spec):
+        return "-" if value is None else format(value, spec)
+    return {
+        "outcome": row["outcome"], "pins": row["plan"] or "-",
+        "n_pins": (row["fixed_pins"] or 0) + (row["moving_pins"] or 0),
+        "heights": ", ".join(f"{s['y_mm']:g}" for s in stations),
+        "friction": row["mu_c"], "width": fmt(row["verified_width_deg"], ".1f"),
+        "in_set": f"{row['in_set']}/{row['trials']}" if row.get("in_set") is not None else "-",
+        "share_lower_bound": fmt(100 * row["share_lower_bound"] if row.get("share_lower_bound") is not None
+                                 else None, ".2f"),
+        "speed_limit": fmt(row["speed_limit_mm_s"], ".0f"), "belt_speed": fmt(row["belt_speed_mm_s"], ".0f"),
+        "throughput": fmt(row["throughput_per_min"], ".0f"), "pitch": fmt(feeder.get("pitch_mm"), ".0f"),
+        "belt_width": fmt(feeder.get("belt_width_mm"), ".0f"),
+        "planning_seconds": fmt(row["planning_seconds"], ".0f"),
+    }
+
+
+def _machine() -> str:
+    """The machine in words: processor, cores, Python."""
+    return (f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()}, "
+            f"Python {platform.python_version()}")
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(ROOT))
+    if len(sys.argv) == 4 and sys.argv[1] == "part":
+        run_part(sys.argv[2], Path(sys.argv[3]))
+    else:
+        GENERATED.mkdir(parents=True, exist_ok=True)
+        default_run()
+        print(GENERATED)
