@@ -18,7 +18,7 @@ import xarray as xr
 
 from kernels.batch import _rollout_grid, blocks_for
 from kernels.points import _rollout_points
-from kernels.models import MINPOWER_POINTS, MODEL_NAMES
+from kernels.models import MINPOWER_POINTS, MODEL_NAMES, STICK, TWIST_OK, _contact_twist
 from kernels.support import _point_table
 from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NAMES,
                              _rollout, max_steps_for)
@@ -506,3 +506,53 @@ def _dynamic_passage(part, theta, dd, mu_c, pin_radius, v_pin, fr, restitution, 
                        int(max_steps or DEFAULT_MAX_STEPS), bool(trajectory))
     status, reason, theta_f, dy, travel, changes, peak, traj, force, twist = res
     return status, DYN_REASONS[reason] or "none", theta_f, dy, travel, changes, peak, traj, force, twist
+
+CONTACT_MODES = {0: "stick", 1: "slide", -1: "slide", 2: "separate"}
+
+
+def contact_motion(part: Part, theta: float, contact, normal, mu_c: float = 0.0,
+                   model: str = "minpower", v_pin: float = 0.0) -> dict:
+    """The part's instantaneous motion relative to the belt while one pin pushes
+    it: its centre of rotation, turning rate and the pin force (see the manual's
+    mechanics page, section 3). Uniform pressure; quasi-static models only.
+
+    Parameters
+    ----------
+    theta : the part's orientation, degrees.
+    contact : ``(x, y)`` the contact point on the outline, world axes, relative
+        to the centroid, in the part's unit.
+    normal : ``(x, y)`` the contact normal, world axes, pointing into the part
+        (from the pin's centre towards the contact point); need not be unit.
+    mu_c : pin-part friction coefficient (>= 0).
+    model : ``"minpower"`` (default), ``"tip"`` or ``"ellipsoid"``.
+    v_pin : pin speed across the belt over belt speed (0 for a static pin).
+
+    Returns
+    -------
+    dict
+        ``mode`` (``"stick"``, ``"slide"`` or ``"separate"``), ``omega``
+        (radians per unit of belt travel, counter-clockwise positive),
+        ``velocity`` (the centroid's, world axes, per unit of belt travel),
+        ``cor`` (the centre of rotation, world axes relative to the centroid,
+        in the part's unit; ``None`` for a pure translation or no motion) and
+        ``force`` (the pin's force on the part, world axes, units of
+        ``mu_s m g``). ``status`` is ``"ok"``, or ``"jammed"`` when the pin
+        moves into the part and no pushing motion exists.
+    """
+    check_parameters(mu_c, 1.0, model, v_pin)
+    (verts, area, a, quad, m_max, _), code = _kernel_part(part, model, None)
+    t = math.radians(float(theta))
+    to_world = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+    c = to_world.T @ np.asarray(contact, float) / a
+    n = to_world.T @ np.asarray(normal, float)
+    n = n / np.linalg.norm(n)
+    vp = to_world.T @ np.array([-1.0, float(v_pin)])
+    status, vx, vy, om, fx, fy, mode = _contact_twist(
+        code, quad, area, m_max, c[0], c[1], n[0], n[1], vp[0], vp[1], float(mu_c),
+        vp[0], vp[1], 0.0, STICK)
+    cor = None
+    if abs(om) > 1e-12 * (abs(vx) + abs(vy) + 1.0):
+        cor = to_world @ np.array([-vy / om, vx / om]) * a
+    return {"status": "ok" if status == TWIST_OK else "jammed", "mode": CONTACT_MODES[int(mode)],
+            "omega": om / a, "velocity": to_world @ np.array([vx, vy]), "cor": cor,
+            "force": to_world @ np.array([fx, fy])}
