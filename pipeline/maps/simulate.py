@@ -507,6 +507,7 @@ def _dynamic_passage(part, theta, dd, mu_c, pin_radius, v_pin, fr, restitution, 
     status, reason, theta_f, dy, travel, changes, peak, traj, force, twist = res
     return status, DYN_REASONS[reason] or "none", theta_f, dy, travel, changes, peak, traj, force, twist
 
+
 CONTACT_MODES = {0: "stick", 1: "slide", -1: "slide", 2: "separate"}
 
 
