@@ -30,7 +30,8 @@ depend on: the source of ``pipeline/`` and ``kernels/``, ``config/``,
 SciPy. A build with the same key reuses them; any change to the code makes a
 new key, so the manual never shows results of other code. The files a page
 uses are copied to ``docs/_generated/`` (``default_run.json``,
-``feeder_NAME.png``, ``frame_NAME.png``, ``sequence_NAME.png``, ``atlas.txt``).
+``feeder_NAME.png``, ``frame_NAME.png``, ``sequence_NAME.png``,
+``carried_NAME.png``, ``atlas.txt``, ``plans_by_friction.md``).
 
 The README cannot run code, so it shows a committed copy of the front-page
 drawing, ``docs/feeder_asym_triangle.png``, which records its plan in the
@@ -90,7 +91,7 @@ def default_run(log=print) -> dict:
         _compute(cached)
         log(f"pinfeed docs: default plans computed in {time.monotonic() - start:.0f} s")
     summary = json.loads((cached / "default_run.json").read_text())
-    for name in ["default_run.json", "atlas.txt", *summary["figures"]]:
+    for name in ["default_run.json", "atlas.txt", "plans_by_friction.md", *summary["figures"]]:
         shutil.copyfile(cached / name, GENERATED / name)
     return summary
 
@@ -115,6 +116,10 @@ def _compute(target: Path) -> None:
     _summarise(names, work)
     shutil.rmtree(target, ignore_errors=True)
     os.replace(work, target)
+    # Results of other code are never used again: keep the cache to this key.
+    for old in target.parent.iterdir():
+        if old != target and not old.name.startswith("work-"):
+            shutil.rmtree(old, ignore_errors=True)
 
 
 def run_part(name: str, work: Path) -> None:
@@ -135,6 +140,7 @@ def run_part(name: str, work: Path) -> None:
     plan_path.parent.mkdir(parents=True, exist_ok=True)
     write_json(plan_command(part, config, "tight", progress=print), plan_path)
     _sequence_png(part, plan_path, config, work / f"sequence_{name}.png")
+    _carried_png(plan_path, config, work / f"carried_{name}.png")
     speed(plan_path, config, work / "speed" / f"{name}.json", work / "speed" / f"{name}.png")
     drawings = {k: work / f"layout_{name}.{k}" for k in ("dxf", "svg", "png")}
     print(layout(plan_path, config, dict(drawings, json=work / f"layout_{name}.json")))
@@ -153,6 +159,15 @@ def run_part(name: str, work: Path) -> None:
     _no_overlaps(still["fig"], text_problems, f"the animation still of {name}")
     still["fig"].savefig(work / f"frame_{name}.png", dpi=110)
     plt.close(still["fig"])
+
+
+def _carried_png(plan_path: Path, config: dict, out: Path) -> None:
+    """The recommended plan's carried sets after each pin against replayed
+    rollouts, as the report draws them (``pipeline.workflow.report.carried_figure``)."""
+    from pipeline.workflow.report import carried_figure
+    result = json.loads(plan_path.read_text())
+    # A tight-only plan file keeps its resting states with the tight plans.
+    carried_figure(config, dict(result, initial_states=result["tight"][0]["initial_states"]), out)
 
 
 def _sequence_png(part, plan_path: Path, config: dict, out: Path) -> None:
@@ -207,12 +222,32 @@ def _summarise(names: list[str], work: Path) -> None:
     printed = subprocess.run([sys.executable, "-m", "pipeline.cli", "atlas", "--results", str(work)],
                              capture_output=True, text=True, check=True, cwd=ROOT).stdout
     (work / "atlas.txt").write_text(printed.replace(str(work), "results/config"))
+    (work / "plans_by_friction.md").write_text(_friction_table(names, work))
     parts = {row["part"]: _numbers(row, work) for row in rows["rows"]}
-    figures = sorted(p.name for p in work.glob("*.png") if p.name.startswith(("feeder_", "frame_", "sequence_")))
+    kinds = ("feeder_", "frame_", "sequence_", "carried_")
+    figures = sorted(p.name for p in work.glob("*.png") if p.name.startswith(kinds))
     summary = {"what": "the default config's plans, computed by the docs build (docs/_ext/default_run.py)",
                "provenance": provenance_attrs(), "machine": _machine(),
                "parts": parts, "figures": figures}
     (work / "default_run.json").write_text(json.dumps(summary, indent=1, sort_keys=True, default=float))
+
+
+def _friction_table(names: list[str], work: Path) -> str:
+    """A Markdown table of each part's recommended plan at the planner's friction
+    range and at each planned friction, with its held-out verdict."""
+    lines = ["| part | mu_c | recommended plan (pin heights, mm) | verified width | trials in one set "
+             "within the tolerance |", "|---|---|---|---|---|"]
+    for name in names:
+        for entry in json.loads((work / "plans" / f"{name}.json").read_text())["tight"]:
+            plan = entry.get("recommended")
+            if plan is None:
+                lines.append(f"| {name} | {entry['friction']} | none: {entry.get('warning', 'no plan')} | | |")
+                continue
+            verdict = plan["verification"]["orientation"]
+            pins = ", ".join(f"{p} {h:g}" for p, h in zip(plan["pins"], plan["pin_heights_mm"]))
+            lines.append(f"| {name} | {entry['friction']} | {pins} | {verdict['width_deg']:.1f} deg | "
+                         f"{verdict['in_tolerance']}/{verdict['trials']} |")
+    return "\n".join(lines) + "\n"
 
 
 def _numbers(row: dict, work: Path) -> dict:

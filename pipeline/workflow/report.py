@@ -75,7 +75,7 @@ def make_figures(config, plan_paths, verify_paths, out: dict):
             if kind in out:
                 _sequence_figure(config, res, plan, what, out[kind][k])
         if "carried" in out:
-            _carried_figure(config, res, out["carried"][k])
+            carried_figure(config, res, out["carried"][k])
         verifications[name] = read_json(verify_path)
         if out.get("verification_plans"):  # optional: one figure per part, its plans stacked
             _verification_figure(verifications[name], out["verification_plans"][k])
@@ -151,7 +151,7 @@ def _sequence_figure(config, res, plan, what, path):
                   config["sweep"]["pin_radius"], f"{name}: {what}", path, speeds=speeds)
 
 
-def _carried_figure(config, res, path):
+def carried_figure(config, res, path):
     """The tight planner's recommended plan (first friction): carried sets against replays."""
     stored = PlanFile.from_dict(res)
     name = stored.name
