@@ -62,7 +62,9 @@ def test_pages_quote_the_computed_plans(built_docs, default_run):
     assert default_run["parts"]["asym_triangle"]["pins"] in index
     written = []
     for page in sorted(DOCS.rglob("*.md")):
-        if "_build" in page.parts or "_generated" in page.parts:
+        # The performance pages are dated records of measured runs (date, machine,
+        # the plan that run found), not statements about this code.
+        if {"_build", "_generated", "performance"} & set(page.relative_to(DOCS).parts):
             continue
         for name, numbers in default_run["parts"].items():
             if numbers["pins"] != "-" and numbers["pins"] in page.read_text():
