@@ -7,6 +7,7 @@ import traceback
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
+from pipeline.progress import reporting
 
 
 @contextlib.contextmanager
@@ -14,12 +15,14 @@ def log_to(path):
     """Redirect stdout and stderr to the log file ``path`` for the block. A known
     error (:class:`PinfeedError`) is one line ``pinfeed: error: ...`` in the log
     and on the console, and the job exits with status 1; anything else is
-    logged with its traceback and raised."""
+    logged with its traceback and raised. Long stages write how far they have
+    got into the log as well (:func:`pipeline.progress.reporting`)."""
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     console = sys.stderr
     with open(path, "w") as fh:
         try:
-            with contextlib.redirect_stdout(fh), contextlib.redirect_stderr(fh):
+            with contextlib.redirect_stdout(fh), contextlib.redirect_stderr(fh), \
+                    reporting(lambda line: print(line, file=fh, flush=True)):
                 yield fh
         except PinfeedError as exc:
             for stream in (fh, console):

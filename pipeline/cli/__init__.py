@@ -32,9 +32,10 @@ import sys
 from pipeline import __version__
 from pipeline.cli import catalog, feeder, maps, plans, sense, support
 from pipeline.cli.maps import DEFAULT_TRIANGLE, PAPER_D
-from pipeline.cli.options import parse_values
+from pipeline.cli.options import parse_values, progress_line
 from pipeline.cli.plan_text import print_plan_result as _print_plan_result
 from pipeline.errors import PinfeedError
+from pipeline.progress import progress_interval, reporting
 
 __all__ = ["DEFAULT_TRIANGLE", "PAPER_D", "PinfeedParser", "build_parser", "main", "parse_values"]
 
@@ -115,7 +116,9 @@ def main(argv=None) -> int:
     try:
         from pipeline.provenance import source_date_epoch
         source_date_epoch()  # before numpy's f2py reads it (and crashes on a bad value)
-        args.func(args)
+        progress_interval()  # a bad PINFEED_PROGRESS_SECONDS is refused before any work
+        with reporting(progress_line):  # long stages say how far they have got, on stderr
+            args.func(args)
     except PinfeedError as exc:
         print(f"pinfeed: error: {exc}", file=sys.stderr)
         return 2

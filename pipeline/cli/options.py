@@ -8,7 +8,8 @@
 * the workflow's files: ``--config`` and ``--results`` (:func:`add_config_option`,
   :func:`add_results_option`, :func:`results_arg`);
 * output: ``--json`` documents (:func:`add_json_option`, :func:`print_json`)
-  and value lists (:func:`parse_values`).
+  and value lists (:func:`parse_values`); progress lines on stderr
+  (:func:`progress_line`).
 """
 from __future__ import annotations
 
@@ -23,6 +24,11 @@ import numpy as np
 from pipeline.errors import PinfeedError
 
 CONFIG_HELP = "workflow config YAML (default: the embedded one)"
+
+
+def progress_line(message: str) -> None:
+    """One progress line on stderr, indented (stdout holds the command's result)."""
+    print(f"  ... {message}", file=sys.stderr, flush=True)
 
 
 def print_json(obj, **kw):

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from pipeline.cli.next_steps import print_next_steps
 from pipeline.cli.options import (add_config_option, add_json_option, add_outline_args, parse_values,
-                                  plan_part_arg, print_json)
+                                  plan_part_arg, print_json, progress_line)
 from pipeline.cli.plan_text import plan_json, print_plan_result
 from pipeline.errors import PinfeedError
 
@@ -48,7 +48,7 @@ def cmd_plan(args, print_result=print_plan_result):
                               support_family=args.support_family)
     part = plan_part_arg(args, config)
     out = plan_store_path(config, part.name, args.out)  # checked before any work
-    result = plan_command(part, config, args.mode, progress=None if args.json else _progress)
+    result = plan_command(part, config, args.mode, progress=progress_line)
     if out is not None:
         from pipeline.maps.io import write_json
         write_json(result, out)
@@ -65,11 +65,6 @@ def plan_options() -> list:
     sub = argparse.ArgumentParser().add_subparsers()
     add_plan_commands(sub)
     return [a for a in sub.choices["plan"]._actions if a.option_strings and a.dest != "help"]
-
-
-def _progress(message):
-    """One progress line of the planner, indented under the plan."""
-    print(f"  ... {message}", flush=True)
 
 
 def cmd_atlas(args):

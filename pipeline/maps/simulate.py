@@ -388,7 +388,7 @@ def _map_dataset(out, th, dd, unit, jam_attrs, attrs) -> xr.Dataset:
 def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str = "minpower",
                    v_pin: float = 0.0, ds_max: float = DEFAULT_DS_MAX, tol: float = DEFAULT_TOL,
                    threads: int | None = None, belt_speed: float | None = None,
-                   mu_s: float = 0.5, support=None) -> dict:
+                   mu_s: float = 0.5, support=None, stretch=None) -> dict:
     """Final states of independent rollouts at scattered points.
 
     ``theta_i`` (degrees), ``d`` and ``mu_c`` are equal-length 1-D arrays (or
@@ -401,6 +401,11 @@ def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str =
     ``kernels.rollout.JAM_REASONS``, which the dynamic model shares),
     ``theta_f`` (degrees, [0, 360)) and ``dy`` (the part's unit). ``support``
     as for :func:`compute_map` (model minpower).
+
+    ``stretch`` (a :class:`pipeline.progress.Stretch`) is told the share of
+    points done: with one that prints, the points are rolled out in pieces of
+    about a second (:func:`pipeline.progress.row_batches`) with a tick
+    between them; every point is independent, so the results are the same.
     """
     dynamic = model == "dynamic"
     if dynamic:
@@ -418,23 +423,37 @@ def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str =
             raise PinfeedError(f"{what} must be finite numbers")
     if np.any(mu < 0):
         raise PinfeedError("contact friction mu_c must be >= 0")
+    mu, th, dd = np.ascontiguousarray(mu), np.radians(th), np.ascontiguousarray(dd)
     with _threads(threads) as n:
         if dynamic:
             from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
                                          _dyn_rollout_points)
             verts, area, a, quad, _, convex = part.prepared()
-            status, reason, theta_f, dy = _dyn_rollout_points(
-                verts, area, a, quad, convex, np.ascontiguousarray(mu), float(pin_radius),
-                np.radians(th), np.ascontiguousarray(dd), float(v_pin), fr, 0.0,
-                DEFAULT_V_REG / float(belt_speed), DEFAULT_H, np.inf, DEFAULT_MAX_STEPS, n)
+
+            def kernel(rows):
+                return _dyn_rollout_points(verts, area, a, quad, convex, mu[rows], float(pin_radius),
+                                           th[rows], dd[rows], float(v_pin), fr, 0.0,
+                                           DEFAULT_V_REG / float(belt_speed), DEFAULT_H, np.inf,
+                                           DEFAULT_MAX_STEPS, n)
         else:
             prep, code = _kernel_part(part, model, sup)
-            status, reason, theta_f, dy = _rollout_points(
-                *prep, code, np.ascontiguousarray(mu), float(pin_radius),
-                np.radians(th), np.ascontiguousarray(dd), float(v_pin), np.inf, float(ds_max),
-                float(tol), n)
+
+            def kernel(rows):
+                return _rollout_points(*prep, code, mu[rows], float(pin_radius), th[rows], dd[rows],
+                                       float(v_pin), np.inf, float(ds_max), float(tol), n)
+        status, reason, theta_f, dy = _in_batches(kernel, th.size, stretch)
     return {"status": status, "jam_reason": reason,
             "theta_f": _wrap_deg(np.degrees(theta_f)), "dy": dy}
+
+
+def _in_batches(kernel, n: int, stretch) -> tuple:
+    """``kernel(rows)`` over the row ranges of :func:`pipeline.progress.row_batches`
+    (one range without a printing ``stretch``), its arrays joined in row order."""
+    from pipeline.progress import row_batches
+    pieces = [kernel(slice(lo, hi)) for lo, hi in row_batches(n, stretch)]
+    if len(pieces) == 1:
+        return pieces[0]
+    return tuple(np.concatenate(arrays) for arrays in zip(*pieces))
 
 
 def status_names(codes) -> np.ndarray:

@@ -62,6 +62,7 @@ from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.parts.support import Support, material_distance, point_support
+from pipeline.progress import Heartbeat
 
 COLUMNS = ("theta_i_deg", "d", "theta_f_deg")
 OPTIONAL = ("mu_c",)
@@ -228,8 +229,10 @@ class _Objective:
         self.holes = tuple(getattr(part, "holes", ()))
         self.evaluations = 0
         self.best_loss, self.best_flat = math.inf, None
+        self.beat = Heartbeat("", 0)  # the search stage to tick after each evaluation (none: silent)
 
     def residuals(self, support) -> np.ndarray:
+        self.beat.tick()
         res = simulate.rollout_points(self.part, self.pushes.theta_i, self.pushes.d, self.mu,
                                       self.pin_radius, "minpower", support=support)
         r = (res["theta_f"] - self.pushes.theta_f + 180.0) % 360.0 - 180.0
@@ -292,6 +295,26 @@ def _random_layouts(part, k, n, seed) -> list[np.ndarray]:
     return out
 
 
+def _search(objective: _Objective, layouts, refine: int, a: float, again_from_best: bool = False) -> None:
+    """Score ``layouts``, then least squares from the ``refine`` best (and, with
+    ``again_from_best``, once more from the best layout found), telling the
+    progress report of :func:`pipeline.progress.reporting` how far it has got."""
+    with Heartbeat("support fit: scoring starting layouts", len(layouts), "layout") as beat:
+        def loss(flat):
+            value = objective.loss(flat)
+            beat.tick(beat.done + 1)
+            return value
+        scored = sorted(layouts, key=loss)[:max(1, int(refine))]
+    with Heartbeat("support fit: least squares", len(scored) + again_from_best, "start") as beat:
+        objective.beat = beat
+        for k, start in enumerate(scored):
+            _least_squares(objective, start, a)
+            beat.tick(k + 1)
+        if again_from_best:
+            _least_squares(objective, objective.best_flat, a)  # a fresh trust region
+    objective.beat = Heartbeat("", 0)
+
+
 def _least_squares(objective: _Objective, start, a: float):
     """Trust-region least squares (soft L1) from ``start``; finite-difference
     steps of 0.1 % and variables scaled by 10 % of ``a``."""
@@ -320,10 +343,7 @@ def fit_support(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: floa
     layouts = _random_layouts(part, int(n_points), int(starts), seed)
     if not layouts:
         raise PinfeedError(f"no {n_points} points inside the outline hold the centroid; try --points 3")
-    scored = sorted(layouts, key=objective.loss)[:max(1, int(refine))]
-    for start in scored:
-        _least_squares(objective, start, part.a)
-    _least_squares(objective, objective.best_flat, part.a)  # again from the best, a fresh trust region
+    _search(objective, layouts, refine, part.a, again_from_best=True)
     support = objective.support_of(objective.best_flat)
     return SupportFit(support, objective.residuals(support), objective.residuals(None), len(pushes),
                       objective.evaluations)
@@ -430,8 +450,7 @@ def fit_support_family(part: Part, pushes: Pushes, mu_c: float | None, pin_radiu
     best = fit_support(part, pushes, mu_c, pin_radius, k, starts, refine, seed)
     recorder = _RecordingObjective(part, pushes, mu_c if mu_c is not None else 0.0, pin_radius)
     layouts = _random_layouts(part, k, int(starts), seed + 1) + [best.support.points.ravel()]
-    for flat in sorted(layouts, key=recorder.loss)[:max(1, int(refine))]:
-        _least_squares(recorder, flat, part.a)
+    _search(recorder, layouts, refine, part.a)
     n = len(pushes)
     estimated = noise_deg is None
     sigma = (float(np.sqrt(np.mean(np.square(best.residuals_deg)) * n / (n - 2 * k)))

@@ -74,6 +74,7 @@ from pipeline.planning.settings import nominal_friction
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.confidence import DEFAULT_CONFIDENCE, check_confidence
 from pipeline.planning.verify import holdout_settings, replay, trial_inputs
+from pipeline.progress import SILENT, Heartbeat, Stretch
 
 SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
 PROBE = (6, 2)  # random trials and corners per resting state that order the candidates
@@ -311,7 +312,9 @@ class FixedPinSearch:
             prefix: FixedPlan | None = None) -> FixedSearch:
         """Search levels 1 to ``depth`` (after the pins of ``prefix``, if given:
         every sequence then starts with them); stop at the first level with an
-        orienting plan."""
+        orienting plan. ``progress`` (a function of one line of text) hears
+        about each level and, at most every few seconds, how far each stage
+        of a level has got (:class:`pipeline.progress.Heartbeat`)."""
         t0 = time.perf_counter()
         result = FixedSearch([], [], int(depth), self.tolerance, self.required,
                              confidence=self.confidence, rule=self.rule)
@@ -325,12 +328,16 @@ class FixedPinSearch:
             empty = self.tree.root()
             result.resting = next(self._judge(empty, np.array([0]),
                                               self._stack(self._trials(0))))
-        for level in self.tree.levels(int(depth), root):
+        def enumeration(length, n):
+            return Heartbeat(f"{self._name(len(self.prefix.labels) + length)}: nominal paths", n,
+                             "candidate sequence", progress)
+
+        for level in self.tree.levels(int(depth), root, enumeration):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
-            found, judged, record = self._level(level, candidates)
+            found, judged, record = self._level(level, candidates, progress)
             result.levels.append({"pins": n_pins, **record})
             if progress:
-                progress(f"{n_pins} fixed pin(s): {record['sequences']} sequences, "
+                progress(f"{self._name(n_pins)}: {record['sequences']} sequences, "
                          f"{record['nominal_within']} within {self.tolerance:g} deg nominally, "
                          f"{record['judged']} replayed in full, {record['orienting']} orient the part")
             runners_up.extend(judged)
@@ -340,11 +347,18 @@ class FixedPinSearch:
             levels.append(level)
         if not result.plans:  # the evidence: the best several-set results of every level
             for level in levels:
-                runners_up.extend(self._several_sets(level, min(candidates, EVIDENCE_PER_LEVEL)))
+                runners_up.extend(self._several_sets(level, min(candidates, EVIDENCE_PER_LEVEL), progress))
             result.best_effort = self.ranked(_distinct(runners_up))[:keep]
         result.rollouts = self.tree.rollouts
         result.seconds = time.perf_counter() - t0
         return result
+
+    def _name(self, n_pins: int) -> str:
+        """A level of the search for people: ``3 fixed pin(s)``, or its moving pins after the prefix."""
+        if not self.speeds.any():
+            return f"{n_pins} fixed pin(s)"
+        after = " ".join(self.prefix.labels) or "no fixed pin"
+        return f"{n_pins - len(self.prefix.labels)} moving pin(s) after {after}"
 
     def ranked(self, plans) -> list:
         """``plans`` best first (:func:`robust_order` with ``planner.width_slack_deg``)."""
@@ -366,8 +380,9 @@ class FixedPinSearch:
 
     # ------------------------------------------------------------------ one level
 
-    def _level(self, level, candidates):
-        """``(orienting plans, every judged plan, the level's counts)``."""
+    def _level(self, level, candidates, progress=None):
+        """``(orienting plans, every judged plan, the level's counts)``; each
+        stage tells ``progress`` how far it has got."""
         record = {"sequences": level.size, "nominal_within": 0, "screened_out": 0, "judged": 0,
                   "orienting": 0, "not_screened": 0, "held_out": 0, "certified": 0}
         if level.size == 0:
@@ -386,22 +401,45 @@ class FixedPinSearch:
             return [], [], record
         # A probe of a few trials per state orders the candidates (most promising
         # first) and already rejects the hopeless ones.
-        probe_fails = self._failures(level, within, self._screen_rows(inputs, *PROBE))
+        name = self._name(n_pins)
+        with Heartbeat(f"{name}: first screen", within.size, "sequence", progress) as beat:
+            probe_fails = self._failures(level, within, self._screen_rows(inputs, *PROBE),
+                                         beat.stretch(0, within.size))
         order = within[probe_fails <= allowed][np.argsort(probe_fails[probe_fails <= allowed], kind="stable")]
         record["screened_out"] = int(within.size - order.size)
+        with Heartbeat(f"{name}: screening and judging", order.size, "sequence", progress) as beat:
+            found, found_idx, judged = self._screen_and_judge(level, order, inputs, allowed, span, candidates,
+                                                              record, beat)
+        record["judged"], record["orienting"] = len(judged), len(found)
+        certified = self._certify(level, found, np.asarray(found_idx, dtype=int), n_pins,
+                                  Heartbeat(f"{name}: held-out trials", len(found), "sequence", progress))
+        record["held_out"], record["certified"] = len(found), len(certified)
+        return certified, judged, record
+
+    def _screen_and_judge(self, level, order, inputs, allowed, span, candidates, record, beat):
+        """Screen the sequences ``order`` (level rows, most promising first) in
+        blocks of ``SCREEN_BLOCK`` and judge the survivors on all the trials
+        ``inputs``, until ``candidates`` are judged and one orients;
+        ``(orienting plans, their rows, every judged plan)``. Adds the
+        screened-out and not-screened counts to ``record``; ``beat`` is
+        ticked with the sequences done."""
         screen, full = self._screen_rows(inputs, *SCREEN), self._stack(inputs)
+        share = screen[0].size / (screen[0].size + full[0].size)  # the screen's share of a block's work
         found, found_idx, judged = [], [], []
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
         done = 0
         while done < order.size and not (found and len(judged) >= candidates):
             block = order[done:done + SCREEN_BLOCK]
-            done += block.size
-            fails = self._failures(level, block, screen)
+            fails = self._failures(level, block, screen, beat.stretch(done, done + share * block.size))
             alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
             record["screened_out"] += int(block.size - alive.size)
+            judging = beat.stretch(done + share * block.size, done + block.size)
+            done += block.size
             for start in range(0, alive.size, step):
                 chunk = alive[start:start + step]
-                for idx, verdict in zip(chunk, self._judge(level, chunk, full)):
+                verdicts = self._judge(level, chunk, full, stretch=judging.part(
+                    start / alive.size, (start + chunk.size) / alive.size))
+                for idx, verdict in zip(chunk, verdicts):
                     plan = self._plan(level, idx, span[idx], verdict)
                     judged.append(plan)
                     if verdict["orients"] and self._holds_for_family(plan):
@@ -409,28 +447,31 @@ class FixedPinSearch:
                         found_idx.append(idx)
                 if found and len(judged) >= candidates:
                     break
-        record["judged"], record["orienting"] = len(judged), len(found)
+            beat.tick(done)
         record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
-        certified = self._certify(level, found, np.asarray(found_idx, dtype=int), n_pins)
-        record["held_out"], record["certified"] = len(found), len(certified)
-        return certified, judged, record
+        if done < order.size:
+            beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
+        return found, found_idx, judged
 
-    def _certify(self, level, found, idx, n_pins) -> list:
+    def _certify(self, level, found, idx, n_pins, beat: Heartbeat) -> list:
         """The plans of ``found`` (level rows ``idx``) whose verdict on the held-out
         trials orients the part; each plan's ``verdict`` becomes its held-out
         verdict (with the width's bootstrap interval) and ``selection`` keeps
-        the verdict on the trials that chose it."""
+        the verdict on the trials that chose it. ``beat`` hears how far it got."""
         if not found:
             return []
         rows = self._stack(trial_inputs(self.states, self.mu_c, n_pins, self.holdout, self.family))
         out = []
         step = max(1, MAX_ROWS // rows[0].size)
-        for start in range(0, idx.size, step):
-            chunk = idx[start:start + step]
-            for plan, held in zip(found[start:start + step], self._judge(level, chunk, rows, interval=True)):
-                plan.selection, plan.verdict = plan.verdict, held
-                if held["orients"]:
-                    out.append(plan)
+        with beat:
+            for start in range(0, idx.size, step):
+                chunk = idx[start:start + step]
+                verdicts = self._judge(level, chunk, rows, interval=True,
+                                       stretch=beat.stretch(start, start + chunk.size))
+                for plan, held in zip(found[start:start + step], verdicts):
+                    plan.selection, plan.verdict = plan.verdict, held
+                    if held["orients"]:
+                        out.append(plan)
         return out
 
     def _holds_for_family(self, plan: FixedPlan) -> bool:
@@ -473,8 +514,9 @@ class FixedPinSearch:
     def _stack(rows):
         return tuple(np.concatenate([r[k] for r in rows]) for k in range(5))
 
-    def _replay(self, level, idx, rows):
-        """Final orientations ``(len(idx), trials)`` and jam flags of plans ``idx`` on ``rows``."""
+    def _replay(self, level, idx, rows, stretch: Stretch = SILENT):
+        """Final orientations ``(len(idx), trials)`` and jam flags of plans ``idx`` on ``rows``
+        (``stretch`` is told how far the replay has got)."""
         th, yc, mu, offs, sup = rows
         n_trials, n_plans = th.size, idx.size
         pre = self.prefix
@@ -485,32 +527,34 @@ class FixedPinSearch:
                                np.repeat(speeds, n_trials, axis=0), np.tile(th, n_plans), np.tile(yc, n_plans),
                                np.tile(mu, n_plans), np.tile(offs, (n_plans, 1)), self.pin_radius,
                                self.model, self.kernel["ds_max"], self.kernel["tol"], **self.belt,
-                               support=np.tile(sup, n_plans), supports=self.supports)
+                               support=np.tile(sup, n_plans), supports=self.supports, stretch=stretch)
         return tf.reshape(n_plans, n_trials), (jam != "").reshape(n_plans, n_trials)
 
-    def _failures(self, level, idx, rows):
-        """Trials of ``rows`` that no one arc of the tolerance can hold, per plan."""
+    def _failures(self, level, idx, rows, stretch: Stretch = SILENT):
+        """Trials of ``rows`` that no one arc of the tolerance can hold, per plan
+        (``stretch`` is told the share of plans done)."""
         out = np.empty(idx.size, dtype=int)
         step = max(1, MAX_ROWS // rows[0].size)
         for start in range(0, idx.size, step):
             chunk = idx[start:start + step]
-            tf, jam = self._replay(level, chunk, rows)
+            tf, jam = self._replay(level, chunk, rows,
+                                   stretch.part(start / idx.size, (start + chunk.size) / idx.size))
             for k in range(chunk.size):
                 held, _ = orient.best_arc(tf[k][~jam[k]], self.tolerance, self.order)
                 out[start + k] = rows[0].size - held
         return out
 
-    def _judge(self, level, idx, rows, interval: bool = False):
-        tf, jam = self._replay(level, idx, rows)
+    def _judge(self, level, idx, rows, interval: bool = False, stretch: Stretch = SILENT):
+        tf, jam = self._replay(level, idx, rows, stretch)
         for k in range(idx.size):
             yield orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order, self.required,
                                self.confidence, interval, self.rule)
 
     # ------------------------------------------------------------------ when nothing orients
 
-    def _several_sets(self, level, candidates):
+    def _several_sets(self, level, candidates, progress=None):
         """The level's sequences whose nominal finals fall into the fewest
-        clusters (gaps over the tolerance), judged in full."""
+        clusters (gaps over the tolerance), judged in full (telling ``progress``)."""
         if level.size == 0:
             return []
         period = 360.0 / self.order
@@ -519,6 +563,9 @@ class FixedPinSearch:
         clusters = np.maximum(1, (gaps > self.tolerance).sum(axis=1))
         spread = period - gaps.max(axis=1)
         best = np.lexsort((-level.margin, spread, clusters))[:candidates]
-        inputs = self._trials(len(self.prefix.labels) + level.seq.shape[1])
-        verdicts = self._judge(level, best, self._stack(inputs))
-        return [self._plan(level, i, spread[i], v) for i, v in zip(best, verdicts)]
+        n_pins = len(self.prefix.labels) + level.seq.shape[1]
+        inputs = self._trials(n_pins)
+        with Heartbeat(f"{self._name(n_pins)}: judging the fewest-set sequences for the evidence", best.size,
+                       "sequence", progress) as beat:
+            verdicts = self._judge(level, best, self._stack(inputs), stretch=beat.stretch(0, best.size))
+            return [self._plan(level, i, spread[i], v) for i, v in zip(best, verdicts)]

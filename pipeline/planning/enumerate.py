@@ -40,6 +40,7 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from pipeline.parts.part import Part
 from pipeline.planning.verify import rollouts_by_speed
+from pipeline.progress import SILENT, Heartbeat, Stretch
 
 QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout
 MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
@@ -110,35 +111,45 @@ class NominalTree:
         return Level(np.zeros((1, 0), dtype=np.int16), states[None, :, 0].copy(),
                      states[None, :, 1].copy(), np.full(1, np.inf))
 
-    def levels(self, depth: int, root: Level | None = None):
+    def levels(self, depth: int, root: Level | None = None, heartbeat=None):
         """Yield the levels of lengths 1 to ``depth`` after ``root`` (default
-        :meth:`root`) in turn (lazily, so a search may stop early)."""
+        :meth:`root`) in turn (lazily, so a search may stop early).
+
+        ``heartbeat(length, n)``, if given, returns the
+        :class:`~pipeline.progress.Heartbeat` that the enumeration of the
+        ``n`` sequences of ``length`` pins after ``root`` reports to."""
+        heartbeat = heartbeat or (lambda length, n: Heartbeat("", n))
         level = self.root() if root is None else root
         for _ in range(depth):
-            level = self.extend(level)
+            n = level.size * self.heights.size
+            with heartbeat(level.seq.shape[1] + 1, n) as beat:
+                level = self.extend(level, beat.stretch(0, n))
             yield level
             if level.size == 0:
                 return
 
-    def extend(self, level: Level) -> Level:
+    def extend(self, level: Level, stretch: Stretch = SILENT) -> Level:
         """Every surviving sequence of ``level`` followed by every candidate pin
-        (in chunks of parents, so memory stays bounded on long levels)."""
+        (in chunks of parents, so memory stays bounded on long levels);
+        ``stretch`` is told the share of parents done."""
         per_parent = max(1, self.heights.size * level.theta.shape[1])
         step = max(1, MAX_PAIRS // per_parent)
         if level.size <= step:
-            return self._extend(level)
+            return self._extend(level, stretch)
         parts = [self._extend(Level(level.seq[i:i + step], level.theta[i:i + step], level.y[i:i + step],
-                                    level.margin[i:i + step])) for i in range(0, level.size, step)]
+                                    level.margin[i:i + step]),
+                              stretch.part(i / level.size, min(i + step, level.size) / level.size))
+                 for i in range(0, level.size, step)]
         return Level(*(np.concatenate([getattr(p, k) for p in parts])
                        for k in ("seq", "theta", "y", "margin")))
 
-    def _extend(self, level: Level) -> Level:
+    def _extend(self, level: Level, stretch: Stretch = SILENT) -> Level:
         n_pins, n = self.heights.size, level.size
         theta = np.repeat(level.theta, n_pins, axis=0)
         y_c = np.repeat(level.y, n_pins, axis=0)
         y_pin = np.tile(self.heights, n)[:, None]
         v_pin = np.broadcast_to(np.tile(self.speeds, n)[:, None], theta.shape)
-        status, theta_f, dy = self._rollouts(theta, y_pin - y_c, v_pin)
+        status, theta_f, dy = self._rollouts(theta, y_pin - y_c, v_pin, stretch)
         touched = status != MISS
         d_abs = np.abs(y_pin - y_c) / self.part.a
         bad = ((status == JAMMED) | (status == TRUNCATED)).any(axis=1)
@@ -151,10 +162,10 @@ class NominalTree:
         margin = np.minimum(np.repeat(level.margin, n_pins), step_margin)
         return Level(seq[keep], theta_f[keep], (y_c + dy)[keep], margin[keep])
 
-    def _rollouts(self, theta, dy_pin, v_pin):
+    def _rollouts(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT):
         """``(status, theta_f, dy)`` arrays shaped like ``theta`` for the pin offsets
         ``dy_pin`` (mm) and pin speeds ``v_pin``, one rollout per distinct
-        quantised pose and speed."""
+        quantised pose and speed (``stretch`` is told the share done)."""
         a = self.part.a
         speed_index = np.searchsorted(np.unique(self.speeds), v_pin)
         support = np.broadcast_to(self.column_support[None, :], theta.shape)
@@ -168,7 +179,7 @@ class NominalTree:
         # Roll out from the rounded pose itself, so an outcome depends on its key only.
         res = rollouts_by_speed(self.part, uniq[:, 0] * QUANTUM, uniq[:, 1] * QUANTUM / a,
                                 np.full(uniq.shape[0], self.mu_c), np.unique(self.speeds)[uniq[:, 2]],
-                                self.pin_radius, self.model, self.kernel, uniq[:, 3], self.supports)
+                                self.pin_radius, self.model, self.kernel, uniq[:, 3], self.supports, stretch)
         self.rollouts += uniq.shape[0]
         shape = theta.shape
         return (res["status"][inverse].reshape(shape), res["theta_f"][inverse].reshape(shape),

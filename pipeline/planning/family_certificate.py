@@ -30,6 +30,7 @@ from pipeline.planning.confidence import DEFAULT_CONFIDENCE, share_upper_bound
 from pipeline.planning.propagate import resting_states
 from pipeline.planning.verify import perturbed_batch, replay
 from pipeline.planning.worst_member import JAM_SCORE, member_space, outside
+from pipeline.progress import SILENT, Heartbeat, Stretch
 
 MIN_FRESH_MEMBERS = 300
 FRESH_TRIALS = 4  # perturbed trials per member and resting state (besides the nominal one)
@@ -46,10 +47,12 @@ def fresh_members(part, family, n: int, seed: int) -> list:
     return out + list(space.fixed)
 
 
-def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIALS, seed: int = 0):
+def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIALS, seed: int = 0,
+                 stretch: Stretch = SILENT):
     """Final orientations ``(members, states * (1 + trials))`` and jam flags of
     every member, each from every resting state nominally and with ``trials``
-    perturbed starts (the verification's perturbation box)."""
+    perturbed starts (the verification's perturbation box); ``stretch`` is
+    told how far the replay has got."""
     rng = np.random.default_rng([int(seed), 35])
     n_pins = len(heights)
     rows = []
@@ -63,21 +66,24 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
     kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
     tf, _, jam, _ = replay(part, list(heights), list(speeds) or [0.0] * n_pins, th, yc, mu, offs,
                            st.pin_radius, st.model, **kw, support=sup,
-                           supports=[None if m.is_uniform else m for m in members])
+                           supports=[None if m.is_uniform else m for m in members], stretch=stretch)
     order = np.argsort(sup, kind="stable")
     per = th.size // len(members)
     return tf[order].reshape(len(members), per), (jam[order] != "").reshape(len(members), per)
 
 
 def family_certificate(part, heights, family, check: dict, st, n_members: int = MIN_FRESH_MEMBERS,
-                       speeds=(), confidence: float = DEFAULT_CONFIDENCE) -> dict:
+                       speeds=(), confidence: float = DEFAULT_CONFIDENCE, progress=None) -> dict:
     """The certificate of a plan (pins at ``heights``) for ``family`` given its
     worst-member ``check`` (:func:`~pipeline.planning.worst_member.check_plan_for_family`);
-    a JSON-ready dict (see the module docstring)."""
+    a JSON-ready dict (see the module docstring). ``progress`` hears how far
+    the fresh members' replay has got."""
     n_members = max(int(n_members), MIN_FRESH_MEMBERS)
     period = 360.0 / part.symmetry_order()
     members = fresh_members(part, family, n_members, st.seed)
-    tf, jam = fresh_replay(part, heights, members, st, speeds, seed=st.seed)
+    with Heartbeat(f"fresh members of {family.label}", len(members), "member", progress) as beat:
+        tf, jam = fresh_replay(part, heights, members, st, speeds, seed=st.seed,
+                               stretch=beat.stretch(0, len(members)))
     arc = check.get("set_deg")
     dist = np.where(jam, JAM_SCORE, outside(tf, tuple(arc), period)) if arc else np.full(tf.shape, JAM_SCORE)
     leaving = int(np.sum(dist.max(axis=1) > 0.0))

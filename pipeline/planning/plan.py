@@ -45,6 +45,7 @@ from pipeline.planning.settings import candidate_pins, friction_label, parse_fri
 from pipeline.planning.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import holdout_settings, verify_plan
+from pipeline.progress import SILENT, Heartbeat
 
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
@@ -113,19 +114,18 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
     depth = int(depth if depth is not None else config["planner"]["depth"])
     family = None if family is None or family.is_uniform else family
     planner = planner_for(part, config, mu_c, lattices)
-    checker = family_checker(part, config, mu_c, family)
+    checker = family_checker(part, config, mu_c, family, progress)
     fixed = _fixed_search(part, config, mu_c, planner, depth, keep, progress, family, checker)
     verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
     # No pin is the plan with the fewest pins: then nothing is certified or recommended.
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
-    candidates = [carried_plan(planner, p.labels, p.margin, verify_cfg, family) for p in chosen]
+    candidates = _carried(planner, chosen, verify_cfg, family, progress)
     selections = [p.selection or p.verdict for p in chosen]
     moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, config, mu_c, planner)
     moving_search = None
     if moving is not None:
         moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress, family, checker)
-        candidates += [carried_plan(moving, p.labels, p.margin, verify_cfg, family)
-                       for p in moving_search.plans]
+        candidates += _carried(moving, moving_search.plans, verify_cfg, family, progress)
         selections += [p.selection or p.verdict for p in moving_search.plans]
         planner = moving
     states = resting_states(part)
@@ -139,6 +139,24 @@ def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None 
         result["support_family"] = family.to_dict()
         certify_for_family(result, part, config, mu_c, family, checker, good)
     return result
+
+
+def _carried(planner, chosen, verify_cfg: dict, family, progress) -> list:
+    """The carried sets of each chosen plan (``certify.carried_plan``), telling
+    ``progress`` how many are done (and, between the propagation's rollout
+    batches, that it is still at it)."""
+    out = []
+    with Heartbeat("carried sets of the chosen plans", len(chosen), "plan", progress) as beat:
+        try:
+            for p in chosen:
+                for lattice in planner.lattices.values():
+                    lattice.stretch = beat.stretch(len(out), len(out))
+                out.append(carried_plan(planner, p.labels, p.margin, verify_cfg, family))
+                beat.tick(len(out))
+        finally:
+            for lattice in planner.lattices.values():
+                lattice.stretch = SILENT
+    return out
 
 
 def planner_tolerance(config: dict) -> float:
@@ -228,7 +246,8 @@ def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=No
             total.skipped.append({"after": after,
                                   "why": f"a plan of {len(after) + room} pins already orients the part"})
             continue
-        res = search.run(room, candidates=int(pc.get("candidates", 12)), keep=keep, prefix=prefix)
+        res = search.run(room, candidates=int(pc.get("candidates", 12)), keep=keep, progress=progress,
+                         prefix=prefix)
         total.plans += res.plans
         total.levels += [dict(lv, after=after) for lv in res.levels]
         total.rollouts += res.rollouts
@@ -275,11 +294,12 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
     confidence, rule = verify_confidence(config), verify_rule(config)
     selections = list(selections or []) + [None] * len(candidates)
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
-    for plan, selection in zip(candidates, selections):
+    beat = Heartbeat("verifying the chosen plans on held-out trials", len(candidates), "plan", progress).start()
+    for k, (plan, selection) in enumerate(zip(candidates, selections)):
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
                           config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
                           kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
-                          mu_s=planner.mu_s, family=family)
+                          mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1))
         verdict = judge_verification(res, tolerance, planner.order, required, confidence, rule)
         plan.verification = {"held_out": True, "seed": verify_cfg["seed"],
                              "trials": res["trials"], "successes": res["successes"],
@@ -292,6 +312,7 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
         if progress:
             progress(f"mu_c {friction_label(mu_c)}: verified {' '.join(plan.pins)} on held-out trials: "
                      + describe_claim(verdict))
+    beat.finish()
 
 
 def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance: float,
@@ -469,12 +490,13 @@ def _labelled(progress, label: str):
 
 # ---------------------------------------------------------------------- support families: the family's edge
 
-def family_checker(part: Part, config: dict, mu_c, family) -> FamilyChecker | None:
+def family_checker(part: Part, config: dict, mu_c, family, progress=None) -> FamilyChecker | None:
     """The worst-member check for plans for ``family`` (None without a family),
-    with the planner's verification settings and ``planner.worst_member_budget``."""
+    with the planner's verification settings and ``planner.worst_member_budget``;
+    each search tells ``progress`` how far it has got."""
     if family is None or family.is_uniform:
         return None
-    return FamilyChecker(part, family, FamilyCheckSettings.from_config(config, mu_c))
+    return FamilyChecker(part, family, FamilyCheckSettings.from_config(config, mu_c), progress)
 
 
 def judge_for_family(candidates, checker: FamilyChecker | None) -> None:
@@ -506,7 +528,7 @@ def certify_for_family(result: dict, part: Part, config: dict, mu_c, family, che
     check = rec and rec.verification.get("family_check")
     if check and check["holds"]:
         cert = family_certificate(part, rec.pin_heights_mm, family, check, checker.settings,
-                                  speeds=rec.pin_speeds)
+                                  speeds=rec.pin_speeds, progress=checker.progress)
         result["family_certificate"] = cert
         result["recommended"]["family_certificate"] = cert
         return

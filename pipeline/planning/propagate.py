@@ -50,6 +50,7 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import arc_within, merge_arcs
+from pipeline.progress import SILENT
 
 # Lattice units: theta in 1/64 deg, d in 1/3200, mu in 1/1600.
 UNITS = (1.0 / 64.0, 1.0 / 3200.0, 1.0 / 1600.0)
@@ -161,7 +162,9 @@ class OutcomeLattice:
     ``belt_speed`` (mm/s) and ``mu_s`` select the dynamic model
     (``kernels.dynamic``) at that belt speed; ``belt_speed=None`` is the
     quasi-static ``model``. ``known`` maps integer lattice keys to
-    ``(status, theta_f_deg, dy)``.
+    ``(status, theta_f_deg, dy)``. ``stretch`` (a
+    :class:`pipeline.progress.Stretch`, default silent) is ticked while a
+    batch is computed, so the stage that asked for it shows it is moving.
     """
 
     def __init__(self, part: Part, model: str, pin_radius: float, v_pin: float = 0.0,
@@ -175,6 +178,7 @@ class OutcomeLattice:
         self.known: dict[tuple[int, int, int], tuple[int, float, float]] = {}
         self.n_computed = 0
         self.n_stored = 0
+        self.stretch = SILENT
 
     def ensure(self, keys) -> None:
         """Compute every key not yet known, in one parallel batch."""
@@ -192,7 +196,7 @@ class OutcomeLattice:
             kw["tol"] = self.tol
         res = simulate.rollout_points(self.part, arr[:, 0] * UNITS[0], arr[:, 1] * UNITS[1],
                                       arr[:, 2] * UNITS[2], self.pin_radius, self.model,
-                                      v_pin=self.v_pin, **kw)
+                                      v_pin=self.v_pin, **kw, stretch=self.stretch)
         for key, st, tf, dy in zip(todo, res["status"], res["theta_f"], res["dy"]):
             self.known[key] = (int(st), float(tf), float(dy))
         self.n_computed += len(todo)

@@ -25,6 +25,7 @@ from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import in_arc
+from pipeline.progress import SILENT, Heartbeat, Stretch, prefixed
 
 DEFAULT_SPEEDS = (10.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
 
@@ -71,14 +72,15 @@ def _draws(part, pin_heights, states, mu_c, perturb, trials, seed):
 
 
 def success_fraction(part: Part, pin_heights, pin_speed_ratios, draws, final_arcs, belt_speed,
-                     mu_s=0.5, r_pin=1.0, threads=None):
+                     mu_s=0.5, r_pin=1.0, threads=None, stretch: Stretch = SILENT):
     """Fraction of the drawn trials that end in the final arcs at ``belt_speed``.
 
     Every trial of every initial state is rolled past pin 1, then the
     survivors past pin 2, and so on, one parallel batch per pin
     (``kernels.dynamic._dyn_rollout_points`` through
     :func:`pipeline.maps.simulate.rollout_points`); a jammed or truncated passage
-    fails the trial, a miss leaves the part as it was.
+    fails the trial, a miss leaves the part as it was. ``stretch`` is told
+    how far the trials have got, each pin an equal share.
     """
     from kernels.dynamic import JAMMED, TRUNCATED
 
@@ -95,7 +97,8 @@ def success_fraction(part: Part, pin_heights, pin_speed_ratios, draws, final_arc
             break
         d_k = contact_parameter(pins[idx, k], y_c[idx], part.a)
         res = rollout_points(part, theta[idx], d_k, mu[idx], r_pin, "dynamic", v_pin=float(v_pin),
-                             threads=threads, belt_speed=float(belt_speed), mu_s=float(mu_s))
+                             threads=threads, belt_speed=float(belt_speed), mu_s=float(mu_s),
+                             stretch=stretch.part(k / len(pin_speed_ratios), (k + 1) / len(pin_speed_ratios)))
         stuck = (res["status"] == JAMMED) | (res["status"] == TRUNCATED)
         alive[idx[stuck]] = False
         theta[idx] = res["theta_f"]
@@ -106,7 +109,7 @@ def success_fraction(part: Part, pin_heights, pin_speed_ratios, draws, final_arc
 
 def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final_arcs, mu_c,
                 mu_s=0.5, perturb=None, trials=300, speeds=DEFAULT_SPEEDS, resolution=5.0,
-                required=0.99, r_pin=1.0, seed=0):
+                required=0.99, r_pin=1.0, seed=0, progress=None):
     """Success fraction against belt speed and the plan's speed limit.
 
     Parameters
@@ -123,6 +126,8 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
     trials : random trials per initial state (plus its four corners).
     speeds : coarse grid of belt speeds, mm/s (capped where the pin would
         throw the part, see ``checks.FROUDE_MAX``).
+    progress : takes a line per belt speed tried and, while its trials run,
+        how far they have got (default: :func:`pipeline.progress.reporting`'s).
 
     Returns
     -------
@@ -144,15 +149,18 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
     draws = _draws(part, pin_heights, initial_states, mu_c, perturb, trials, seed)
     curve = {}
 
+    n_trials = int(sum(d[0].size for d in draws))
+
     def frac(v):
         if v not in curve:
-            curve[v] = success_fraction(part, pin_heights, pin_speed_ratios, draws, final_arcs, v,
-                                        mu_s, r_pin)
+            with Heartbeat(f"speed limit: belt at {v:g} mm/s", n_trials, "trial", progress) as beat:
+                curve[v] = success_fraction(part, pin_heights, pin_speed_ratios, draws, final_arcs, v,
+                                            mu_s, r_pin, stretch=beat.stretch(0, n_trials))
         return curve[v]
 
     limit = _speed_limit(frac, grid, required, resolution)
     return {"curve": [[v, curve[v]] for v in sorted(curve)], "speed_limit_mm_s": float(limit),
-            "trials_per_speed": int(sum(d[0].size for d in draws)),
+            "trials_per_speed": n_trials,
             "seconds": round(time.perf_counter() - start_time, 2)}
 
 
@@ -188,7 +196,7 @@ def _speed_limit(frac, grid, required, resolution) -> float:
 
 def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: float = 0.5,
                       trials: int = 300, speeds=DEFAULT_SPEEDS, resolution: float = 5.0,
-                      required: float = 0.99, seed: int = 0) -> dict:
+                      required: float = 0.99, seed: int = 0, progress=None) -> dict:
     """The speed curve and speed limit of a stored tight plan (a plan file's
     ``tight`` entry, see :func:`pick_tight_plan`; ``result`` a
     :class:`~pipeline.planning.types.PlanFile` or its dict), with the verify stage's
@@ -200,6 +208,7 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
     ``required``, ``speed_limit_mm_s``, ``curve`` (rows of speed in mm/s and
     success fraction), ``planned_belt_speed`` (``None``: planned
     quasi-static), ``trials``, ``trials_per_speed``, ``seconds`` and ``method``.
+    ``progress`` hears about each belt speed tried (:func:`speed_curve`).
     """
     from pipeline.planning.family_certificate import family_assumption
     from pipeline.planning.plan import pick_tight_plan
@@ -218,7 +227,7 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
     res = speed_curve(part, chosen.pin_heights_mm, chosen.pin_speeds, states, arcs, mu_c,
                       mu_s=mu_s, perturb=perturb, trials=trials, speeds=speeds,
                       resolution=resolution, required=required,
-                      r_pin=config["sweep"]["pin_radius"], seed=seed)
+                      r_pin=config["sweep"]["pin_radius"], seed=seed, progress=progress)
     return {"part": part.name, "pin_labels": list(chosen.pins),
             "pin_heights_mm": list(chosen.pin_heights_mm),
             "pin_speeds": list(chosen.pin_speeds),
@@ -267,7 +276,9 @@ def attach_speed_limits(result: dict, config: dict) -> dict:
     that the report, ``pinfeed speed`` and ``pinfeed layout`` show one figure
     per plan. A plan whose speed limit cannot be computed (a part any grid
     speed would throw) gets none: the speed stage then says why. Returns
-    ``result`` (changed in place)."""
+    ``result`` (changed in place). The belt speeds tried go to the progress
+    report of :func:`pipeline.progress.reporting`, labelled with the friction
+    and the plan's number."""
     tight = result.get("tight") or []
     if not tight or not tight[0]["plans"]:
         return result
@@ -276,7 +287,8 @@ def attach_speed_limits(result: dict, config: dict) -> dict:
     fixed = [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.get("pin_speeds") or ())]
     for number in sorted({1, *fixed[:1]}):
         try:
-            record = stored_plan_speed(result, config, plan=number, **settings)
+            record = stored_plan_speed(result, config, plan=number, **settings,
+                                       progress=prefixed(f"mu_c {entry['friction']}: plan {number}"))
         except PinfeedError:
             continue
         record.pop("seconds", None)  # a timing would make the same plan differ between runs

@@ -30,6 +30,7 @@ from pipeline.maps import simulate
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.arcs import in_arc, merge_arcs
+from pipeline.progress import SILENT, Stretch
 
 PERTURB_DEFAULTS = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 DEFAULTS = {"trials": 300, "corners": True, **PERTURB_DEFAULTS, "seed": 1}
@@ -163,7 +164,7 @@ def _start(state):
 
 def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
            ds_max=DEFAULT_DS_MAX, tol=DEFAULT_TOL, path=None, belt_speed=None, mu_s=0.5,
-           support=None, supports=None):
+           support=None, supports=None, stretch: Stretch = SILENT):
     """Roll every trial past every pin in turn (batched per pin).
 
     ``belt_speed`` (mm/s) replays with the dynamic model at that speed and
@@ -176,7 +177,9 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
 
     Returns ``(theta_f, y_c, jam_reason_or_empty, missed)``: arrays over trials,
     ``missed`` a boolean array ``(n_trials, n_pins)``. If ``path`` is a list,
-    ``(theta, y_c)`` arrays after each pin are appended to it."""
+    ``(theta, y_c)`` arrays after each pin are appended to it. ``stretch``
+    (:class:`pipeline.progress.Stretch`) is told how far the replay has got,
+    each pin an equal share."""
     theta, y_c = np.array(theta, float), np.array(y_c, float)
     n = theta.size
     n_pins = np.shape(pin_speeds)[-1] if np.ndim(pin_speeds) else 0
@@ -194,7 +197,8 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
         d = contact_parameter(heights[idx, k] + offsets[idx, k], y_c[idx], part.a)
         res = rollouts_by_speed(part, theta[idx], d, mu[idx], speeds[idx, k], pin_radius,
                                  model if belt_speed is None else "dynamic", kw,
-                                 None if support is None else support[idx], supports)
+                                 None if support is None else support[idx], supports,
+                                 stretch.part(k / n_pins, (k + 1) / n_pins))
         st = res["status"]
         stuck = (st == JAMMED) | (st == TRUNCATED)
         for j in np.flatnonzero(stuck):
@@ -209,29 +213,31 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
 
 
 def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw, support=None,
-                      supports=None) -> dict:
+                      supports=None, stretch: Stretch = SILENT) -> dict:
     """``simulate.rollout_points`` for rows whose pins may move at different
     speeds ``v_pin`` and, with ``support`` (an index per row into
     ``supports``), rest on different supports: one batch per (speed,
-    support), results in row order."""
+    support), results in row order. ``stretch`` is told the share of rows
+    done."""
     v_pin = np.broadcast_to(np.asarray(v_pin, dtype=float), theta.shape)
     supports = supports or [None]
     support = np.zeros(theta.size, int) if support is None else np.asarray(support, dtype=int)
     groups, group_of = np.unique(np.column_stack([v_pin, support]), axis=0, return_inverse=True)
     group_of = group_of.ravel()
 
-    def batch(rows, g):
+    def batch(rows, g, share):
         v, s = groups[g]
         extra = {} if supports[int(s)] is None else {"support": supports[int(s)]}
         return simulate.rollout_points(part, theta[rows], d[rows], mu[rows], pin_radius, model,
-                                       v_pin=float(v), **kw, **extra)
+                                       v_pin=float(v), **kw, **extra, stretch=share)
 
     if len(groups) == 1:
-        return batch(np.arange(theta.size), 0)
-    out = None
+        return batch(np.arange(theta.size), 0, stretch)
+    out, before = None, 0
     for g in range(len(groups)):
         rows = np.flatnonzero(group_of == g)
-        res = batch(rows, g)
+        res = batch(rows, g, stretch.part(before / theta.size, (before + rows.size) / theta.size))
+        before += rows.size
         if out is None:
             out = {key: np.empty(theta.size, dtype=arr.dtype) for key, arr in res.items()}
         for key, arr in res.items():
@@ -239,10 +245,21 @@ def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw, support=
     return out
 
 
+def _failure(jammed: str, theta_f: float, finals, missed, expected) -> str | None:
+    """Why a trial failed (``None``: it ended in a predicted set): its jam, a pin
+    it missed where the plan expected a contact, else another band."""
+    if jammed:
+        return jammed
+    if any(in_arc(theta_f, s, w, 1e-6) for s, w in finals):
+        return None
+    return "missed a pin" if any(m and e for m, e in zip(missed, expected)) else "other band"
+
+
 def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, pin_radius: float,
                 model: str = "minpower", settings: dict | None = None,
                 speeds: dict | None = None, kernel: dict | None = None,
-                belt_speed: float | None = None, mu_s: float = 0.5, family=None) -> dict:
+                belt_speed: float | None = None, mu_s: float = 0.5, family=None,
+                stretch: Stretch = SILENT) -> dict:
     """Run the trials for a stored plan (``to_dict()`` of a plan).
 
     ``family`` (a :class:`~pipeline.parts.support_family.SupportFamily`)
@@ -258,7 +275,8 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     pin position shifts a moving pin's whole path. ``initial_states`` maps
     labels to ``(theta_deg, y_c_mm)``. ``mu_c`` is a value or a range
     ``(lo, hi)``. Returns per-state counts (``rows``), totals and every
-    trial's outcome."""
+    trial's outcome. ``stretch`` (:class:`pipeline.progress.Stretch`) is told
+    how far the trials have got, each initial state an equal share."""
     speeds = speeds or {}
     cfg = dict(DEFAULTS, **(settings or {}))
     kernel = kernel or {}
@@ -268,21 +286,19 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     rows, trials = [], []
     inputs = trial_inputs(initial_states, mu_c, len(labels), cfg, family)
     supports = None if family is None else family.kernel_supports
-    for (label, state), (th, yc, mu, offs, sup) in zip(initial_states.items(), inputs):
+    for i, ((label, state), (th, yc, mu, offs, sup)) in enumerate(zip(initial_states.items(), inputs)):
         theta0, yc0 = _start(state)
         tf, yf, jam, missed = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
                                      kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL),
-                                     belt_speed=belt_speed, mu_s=mu_s, support=sup, supports=supports)
+                                     belt_speed=belt_speed, mu_s=mu_s, support=sup, supports=supports,
+                                     stretch=stretch.part(i / len(inputs), (i + 1) / len(inputs)))
         finals = predicted_sets(plan, label)
         first = plan.get("initial_sets", {}).get(label)
         start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)
         expected = [_expects_contact(plan, label, k, start_arc) for k in range(len(labels))]
         counts = {"state": label, "trials": 0, "successes": 0, "failures": 0, "reasons": {}}
         for j in range(tf.size):
-            reason = jam[j] or None
-            if reason is None and not any(in_arc(tf[j], s, w, 1e-6) for s, w in finals):
-                unexpected = any(missed[j, k] and expected[k] for k in range(len(labels)))
-                reason = "missed a pin" if unexpected else "other band"
+            reason = _failure(jam[j], tf[j], finals, missed[j], expected)
             counts["trials"] += 1
             counts["successes" if reason is None else "failures"] += 1
             if reason:

@@ -58,6 +58,7 @@ from pipeline.planning.propagate import resting_states
 from pipeline.planning.settings import nominal_friction
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import corner_inputs, replay, trial_inputs
+from pipeline.progress import Heartbeat
 
 DEFAULT_BUDGET = 150  # member evaluations per search (planner.worst_member_budget)
 JAM_SCORE = 180.0  # deg: a jam is as far outside the set as anything can be
@@ -398,19 +399,23 @@ def check_budget(budget) -> int:
 
 def search_worst_member(probe: PlanProbe, space: MemberSpace, arc: tuple, period: float = 360.0,
                         budget: int = DEFAULT_BUDGET, seed: int = 0,
-                        stop_when_broken: bool = True) -> WorstMember:
+                        stop_when_broken: bool = True, beat: Heartbeat | None = None) -> WorstMember:
     """The member of ``space`` whose probe finals lie farthest outside ``arc``
     (``(start, width)`` degrees) within ``budget`` member evaluations.
 
     Every fixed member is scored; then, for each continuous space, its
     geometric corners and ``RANDOM_STARTS`` seeded random members are scored
     and Nelder-Mead runs from the highest-scoring starts until the budget is
-    spent (the budget is shared between the spaces)."""
+    spent (the budget is shared between the spaces). ``beat`` (a
+    :class:`~pipeline.progress.Heartbeat` counting evaluations) is ticked
+    after each one."""
     budget = check_budget(budget)
     best = {"obj": -np.inf}
     used = [0]
+    beat = (beat or Heartbeat("", budget)).start()
 
     def keep(obj, tf, support, params, source):
+        beat.tick(used[0])
         if obj > best["obj"]:
             best.update(obj=obj, tf=tf, support=support, params=params, source=source)
 
@@ -426,6 +431,7 @@ def search_worst_member(probe: PlanProbe, space: MemberSpace, arc: tuple, period
             break
     if best["obj"] == -np.inf:
         raise PinfeedError(f"support family {space.label!r} has no member to search")
+    beat.finish(used[0], "a member breaks the plan" if best["obj"] > 0 else "")
     return WorstMember(best["support"], best["params"], float(best["obj"]), best["tf"], used[0],
                        best["source"], probe.nominal)
 
@@ -504,20 +510,23 @@ def claimed_arc(verdict: dict, tolerance: float) -> tuple | None:
     return (s["start"] - grow, max(s["width"], tolerance))
 
 
-def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings, speeds=()) -> dict:
-    """The verification's trials of a plan (``verify.trial_inputs``) on ``family``, judged."""
+def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings, speeds=(),
+                   progress=None, what: str = "verification on the family's members") -> dict:
+    """The verification's trials of a plan (``verify.trial_inputs``) on ``family``,
+    judged; ``progress`` hears how far the trials have got (stage ``what``)."""
     inputs = trial_inputs(resting_states(part), st.mu_c, len(heights), st.verify, family)
     th, yc, mu, offs, sup = (np.concatenate([r[k] for r in inputs]) for k in range(5))
     kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
-    tf, _, jam, _ = replay(part, list(heights), list(speeds) or [0.0] * len(heights), th, yc, mu, offs,
-                           st.pin_radius,
-                           st.model, **kw, support=sup, supports=family.kernel_supports)
+    with Heartbeat(what, th.size, "trial", progress) as beat:
+        tf, _, jam, _ = replay(part, list(heights), list(speeds) or [0.0] * len(heights), th, yc, mu, offs,
+                               st.pin_radius, st.model, **kw, support=sup, supports=family.kernel_supports,
+                               stretch=beat.stretch(0, th.size))
     return orient.judge(tf[jam == ""], th.size, st.tolerance, part.symmetry_order(), st.required,
                         st.verify.get("confidence", DEFAULT_CONFIDENCE), rule=st.verify.get("rule", "bound"))
 
 
 def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckSettings,
-                          verdict: dict | None = None, speeds=()) -> dict:
+                          verdict: dict | None = None, speeds=(), progress=None, name: str = "the plan") -> dict:
     """Search the worst member of ``family`` for the plan of pins at ``heights``
     (mm); when it breaks the plan, the member joins the verification's members
     and the plan is judged again, up to ``MAX_ROUNDS`` times.
@@ -526,25 +535,29 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
     outside the re-judged set and the re-judged verification orients),
     ``worst_member`` (:meth:`WorstMember.to_dict`), ``members`` and ``trials``
     of the last verification, ``rounds`` (what each search found), the
-    ``verdict`` and ``set_deg`` the claim rests on, ``space``."""
+    ``verdict`` and ``set_deg`` the claim rests on, ``space``. ``progress``
+    hears how far each search and verification has got (the plan called ``name``)."""
     space = member_space(part, family)
     probe = PlanProbe(part, tuple(float(h) for h in heights), st.mu_c, st.verify, st.pin_radius,
                       st.model, st.kernel, tuple(float(v) for v in speeds))
     period = 360.0 / part.symmetry_order()
-    verdict = verdict or verify_members(part, heights, family, st, speeds)
+    what = f"worst member of {family.label} for {name}"
+    verdict = verdict or verify_members(part, heights, family, st, speeds, progress, f"{what}: verification")
     joined, rounds, worst = family, [], None
     for k in range(MAX_ROUNDS):
         arc = claimed_arc(verdict, st.tolerance)
         if not verdict["orients"] or arc is None:
             break
-        worst = search_worst_member(probe, space, arc, period, st.budget, st.seed + k)
+        beat = Heartbeat(f"{what}: search {k + 1}", st.budget, "member evaluation", progress)
+        worst = search_worst_member(probe, space, arc, period, st.budget, st.seed + k, beat=beat)
         rounds.append({"set_deg": [round(arc[0] % period, 3), round(arc[1], 3)], **worst.to_dict()})
         if not worst.breaks:
             break
         extra = dataclasses.replace(worst.support, label=f"worst member {k + 1}")
         joined = SupportFamily(f"{joined.label} + worst member {k + 1}", joined.members + (extra,),
                                tuple(joined.representatives) + (len(joined.members),))
-        verdict = verify_members(part, heights, joined, st, speeds)
+        verdict = verify_members(part, heights, joined, st, speeds, progress,
+                                 f"{what}: verification with worst member {k + 1}")
     holds = bool(verdict["orients"] and worst is not None and not worst.breaks)
     arc = claimed_arc(verdict, st.tolerance)
     return {"holds": holds, "space": space.describe(), "budget": st.budget,
@@ -557,10 +570,11 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
 class FamilyChecker:
     """What the complete search asks of a plan that passed its sampled
     verification: does the worst member of the family break it?
-    Results are kept per pin sequence (``results``)."""
+    Results are kept per pin sequence (``results``); each search tells
+    ``progress`` (a function of one line) how far it has got."""
 
-    def __init__(self, part, family: SupportFamily, settings: FamilyCheckSettings):
-        self.part, self.family, self.settings = part, family, settings
+    def __init__(self, part, family: SupportFamily, settings: FamilyCheckSettings, progress=None):
+        self.part, self.family, self.settings, self.progress = part, family, settings, progress
         member_space(part, family)  # an empty space is an error before any search
         self.results: dict = {}
 
@@ -568,7 +582,7 @@ class FamilyChecker:
         key = self.key(labels, heights)
         if key not in self.results:
             self.results[key] = check_plan_for_family(self.part, heights, self.family, self.settings,
-                                                      verdict, speeds)
+                                                      verdict, speeds, self.progress, " ".join(labels))
         return self.results[key]["holds"]
 
     @staticmethod

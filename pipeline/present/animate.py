@@ -82,14 +82,18 @@ def _check_animation_out(out, frames: int, fps: int) -> Path:
 def _write_animation(fig, draw, b_end: float, out: Path, frames: int, fps: int) -> int:
     """Draw ``frames`` evenly spaced belt travels 0..``b_end`` with ``draw(B)``,
     write them to ``out`` (Pillow for .gif, ffmpeg for .mp4), close ``fig`` and
-    return the number of frames written."""
+    return the number of frames written; the frames drawn so far go to the
+    progress report of :func:`pipeline.progress.reporting`, if any."""
     import matplotlib.pyplot as plt
     from matplotlib import animation
+
+    from pipeline.progress import Heartbeat
     B = np.linspace(0.0, b_end, int(frames))
     anim = animation.FuncAnimation(fig, lambda i: draw(B[i]), frames=len(B), blit=False)
     out.parent.mkdir(parents=True, exist_ok=True)
     writer = animation.PillowWriter(fps=fps) if out.suffix.lower() == ".gif" else animation.FFMpegWriter(fps=fps)
-    anim.save(str(out), writer=writer, dpi=DPI)
+    with Heartbeat(f"writing {out.name}", len(B), "frame") as beat:
+        anim.save(str(out), writer=writer, dpi=DPI, progress_callback=lambda i, n: beat.tick(i + 1))
     plt.close(fig)
     return int(len(B))
 

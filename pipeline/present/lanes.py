@@ -213,10 +213,13 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
     Returns
     -------
     list of :class:`Trial`, state by state.
+
+    How far the trials have got goes to the progress report of
+    :func:`pipeline.progress.reporting`, if any.
     """
-    from pipeline.maps import simulate
     from pipeline.planning.settings import nominal_friction
     from pipeline.planning.verify import PERTURB_DEFAULTS, corner_inputs, perturbed_batch
+    from pipeline.progress import Heartbeat
     cfg = dict(PERTURB_DEFAULTS, **(perturb or {}))
     rng = np.random.default_rng(seed)
     heights = np.asarray(heights, float)
@@ -224,7 +227,8 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
     belt = {"model": "dynamic", "belt_speed": float(belt_speed), "mu_s": float(mu_s)} \
         if belt_speed is not None else {"model": model}
     out = []
-    for label, (theta0, yc0) in states.items():
+    beat = Heartbeat("nominal passages" if nominal else "layout trials", len(states), "initial state").start()
+    for i, (label, (theta0, yc0)) in enumerate(states.items()):
         if nominal:
             th, yc = np.array([theta0], float), np.array([yc0], float)
             mu, offs = np.array([nominal_friction(mu_c)]), np.zeros((1, n_pins))
@@ -236,18 +240,26 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
                 offs = np.concatenate([offs, extra[3]])
         for j in range(th.size):
             trial = Trial(label, float(th[j]) % 360.0, float(yc[j]), float(mu[j]), heights + offs[j])
-            theta, y = trial.theta, trial.y_c
-            for k, h in enumerate(trial.heights):
-                ds = simulate.rollout(part, theta, contact_parameter(h, y, part.a), trial.mu_c, pin_radius,
-                                      trajectory=True, **belt)
-                trial.steps.append((theta, y, ds))
-                status = str(ds.status.item())
-                if status in ("jammed", "truncated"):
-                    trial.jam = f"{status} at pin {k + 1} ({ds.jam_reason.item()})"
-                    break
-                theta, y = float(ds.theta_f), y + float(ds.dy)
-            out.append(trial)
+            out.append(_roll_trial(part, trial, pin_radius, belt))
+            beat.tick(i + (j + 1) / th.size)
+    beat.finish()
     return out
+
+
+def _roll_trial(part: Part, trial: Trial, pin_radius: float, belt: dict) -> Trial:
+    """``trial`` rolled past its pins in turn (with trajectories), up to a jam."""
+    from pipeline.maps import simulate
+    theta, y = trial.theta, trial.y_c
+    for k, h in enumerate(trial.heights):
+        ds = simulate.rollout(part, theta, contact_parameter(h, y, part.a), trial.mu_c, pin_radius,
+                              trajectory=True, **belt)
+        trial.steps.append((theta, y, ds))
+        status = str(ds.status.item())
+        if status in ("jammed", "truncated"):
+            trial.jam = f"{status} at pin {k + 1} ({ds.jam_reason.item()})"
+            break
+        theta, y = float(ds.theta_f), y + float(ds.dy)
+    return trial
 
 
 def outlines(vertices, x, y, theta_deg) -> np.ndarray:

@@ -23,6 +23,7 @@ from pipeline.planning.speed_limit import attach_speed_limits
 from pipeline.planning.settings import nominal_friction, parse_friction
 from pipeline.planning.types import PlanFile, validate_plan_file
 from pipeline.planning.verify import verify_plan
+from pipeline.progress import Heartbeat
 from pipeline.provenance import provenance_attrs
 
 
@@ -74,22 +75,22 @@ def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:
     """Make sure the catalog holds the maps the planner needs for ``part``:
     the planner's model at its mu_c over the sweep's d grid, for a static pin
     and for every dynamic speed the planner may use. Missing ones are
-    computed with the sweep settings, stored atomically and indexed."""
+    computed with the sweep settings, stored atomically and indexed (how
+    many, on the progress report of :func:`pipeline.progress.reporting`)."""
     root = Path(config["catalog_dir"])
     pc = config["planner"]
     cat = Catalog.open(root) if (root / "index.json").is_file() else None
     entries = cat.entries if cat else []
     fam = next((e["family"] for e in entries if e["part_id"] == part.id), family)
     mu = nominal_friction(parse_friction(pc["mu_c"]))
-    wrote = False
-    for v in [0.0] + [float(x) for x in pc.get("dynamic", {}).get("speeds", [])]:
-        have = any(e["part_id"] == part.id and e["model"] == pc["model"]
-                   and e["mu_c"] == mu and e.get("v_pin", 0.0) == v
-                   and not e.get("support_key") for e in entries)
-        if not have:
+    missing = [v for v in [0.0] + [float(x) for x in pc.get("dynamic", {}).get("speeds", [])]
+               if not any(e["part_id"] == part.id and e["model"] == pc["model"] and e["mu_c"] == mu
+                          and e.get("v_pin", 0.0) == v and not e.get("support_key") for e in entries)]
+    with Heartbeat(f"maps of {part.name} for the paper-mode planner", len(missing), "map") as beat:
+        for k, v in enumerate(missing):
             write_shard(config, ShardJob(fam, part, pc["model"], mu, v))
-            wrote = True
-    if wrote:
+            beat.tick(k + 1)
+    if missing:
         cat = Catalog.rebuild(root)
     return cat
 

@@ -66,8 +66,9 @@ def test_outline_to_animation_with_the_printed_commands(fresh, capsys):
     assert code == 0, err
     plan_file = fresh / "res" / "tiny" / "plans" / "tri.json"
     assert plan_file.is_file() and f"stored the plan at {Path('res/tiny/plans/tri.json')}" in out
-    progress = [ln for ln in out.splitlines() if ln.startswith("  ... ")]
+    progress = [ln for ln in err.splitlines() if ln.startswith("  ... ")]  # on stderr: stdout is the plan
     assert progress and all(ln.startswith("  ... mu_c 0: ") for ln in progress)  # which friction
+    assert "  ... " not in out
     stored_plans = json.loads(plan_file.read_text())["tight"][0]
     rec = [ln for ln in out.splitlines() if "(recommended)" in ln]
     assert len(rec) == 1 and rec[0].startswith(f"  #{stored_plans['plans'].index(stored_plans['recommended']) + 1}")
@@ -134,13 +135,14 @@ def test_ctrl_c_is_one_line_exit_130_and_the_rollouts_are_kept(fresh):
     # the child the default disposition, so that it gets its KeyboardInterrupt.
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    for line in proc.stdout:
+    for line in proc.stderr:  # the planner's progress lines
         if "mu_c 0: verified" in line:  # the first friction's plans are carried (rollouts done)
             proc.send_signal(signal.SIGINT)
             break
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130
-    assert err.count("\n") == 1 and err.startswith("pinfeed: interrupted") and "Traceback" not in err
+    said = [ln for ln in err.splitlines() if not ln.startswith("  ... ")]
+    assert len(said) == 1 and said[0].startswith("pinfeed: interrupted") and "Traceback" not in err
     assert not (fresh / "res").exists()  # no plan file, not even half of one
     kept = list((fresh / "cat" / "refine").rglob("*.h5"))
     assert kept, "the rollouts computed before Ctrl-C were not saved"
