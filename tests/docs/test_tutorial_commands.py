@@ -22,9 +22,22 @@ that config and 2 cores; the page's other commands then run as written. The
 lines they print that do not depend on the grid (the catalog's part ids and
 vertices, the rollouts a query returns, the atlas's header and columns, the
 files made) must equal those of the full run that the page shows.
+
+Stored outputs: the own-part page shows a drawing and figures of plans of
+parts that are not in the default config, whose planning takes too long to
+repeat in every docs build. So it shows files its own commands write, kept
+beside the page (:data:`STORED`): the holed bracket's feeder drawing (a PNG
+that records its plan in the ``pinfeed-plan`` text field) and the wedge's
+layout file (from which the docs build draws the plan's pin sequence, the
+feeder drawing and a frame of the animation, ``docs/_ext/tutorial_figures.py``).
+After the page's commands ran, each kept copy must show what the commands
+wrote: the same plan, which the commands print, and for the layout file the
+same stations, pitch, belt speed and drawn poses.
 """
 from __future__ import annotations
 
+import json
+import math
 import os
 import re
 import shlex
@@ -43,6 +56,14 @@ BLOCK = re.compile(r"^```(?:console|\{code-block\} console)\n((?::[\w-]+:[^\n]*\
 FENCE = re.compile(r"^```([^\n]*)\n(.*?)^```", re.S | re.M)
 MAKE_RUN = [sys.executable, "-m", "pipeline.workflow", "run", "--cores", "2", "--rerun-incomplete",
             "--snakefile", str(ROOT / "Snakefile"), "--configfile", "config.yaml"]
+
+
+#: Files a page shows that its own commands write, kept beside the page: page ->
+#: {kept copy in docs/tutorials/: the file the commands write, relative to their folder}.
+STORED = {"own-part": {"holed_bracket_feeder.png": "feeder_holed_bracket.png",
+                       "layout_wedge.json": "results/config/layout_wedge.json"}}
+#: Layout keys that say when and by which build a file was made, not what it holds.
+PROVENANCE = {"created", "git_commit", "pinfeed_version"}
 
 
 def line_numbers(spec: str) -> set[int]:
@@ -123,6 +144,50 @@ def test_make_run_stand_in_runs_what_make_run_runs():
     assert MAKE_RUN[1:7] == ["-m", "pipeline.workflow", "run", "--cores", "2", "--rerun-incomplete"]
 
 
+def shown(path: Path):
+    """What a kept output shows: a drawing's plan (its PNG's ``pinfeed-plan``
+    field), or a layout file without its provenance."""
+    if path.suffix == ".png":
+        from PIL import Image
+        with Image.open(path) as image:
+            image.load()
+            return {"plan": image.text.get("pinfeed-plan")}
+    return {k: v for k, v in json.loads(path.read_text()).items() if k not in PROVENANCE}
+
+
+def differences(kept, fresh, where="") -> list[str]:
+    """Where ``kept`` and ``fresh`` (JSON values) differ; numbers within 0.05."""
+    if isinstance(kept, dict) and isinstance(fresh, dict):
+        return [d for k in sorted(set(kept) | set(fresh), key=str)
+                for d in differences(kept.get(k), fresh.get(k), f"{where}.{k}")]
+    if isinstance(kept, list) and isinstance(fresh, list) and len(kept) == len(fresh):
+        return [d for k, (a, b) in enumerate(zip(kept, fresh)) for d in differences(a, b, f"{where}[{k}]")]
+    numbers = (int, float)
+    if (isinstance(kept, numbers) and isinstance(fresh, numbers) and not isinstance(kept, bool)
+            and math.isclose(kept, fresh, rel_tol=0.0, abs_tol=0.05)):
+        return []
+    return [] if kept == fresh else [f"{where or 'value'}: kept {kept!r}, written now {fresh!r}"]
+
+
+def test_differences_of_kept_outputs():
+    assert differences({"a": [1.0, {"b": "P1 P2"}]}, {"a": [1.04, {"b": "P1 P2"}]}) == []
+    assert differences({"a": [1.0]}, {"a": [1.2]}) == [".a[0]: kept 1.0, written now 1.2"]
+    assert differences({"plan": "P1"}, {"plan": "P2", "x": 1}) == [
+        ".plan: kept 'P1', written now 'P2'", ".x: kept None, written now 1"]
+
+
+def check_kept_outputs(page: Path, folder: Path, printed_text: str) -> None:
+    """Each output the page keeps shows what its commands wrote in ``folder``
+    (see the module docstring); ``printed_text``: all they printed, squeezed."""
+    for kept, written in STORED.get(page.stem, {}).items():
+        fresh = shown(folder / written)
+        plan = fresh["plan"] if isinstance(fresh["plan"], str) else " ".join(fresh["plan"]["pins"])
+        assert plan and f"plan 1: {plan} (" in printed_text, (written, plan)
+        assert differences(shown(TUTORIALS / kept), fresh) == [], (
+            f"docs/tutorials/{kept} no longer shows what the {page.stem} tutorial's commands write: "
+            f"copy their {written} there")
+
+
 def setup_folder(page: Path, folder: Path) -> None:
     """What a page's commands start from (see the module docstring)."""
     if page.stem == "paper-feeder":
@@ -148,9 +213,12 @@ def test_tutorial_commands_run_and_print_what_the_page_shows(page, tmp_path):
     setup_folder(page, tmp_path)
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg",
            "PATH": f"{VENV_BIN}{os.pathsep}{os.environ.get('PATH', '')}"}  # snakemake for make run
+    everything = []
     for command, expected in console_steps(page.read_text()):
         run = subprocess.run(command_line(command), cwd=tmp_path, env=env, capture_output=True, text=True,
                              timeout=600)
         output = squeeze(run.stdout + run.stderr)
+        everything.append(output)
         assert run.returncode == 0, f"{command}\n{run.stdout[-3000:]}\n{run.stderr[-3000:]}"
         assert [line for line in expected if not printed(line, output)] == [], f"{command}\n{output[-5000:]}"
+    check_kept_outputs(page, tmp_path, " ".join(everything))

@@ -91,11 +91,14 @@ def test_band_map_figure_labels_legend_and_ticks():
     plt.close(fig)
 
 
-@pytest.mark.parametrize("n_d, ncols", [(4, 2), (18, 6), (1, 6)])
-def test_map_figure_fits_its_labels(n_d, ncols):
+@pytest.mark.parametrize("n_d, ncols, only_ok", [(4, 2, False), (18, 6, False), (1, 6, False), (2, 6, True)])
+def test_map_figure_fits_its_labels(n_d, ncols, only_ok):
+    """Also with one row of legend (every rollout ok: no miss or jam entries)."""
     from pipeline.present.figures import text_problems
     from pipeline.present.figures.maps import map_figure
     tf, dy, st = _synthetic_map()
+    if only_ok:
+        st = np.full_like(st, OK)
     ds = xr.Dataset({"theta_f": (("d", "theta_i"), np.tile(tf, (n_d, 1))),
                      "dy": (("d", "theta_i"), np.tile(dy, (n_d, 1))),
                      "status": (("d", "theta_i"), np.tile(st, (n_d, 1)))},

@@ -240,6 +240,9 @@ def test_svg_and_png_drawings(stored, tmp_path):
         path = write_drawing(stored["layout"], tmp_path / f"feeder{suffix}")
         if suffix == ".png":
             assert_png_figure(path)
+            from PIL import Image
+            with Image.open(path) as image:  # the PNG records the plan it draws
+                assert image.text["pinfeed-plan"] == " ".join(stored["layout"]["plan"]["pins"])
         else:
             assert path.read_text().lstrip().startswith("<?xml") and "<svg" in path.read_text()
     assert "pitch" in (tmp_path / "feeder.svg").read_text()

@@ -98,11 +98,13 @@ def legend_handles(factor_c: float, statuses) -> list:
 def bottom_legend(fig, handles) -> float:
     """A legend under the panels, wrapped into as many rows as the figure's width
     needs; returns the fraction of the height it takes (for ``tight_layout``'s rect)."""
-    width = fig.get_size_inches()[0]
+    width, height = fig.get_size_inches()
     per_row = max(1, min(len(handles), int(width // 2.3)))
     rows = math.ceil(len(handles) / per_row)
-    fig.legend(handles=handles, loc="lower center", ncol=per_row, fontsize=8, frameon=False)
-    return (0.28 * rows + 0.1) / fig.get_size_inches()[1]
+    legend = fig.legend(handles=handles, loc="lower center", ncol=per_row, fontsize=8, frameon=False)
+    # Measured, not estimated: a row of mathtext labels is taller than plain text.
+    measured = legend.get_window_extent(fig.canvas.get_renderer()).height / fig.dpi
+    return (max(measured, 0.28 * rows) + 0.1) / height
 
 
 def plot_band_maps(maps_by_model: dict, d_values, threshold_T, factor_c, title, out) -> Path:

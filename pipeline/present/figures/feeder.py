@@ -107,15 +107,21 @@ def label_row_mm(span_mm: float) -> float:
 
 
 ALERT_COLOUR = "#bb0000"  # warnings (several final sets, a belt above its limit): red
+#: The PNG text field that records the drawing's plan (its pins, space-separated).
+PLAN_FIELD = "pinfeed-plan"
 
 
 def draw_feeder(layout: dict, out) -> Path:
-    """The drawing as PNG or SVG (by ``out``'s suffix), written atomically."""
+    """The drawing as PNG or SVG (by ``out``'s suffix), written atomically. A PNG
+    records the plan it draws in its :data:`PLAN_FIELD` text field."""
     import matplotlib.pyplot as plt
     fig = feeder_figure(layout)
     out = Path(out)
+    kind = out.suffix.lower().lstrip(".")
+    plan = (layout.get("plan") or {}).get("pins")
+    metadata = {PLAN_FIELD: " ".join(plan)} if kind == "png" and plan else None
     with atomic_target(out) as tmp:
-        fig.savefig(tmp, format=out.suffix.lower().lstrip("."), dpi=110)
+        fig.savefig(tmp, format=kind, dpi=110, metadata=metadata)
     plt.close(fig)
     return out
 

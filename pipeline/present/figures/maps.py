@@ -59,5 +59,8 @@ def map_figure(ds: xr.Dataset, ncols: int = 6, bands: tuple[float, float] | None
                  f"$\\mu_c$ = {attrs.get('mu_c', float('nan')):g}, pin radius "
                  f"{attrs.get('pin_radius', float('nan')):g} {unit}", fontsize=10)
     bottom = bottom_legend(fig, handles)
+    # Twice: the first pass sizes the equal-aspect panels, the second fits their
+    # labels above the legend (one pass can leave the x labels on it).
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     fig.tight_layout(rect=(0, bottom, 1, 1))
     return fig
