@@ -25,6 +25,7 @@ from kernels.rollout import OK
 
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
+from pipeline.progress import Heartbeat
 
 
 @dataclass
@@ -97,10 +98,16 @@ def extreme_members(shift: np.ndarray) -> tuple:
 def family_spread(part: Part, family, theta_i, d, mu_c: float, pin_radius: float,
                   model: str = "minpower", threads: int | None = None) -> FamilySpread:
     """Maps of every member of ``family`` and of uniform pressure on the grid
-    ``d x theta_i`` at one friction (model minpower), and their shifts."""
-    uniform = simulate.compute_map(part, theta_i, d, mu_c, pin_radius, model, threads=threads)
-    maps = [simulate.compute_map(part, theta_i, d, mu_c, pin_radius, model, threads=threads,
-                                 support=s) for s in family.kernel_supports]
+    ``d x theta_i`` at one friction (model minpower), and their shifts; how
+    many maps are done goes to the progress report of
+    :func:`pipeline.progress.reporting`, if any."""
+    maps = []
+    with Heartbeat(f"maps of {family.label} at mu_c {mu_c:g}", len(family.kernel_supports) + 1, "map") as beat:
+        for s in [None, *family.kernel_supports]:
+            maps.append(simulate.compute_map(part, theta_i, d, mu_c, pin_radius, model, threads=threads,
+                                             **({} if s is None else {"support": s})))
+            beat.tick(len(maps))
+    uniform, maps = maps[0], maps[1:]
     keep = ["theta_f", "dy", "status", "jam_reason"]
     stacked = xr.concat([m[keep].drop_attrs() for m in maps], dim="support")
     stacked = stacked.assign_coords(support=("support", family.labels, {"long_name": "support distribution"}))

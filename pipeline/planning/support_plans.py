@@ -21,6 +21,7 @@ from pipeline.planning.propagate import resting_states
 from pipeline.planning.settings import friction_label, parse_friction
 from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.verify import verify_plan
+from pipeline.progress import Heartbeat
 
 
 def map_spread(part: Part, family: SupportFamily, config: dict) -> tuple:
@@ -42,15 +43,20 @@ def map_spread(part: Part, family: SupportFamily, config: dict) -> tuple:
     return summary, spreads, extremes
 
 
-def verify_under_family(part: Part, config: dict, plan: dict, mu_c, family: SupportFamily) -> dict:
+def verify_under_family(part: Part, config: dict, plan: dict, mu_c, family: SupportFamily,
+                        progress=None) -> dict:
     """A stored plan (``to_dict()``) replayed with the verification's trials,
-    each on a member of ``family``; the orientation verdict and the counts."""
+    each on a member of ``family``; the orientation verdict and the counts.
+    ``progress`` hears how far the trials have got."""
     pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
     speeds = dict(zip(plan["pins"], plan.get("pin_speeds", [0.0] * len(plan["pins"]))))
-    res = verify_plan(part, plan, pins, resting_states(part), mu_c, config["sweep"]["pin_radius"],
-                      config["planner"]["model"], dict(VERIFY_DEFAULTS, **config.get("verify", {})),
-                      speeds={k: v for k, v in speeds.items() if v}, kernel=config["sweep"].get("kernel"),
-                      family=family)
+    states = resting_states(part)
+    with Heartbeat(f"trials of {' '.join(plan['pins'])} under {family.label}", len(states), "initial state",
+                   progress) as beat:
+        res = verify_plan(part, plan, pins, states, mu_c, config["sweep"]["pin_radius"],
+                          config["planner"]["model"], dict(VERIFY_DEFAULTS, **config.get("verify", {})),
+                          speeds={k: v for k, v in speeds.items() if v}, kernel=config["sweep"].get("kernel"),
+                          family=family, stretch=beat.stretch(0, len(states)))
     verdict = judge_verification(res, planner_tolerance(config), part.symmetry_order(),
                                  verify_required(config))
     by_member = {}
@@ -105,7 +111,7 @@ def support_study(part: Part, config: dict, family, uniform_entry: dict | None, 
     if rec is not None:
         if progress:
             progress(f"replaying the recommended plan {' '.join(rec['pins'])} under {family.label}")
-        out["survival"] = verify_under_family(part, config, rec, mu_c, family)
+        out["survival"] = verify_under_family(part, config, rec, mu_c, family, progress)
         out["survives"] = bool(out["survival"]["orientation"]["orients"])
         uniform_width = ((rec.get("verification") or {}).get("orientation") or {}).get("width_deg")
         out["widening"] = {"uniform_width_deg": uniform_width,
