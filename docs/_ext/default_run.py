@@ -187,12 +187,15 @@ def _sequence_png(part, plan_path: Path, config: dict, out: Path) -> None:
         return
     pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
     speeds = {q: v for q, v in zip(plan["pins"], plan.get("pin_speeds") or ()) if v}
-    mu_c = nominal_friction(parse_friction(tight["mu_c"]))
+    planned = parse_friction(tight["mu_c"])
+    mu_c = nominal_friction(planned)
+    where = (f"the middle of the planned range {planned[0]:g}-{planned[1]:g}" if isinstance(planned, tuple)
+             else "the planned friction")
     paths = nominal_paths({"part": stored["part"], "initial_states": tight["initial_states"], "mu_c": mu_c,
                            "model": stored["model"]}, config, plan, pins, speeds, mu_c)
     fig = sequence_figure(part, plan, pins, paths, config["sweep"]["pin_radius"],
-                          f"{part.name}: recommended plan, nominal paths at $\\mu_c$ {mu_c:g} "
-                          f"(planned for {tight['mu_c']})", speeds=speeds)
+                          f"{part.name}: recommended plan; nominal paths at $\\mu_c$ = {mu_c:g}, {where}",
+                          speeds=speeds)
     _no_overlaps(fig, text_problems, f"the pin sequence of {part.name}")
     fig.savefig(out, dpi=110, metadata={PLAN_FIELD: " ".join(plan["pins"]), "Software": "pinfeed"})
     plt.close(fig)
