@@ -5,7 +5,10 @@ Pin sequence for the symmetric triangle (Fig. 9)
 The paper's Fig. 9: the symmetric triangle's three resting states taken by
 fixed pins to two final orientations, which fixed pins alone cannot merge
 (a force/torque sensor on the first pin, or a moving pin, can). Coarse maps
-(2-degree grid) keep this to about 20 seconds.
+(2-degree grid) keep it short.
+
+Its run time on the machine that built this manual is on the
+:ref:`computation times <sphx_glr_sg_execution_times>` page.
 """
 import os
 
