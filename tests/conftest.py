@@ -112,3 +112,12 @@ def built_docs(tmp_path_factory) -> Path:
                          cwd=_DOCS_ROOT, env=env, capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, f"the docs build failed:\n{run.stdout}\n{run.stderr}"
     return out
+
+
+def pytest_collection_modifyitems(config, items):
+    """Under pytest-xdist (``make test`` runs two workers), the tests that read the
+    built manual share one worker, so the manual is built once; the other tests
+    spread over the workers (``--dist loadgroup``)."""
+    for item in items:
+        if "built_docs" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.xdist_group("built_docs"))
