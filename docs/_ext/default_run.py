@@ -129,88 +129,73 @@ def run_part(name: str, work: Path) -> None:
     from pipeline.config import load_config
     from pipeline.maps.io import write_json
     from pipeline.present.animate import station_figure, station_scene, station_title
-    from pipeline.present.figures import text_problems
     from pipeline.present.figures.feeder import feeder_figure
     from pipeline.workflow.commands import named_part, plan_command, planner_settings
     from pipeline.workflow.layout import layout
+    from pipeline.workflow.report import carried_figure
     from pipeline.workflow.speed import speed
+    from tutorial_figures import checked
     config = planner_settings(load_config(None), catalog=str(work / "catalog"))
     part = named_part(config, name)
     plan_path = work / "plans" / f"{name}.json"
     plan_path.parent.mkdir(parents=True, exist_ok=True)
     write_json(plan_command(part, config, "tight", progress=print), plan_path)
-    _sequence_png(part, plan_path, config, work / f"sequence_{name}.png")
-    _carried_png(plan_path, config, work / f"carried_{name}.png")
+    result = json.loads(plan_path.read_text())  # as the later stages read it
+    tight = result["tight"][0]
+    _sequence_png(part, tight, result["model"], config, work / f"sequence_{name}.png")
+    # The report's figure reads the resting states at the top of a plan file;
+    # a tight-only plan keeps them with its tight plans.
+    carried_figure(config, dict(result, initial_states=tight["initial_states"]), work / f"carried_{name}.png")
     speed(plan_path, config, work / "speed" / f"{name}.json", work / "speed" / f"{name}.png")
     drawings = {k: work / f"layout_{name}.{k}" for k in ("dxf", "svg", "png")}
     print(layout(plan_path, config, dict(drawings, json=work / f"layout_{name}.json")))
     feeder = json.loads((work / f"layout_{name}.json").read_text())
     if not feeder.get("stations"):
         return
-    fig = feeder_figure(feeder)
-    _no_overlaps(fig, text_problems, f"the feeder drawing of {name}")
+    fig = checked(feeder_figure(feeder), f"the feeder drawing of {name}")
     fig.savefig(work / f"feeder_{name}.png", dpi=110,
                 metadata={PLAN_FIELD: " ".join(feeder["plan"]["pins"]), "Software": "pinfeed"})
     plt.close(fig)
-    states = {k: tuple(v) for k, v in part_states(plan_path).items()}
-    scene = station_scene(part, feeder, states, feeder["mu_c"])
+    scene = station_scene(part, feeder, _states(tight), feeder["mu_c"])
     still = station_figure(scene, station_title(name, scene, "the laid-out feeder"))
     still["draw"](0.55 * scene.b_end)   # mid-stream: parts before, at and after the pins
-    _no_overlaps(still["fig"], text_problems, f"the animation still of {name}")
-    still["fig"].savefig(work / f"frame_{name}.png", dpi=110)
+    checked(still["fig"], f"the animation still of {name}").savefig(work / f"frame_{name}.png", dpi=110)
     plt.close(still["fig"])
 
 
-def _carried_png(plan_path: Path, config: dict, out: Path) -> None:
-    """The recommended plan's carried sets after each pin against replayed
-    rollouts, as the report draws them (``pipeline.workflow.report.carried_figure``)."""
-    from pipeline.workflow.report import carried_figure
-    result = json.loads(plan_path.read_text())
-    # A tight-only plan file keeps its resting states with the tight plans.
-    carried_figure(config, dict(result, initial_states=result["tight"][0]["initial_states"]), out)
-
-
-def _sequence_png(part, plan_path: Path, config: dict, out: Path) -> None:
+def _sequence_png(part, tight: dict, model: str, config: dict, out: Path) -> None:
     """The recommended plan as the report's pin-sequence figure: one row per
     resting state, the part's nominal path past the pins (a rollout per pin and
     state) at the middle of the planned friction range."""
     import matplotlib.pyplot as plt
 
+    from pipeline.maps.simulate import nominal_path
     from pipeline.planning.settings import nominal_friction, parse_friction
-    from pipeline.present.figures import text_problems
     from pipeline.present.figures.sequence import sequence_figure
-    from pipeline.workflow.report import nominal_paths
-    stored = json.loads(plan_path.read_text())
-    tight = stored["tight"][0]
+    from pipeline.workflow.report import tight_plan_pins
+    from tutorial_figures import checked
     plan = tight.get("recommended")
     if not plan:
         return
-    pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
-    speeds = {q: v for q, v in zip(plan["pins"], plan.get("pin_speeds") or ()) if v}
+    pins, speeds = tight_plan_pins(plan)
     planned = parse_friction(tight["mu_c"])
     mu_c = nominal_friction(planned)
     where = (f"the middle of the planned range {planned[0]:g}-{planned[1]:g}" if isinstance(planned, tuple)
              else "the planned friction")
-    paths = nominal_paths({"part": stored["part"], "initial_states": tight["initial_states"], "mu_c": mu_c,
-                           "model": stored["model"]}, config, plan, pins, speeds, mu_c)
+    paths = {label: nominal_path(part, theta, y_c, plan["pin_heights_mm"], mu_c, config["sweep"]["pin_radius"],
+                                 model, [speeds.get(p, 0.0) for p in plan["pins"]])
+             for label, (theta, y_c) in _states(tight).items()}
     fig = sequence_figure(part, plan, pins, paths, config["sweep"]["pin_radius"],
                           f"{part.name}: recommended plan; nominal paths at $\\mu_c$ = {mu_c:g}, {where}",
                           speeds=speeds)
-    _no_overlaps(fig, text_problems, f"the pin sequence of {part.name}")
+    checked(fig, f"the pin sequence of {part.name}")
     fig.savefig(out, dpi=110, metadata={PLAN_FIELD: " ".join(plan["pins"]), "Software": "pinfeed"})
     plt.close(fig)
 
 
-def part_states(plan_path: Path) -> dict:
-    """The stored plan's initial (resting) states: label -> (theta deg, y_c mm)."""
-    stored = json.loads(plan_path.read_text())["tight"][0]["initial_states"]
-    return {label: (s["theta"], s["y_c"]) for label, s in stored.items()}
-
-
-def _no_overlaps(fig, text_problems, what: str) -> None:
-    problems = text_problems(fig)
-    if problems:
-        raise RuntimeError(f"{what} has overlapping labels: {problems}")
+def _states(tight: dict) -> dict:
+    """The tight plans' initial (resting) states: label -> (theta deg, y_c mm)."""
+    return {label: (s["theta"], s["y_c"]) for label, s in tight["initial_states"].items()}
 
 
 def _summarise(names: list[str], work: Path) -> None:

@@ -27,12 +27,18 @@ TUTORIALS = Path(__file__).resolve().parents[1] / "tutorials"
 PIN_RADIUS = 3.0
 
 
-def _checked(fig, what: str):
+def checked(fig, what: str):
+    """``fig``, after making sure none of its labels overlap (``what`` names it
+    in the error that fails the build otherwise)."""
     from pipeline.present.figures import text_problems
     problems = text_problems(fig)
     if problems:
-        raise RuntimeError(f"the tutorial figure {what} has overlapping labels: {problems}")
+        raise RuntimeError(f"{what} has overlapping labels: {problems}")
     return fig
+
+
+def _checked(fig, what: str):
+    return checked(fig, f"the tutorial figure {what}")
 
 
 def tutorial_part(source: str):
@@ -118,7 +124,6 @@ def layout_sequence(source: str):
     state, the part before the first pin and after each pin (nominal rollouts of
     the plan's model at its friction)."""
     from pipeline.maps import simulate
-    from pipeline.parts.contact import contact_parameter
     from pipeline.planning.settings import nominal_friction, parse_friction
     from pipeline.present.figures.sequence import sequence_figure
     part = tutorial_part(source)
@@ -126,14 +131,8 @@ def layout_sequence(source: str):
     plan = layout["plan"]
     pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
     mu_c = nominal_friction(parse_friction(plan["friction"]))
-    paths = {}
-    for label, (theta, y) in _resting_states(part).items():
-        path = [(theta, y)]
-        for pin in plan["pins"]:
-            one = simulate.rollout(part, theta, contact_parameter(pins[pin], y, part.a), mu_c, PIN_RADIUS)
-            theta, y = float(one.theta_f), y + float(one.dy)
-            path.append((theta, y))
-        paths[label] = path
+    paths = {label: simulate.nominal_path(part, theta, y, plan["pin_heights_mm"], mu_c, PIN_RADIUS)
+             for label, (theta, y) in _resting_states(part).items()}
     title = f"{part.name}: recommended plan at $\\mu_c$ {mu_c:g}, nominal paths"
     return _checked(sequence_figure(part, plan, pins, paths, PIN_RADIUS, title), f"sequence of {source}")
 

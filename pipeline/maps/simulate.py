@@ -26,6 +26,7 @@ from kernels.rollout import (DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, STATUS_NA
 from pipeline import __version__
 from pipeline.checks import check_belt, check_kernel_settings, check_pin_ratio
 from pipeline.errors import PinfeedError
+from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.parts.support import Support, parse_support, point_support
 
@@ -209,6 +210,38 @@ def rollout(part: Part, theta_i: float, d: float, mu_c: float, pin_radius: float
     if trajectory:
         _add_trajectory(ds, traj, force, length_unit, "centroid displacement along the belt")
     return ds
+
+
+def nominal_path(part: Part, theta: float, y_c: float, heights, mu_c: float, pin_radius: float,
+                 model: str = "minpower", speeds=None) -> list[tuple[float, float]]:
+    """An unperturbed passage past a sequence of pins, one :func:`rollout` each.
+
+    Parameters
+    ----------
+    part : Part
+    theta, y_c : float
+        The orientation (deg) and centroid height (mm above the fence line)
+        before the first pin.
+    heights : sequence of float
+        The pins' heights above the fence line, mm, in the order the part meets them.
+    mu_c, pin_radius, model
+        As :func:`rollout`.
+    speeds : sequence of float, optional
+        Each pin's speed across the belt over the belt speed (default: static).
+
+    Returns
+    -------
+    list of (theta deg, y_c mm)
+        Before the first pin, then after each pin.
+    """
+    path = [(float(theta), float(y_c))]
+    for k, height in enumerate(heights):
+        v_pin = float(speeds[k]) if speeds is not None else 0.0
+        one = rollout(part, theta, contact_parameter(height, y_c, part.a), mu_c, pin_radius,
+                      model=model, v_pin=v_pin)
+        theta, y_c = float(one.theta_f), y_c + float(one.dy)
+        path.append((theta, y_c))
+    return path
 
 
 def _passage_dataset(status_name, reason_name, reason_long_name, theta_f, dy, travel, changes,

@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from pipeline.maps import simulate
-from pipeline.parts.contact import contact_parameter
 from pipeline.planning.paper import Planner, load_maps
 from pipeline.planning.settings import candidate_pins
 from pipeline.present.figures.sequence import sequence_figure
@@ -35,14 +34,8 @@ def best_coarse_plan_figure(part, depth: int = 3, theta_step: float = 2.0):
     """:func:`best_coarse_plan` drawn as the paper's pin-sequence figure, one
     row per resting state; returns ``(figure, plan dict)``."""
     planner, pins, plan = best_coarse_plan(part, depth, theta_step)
-    paths = {}
-    for label, state in planner.initial_states().items():
-        theta, y = state.arc[0], state.y_lo
-        path = [(theta, y)]
-        for pin in plan["pins"]:
-            one = simulate.rollout(part, theta, contact_parameter(pins[pin], y, part.a), MU_C, PIN_RADIUS)
-            theta, y = float(one["theta_f"]), y + float(one["dy"])
-            path.append((theta, y))
-        paths[label] = path
+    heights = [pins[pin] for pin in plan["pins"]]
+    paths = {label: simulate.nominal_path(part, state.arc[0], state.y_lo, heights, MU_C, PIN_RADIUS)
+             for label, state in planner.initial_states().items()}
     title = f"{part.name}: best fixed-pin plan on a {theta_step:g}-degree grid, mu_c {MU_C:g}"
     return sequence_figure(part, plan, pins, paths, PIN_RADIUS, title), plan

@@ -10,7 +10,6 @@ from pipeline.maps import simulate
 from pipeline.maps.catalog import Catalog
 from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_source
-from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.settings import nominal_friction, parse_friction
 from pipeline.planning.types import PlanFile, validate_plan_file
@@ -34,18 +33,19 @@ def nominal_paths(plan_result: dict, config: dict, plan: dict | None = None, pin
     best = plan or plan_result["plans"][0]
     pins = plan_result["pins"] if pins is None else pins
     speeds = plan_result.get("pin_speeds", {}) if speeds is None else speeds
-    paths = {}
-    for label, s in plan_result["initial_states"].items():
-        theta, y = s["theta"], s["y_c"]
-        path = [(theta, y)]
-        for pin in best["pins"]:
-            r = simulate.rollout(part, theta, contact_parameter(pins[pin], y, part.a),
-                                 plan_result["mu_c"] if mu_c is None else mu_c, config["sweep"]["pin_radius"],
-                                 model=plan_result["model"], v_pin=speeds.get(pin, 0.0))
-            theta, y = float(r.theta_f), y + float(r.dy)
-            path.append((theta, y))
-        paths[label] = path
-    return paths
+    mu_c = plan_result["mu_c"] if mu_c is None else mu_c
+    return {label: simulate.nominal_path(part, s["theta"], s["y_c"], [pins[p] for p in best["pins"]], mu_c,
+                                         config["sweep"]["pin_radius"], plan_result["model"],
+                                         [speeds.get(p, 0.0) for p in best["pins"]])
+            for label, s in plan_result["initial_states"].items()}
+
+
+def tight_plan_pins(plan: dict) -> tuple[dict, dict]:
+    """A tight plan's own pins: label -> height (mm), and label -> speed (v_pin / v_b)
+    of its moving pins."""
+    pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
+    speeds = {q: v for q, v in zip(plan["pins"], plan.get("pin_speeds") or ()) if v}
+    return pins, speeds
 
 
 def make_figures(config, plan_paths, verify_paths, out: dict):
@@ -144,8 +144,7 @@ def _sequence_figure(config, res, plan, what, path):
     part = Part.from_dict(res["part"], name=name)
     pins, speeds, mu_c = res["pins"], res.get("pin_speeds", {}), None
     if plan.get("pin_heights_mm") is not None:  # a tight plan: its own heights, speeds and friction
-        pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
-        speeds = {q: v for q, v in zip(plan["pins"], plan.get("pin_speeds") or ()) if v}
+        pins, speeds = tight_plan_pins(plan)
         mu_c = nominal_friction(parse_friction(res["tight"][0]["mu_c"]))
     plot_sequence(part, plan, pins, nominal_paths(res, config, plan, pins, speeds, mu_c),
                   config["sweep"]["pin_radius"], f"{name}: {what}", path, speeds=speeds)
