@@ -223,19 +223,20 @@ def _summarise(names: list[str], work: Path) -> None:
 def _friction_table(names: list[str], work: Path) -> str:
     """A Markdown table of each part's recommended plan at the planner's friction
     range and at each planned friction, with its held-out verdict."""
-    lines = ["| part | mu_c | recommended plan (pin heights, mm) | verified width | trials in one set "
-             "within the tolerance |", "|---|---|---|---|---|"]
+    from pipeline.present.figures.tables import markdown_table
+    rows = []
     for name in names:
         for entry in json.loads((work / "plans" / f"{name}.json").read_text())["tight"]:
             plan = entry.get("recommended")
             if plan is None:
-                lines.append(f"| {name} | {entry['friction']} | none: {entry.get('warning', 'no plan')} | | |")
+                rows.append([name, entry["friction"], f"none: {entry.get('warning', 'no plan')}", "", ""])
                 continue
             verdict = plan["verification"]["orientation"]
             pins = ", ".join(f"{p} {h:g}" for p, h in zip(plan["pins"], plan["pin_heights_mm"]))
-            lines.append(f"| {name} | {entry['friction']} | {pins} | {verdict['width_deg']:.1f} deg | "
-                         f"{verdict['in_tolerance']}/{verdict['trials']} |")
-    return "\n".join(lines) + "\n"
+            rows.append([name, entry["friction"], pins, f"{verdict['width_deg']:.1f} deg",
+                         f"{verdict['in_tolerance']}/{verdict['trials']}"])
+    return markdown_table(rows, ["part", "mu_c", "recommended plan (pin heights, mm)", "verified width",
+                                 "trials in one set within the tolerance"])
 
 
 def _numbers(row: dict, work: Path) -> dict:
