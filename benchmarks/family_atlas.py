@@ -51,7 +51,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pipeline.config import config_name, load_config  # noqa: E402
-from pipeline.planning.settings import nominal_friction, parse_friction  # noqa: E402
+from pipeline.planning import PlannerSettings  # noqa: E402
 
 # Stage of each rule on the way to the atlas that writes a benchmark file, in the order they run.
 STAGES = ["sweep_shard", "plan", "speed", "layout", "atlas"]
@@ -63,7 +63,7 @@ def planner_sweep(config: dict) -> dict:
     pc = config["planner"]
     # every listed speed, even at dynamic depth 0: the paper-mode planner loads them all
     speeds = [float(v) for v in (pc.get("dynamic") or {}).get("speeds", [])]
-    config["sweep"].update(models=[pc["model"]], mu_c=[nominal_friction(parse_friction(pc["mu_c"]))],
+    config["sweep"].update(models=[pc["model"]], mu_c=[PlannerSettings.from_config(config).friction.nominal],
                            v_pin=[0.0] + speeds)
     config["sweep"].pop("supports", None)
     return config

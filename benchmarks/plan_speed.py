@@ -22,7 +22,7 @@ import numpy as np
 
 from pipeline.config import load_config
 from pipeline.parts.part import Part
-from pipeline.planning.plan import plan_tight_all
+from pipeline.planning import PlannerSettings, plan_tight_all
 
 PARTS = {
     "asym_triangle": [[0, 0], [60, 0], [15, 35]],
@@ -55,7 +55,7 @@ def main() -> None:
         part = Part.from_vertices(PARTS[name], name=name)
         with tempfile.TemporaryDirectory() as root:
             t0 = time.perf_counter()
-            res = plan_tight_all(part, config, root)[0]
+            res = plan_tight_all(part, PlannerSettings.from_config(config), root)[0]
             dt = time.perf_counter() - t0
         times.append(dt)
         rec = res["recommended"]

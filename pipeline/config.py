@@ -10,6 +10,7 @@ fails with one clear message before any work starts.
 from __future__ import annotations
 
 import copy
+import functools
 import hashlib
 import json
 import math
@@ -28,9 +29,25 @@ SCHEMA_PATH = Path(__file__).resolve().parent.parent / "config" / "schema.yaml"
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config" / "config.yaml"
 
 
+@functools.lru_cache(maxsize=1)
+def _schema_text() -> str:
+    return SCHEMA_PATH.read_text()
+
+
 def _schema():
-    with open(SCHEMA_PATH) as fh:
-        return yaml.safe_load(fh)
+    return yaml.safe_load(_schema_text())
+
+
+def schema_default(*path: str):
+    """The default that ``config/schema.yaml`` gives the key at ``path`` (for
+    example ``schema_default("verify", "trials")``): the one place defaults
+    live, read by the settings' types for callers that come without a config."""
+    node = _schema()
+    for key in path:
+        node = node["properties"][key]
+    if "default" not in node:
+        raise KeyError(f"config/schema.yaml gives {'/'.join(path)} no default")
+    return copy.deepcopy(node["default"])
 
 
 def _fill_defaults(validator_cls):

@@ -78,7 +78,7 @@ def one_set_sequences(part, pins: dict, depth, trials_for):
 
 
 # ---------------------------------------------------------------------- orientation within a tolerance
-# A second oracle for the complete search (pipeline/planning/complete.py): its
+# A second oracle for the complete search (pipeline/planning/tight/complete.py): its
 # own trials (uniform in the perturbation box, its corners and the nominal
 # start), its own replay through the public batch rollout API and its own
 # judgement of "one set within the tolerance". Nothing of the planner's

@@ -170,7 +170,7 @@ def _sequence_png(part, tight: dict, model: str, config: dict, out: Path) -> Non
     import matplotlib.pyplot as plt
 
     from pipeline.maps.simulate import nominal_path
-    from pipeline.planning.settings import nominal_friction, parse_friction
+    from pipeline.planning import Friction
     from pipeline.present.figures.sequence import sequence_figure
     from pipeline.workflow.report import tight_plan_pins
     from tutorial_figures import checked
@@ -178,9 +178,9 @@ def _sequence_png(part, tight: dict, model: str, config: dict, out: Path) -> Non
     if not plan:
         return
     pins, speeds = tight_plan_pins(plan)
-    planned = parse_friction(tight["mu_c"])
-    mu_c = nominal_friction(planned)
-    where = (f"the middle of the planned range {planned[0]:g}-{planned[1]:g}" if isinstance(planned, tuple)
+    planned = Friction.parse(tight["mu_c"])
+    mu_c = planned.nominal
+    where = (f"the middle of the planned range {planned.lo:g}-{planned.hi:g}" if planned.is_range
              else "the planned friction")
     paths = {label: nominal_path(part, theta, y_c, plan["pin_heights_mm"], mu_c, config["sweep"]["pin_radius"],
                                  model, [speeds.get(p, 0.0) for p in plan["pins"]])

@@ -124,13 +124,13 @@ def layout_sequence(source: str):
     state, the part before the first pin and after each pin (nominal rollouts of
     the plan's model at its friction)."""
     from pipeline.maps import simulate
-    from pipeline.planning.settings import nominal_friction, parse_friction
+    from pipeline.planning import Friction
     from pipeline.present.figures.sequence import sequence_figure
     part = tutorial_part(source)
     layout = stored_layout(part.name)
     plan = layout["plan"]
     pins = dict(zip(plan["pins"], plan["pin_heights_mm"]))
-    mu_c = nominal_friction(parse_friction(plan["friction"]))
+    mu_c = Friction.parse(plan["friction"]).nominal
     paths = {label: simulate.nominal_path(part, theta, y, plan["pin_heights_mm"], mu_c, PIN_RADIUS)
              for label, (theta, y) in _resting_states(part).items()}
     title = f"{part.name}: recommended plan at $\\mu_c$ {mu_c:g}, nominal paths"

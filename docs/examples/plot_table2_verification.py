@@ -15,7 +15,7 @@ import os
 import matplotlib.pyplot as plt
 
 from pipeline.parts.part import Part
-from pipeline.planning.verify import verify_plan
+from pipeline.planning import verify_plan
 from pipeline.present.coarse_plans import MU_C, PIN_RADIUS, best_coarse_plan
 from pipeline.present.figures.tables import FAIL_COLOUR, HEADER, verification_rows
 

@@ -18,7 +18,7 @@ from pipeline.cli.options import (add_config_option, add_json_option, add_result
 def cmd_speed(args):
     """A plan's success rate against belt speed and its speed limit (dynamic model)."""
     from pipeline.config import load_config
-    from pipeline.planning.speed_limit import speed_label
+    from pipeline.planning import speed_label
     from pipeline.workflow.commands import speed_command, stored_plan
     config = load_config(args.config)
     result, _ = stored_plan(config, results_arg(args, config), args.part, args.config)

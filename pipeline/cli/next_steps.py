@@ -62,7 +62,7 @@ def fallback_steps(result, out, config, args, plan_options) -> list[tuple[str, s
 
 def _trials_step(tight, config_path):
     """More verification trials, where too few (or a near miss) kept the claim from being made."""
-    from pipeline.planning.orient import min_trials
+    from pipeline.planning import min_trials
     search = tight.get("fixed_pin_search") or {}
     short = [lv for lv in search.get("levels", ()) if lv.get("too_few_trials")]
     where = f"in {config_path}" if config_path else "in a config file of your own (--config FILE)"
@@ -108,7 +108,7 @@ def _sensor_step(result, tight, out, config, config_path):
 def _each_state_in_one_set(rec, tight) -> bool:
     """Whether every initial state's branches of ``rec`` end within one arc of the
     tolerance (so that knowing the state tells the final set); true when unknown."""
-    from pipeline.planning.orient import narrowest_arc
+    from pipeline.planning import narrowest_arc
     order = tight.get("symmetry_order") or 1
     for branches in (rec.get("initial_states") or {}).values():
         ends = [b[-1].get("carried", {}).get("arc") or b[-1]["band"] for b in branches if b]
@@ -160,7 +160,7 @@ def _grid_step(result, tight, rerun):
     """A wider or denser grid of candidate pin heights: the grid fitted to the part
     (``planner.pins: auto``), where the search's pins leave part of it out."""
     from pipeline.parts.part import Part
-    from pipeline.planning.settings import fitted_pins
+    from pipeline.planning import fitted_pins
     used = sorted(float(y) for y in (tight.get("pins_used") or {}).values())
     fitted = sorted(fitted_pins(Part.from_dict(result["part"])).values())
     if not used or len(fitted) < 2:

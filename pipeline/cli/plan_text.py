@@ -6,7 +6,7 @@
 """
 from __future__ import annotations
 
-from pipeline.planning.arcs import format_arcs, merge_modulo
+from pipeline.planning import format_arcs, merge_modulo
 
 
 def _verification_counts(plan) -> dict | None:
@@ -83,11 +83,12 @@ def plan_json(result, mode) -> dict:
 
 def print_plan_result(result, part, config, mode):
     """A plan result (the dict ``plan_command`` returns), for people."""
-    from pipeline.planning.plan import mechanics_label, planner_belt
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning import PlannerSettings, mechanics_label, planner_belt
+    from pipeline.planning import as_plan_file
     result = as_plan_file(result)
     pc = config["planner"]
-    print(f"part {part.id}: model {mechanics_label(pc['model'], *planner_belt(config))}, depth {pc['depth']}")
+    search = PlannerSettings.from_config(config).search
+    print(f"part {part.id}: model {mechanics_label(search.model, *planner_belt(search))}, depth {search.depth}")
     for k, (theta, y_c) in enumerate(part.stable_states(), start=1):
         print(f"  state {k}: resting on the fence at theta = {theta:.1f} deg, y_c = {y_c:.2f} mm")
     for t in result.tight or ():
@@ -104,7 +105,7 @@ def print_plan_result(result, part, config, mode):
             print(f"  {search['evidence']}")
         cert = t.extra.get("family_certificate")
         if cert:
-            from pipeline.planning.family_certificate import family_certificate_line
+            from pipeline.planning import family_certificate_line
             print(f"  {family_certificate_line(cert)}")
         if t.warning:
             print(f"  WARNING: {t.warning}")
@@ -143,8 +144,8 @@ def sets_text(arcs, order: int) -> str:
 
 def _print_claim(plan) -> None:
     """The held-out claim with its uncertainty, the selection trials apart, the margin in words."""
-    from pipeline.planning.complete import margin_text
-    from pipeline.planning.orient import describe_claim
+    from pipeline.planning import margin_text
+    from pipeline.planning import describe_claim
     v = plan.verification
     o = v.extra.get("orientation") if v else None
     if o and "share_lower_bound" in o:

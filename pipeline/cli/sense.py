@@ -37,7 +37,7 @@ def cmd_sense_classify(args):
 
 def _print_classification(result: dict, context: dict, profile):
     """A measured profile's verdict and final orientation, for people."""
-    from pipeline.planning.arcs import format_arcs
+    from pipeline.planning import format_arcs
     stored, final = context["stored"], result["final_sets"]
     mu_planned, margin = result["mu_c"], result["margin"]
     planned = f"{mu_planned[0]:g}:{mu_planned[1]:g}" if isinstance(mu_planned, list) else f"{mu_planned:g}"

@@ -46,7 +46,7 @@ from pipeline.parts.part import Part
 from pipeline.parts.support import support_key
 
 INDEX_NAME = "index.json"
-# The planner's refinement shards (pipeline.planning.lattice_store) live under
+# The planner's refinement shards (pipeline.planning.tight.store) live under
 # ROOT/refine/PART_ID/...: listed by the index apart from the maps.
 REFINE_FOLDER = "refine"
 INDEX_VERSION = 1
@@ -279,7 +279,7 @@ class Catalog:
             if path.name.startswith("."):
                 continue  # an unfinished atomic write
             if path.relative_to(root).parts[0] == REFINE_FOLDER:
-                # the planner's on-demand rollouts (pipeline.planning.lattice_store), not maps
+                # the planner's on-demand rollouts (pipeline.planning.tight.store), not maps
                 rel = path.relative_to(root)
                 refinements.append({"file": rel.as_posix(), **refinement_fields(rel),
                                     "sha256": _sha256(path)})

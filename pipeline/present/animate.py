@@ -226,11 +226,11 @@ _LABEL = re.compile(r"^P(\d+)(?:v([+-]?[\d.]+))?$")
 
 
 def recommended_index(result):
-    """Which plan of a stored result (a :class:`~pipeline.planning.types.PlanFile`
+    """Which plan of a stored result (a :class:`~pipeline.planning.core.types.PlanFile`
     or its dict) is the recommended one: ``"tight"`` (the tight planner's
     recommended plan at the first friction), else ``1`` (paper mode's best),
     else None (no plan)."""
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning import as_plan_file
     result = as_plan_file(result)
     if result.tight and result.tight[0].recommended:
         return "tight"
@@ -241,7 +241,7 @@ def _chosen_plan(result, plan_index):
     """(:class:`Plan`, friction, description) of ``plan_index`` in the
     :class:`PlanFile` ``result``: None (the recommended plan), ``"tight"``, or
     a 1-based paper-mode index."""
-    from pipeline.planning.settings import nominal_friction, parse_friction
+    from pipeline.planning import Friction
     name = result.name
     if plan_index is None:
         plan_index = recommended_index(result)
@@ -251,7 +251,7 @@ def _chosen_plan(result, plan_index):
         tight = result.tight[0] if result.tight else None
         if not tight or not tight.recommended:
             raise PinfeedError(f"{name}: the stored result has no recommended tight plan")
-        mu = nominal_friction(parse_friction(tight.mu_c))
+        mu = Friction.parse(tight.mu_c).nominal
         return tight.recommended, mu, f"tight plan at mu_c {tight.friction}"
     plans = result.plans or ()
     if not plans:
@@ -263,7 +263,7 @@ def _chosen_plan(result, plan_index):
 
 def _resting_states(*stored) -> dict:
     """label -> ``(theta_deg, y_c_mm)`` of the first non-empty of ``stored``
-    (label -> :class:`~pipeline.planning.types.RestingState` maps or None):
+    (label -> :class:`~pipeline.planning.core.types.RestingState` maps or None):
     ``pinfeed plan --mode tight`` files keep them per friction entry only."""
     found = next((s for s in stored if s), {})
     return {k: (float(s.theta), float(s.y_c)) for k, s in found.items()}
@@ -271,13 +271,13 @@ def _resting_states(*stored) -> dict:
 
 def plan_inputs(result, plan_index, config: dict) -> dict:
     """Plain inputs of a plan of a stored plan result (``RESULTS/plans/NAME.json``;
-    a :class:`~pipeline.planning.types.PlanFile` or its dict): pin labels,
+    a :class:`~pipeline.planning.core.types.PlanFile` or its dict): pin labels,
     heights, speeds, states, physics, and ``what`` (which plan).
     ``plan_index``: None for the recommended plan (the tight planner's, else
     paper mode's best), ``"tight"``, or a 1-based paper-mode plan. Heights: the
     plan's ``pin_heights_mm`` if present, else the result's label -> height
     table, else the config's ``planner.pins`` by label P1..."""
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning import as_plan_file
     result = as_plan_file(result)
     plan, mu_c, what = _chosen_plan(result, plan_index)
     labels = list(plan.pins)
@@ -308,12 +308,12 @@ def plan_inputs(result, plan_index, config: dict) -> dict:
 
 def layout_inputs(result, layout: dict) -> dict:
     """The plan a layout (``pinfeed layout``'s JSON) was made from, in a stored plan
-    result (a :class:`~pipeline.planning.types.PlanFile` or its dict):
+    result (a :class:`~pipeline.planning.core.types.PlanFile` or its dict):
     ``{"labels", "heights", "states", "mu_c", "what"}``. A one-line
     :class:`PinfeedError` when the layout is of another part, has no plan, or
     its pins are not the stored plan's."""
-    from pipeline.planning.plan import pick_tight_plan
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning import pick_tight_plan
+    from pipeline.planning import as_plan_file
     result = as_plan_file(result)
     name = result.name
     if layout.get("part") != name:
@@ -354,7 +354,7 @@ def animate_stored(result, config: dict, out, plan_index=None, frames: int = 120
     stations, parts arriving at the layout's pitch; ``plan_index`` is then
     not used."""
     from pipeline.parts.part import Part
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning import as_plan_file
     result = as_plan_file(result)
     if layout is not None:
         inputs = layout_inputs(result, layout)
@@ -416,7 +416,7 @@ def station_scene(part, layout: dict, states: dict, mu_c, n_parts: int | None = 
     ``mu_s``, ``method.model``, ``method.margins_mm``). ``states``: label ->
     ``(theta_deg, y_c_mm)``. ``n_parts``: default one per state, at least 3."""
     from pipeline.present.lanes import run_trials, trial_lanes
-    from pipeline.planning.settings import nominal_friction
+    from pipeline.planning import nominal_friction
     rows = layout.get("stations") or []
     if not rows:
         raise PinfeedError(f"the layout of {layout.get('part', 'the part')} has no pin stations "

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from pipeline.maps import simulate
-from pipeline.planning.paper import Planner, load_maps
-from pipeline.planning.settings import candidate_pins
+from pipeline.planning import Planner, load_maps
+from pipeline.planning import candidate_pins
 from pipeline.present.figures.sequence import sequence_figure
 
 MU_C, PIN_RADIUS, THRESHOLD_T, FACTOR_C = 0.15, 3.0, 5.0, 2.0

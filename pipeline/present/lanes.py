@@ -217,8 +217,8 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
     How far the trials have got goes to the progress report of
     :func:`pipeline.progress.reporting`, if any.
     """
-    from pipeline.planning.settings import nominal_friction
-    from pipeline.planning.verify import PERTURB_DEFAULTS, corner_inputs, perturbed_batch
+    from pipeline.planning import nominal_friction
+    from pipeline.planning import PERTURB_DEFAULTS, corner_inputs, perturbed_batch
     from pipeline.progress import Heartbeat
     cfg = dict(PERTURB_DEFAULTS, **(perturb or {}))
     rng = np.random.default_rng(seed)

@@ -356,7 +356,7 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
                   belt_speed: float | None = None, mu_s: float | None = None,
                   quasi_static: bool = False, settings: dict | None = None) -> dict:
     """The layout of tight plan ``plan_number`` of a stored plan result
-    (``RESULTS/plans/NAME.json``; a :class:`~pipeline.planning.types.PlanFile`
+    (``RESULTS/plans/NAME.json``; a :class:`~pipeline.planning.core.types.PlanFile`
     or its dict), as ``pinfeed layout`` and the workflow make it.
 
     The plan's speed limit is the one stored with the plan (at the same belt
@@ -371,9 +371,9 @@ def layout_stored(result, config: dict, plan_number: int = 1, mu_text=None,
     throughput, and ``warnings`` says so).
     """
     from pipeline.maps import simulate
-    from pipeline.planning.settings import friction_label
-    from pipeline.planning.speed_limit import DEFAULT_SPEEDS
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning import friction_label
+    from pipeline.planning import DEFAULT_SPEEDS
+    from pipeline.planning import as_plan_file
     from pipeline.provenance import provenance_attrs
     cfg = check_layout_settings({**config.get("layout", {}), **(settings or {})})
     result = as_plan_file(result)
@@ -415,7 +415,7 @@ def _family_assumption(out: dict, result) -> None:
     """For a plan made for a support family: ``assumes`` and a one-line
     ``assumption`` (also among the warnings): the belt speed and spacing come
     from the dynamic model, which assumes uniform pressure."""
-    from pipeline.planning.family_certificate import family_assumption
+    from pipeline.planning import family_assumption
     note = family_assumption(result, "layout")
     if note:
         out.update(note)
@@ -426,7 +426,7 @@ def _record_speed_limit(out: dict, curve: dict, trials: int, stored: dict | None
     """Write into the layout ``out`` where its speed limit comes from: the trials per
     state (``speed_limit_trials``), the plan file's figure (``stored_speed_limit``)
     and ``method.speed_limit``."""
-    from pipeline.planning.speed_limit import DEFAULT_SPEEDS
+    from pipeline.planning import DEFAULT_SPEEDS
     out["speed_limit_trials"] = int(trials)
     out["stored_speed_limit"] = None if stored is None else {
         k: stored[k] for k in ("speed_limit_mm_s", "trials", "mu_s")}
@@ -441,24 +441,24 @@ def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, config, cfg) -> tup
     """``(curve, trials, stored)``: the speed limit stored with ``plan`` when it was
     computed at belt friction ``mu_s`` (one speed limit per plan), else one computed
     here with ``speed_trials`` trials per state; ``stored``: the plan's record or None."""
-    from pipeline.planning.speed_limit import perturbation_from_verify, speed_curve, stored_speed_limit
+    from pipeline.planning import PlannerSettings, perturbation_from_verify, speed_curve, stored_speed_limit
     stored = stored_speed_limit(plan)
     if stored and stored["settings"]["mu_s"] == mu_s:
         return stored, stored["trials"], stored
     heights = [float(h) for h in plan.pin_heights_mm]
     curve = speed_curve(part, heights, [0.0] * len(heights), states, plan.final_arcs, mu_c, mu_s=mu_s,
-                        perturb=perturbation_from_verify(config.get("verify", {})),
+                        perturb=perturbation_from_verify(PlannerSettings.from_config(config).verify.perturbation),
                         trials=cfg["speed_trials"], r_pin=pin_radius, seed=cfg["seed"])
     return curve, cfg["speed_trials"], stored
 
 
 def _fixed_pin_plan(result, plan_number, mu_text):
     """``(plan, mu_c, states)``: tight plan ``plan_number`` at friction ``mu_text``
-    of the :class:`~pipeline.planning.types.PlanFile` ``result``
-    (:func:`~pipeline.planning.plan.pick_tight_plan`), refused with a one-line
+    of the :class:`~pipeline.planning.core.types.PlanFile` ``result``
+    (:func:`~pipeline.planning.plans.plan.pick_tight_plan`), refused with a one-line
     :class:`PinfeedError` if it has moving pins; ``states``: label ->
     ``(theta_deg, y_c_mm)``, the entry's resting states, else the file's."""
-    from pipeline.planning.plan import pick_tight_plan
+    from pipeline.planning import pick_tight_plan
     plan, mu_c, entry = pick_tight_plan(result, int(plan_number), mu_text)
     if any(float(v) for v in plan.pin_speeds or ()):
         fixed = [f"--plan {k} ({' '.join(p.pins)})" for k, p in enumerate(entry.plans, start=1)
@@ -478,7 +478,7 @@ def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
     (mm/s), or none and the quasi-static model when no speed passes; a given
     speed above the limit is kept with a warning.
     """
-    from pipeline.planning.speed_limit import DEFAULT_SPEEDS
+    from pipeline.planning import DEFAULT_SPEEDS
     warnings = []
     if belt_speed is None and limit > 0:
         belt_speed = cfg["speed_fraction"] * limit
@@ -502,7 +502,7 @@ def final_sets_warning(plan: dict) -> list[str]:
     several final orientation sets: such a feeder does not orient them fully. A
     plan whose verification says it orients (its trials end in one set within
     the tolerance, though the claim names several narrower ones) gets none."""
-    from pipeline.planning.arcs import format_arcs
+    from pipeline.planning import format_arcs
     n = plan.get("n_final_sets") or len(plan.get("final_sets") or ())
     orientation = (plan.get("verification") or {}).get("orientation") or {}
     if n <= 1 or orientation.get("orients"):
@@ -559,7 +559,7 @@ def layout_part(plan_result, config: dict, outputs: dict) -> str:
     import time
 
     from pipeline.maps.io import write_json
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning import as_plan_file
     start = time.perf_counter()
     plan_result = as_plan_file(plan_result)
     first_plans = plan_result.tight[0].plans if plan_result.tight else ()

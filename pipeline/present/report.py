@@ -14,7 +14,7 @@ from pathlib import Path
 from pipeline import __version__
 from pipeline.config import config_hash
 from pipeline.maps.io import write_text_atomic
-from pipeline.planning.arcs import format_arcs
+from pipeline.planning import format_arcs
 from pipeline.present.atlas_section import atlas_section
 from pipeline.present.figures.tables import HEADER, verification_rows
 from pipeline.present.layout import speed_limit_text

@@ -18,9 +18,7 @@ from pipeline.maps.catalog import Catalog, entry_part
 from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_id
 from pipeline.parts.part import Part
-from pipeline.planning.plan import best_fixed_plan, plan_hint, tight_entry
-from pipeline.planning.settings import parse_friction
-from pipeline.planning.types import load_plan
+from pipeline.planning import PlannerSettings, best_fixed_plan, load_plan, plan_hint, tight_entry
 from pipeline.sensing.profiles import Sensor, classify, read_profile_csv, reference_profiles, resample, sign_matrix
 from pipeline.sensing.sensor_plan import count_sets, final_for_verdict, sensing_frictions, stored_sensor_plan
 
@@ -41,7 +39,7 @@ def classify_measured(config: dict, part_name: str, profile, root, catalog=None,
     y_pin, first_pin, source, entry = _pin(y_pin, stored, plan, root, name)
     if y_pin is None:
         raise PinfeedError(f"no sensor pin for {name}: no stored sensor plan and no recommended plan under "
-                           f"{root}; {plan_hint(config, name, root)} or give the sensor pin's height with "
+                           f"{root}; {plan_hint(config['planner']['parts'], name, root)} or give the sensor pin's height with "
                            f"--y-pin MM")
     sensor, mu_planned, mu_profiles, model, pin_radius = _sensing_inputs(config, stored, plan, entry,
                                                                          catalog_radius)
@@ -71,7 +69,7 @@ def classify_measured(config: dict, part_name: str, profile, root, catalog=None,
 
 def _stored_plans(root: Path, part: Part):
     """``(sensor plan, plan result)`` stored under ``root`` for ``part`` (the plan
-    result a :class:`~pipeline.planning.types.PlanFile`); each None when
+    result a :class:`~pipeline.planning.core.types.PlanFile`); each None when
     absent, not found, or stored for another outline of that name."""
     stored = stored_sensor_plan(root, part.name)
     if stored is not None and (not stored.get("found") or stored["part"].get("id", part.id) != part.id):
@@ -97,7 +95,7 @@ def _sensing_inputs(config, stored, plan, entry, catalog_radius):
     elif plan is not None and plan.mu_c is not None:
         friction = {"mu_c": plan.mu_c}
     else:
-        friction = {"mu_c": parse_friction(config["planner"]["mu_c"])}
+        friction = {"mu_c": PlannerSettings.from_config(config).friction.value}
     mu_planned, mu_profiles = sensing_frictions(friction)
     mu_planned = list(mu_planned) if isinstance(mu_planned, tuple) else mu_planned
     model = plan.model if plan is not None and plan.model is not None else config["planner"]["model"]

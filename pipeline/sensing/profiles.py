@@ -53,7 +53,7 @@ from scipy.ndimage import uniform_filter1d
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.verify import PERTURB_DEFAULTS, perturbed_inputs  # one set of perturbation sizes for every check
+from pipeline.planning import PERTURB_DEFAULTS, perturbed_inputs  # one set of perturbation sizes for every check
 
 
 @dataclass
@@ -240,7 +240,7 @@ def reference_profiles(part, states: dict, y_pin, mu_c, pin_radius, model, senso
 def synthetic_measurement(part, state: dict, y_pin, mu_c, pin_radius, model, sensor: Sensor,
                           perturb: dict, rng) -> Profile:
     """One synthetic reading of ``state`` at the pin: inputs drawn from the
-    verify stage's perturbation box (:func:`pipeline.planning.verify.perturbed_inputs`:
+    verify stage's perturbation box (:func:`pipeline.planning.claims.verify.perturbed_inputs`:
     theta_i and a friction value normal, truncated at 2 sigma, friction
     clipped at 0, a friction range ``(lo, hi)`` uniform; y_c and the pin
     position uniform; sizes from ``perturb``) rolled out again, sampled at the

@@ -14,10 +14,10 @@ workflow) and takes the tight planner's *verified* plans at one friction
 (default the first entry, ``planner.mu_c``, the friction of the recommended
 plan), in the order the plan stage ranked them. Each stored plan holds, per
 initial state, the branches of sets carried by the tight propagation
-(:mod:`pipeline.planning.propagate`) ending in that state's final arcs, and those arcs
+(:mod:`pipeline.planning.tight.propagate`) ending in that state's final arcs, and those arcs
 have passed the verify stage's full rollouts; rejected plans are never
 candidates. We chose the stored plans over a new search
-(:mod:`pipeline.planning.complete`) so that the sensor plan is one of
+(:mod:`pipeline.planning.tight.complete`) so that the sensor plan is one of
 the plans the user was shown and verified. The price: a plan the plan stage
 ranked below its stored ``keep`` best (for instance one pin that leaves each
 state in its own set while a two-set plan exists) is not seen; a wider search
@@ -62,15 +62,15 @@ from pathlib import Path
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
-from pipeline.planning.arcs import arc_within, merge_arcs, merge_modulo
-from pipeline.planning.verify import predicted_sets
+from pipeline.planning import arc_within, merge_arcs, merge_modulo
+from pipeline.planning import predicted_sets
 from pipeline.sensing.profiles import PERTURB_DEFAULTS, Sensor, score_table
 
 
 def sensing_frictions(entry: dict):
     """``(planned, profiles)``: the entry's friction as planned (a value or a
     tuple ``(lo, hi)``) and the one value the simulated profiles use."""
-    from pipeline.planning.settings import nominal_friction
+    from pipeline.planning import nominal_friction
     mu = entry["mu_c"]
     planned = (float(mu[0]), float(mu[1])) if isinstance(mu, (list, tuple)) else float(mu)
     return planned, nominal_friction(planned)
@@ -240,7 +240,7 @@ def _summary(plan: dict) -> dict:
 
 def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor: Sensor,
                        settings: dict | None = None, kernel: dict | None = None) -> dict:
-    """End-to-end check by perturbed full rollouts (as :mod:`pipeline.planning.verify`): each
+    """End-to-end check by perturbed full rollouts (as :mod:`pipeline.planning.claims.verify`): each
     trial perturbs theta_i, y_c, mu_c (a range: uniformly over it) and every
     pin position, rolls the part past the first pin while the sensor reads it
     (bias and noise added), classifies the reading against the stored
@@ -255,10 +255,10 @@ def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor
     import numpy as np
 
     from pipeline.maps.simulate import rollout
-    from pipeline.planning.verify import DEFAULTS, perturbed_inputs
+    from pipeline.planning import VERIFY_DEFAULTS, perturbed_inputs
     from pipeline.progress import progress
     from pipeline.sensing.profiles import classify, measure, profile_from_rollout, sign_matrix
-    cfg = dict(DEFAULTS, **(settings or {}))
+    cfg = dict(VERIFY_DEFAULTS, **(settings or {}))
     cfg["corners"] = False
     kernel = {k: v for k, v in (kernel or {}).items() if k in ("ds_max", "tol")}
     rng = np.random.default_rng(cfg["seed"])
@@ -306,8 +306,8 @@ def sense_part(plan_path, config: dict, log=print, friction=None) -> dict:
     table at its first pin, the per-verdict final sets and their end-to-end
     check, with provenance."""
     from pipeline.parts.part import Part
-    from pipeline.planning.plan import tight_entry
-    from pipeline.planning.types import load_plan
+    from pipeline.planning import tight_entry
+    from pipeline.planning import load_plan
     from pipeline.provenance import provenance_attrs
     sc, sweep = config["sensing"], config["sweep"]
     stored = load_plan(plan_path)
@@ -350,8 +350,8 @@ SENSING_SCHEMA = {
                             "states": {"type": "object", "additionalProperties": {
                                 "type": "object", "required": ["final_sets"]}}}},
 }
-# A stored plan result is checked against ``pipeline/planning/plan.schema.json``
-# (``pipeline.planning.types.validate_plan_file``).
+# A stored plan result is checked against ``pipeline/planning/core/plan.schema.json``
+# (``pipeline.planning.core.types.validate_plan_file``).
 
 
 def read_checked_json(path, schema: dict, what: str) -> dict:

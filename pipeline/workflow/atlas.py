@@ -26,7 +26,7 @@ import tempfile
 from pathlib import Path
 
 from pipeline.maps.io import read_json, write_json
-from pipeline.planning.types import validate_plan_file
+from pipeline.planning import validate_plan_file
 from pipeline.provenance import provenance_attrs
 
 COLUMNS = ("part", "part_id", "outcome", "orients", "tolerance_deg", "fixed_pins", "moving_pins",

@@ -13,9 +13,7 @@ from pipeline.errors import PinfeedError
 from pipeline.maps.catalog import Catalog, entry_part
 from pipeline.parts.families import family_parts
 from pipeline.parts.part import Part
-from pipeline.planning.orient import check_tolerance
-from pipeline.planning.plan import plan_tight_all, planner_belt
-from pipeline.planning.settings import parse_friction
+from pipeline.planning import Friction, PlannerSettings, check_tolerance, plan_tight_all, planner_belt
 from pipeline.provenance import provenance_attrs
 
 
@@ -41,7 +39,7 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
     if mu_c is not None:
         pc["mu_c"] = mu_c
         pc["frictions"] = []
-    parse_friction(pc["mu_c"])  # a clear error before any work
+    Friction.parse(pc["mu_c"])  # a clear error before any work
     if depth is not None and depth < 1:
         raise PinfeedError(f"--depth must be at least 1 (the largest number of pins), got {depth}")
     for key, value in (("model", model), ("depth", depth), ("coverage", coverage)):
@@ -94,12 +92,12 @@ def named_part(config: dict, name: str | None) -> Part:
     return entry_part(e)
 
 
-def plan_tight_only(part: Part, config: dict, progress=None) -> dict:
+def plan_tight_only(part: Part, settings: PlannerSettings, catalog_root, progress=None) -> dict:
     """A plan file with the tight planner's plans only (``pinfeed plan --mode tight``)."""
-    belt_speed, mu_s = planner_belt(config, part)
+    belt_speed, mu_s = planner_belt(settings.search, part)
     belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
-    return {"part": part.to_dict(), "model": config["planner"]["model"], **belt,
-            "tight": plan_tight_all(part, config, config["catalog_dir"], progress=progress),
+    return {"part": part.to_dict(), "model": settings.search.model, **belt,
+            "tight": plan_tight_all(part, settings, catalog_root, progress=progress),
             **provenance_attrs()}
 
 
@@ -107,33 +105,33 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     """What ``pinfeed plan`` stores: plans of ``part`` with the planner(s) of
     ``mode`` (``tight``, ``paper`` or ``both``), each verified, the tight ones
     with their speed limit (``speed_limit.attach_speed_limits``). A belt speed
-    plans with the tight planner only (a one-line error otherwise)."""
-    belt_speed, _ = planner_belt(config, part)  # a bad belt: a one-line error before any work
+    plans with the tight planner only (a one-line error otherwise). The
+    planner's settings are made here, once, from ``config``."""
+    settings = PlannerSettings.from_config(config)
+    belt_speed, _ = planner_belt(settings.search, part)  # a bad belt: a one-line error before any work
     if belt_speed is not None and mode != "tight":
         raise PinfeedError("--belt-speed plans with the tight planner (its rollouts at that speed); "
                            "the paper-mode planner uses the quasi-static map shards: use --mode tight")
-    family = config["planner"].get("support_family")
+    family = settings.search.support_family
     if family:
         from pipeline.parts.support_family import parse_support_family
-        from pipeline.planning.family import check_family_mechanics
+        from pipeline.planning import check_family_mechanics
         if mode != "tight":
             raise PinfeedError("--support-family plans with the tight planner (its trials sample the "
                                "family); the paper-mode planner's map shards assume one support: use "
                                "--mode tight")
-        check_family_mechanics(config)
+        check_family_mechanics(settings.search)
         parse_support_family(family, part)  # a bad family: a one-line error before any work
-    from pipeline.planning.speed_limit import attach_speed_limits
+    from pipeline.planning import attach_speed_limits
     if mode == "tight":
-        return attach_speed_limits(plan_tight_only(part, config, progress=progress), config)
+        return attach_speed_limits(plan_tight_only(part, settings, config["catalog_dir"], progress=progress),
+                                   settings)
     from pipeline.workflow.plan import ensure_maps, plan_part
     cat = ensure_maps(config, part)
-    if mode == "paper":
-        pc = config["planner"]
-        config = dict(config, planner=dict(pc, mu_c=pc["mu_c"], frictions=[]))
-    result = plan_part(cat, part.id, config, progress=progress, tight=mode == "both")
+    result = plan_part(cat, part.id, settings, progress=progress, tight=mode == "both")
     if mode == "paper":
         result.pop("tight")
-    return attach_speed_limits(result, config)
+    return attach_speed_limits(result, settings)
 
 
 def layout_settings(margin=None, trials=None) -> dict:
@@ -259,7 +257,7 @@ def next_step_hints(result: dict, path, config: dict, config_path=None) -> list[
 def fixed_pin_plans(result) -> list[int]:
     """Numbers (1 = recommended) of the tight plans of fixed pins only at the first
     planned friction of a stored plan (a :class:`PlanFile` or its dict)."""
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning import as_plan_file
     tight = as_plan_file(result).tight
     plans = tight[0].plans if tight else ()
     return [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.pin_speeds or ())]
@@ -291,7 +289,7 @@ def stored_plan(config: dict, root, part_name: str, config_path=None) -> tuple:
     (``config_path``: the ``--config`` the hint repeats)."""
     from pathlib import Path
 
-    from pipeline.planning.types import validate_plan_file
+    from pipeline.planning import validate_plan_file
     path = Path(root) / "plans" / f"{part_name}.json"
     if not path.is_file():
         raise PinfeedError(f"no stored plan for {part_name} at {path}; "
@@ -338,11 +336,11 @@ def speed_command(result, config: dict, plan: int = 1, mu_text=None, mu_s=None, 
     default to those of the speed limit stored with the plan (else the config's
     ``speed`` section); with the same settings the stored figure is returned
     (``source``: ``stored with the plan``), else it is computed (``computed``)."""
-    from pipeline.planning.plan import pick_tight_plan
-    from pipeline.planning.speed_limit import speed_settings, stored_plan_speed, stored_speed_limit
+    from pipeline.planning import pick_tight_plan, stored_plan_speed, stored_speed_limit
+    planner = PlannerSettings.from_config(config)
     chosen, _, _ = pick_tight_plan(result, plan, mu_text)
     stored = stored_speed_limit(chosen)
-    settings = dict(stored["settings"]) if stored else speed_settings(config)
+    settings = dict(stored["settings"]) if stored else planner.speed.as_kwargs()
     if mu_s is not None:
         if not mu_s > 0:
             raise PinfeedError(f"--mu-s must be > 0, got {mu_s}")
@@ -353,5 +351,5 @@ def speed_command(result, config: dict, plan: int = 1, mu_text=None, mu_s=None, 
         settings["trials"] = int(trials)
     if stored and stored["settings"] == settings:
         return dict({k: v for k, v in stored.items() if k != "settings"}, source="stored with the plan"), stored
-    out = stored_plan_speed(result, config, plan=plan, mu_text=mu_text, **settings)
+    out = stored_plan_speed(result, planner, plan=plan, mu_text=mu_text, **settings)
     return dict(out, source="computed"), stored

@@ -1,7 +1,7 @@
 """The function of ``rules/layout.smk``: the feeder to build for one part."""
 from __future__ import annotations
 
-from pipeline.planning.types import validate_plan_file
+from pipeline.planning import validate_plan_file
 from pipeline.present.layout import layout_part
 
 

@@ -17,12 +17,9 @@ from pipeline.maps.io import read_map, write_json
 from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
 from pipeline.parts.support import support_key
-from pipeline.planning.paper import build_planner, load_maps, paper_depth
-from pipeline.planning.plan import plan_tight_all
-from pipeline.planning.speed_limit import attach_speed_limits
-from pipeline.planning.settings import nominal_friction, parse_friction
-from pipeline.planning.types import PlanFile, validate_plan_file
-from pipeline.planning.verify import verify_plan
+from pipeline.parts.families import config_part_id
+from pipeline.planning import (PlanFile, PlannerSettings, attach_speed_limits, build_planner, load_maps,
+                               paper_depth, plan_tight_all, validate_plan_file, verify_plan)
 from pipeline.progress import Heartbeat
 from pipeline.provenance import provenance_attrs
 
@@ -40,33 +37,33 @@ def shard_bands(shard, threshold_T, factor_c) -> dict:
             **provenance_attrs()}
 
 
-def plan_part(cat: Catalog, name: str, config: dict, keep: int = 5, progress=None,
+def plan_part(cat: Catalog, part_id: str, settings: PlannerSettings, keep: int = 5, progress=None,
               tight: bool = True) -> dict:
-    """Plans for one part: the paper's adjusted-band planner (``plans``,
-    ``best_static``: fixed pins, then moving pins) at the stored friction
-    nearest the planner's, and the tight planner (``tight``) at every
-    friction of :func:`~pipeline.planning.plan.plan_frictions`, each verified by full rollouts."""
-    pc = config["planner"]
-    part, planner, mu_used, selection = build_planner(cat, name, config)
-    dyn = pc.get("dynamic", {})
-    plans = planner.search(paper_depth(config), keep=keep, dynamic_depth=dyn.get("depth", 0),
-                           dynamic_beam=dyn.get("beam", 50))
+    """Plans for one catalog part (``part_id``: its id or catalog name): the
+    paper's adjusted-band planner (``plans``, ``best_static``: fixed pins,
+    then moving pins) at the stored friction nearest the planner's, and the
+    tight planner (``tight``) at every friction of ``settings.frictions``,
+    each verified by full rollouts."""
+    search = settings.search
+    part, planner, mu_used, selection = build_planner(cat, part_id, settings)
+    depth = paper_depth(search)
+    plans = planner.search(depth, keep=keep, dynamic_depth=search.dynamic_depth, dynamic_beam=search.beam)
     states = planner.initial_states()
     static_only = [p for p in plans if p.n_dynamic == 0]
     if planner.dynamic_labels and not static_only:
-        static_only = [p for p in planner.search(paper_depth(config), keep=1) if p.n_dynamic == 0]
+        static_only = [p for p in planner.search(depth, keep=1) if p.n_dynamic == 0]
     return {
-        "part": part.to_dict(), "model": pc["model"], "mu_c": mu_used, "selection": selection,
+        "part": part.to_dict(), "model": search.model, "mu_c": mu_used, "selection": selection,
         "pins": planner.pins,
         "pin_speeds": {k: v for k, v in planner.speeds.items() if v != 0.0},
-        "depth": paper_depth(config), "dynamic_depth": dyn.get("depth", 0) if planner.dynamic_labels else 0,
-        "d_min": pc["d_min"], "d_max": pc["d_max"],
+        "depth": depth, "dynamic_depth": search.dynamic_depth if planner.dynamic_labels else 0,
+        "d_min": search.d_min, "d_max": search.d_max,
         "coverage": planner.coverage,
         "best_static": static_only[0].to_dict() if static_only else None,
         "initial_states": {k: {"theta": s.arc[0], "y_c": s.y_lo} for k, s in states.items()},
         "plans": [p.to_dict() for p in plans],
         "found": bool(plans),
-        "tight": plan_tight_all(part, config, cat.root, keep=keep, progress=progress) if tight else [],
+        "tight": plan_tight_all(part, settings, cat.root, keep=keep, progress=progress) if tight else [],
         **provenance_attrs(),
     }
 
@@ -78,17 +75,17 @@ def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:
     computed with the sweep settings, stored atomically and indexed (how
     many, on the progress report of :func:`pipeline.progress.reporting`)."""
     root = Path(config["catalog_dir"])
-    pc = config["planner"]
+    settings = PlannerSettings.from_config(config)
+    search, mu = settings.search, settings.friction.nominal
     cat = Catalog.open(root) if (root / "index.json").is_file() else None
     entries = cat.entries if cat else []
     fam = next((e["family"] for e in entries if e["part_id"] == part.id), family)
-    mu = nominal_friction(parse_friction(pc["mu_c"]))
-    missing = [v for v in [0.0] + [float(x) for x in pc.get("dynamic", {}).get("speeds", [])]
-               if not any(e["part_id"] == part.id and e["model"] == pc["model"] and e["mu_c"] == mu
+    missing = [v for v in [0.0, *search.dynamic_speeds]
+               if not any(e["part_id"] == part.id and e["model"] == search.model and e["mu_c"] == mu
                           and e.get("v_pin", 0.0) == v and not e.get("support_key") for e in entries)]
     with Heartbeat(f"maps of {part.name} for the paper-mode planner", len(missing), "map") as beat:
         for k, v in enumerate(missing):
-            write_shard(config, ShardJob(fam, part, pc["model"], mu, v))
+            write_shard(config, ShardJob(fam, part, search.model, mu, v))
             beat.tick(k + 1)
     if missing:
         cat = Catalog.rebuild(root)
@@ -112,7 +109,7 @@ def plans_to_check(plan_result: dict) -> dict:
     return out
 
 
-def verify_part(plan_result: dict, config: dict) -> dict:
+def verify_part(plan_result: dict, settings: PlannerSettings) -> dict:
     """Perturbed full rollouts of the paper-mode plans (best fixed-pin plan and
     best plan with dynamic pins, if any) and of the tight planner's
     recommended plan at every friction: ``{"part", "checks": [verify_plan
@@ -121,10 +118,10 @@ def verify_part(plan_result: dict, config: dict) -> dict:
     out = {"part": name, "checks": [], **provenance_attrs()}
     part = Part.from_dict(plan_result["part"], name=name)
     states = {k: (v["theta"], v["y_c"]) for k, v in plan_result["initial_states"].items()}
-    radius, kernel = config["sweep"]["pin_radius"], config["sweep"].get("kernel")
+    radius, kernel = settings.search.pin_radius, settings.search.kernel_settings
     for kind, plan in plans_to_check(plan_result).items():
         res = verify_plan(part, plan, plan_result["pins"], states, plan_result["mu_c"], radius,
-                          plan_result["model"], config.get("verify", {}),
+                          plan_result["model"], settings.verify,
                           speeds=plan_result.get("pin_speeds", {}), kernel=kernel)
         res.pop("trials_detail")
         out["checks"].append({"kind": f"paper mode, {kind}", **res})
@@ -133,7 +130,7 @@ def verify_part(plan_result: dict, config: dict) -> dict:
         if plan is None:
             continue
         res = verify_plan(part, plan.to_dict(), dict(zip(plan.pins, plan.pin_heights_mm)), states,
-                          tight.mu_c, radius, plan_result["model"], config.get("verify", {}), kernel=kernel,
+                          tight.mu_c, radius, plan_result["model"], settings.verify, kernel=kernel,
                           speeds=dict(zip(plan.pins, plan.pin_speeds)),
                           belt_speed=tight.belt_speed, mu_s=tight.mu_s or 0.5)
         res.pop("trials_detail")
@@ -162,14 +159,14 @@ def planner_shards(config: dict, jobs: dict, name: str) -> list[str]:
     a static pin and at every ``planner.dynamic`` speed. The plan job takes
     these as input, so the atlas needs these shards alone, and a shard of
     another model, friction or support re-plans nothing."""
-    pc = config["planner"]
+    settings = PlannerSettings.from_config(config)
     own = {path: job for path, job in jobs.items()
-           if job.part.name == name and not support_key(job.support) and job.model == pc["model"]
+           if job.part.name == name and not support_key(job.support) and job.model == settings.search.model
            and not job.belt_speed}
     if not own:
         return []
-    mu_c = nearest_stored({job.mu_c for job in own.values()}, nominal_friction(parse_friction(pc["mu_c"])))
-    speeds = {0.0, *(float(v) for v in (pc.get("dynamic") or {}).get("speeds", []))}
+    mu_c = nearest_stored({job.mu_c for job in own.values()}, settings.friction.nominal)
+    speeds = {0.0, *settings.search.dynamic_speeds}
     return sorted(path for path, job in own.items() if job.mu_c == mu_c and float(job.v_pin) in speeds)
 
 
@@ -189,7 +186,8 @@ def plan(config: dict, name: str, out, shards=None) -> dict:
                                f"(planner.model {model}, sweep.models {', '.join(config['sweep']['models'])}); "
                                f"add {model} to sweep.models")
         cat = Catalog.of_files(root, shards)
-    result = attach_speed_limits(plan_part(cat, name, config), config)
+    settings = PlannerSettings.from_config(config)
+    result = attach_speed_limits(plan_part(cat, config_part_id(config, name), settings), settings)
     write_json(result, out)
     return result
 
@@ -197,6 +195,6 @@ def plan(config: dict, name: str, out, shards=None) -> dict:
 def verify(plan_path, config: dict, out) -> dict:
     """Rule ``verify``: :func:`verify_part` of the stored plans at ``plan_path``,
     written to ``out``."""
-    result = verify_part(validate_plan_file(plan_path), config)
+    result = verify_part(validate_plan_file(plan_path), PlannerSettings.from_config(config))
     write_json(result, out)
     return result

@@ -11,8 +11,8 @@ from pipeline.maps.catalog import Catalog
 from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_source
 from pipeline.parts.part import Part
-from pipeline.planning.settings import nominal_friction, parse_friction
-from pipeline.planning.types import PlanFile, validate_plan_file
+from pipeline.planning import Friction
+from pipeline.planning import PlanFile, validate_plan_file
 from pipeline.present.animate import animate_stored, recommended_index
 from pipeline.present.figures import placeholder, placeholder_gif
 from pipeline.present.figures.bands import plot_band_maps
@@ -145,7 +145,7 @@ def _sequence_figure(config, res, plan, what, path):
     pins, speeds, mu_c = res["pins"], res.get("pin_speeds", {}), None
     if plan.get("pin_heights_mm") is not None:  # a tight plan: its own heights, speeds and friction
         pins, speeds = tight_plan_pins(plan)
-        mu_c = nominal_friction(parse_friction(res["tight"][0]["mu_c"]))
+        mu_c = Friction.parse(res["tight"][0]["mu_c"]).nominal
     plot_sequence(part, plan, pins, nominal_paths(res, config, plan, pins, speeds, mu_c),
                   config["sweep"]["pin_radius"], f"{name}: {what}", path, speeds=speeds)
 

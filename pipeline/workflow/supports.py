@@ -4,9 +4,7 @@ from __future__ import annotations
 from pipeline.config import config_hash
 from pipeline.maps.io import write_json
 from pipeline.parts.part import Part
-from pipeline.planning.settings import nominal_friction, parse_friction
-from pipeline.planning.support_plans import support_study
-from pipeline.planning.types import validate_plan_file
+from pipeline.planning import PlannerSettings, support_study, validate_plan_file
 from pipeline.present.figures import placeholder
 from pipeline.present.figures.supports import plot_support_maps
 from pipeline.provenance import provenance_attrs
@@ -22,7 +20,7 @@ def studied_parts(config: dict) -> list[str]:
 
 
 def support_part(plan_path, config: dict, out, figure, progress=print) -> dict:
-    """Rule ``support``: :func:`~pipeline.planning.support_plans.support_study`
+    """Rule ``support``: :func:`~pipeline.planning.plans.support_study.support_study`
     of the part of the stored plans at ``plan_path`` (its recommended tight
     plan at ``planner.mu_c``) against ``support_study.family``; the JSON to
     ``out`` (with provenance) and the overlaid maps (swept friction nearest
@@ -31,9 +29,10 @@ def support_part(plan_path, config: dict, out, figure, progress=print) -> dict:
     part = Part.from_dict(stored["part"])
     uniform = (stored.get("tight") or [None])[0]
     family = config["support_study"]["family"]
-    result = support_study(part, config, family, uniform, progress=progress)
+    settings = PlannerSettings.from_config(config)
+    result = support_study(part, settings, family, uniform, progress=progress)
     spreads = result.pop("_spreads")
-    mu = nominal_friction(parse_friction(config["planner"]["mu_c"]))
+    mu = settings.friction.nominal
     near = min(spreads, key=lambda m: abs(m - mu))
     write_json({**result, "figure_mu_c": near, "config_hash": config_hash(config), **provenance_attrs()}, out)
     spread = spreads[near]

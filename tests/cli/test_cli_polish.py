@@ -4,7 +4,7 @@ import io
 import pytest
 
 from pipeline.cli import build_parser, main
-from pipeline.planning.bands import format_arc, format_arcs
+from pipeline.planning.paper.bands import format_arc, format_arcs
 from pipeline.progress import progress
 
 
@@ -83,10 +83,10 @@ def test_rollout_trajectory_table(capsys):
 
 
 def test_sense_hint_names_pinfeed_plan_for_an_ad_hoc_part(tmp_path):
-    from pipeline.planning.plan import plan_hint
-    config = {"planner": {"parts": ["asym_triangle"]}}
-    assert "make run" in plan_hint(config, "asym_triangle", tmp_path)
-    hint = plan_hint(config, "bracket", tmp_path)
+    from pipeline.planning.plans.plan import plan_hint
+    planned = ["asym_triangle"]
+    assert "make run" in plan_hint(planned, "asym_triangle", tmp_path)
+    hint = plan_hint(planned, "bracket", tmp_path)
     assert hint == f"run 'pinfeed plan --part bracket --out {tmp_path / 'plans' / 'bracket.json'}'"
 
 

@@ -127,7 +127,7 @@ def test_only_what_applies_is_suggested(rect):
     tight["moving_pin_search"] = {"orients": False, "depth": 1}
     tight["depth"] = load_config(None)["planner"]["depth"]
     from pipeline.parts.part import Part
-    from pipeline.planning.settings import fitted_pins
+    from pipeline.planning.core.settings import fitted_pins
     tight["pins_used"] = fitted_pins(Part.from_dict(stored["part"]))
     for level in tight["fixed_pin_search"]["levels"]:
         level.pop("too_few_trials", None)

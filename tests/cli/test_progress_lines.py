@@ -16,7 +16,7 @@ from cli_runs import run_cli, small_config_file
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.planning.speed_limit import speed_curve
+from pipeline.planning.plans.speed_limit import speed_curve
 from pipeline.progress import Heartbeat, Stretch, prefixed, progress_interval, reporting, row_batches
 
 

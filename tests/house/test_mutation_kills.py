@@ -8,8 +8,8 @@ import pytest
 from conftest import TRIANGLE, circular_diff
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.planning.lattice_store import load_lattice, save_lattice
-from pipeline.planning.propagate import OutcomeLattice
+from pipeline.planning.tight.store import load_lattice, save_lattice
+from pipeline.planning.tight.propagate import OutcomeLattice
 
 PART = Part.from_vertices(TRIANGLE, name="tri")
 R_PIN = 3.0
@@ -81,7 +81,7 @@ def test_predicted_sets_take_every_branch_of_a_state():
     the union of every branch's last set (a state with no branch predicts
     nothing). Arcs by hand: [10, 15] and [12, 22] overlap into [10, 22]
     (start 10, width 12); [200, 204] and [350, 365] stay apart."""
-    from pipeline.planning.verify import predicted_sets
+    from pipeline.planning.claims.verify import predicted_sets
 
     def step(start, width):
         return {"band": {"start": start, "width": width}}

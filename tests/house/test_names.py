@@ -9,7 +9,7 @@ import numpy as np
 
 from kernels.rollout import OK
 from pipeline.maps import simulate
-from pipeline.planning.bands import extract_bands
+from pipeline.planning.paper.bands import extract_bands
 
 KEYS_BEFORE = ["start", "width", "mean", "sigma", "adj_start", "adj_width", "com_min", "com_max",
                "n", "kernel", "members"]  # a stored band's keys, in their stored order

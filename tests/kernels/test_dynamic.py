@@ -30,10 +30,10 @@ from images import assert_animation, assert_png_figure
 from conftest import fewer_examples
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.planning.paper import Planner, load_maps
-from pipeline.planning.settings import candidate_pins
-from pipeline.planning.paper import dynamic_label
-from pipeline.planning.verify import verify_plan
+from pipeline.planning.paper.planner import Planner, load_maps
+from pipeline.planning.core.settings import candidate_pins
+from pipeline.planning.paper.planner import dynamic_label
+from pipeline.planning.claims.verify import verify_plan
 from test_invariants import (R_PIN, _contact_fraction, assert_maps_agree, d_values, models,
                              mu_values, parts, theta_grid)
 
@@ -148,7 +148,7 @@ def default_planners():
             ds = simulate.compute_map(part, theta, sw["d"], PAPER_MU, sw["pin_radius"], model=pc["model"], v_pin=v)
             return load_maps(ds, bc["threshold_T"], bc["factor_c"])
 
-        static = candidate_pins(part, pc)
+        static = candidate_pins(part, pc["pins"])
         vs = [float(v) for v in pc["dynamic"]["speeds"]]
         dynamic = {dynamic_label(k, v): (y, v) for k, y in static.items() for v in vs}
         out[name] = Planner(part, maps(0.0), static, pc["d_min"], pc["d_max"], coverage=pc["coverage"],

@@ -196,7 +196,7 @@ def test_speed_limit_of_a_small_plan_holds_on_replay():
     final set is the quasi-static outcome +- 3 deg. The limit is found by
     bisection to 5 mm/s, the next 5 mm/s fail, and a replay with fresh random
     draws at the limit holds (99% in-sample; 97% allows for sampling noise)."""
-    from pipeline.planning.speed_limit import _draws, speed_curve, success_fraction
+    from pipeline.planning.plans.speed_limit import _draws, speed_curve, success_fraction
     theta, yc = ASYM.stable_states()[1]
     y_pin = yc - 0.3 * ASYM.a
     ref = qs(ASYM, theta, -0.3, 0.3)

@@ -16,9 +16,9 @@ from pipeline.config import load_config
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.planning.lattice_store import lattice_path, load_lattice
-from pipeline.planning.propagate import UNITS
-from pipeline.planning.verify import replay
+from pipeline.planning.tight.store import lattice_path, load_lattice
+from pipeline.planning.tight.propagate import UNITS
+from pipeline.planning.claims.verify import replay
 
 TRI = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 BELT = 150.0
@@ -123,7 +123,8 @@ def test_speed_stage_json_and_figure(planned, tmp_path):
     from pipeline.workflow.speed import speed_figure, speed_part
     tmp, cfg = planned
     config = load_config(cfg)
-    result = speed_part(read_json(tmp / "res" / "plans" / "tri.json"), config)
+    from pipeline.planning import PlannerSettings
+    result = speed_part(read_json(tmp / "res" / "plans" / "tri.json"), PlannerSettings.from_config(config))
     assert set(result) >= {"pin_labels", "pin_heights_mm", "final_set", "mu_c", "mu_s",
                            "speed_limit_mm_s", "curve", "git_commit"}
     fractions = dict((v, f) for v, f in result["curve"])
@@ -181,7 +182,7 @@ def test_config_belt_speed_where_the_part_is_thrown_is_refused():
 
 
 def test_batched_success_fraction_equals_passages_one_at_a_time():
-    from pipeline.planning.speed_limit import _draws, success_fraction
+    from pipeline.planning.plans.speed_limit import _draws, success_fraction
     heights, arcs = [27.5, 7.5], [(0.0, 40.0), (120.0, 30.0)]
     draws = _draws(TRI, heights, [(0.0, 11.67), (217.9, 12.28)], (0.1, 0.3),
                    {"theta_deg": 2.0, "y_mm": 0.5, "pin_mm": 0.3}, 3, seed=5)

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from pipeline.errors import PinfeedError
-from pipeline.planning import orient
-from pipeline.planning.complete import FixedPlan, margin_text, orientation_rank, robust_order
-from pipeline.planning.confidence import share_lower_bound
-from pipeline.planning.verify import holdout_settings, trial_inputs
+from pipeline.planning.claims import orient
+from pipeline.planning.tight.complete import FixedPlan, margin_text, orientation_rank, robust_order
+from pipeline.planning.claims.confidence import share_lower_bound
+from pipeline.planning.claims.verify import holdout_settings, trial_inputs
 
 N, REQUIRED = 1092, 0.995  # the default triangle's trials: 3 states x (300 + 64 corners)
 
@@ -157,9 +157,9 @@ def test_confidence_outside_unit_interval_is_refused_by_config_validation(bad):
 
 @pytest.mark.parametrize("bad", [0.0, 1.0, 1.5])
 def test_confidence_outside_unit_interval_is_refused_by_the_planner_settings(bad):
-    from pipeline.planning.plan import verify_confidence
+    from pipeline.planning.core.settings import ClaimSettings
     with pytest.raises(PinfeedError) as err:
-        verify_confidence({"verify": {"confidence": bad}})
+        ClaimSettings(confidence=bad)
     assert "\n" not in str(err.value) and "verify.confidence" in str(err.value)
 
 
@@ -217,11 +217,12 @@ def test_too_few_trials_for_the_claim_is_said_with_the_way_out():
     """A search whose trials cannot support the bound at all says so, with the
     number needed, instead of only 'no plan orients'."""
     from pipeline.parts.part import Part
-    from pipeline.planning.complete import FixedPinSearch
+    from pipeline.planning.tight.complete import FixedPinSearch
 
     part = Part.from_vertices([(0, 0), (50, 0), (0, 30)], "right_triangle")
-    search = FixedPinSearch(part, {"P1": 0.0, "P2": 8.0, "P3": 16.0}, (0.1, 0.2), 10.0, 0.995,
-                            {"trials": 10, "seed": 3, "rule": "bound"}, 3.0)
+    from pipeline.planning.core.settings import ClaimSettings, SearchSettings, VerifySettings
+    search = FixedPinSearch(part, {"P1": 0.0, "P2": 8.0, "P3": 16.0}, (0.1, 0.2), ClaimSettings(10.0, 0.995),
+                            VerifySettings(trials=10, seed=3), SearchSettings(3.0))
     result = search.run(1, candidates=2, keep=2)
     evidence = result.evidence()
     assert not result.orients

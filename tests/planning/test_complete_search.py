@@ -12,16 +12,18 @@ from oracle import box_trials, most_in_arc, orienting_sequences, replay_box
 from strategies import convex_polygons, triangles
 
 from pipeline.parts.part import Part
-from pipeline.planning import orient
-from pipeline.planning.complete import FixedPinSearch
+from pipeline.planning.claims import orient
+from pipeline.planning.core.settings import ClaimSettings, PlannerSettings, SearchSettings, VerifySettings
+from pipeline.planning.tight.complete import FixedPinSearch
 
 MU = (0.1, 0.2)
-VERIFY = {"trials": 20, "seed": 3, "rule": "point"}  # few trials: the point rule
+VERIFY = VerifySettings(trials=20, seed=3)  # few trials: the point rule
 RADIUS = 3.0
 
 
 def _search(part, pins, tolerance, depth):
-    search = FixedPinSearch(part, pins, MU, tolerance, 0.995, VERIFY, RADIUS)
+    search = FixedPinSearch(part, pins, MU, ClaimSettings(tolerance, 0.995, rule="point"), VERIFY,
+                            SearchSettings(RADIUS))
     return search.run(depth, candidates=4, keep=5)
 
 
@@ -138,12 +140,12 @@ def test_sampled_claim_splits_outliers_and_holds_in_an_independent_replay():
     not a 160-degree hull), and the verification's own trials (another seed)
     end in the claimed sets."""
     from pipeline.config import load_config
-    from pipeline.planning.certify import CLUSTER_GAP_DEG, sampled_plan
-    from pipeline.planning.plan import planner_for
-    from pipeline.planning.verify import verify_plan
+    from pipeline.planning.tight.certify import CLUSTER_GAP_DEG, sampled_plan
+    from pipeline.planning.plans.plan import planner_for
+    from pipeline.planning.claims.verify import verify_plan
     part = Part.from_vertices([[0, 0], [60, 0], [15, 35]])
     config = load_config()
-    planner = planner_for(part, config, 0.3)
+    planner = planner_for(part, PlannerSettings.from_config(config).at(0.3))
     labels = [k for k, p in planner.pins.items() if p.y in (10.0, 27.5, 47.5)]
     labels = sorted(labels, key=lambda k: [10.0, 27.5, 47.5].index(planner.pins[k].y))
     plan = sampled_plan(planner, labels, 0.0, {"trials": 100})
@@ -163,12 +165,12 @@ def test_moving_pins_only_when_fixed_pins_cannot_and_their_plan_holds():
     moving pins after it (same enumeration) do orient it, and the recommended
     moving-pin plan holds in the oracle's own replay with the pins moving."""
     from pipeline.config import load_config
-    from pipeline.planning.plan import plan_tight
+    from pipeline.planning.plans.plan import plan_tight
     config = load_config()
     config["planner"].update(pins="auto", depth=1, tolerance_deg=10.0)
     config["verify"].update(trials=30, rule="point")  # few trials: the point rule
     part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]], name="trapezoid")
-    entry = plan_tight(part, config, (0.1, 0.3))
+    entry = plan_tight(part, PlannerSettings.from_config(config).at((0.1, 0.3)))
     assert not entry["fixed_pin_search"]["orients"]
     assert entry["fixed_pin_search"]["evidence"].startswith("no fixed-pin sequence of up to 1 pins")
     assert entry["moving_pin_search"]["orients"] and entry["orients"]
@@ -183,13 +185,13 @@ def test_no_plan_recommends_fixed_pins_for_a_sensor():
     """When neither fixed nor moving pins orient the part, the recommended plan
     is a several-set plan of fixed pins and the warning names the sensor."""
     from pipeline.config import load_config
-    from pipeline.planning.plan import plan_tight
+    from pipeline.planning.plans.plan import plan_tight
     config = load_config()
     config["planner"].update(pins=[0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0], depth=1, tolerance_deg=12.0)
     config["planner"]["dynamic"].update(speeds=[-2.0, 2.0], depth=1)
     config["verify"].update(trials=30, rule="point")  # few trials: the point rule
     part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]], name="trapezoid")
-    entry = plan_tight(part, config, 0.15)
+    entry = plan_tight(part, PlannerSettings.from_config(config).at(0.15))
     assert not entry["orients"] and not entry["moving_pin_search"]["orients"]
     assert entry["recommended"]["n_dynamic_pins"] == 0
     assert "nor do up to 1 moving pins" in entry["warning"] and "a sensor must tell them apart" in entry["warning"]
@@ -212,7 +214,7 @@ def _thin_triangle_entry(depth: int, prune: bool, monkeypatch):
     """The tight plan of a 60 x 20 mm right triangle that no fixed pin of up to
     ``depth`` orients, with (or, ``prune`` False, without) the moving search's
     pruning of prefixes that cannot beat a plan already found."""
-    import pipeline.planning.plan as plan_module
+    import pipeline.planning.plans.plan as plan_module
     from pipeline.config import load_config
     config = load_config()
     config["planner"].update(pins="auto", depth=depth, tolerance_deg=10.0)
@@ -222,7 +224,7 @@ def _thin_triangle_entry(depth: int, prune: bool, monkeypatch):
     with monkeypatch.context() as patch:
         if not prune:
             patch.setattr(plan_module, "moving_room", lambda found, n_prefix, depth: depth)
-        return plan_module.plan_tight(part, config, 0.15)
+        return plan_module.plan_tight(part, PlannerSettings.from_config(config).at(0.15))
 
 
 def test_moving_prefixes_that_cannot_beat_a_found_plan_change_nothing(monkeypatch):
@@ -250,12 +252,12 @@ def test_best_fixed_pin_results_name_each_sequence_once():
     follow) list a sequence once, though it may be both judged and among the
     fewest-cluster sequences of its level."""
     from pipeline.config import load_config
-    from pipeline.planning.plan import plan_tight
+    from pipeline.planning.plans.plan import plan_tight
     config = load_config()
     config["planner"].update(pins="auto", depth=3, tolerance_deg=10.0)
     config["planner"]["dynamic"].update(depth=0)
     config["verify"].update(trials=30, rule="point")
     part = Part.from_vertices([[0, 0], [60, 0], [45, 50]], name="leaning_triangle")
-    best = plan_tight(part, config, 0.15)["fixed_pin_search"]["best_effort"]
+    best = plan_tight(part, PlannerSettings.from_config(config).at(0.15))["fixed_pin_search"]["best_effort"]
     assert len(best) == 5 and all(len(b["pins"]) == 3 for b in best[:2])
     assert len({tuple(b["pins"]) for b in best}) == len(best)

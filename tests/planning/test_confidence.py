@@ -7,7 +7,7 @@ import pytest
 from scipy.stats import binom
 
 from pipeline.errors import PinfeedError
-from pipeline.planning.confidence import (check_confidence, share_lower_bound, share_upper_bound,
+from pipeline.planning.claims.confidence import (check_confidence, share_lower_bound, share_upper_bound,
                                           width_interval)
 
 

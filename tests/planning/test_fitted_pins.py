@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from pipeline.parts.part import Part
-from pipeline.planning.complete import FixedPinSearch
-from pipeline.planning.settings import candidate_pins, fitted_pins
+from pipeline.planning.tight.complete import FixedPinSearch
+from pipeline.planning.core.settings import candidate_pins, fitted_pins
 
 TRIANGLE = np.array([[0.0, 0.0], [60.0, 0.0], [15.0, 35.0]])
 
@@ -38,17 +38,18 @@ def test_fitted_grid_spans_the_part(across):
 
 def test_config_pins_override_and_auto():
     part = Part.from_vertices(TRIANGLE)
-    assert candidate_pins(part, {"pins": [1.0, 2.5]}) == {"P1": 1.0, "P2": 2.5}
-    assert candidate_pins(part, {"pins": "auto"}) == fitted_pins(part) == candidate_pins(part, {})
+    assert candidate_pins(part, [1.0, 2.5]) == {"P1": 1.0, "P2": 2.5}
+    assert candidate_pins(part, "auto") == fitted_pins(part) == candidate_pins(part, None)
 
 
 @pytest.mark.parametrize("across", [10.0, 300.0])
 def test_small_and_large_parts_plan_with_fitted_pins(across):
     part = Part.from_vertices(TRIANGLE * across / 60.0)
     radius = 3.0 * across / 60.0  # the pin scaled with the part (scale invariance, spec section 4)
-    search = FixedPinSearch(part, fitted_pins(part), (0.1, 0.3), 15.0, 0.995,
-                            {"trials": 10, "rule": "point", "y_halfwidth": 0.5 * across / 60.0,
-                             "pin_halfwidth": 0.3 * across / 60.0}, radius)
+    from pipeline.planning.core.settings import ClaimSettings, Perturbation, SearchSettings, VerifySettings
+    box = Perturbation(y_halfwidth=0.5 * across / 60.0, pin_halfwidth=0.3 * across / 60.0)
+    search = FixedPinSearch(part, fitted_pins(part), (0.1, 0.3), ClaimSettings(15.0, 0.995, rule="point"),
+                            VerifySettings(trials=10, perturbation=box), SearchSettings(radius))
     result = search.run(3, candidates=2, keep=1)
     assert result.plans, result.evidence()
     assert result.plans[0].verdict["width_deg"] <= 15.0

@@ -9,11 +9,11 @@ claim rule. This is the check the winner's curse would fail."""
 import pytest
 
 from pipeline.config import load_config
-from pipeline.planning.orient import judge_verification
-from pipeline.planning.plan import plan_tight
-from pipeline.planning.propagate import resting_states
-from pipeline.planning.settings import parse_friction
-from pipeline.planning.verify import verify_plan
+from pipeline.planning.claims.orient import judge_verification
+from pipeline.planning.plans.plan import plan_tight
+from pipeline.planning.core.resting import resting_states
+from pipeline.planning.core.settings import PlannerSettings
+from pipeline.planning.claims.verify import verify_plan
 from pipeline.workflow.commands import named_part
 
 CONFIG = load_config()
@@ -25,15 +25,15 @@ def test_recommended_plan_passes_a_fresh_replay(name, tmp_path):
     config = load_config()
     config["catalog_dir"] = str(tmp_path / "catalog")
     part = named_part(config, name)
-    mu_c = parse_friction(config["planner"]["mu_c"])
-    entry = plan_tight(part, config, mu_c)
+    settings = PlannerSettings.from_config(config)
+    entry = plan_tight(part, settings)
     rec = entry["recommended"]
     assert rec is not None and entry["orients"], entry["warning"]
     held = rec["verification"]
     assert held["held_out"] and held["orientation"]["share_lower_bound"] >= config["verify"]["required"]
     assert held["selection"] is not None and held["seed"] != config["verify"]["seed"]
     speeds = dict(zip(rec["pins"], rec.get("pin_speeds") or [0.0] * len(rec["pins"])))
-    fresh = verify_plan(part, rec, dict(zip(rec["pins"], rec["pin_heights_mm"])), resting_states(part), mu_c,
+    fresh = verify_plan(part, rec, dict(zip(rec["pins"], rec["pin_heights_mm"])), resting_states(part), settings.friction.value,
                         config["sweep"]["pin_radius"], config["planner"]["model"],
                         dict(config["verify"], seed=FRESH_SEED), speeds=speeds,
                         kernel=config["sweep"].get("kernel"))

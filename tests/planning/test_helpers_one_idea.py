@@ -15,7 +15,7 @@ import xarray as xr
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
-from pipeline.planning.arcs import arc_within, format_arcs, in_arc
+from pipeline.planning.core.arcs import arc_within, format_arcs, in_arc
 
 # ---------------------------------------------------------------- arc containment
 
@@ -109,8 +109,8 @@ def test_contact_parameter_of_a_part():
 
 
 def test_load_maps_sorts_by_d_and_keeps_each_maps_bands():
-    from pipeline.planning.bands import extract_bands
-    from pipeline.planning.paper import load_maps
+    from pipeline.planning.paper.bands import extract_bands
+    from pipeline.planning.paper.planner import load_maps
     theta = np.arange(0.0, 360.0, 10.0)
     d = np.array([0.5, -0.3, 0.1])  # stored out of order
     tf = np.stack([np.where(theta < 180, 45.0, 225.0), np.full(theta.size, 90.0),
@@ -135,7 +135,7 @@ def test_load_maps_sorts_by_d_and_keeps_each_maps_bands():
 
 
 def test_synthetic_measurement_draws_through_perturbed_inputs(monkeypatch):
-    from pipeline.planning.verify import PERTURB_DEFAULTS, perturbed_inputs
+    from pipeline.planning.claims.verify import PERTURB_DEFAULTS, perturbed_inputs
     from pipeline.sensing import profiles
     from pipeline.sensing.profiles import Sensor
 

@@ -1,4 +1,4 @@
-"""Typed plan records (``pipeline.planning.types``) and the schema of stored plan
+"""Typed plan records (``pipeline.planning.core.types``) and the schema of stored plan
 files: files written by the current code validate and round-trip exactly;
 hand-broken files are refused with the one-line error naming the file."""
 from __future__ import annotations
@@ -15,8 +15,8 @@ from kernels.rollout import OK
 from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_json
 from pipeline.parts.part import Part
-from pipeline.planning.paper import Planner, load_maps
-from pipeline.planning.types import (SCHEMA_PATH, Plan, PlanFile, Step, TightEntry, Verification,
+from pipeline.planning.paper.planner import Planner, load_maps
+from pipeline.planning.core.types import (SCHEMA_PATH, Plan, PlanFile, Step, TightEntry, Verification,
                                      load_plan, plan_schema, validate_plan_dict, validate_plan_file)
 
 VERTICES = "0,0 60,0 15,35"
@@ -71,7 +71,7 @@ def test_the_schema_is_package_data():
     import tomllib
     from pathlib import Path
     pyproject = tomllib.loads((Path(__file__).resolve().parents[2] / "pyproject.toml").read_text())
-    assert SCHEMA_PATH.name in pyproject["tool"]["setuptools"]["package-data"]["pipeline.planning"]
+    assert SCHEMA_PATH.name in pyproject["tool"]["setuptools"]["package-data"]["pipeline.planning.core"]
     assert plan_schema()["type"] == "object"
 
 
@@ -201,20 +201,22 @@ def test_the_verify_stage_replays_the_recommended_tight_plan_as_stored(tight_fil
     # verify_part reads the tight entries as typed records: its check must be
     # the replay of the stored dict with the stored heights, speeds and friction.
     from pipeline.config import load_config
-    from pipeline.planning.verify import verify_plan
+    from pipeline.planning.claims.verify import verify_plan
     from pipeline.workflow.plan import verify_part
     data = json.loads(tight_file.read_text())
     entry = data["tight"][0]
     data.update(initial_states=entry["initial_states"], plans=[], pins={}, mu_c=entry["mu_c"])
     config = load_config(None)
     config["verify"] = dict(config.get("verify", {}), trials=4, rule="point")
-    out = verify_part(data, config)
+    from pipeline.planning import PlannerSettings
+    out = verify_part(data, PlannerSettings.from_config(config))
     assert [c["kind"] for c in out["checks"]] == [f"tight, mu_c {entry['friction']}"]
     rec = entry["recommended"]
     want = verify_plan(Part.from_vertices(data["part"]["vertices"], name="tri"), rec,
                        dict(zip(rec["pins"], rec["pin_heights_mm"])),
                        {k: (v["theta"], v["y_c"]) for k, v in entry["initial_states"].items()},
-                       entry["mu_c"], config["sweep"]["pin_radius"], data["model"], config["verify"],
+                       entry["mu_c"], config["sweep"]["pin_radius"], data["model"],
+                       PlannerSettings.from_config(config).verify,
                        kernel=config["sweep"].get("kernel"))
     want.pop("trials_detail")
     got = dict(out["checks"][0])

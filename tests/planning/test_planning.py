@@ -11,9 +11,9 @@ from oracle import n_clusters, replay_sequence, trial_inputs
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.planning.bands import circular_mean_std, extract_bands, in_arc
-from pipeline.planning.paper import Planner, State, load_maps, merge_arcs
-from pipeline.planning.verify import verify_plan
+from pipeline.planning.paper.bands import circular_mean_std, extract_bands, in_arc
+from pipeline.planning.paper.planner import Planner, State, load_maps, merge_arcs
+from pipeline.planning.claims.verify import verify_plan
 
 GRID = np.arange(0.0, 360.0, 1.0)
 

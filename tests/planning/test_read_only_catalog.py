@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from cli_runs import TRI_PLAN_ARGS, run_cli, small_config_file
-from pipeline.planning import lattice_store
+from pipeline.planning.tight import store as lattice_store
 
 ARGS = TRI_PLAN_ARGS
 
@@ -24,7 +24,7 @@ def _snapshot(root: Path) -> dict:
 def computed(monkeypatch):
     """A list that collects how many lattice rollouts each batch computed (not
     the plan's own count, which also holds unstored verification replays)."""
-    from pipeline.planning.propagate import OutcomeLattice
+    from pipeline.planning.tight.propagate import OutcomeLattice
     counts, ensure = [], OutcomeLattice.ensure
 
     def counting(self, keys):
@@ -81,7 +81,7 @@ def test_plan_twice_on_a_read_only_catalog(tmp_path, capsys, read_only, computed
 
 def test_writable_catalog_keeps_its_refinements(tmp_path, monkeypatch):
     from pipeline.parts.part import Part
-    from pipeline.planning.propagate import OutcomeLattice
+    from pipeline.planning.tight.propagate import OutcomeLattice
     monkeypatch.setenv("PINFEED_CACHE", str(tmp_path / "cache"))
     part = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
     lattice = OutcomeLattice(part, "minpower", 3.0)

@@ -18,13 +18,15 @@ from pipeline.config import load_config
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 from pipeline.parts.support_family import parse_support_family
-from pipeline.planning.complete import FixedPinSearch
-from pipeline.planning.family import planning_family
-from pipeline.planning.verify import DEFAULTS, corner_inputs, perturbed_batch, trial_inputs
+from pipeline.planning.core.settings import ClaimSettings, PlannerSettings, SearchSettings, VerifySettings
+from pipeline.planning.tight.complete import FixedPinSearch
+from pipeline.planning.family.members import planning_family
+from pipeline.planning.claims.verify import DEFAULTS, corner_inputs, perturbed_batch, trial_inputs
 
 MU = (0.1, 0.2)
-VERIFY = {"trials": 20, "seed": 3, "rule": "point"}  # few trials: the point rule
+VERIFY = VerifySettings(trials=20, seed=3)
 TOL = 12.0
+CLAIM = ClaimSettings(TOL, 0.995, rule="point")  # few trials: the point rule
 TRIANGLE = Part.from_vertices([(0, 0), (60, 0), (15, 35)], "asym_triangle")
 
 
@@ -70,7 +72,7 @@ def test_family_search_is_complete_and_sound(spec, n_pins):
     pins = _grid(TRIANGLE, n_pins)
     family = parse_support_family(spec, TRIANGLE)
     oracle = _oracle(TRIANGLE, pins, family, 3, 0.8 * TOL)
-    result = FixedPinSearch(TRIANGLE, pins, MU, TOL, 0.995, VERIFY, 3.0, family=family).run(4, candidates=4)
+    result = FixedPinSearch(TRIANGLE, pins, MU, CLAIM, VERIFY, SearchSettings(3.0), family=family).run(4, candidates=4)
     if oracle:
         assert result.plans, f"oracle found {oracle[0]} for {spec}, the planner none: {result.evidence()}"
         assert len(result.plans[0].labels) <= min(len(s) for s in oracle)
@@ -88,7 +90,7 @@ def test_a_uniform_plan_fails_the_tripod_family():
     well under 95 % of the tripods' trials in one set of the tolerance."""
     pins = _grid(TRIANGLE, 6)
     family = parse_support_family("tripods:4", TRIANGLE)
-    uniform = FixedPinSearch(TRIANGLE, pins, MU, TOL, 0.995, VERIFY, 3.0).run(3, candidates=4)
+    uniform = FixedPinSearch(TRIANGLE, pins, MU, CLAIM, VERIFY, SearchSettings(3.0)).run(3, candidates=4)
     assert uniform.plans and len(uniform.plans[0].labels) <= 3
     for plan in uniform.plans:
         assert not _sound(TRIANGLE, plan, family), plan.labels
@@ -96,7 +98,7 @@ def test_a_uniform_plan_fails_the_tripod_family():
 
 def test_trials_sample_every_member_and_leave_uniform_trials_as_they_were():
     family = parse_support_family("tripods:5", TRIANGLE)
-    family = planning_family(TRIANGLE, family, load_config(None))
+    family = planning_family(TRIANGLE, family, PlannerSettings.from_config(load_config(None)))
     assert 1 <= len(family.extremes) <= 3
     states = {"a": (10.0, 12.0), "b": (200.0, 14.0)}
     cfg = dict(DEFAULTS, trials=23, seed=5)
@@ -139,7 +141,7 @@ def test_family_needs_minpower():
     config = load_config(None)
     config["planner"]["model"] = "tip"
     with pytest.raises(PinfeedError, match="minpower"):
-        planning_family(TRIANGLE, "tripods:3", config)
+        planning_family(TRIANGLE, "tripods:3", PlannerSettings.from_config(config))
 
 
 def test_cli_plans_for_a_family(tmp_path, capsys, monkeypatch):

@@ -16,12 +16,12 @@ from oracle import all_tight_plans, n_clusters, one_set_sequences, replay_sequen
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import format_arc, in_arc, merge_modulo
-from pipeline.planning.lattice_store import lattice_path, load_lattice, save_lattice
-from pipeline.planning.settings import parse_friction
-from pipeline.planning.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Uncertainty, initial_state_sets,
+from pipeline.planning.core.arcs import format_arc, in_arc, merge_modulo
+from pipeline.planning.tight.store import lattice_path, load_lattice, save_lattice
+from pipeline.planning.core.settings import parse_friction
+from pipeline.planning.tight.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Uncertainty, initial_state_sets,
                                 propagate)
-from pipeline.planning.search import TightPlanner
+from pipeline.planning.tight.search import TightPlanner
 
 ASYM = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="asym_triangle")
 

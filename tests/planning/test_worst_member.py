@@ -22,8 +22,9 @@ from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.parts.support import point_support
 from pipeline.parts.support_family import parse_support_family
-from pipeline.planning.complete import FixedPinSearch
-from pipeline.planning.worst_member import (FamilyChecker, FamilyCheckSettings, check_budget,
+from pipeline.planning.core.settings import ClaimSettings, Perturbation, SearchSettings, VerifySettings
+from pipeline.planning.tight.complete import FixedPinSearch
+from pipeline.planning.family.worst_member import (FamilyChecker, FamilyCheckSettings, check_budget,
                                             check_plan_for_family, member_space)
 
 TRIANGLE = Part.from_vertices([(0, 0), (60, 0), (15, 35)], "asym_triangle")
@@ -107,7 +108,8 @@ def test_no_grid_tripod_breaks_a_plan_the_search_returns(part, n_pins, depth, to
     mu = (0.1, 0.2)
     family = parse_support_family("tripods:4", part)
     st = _settings(mu, tolerance, 20, budget=60)
-    search = FixedPinSearch(part, _pins(part, n_pins), mu, tolerance, 0.995, st.verify, 3.0, family=family)
+    search = FixedPinSearch(part, _pins(part, n_pins), mu, ClaimSettings(tolerance, 0.995),
+                            VerifySettings(20, True, 3, None, Perturbation(**BOX)), SearchSettings(3.0), family=family)
     search.member_check = FamilyChecker(part, family, st)
     result = search.run(depth, candidates=1)
     assert result.plans, result.evidence()
@@ -143,7 +145,7 @@ def test_the_old_family_plan_is_broken_by_the_widest_tripod():
     finals = _corner_finals(TRIANGLE, heights, point_support(TRIANGLE, legs, weights), (0.1, 0.3))
     assert _outside(finals, start, width).max() > 0.5
     # the sampled members alone did not break it: the verification on them orients the part
-    from pipeline.planning.worst_member import verify_members
+    from pipeline.planning.family.worst_member import verify_members
     assert verify_members(TRIANGLE, heights, family, st)["orients"]
 
 
@@ -167,7 +169,7 @@ def test_a_search_with_no_budget_is_one_line(budget):
 def test_certificate_of_a_plan_that_holds():
     from scipy.stats import beta
 
-    from pipeline.planning.family_certificate import family_certificate, family_certificate_line
+    from pipeline.planning.family.certificate import family_certificate, family_certificate_line
     family = parse_support_family("tripods:4", RECTANGLE)
     st = _settings((0.1, 0.2), 30.0, 20, budget=40)
     pins = _pins(RECTANGLE, 6)
@@ -186,7 +188,7 @@ def test_certificate_of_a_plan_that_holds():
 
 
 def test_downstream_stages_say_they_assume_uniform_pressure():
-    from pipeline.planning.family_certificate import family_assumption
+    from pipeline.planning.family.certificate import family_assumption
     plan_file = {"tight": [{"support_family": {"label": "tripods:12", "members": []}}]}
     for stage in ("speed limit", "layout"):
         note = family_assumption(plan_file, stage)

@@ -263,7 +263,7 @@ def test_feeder_dxf_has_the_holes_on_the_parts_layer(tmp_path):
 
 def test_a_stored_plan_part_with_holes_passes_the_schema_and_comes_back_whole():
     from pipeline.errors import PinfeedError
-    from pipeline.planning.types import validate_plan_dict
+    from pipeline.planning.core.types import validate_plan_dict
     data = {"part": PART.to_dict(), "model": "minpower", "plans": []}
     stored = validate_plan_dict(data, "plate.json")
     again = Part.from_dict(stored["part"])

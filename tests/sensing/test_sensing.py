@@ -227,7 +227,7 @@ def test_score_table_accuracy_on_the_asymmetric_triangle():
 
 def _stored_plan(finals: dict, pins=("P1",), heights=(10.0,), n_sets=None):
     """A plan shaped like a stored tight plan: per state, one branch per final arc."""
-    from pipeline.planning.arcs import merge_arcs
+    from pipeline.planning.core.arcs import merge_arcs
     step = {"pin": pins[-1], "y_pin": heights[-1], "v_pin": 0.0, "d_range": [0.2, 0.3]}
     branches = {lab: [[dict(step, band={"start": s, "width": 5.0})] for s in starts]
                 for lab, starts in finals.items()}
@@ -382,8 +382,8 @@ def test_final_sets_per_verdict_hold_in_full_rollout_replay(sensed):
     # perturbed full rollouts (the verify stage's sizes, random trials and every
     # corner of the box), ends in that verdict's final sets.
     from pipeline.parts.part import Part
-    from pipeline.planning.arcs import in_arc
-    from pipeline.planning.verify import DEFAULTS, corner_inputs, perturbed_batch, replay
+    from pipeline.planning.core.arcs import in_arc
+    from pipeline.planning.claims.verify import DEFAULTS, corner_inputs, perturbed_batch, replay
     res = sensed["partial"]
     kernel = _sense_config()["sweep"]["kernel"]  # the verify stage's rollout settings
     part = Part.from_vertices(res["part"]["vertices"])

@@ -15,6 +15,7 @@ from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_json
 from pipeline.parts.part import Part
 from pipeline.workflow.atlas import COLUMNS, build_atlas, write_atlas
+from pipeline.planning import PlannerSettings
 from pipeline.workflow.commands import plan_tight_only
 
 PARTS = {"right_triangle": [[0, 0], [50, 0], [0, 30]],
@@ -38,7 +39,7 @@ def planned(tmp_path_factory):
     for name, vertices in PARTS.items():
         path = root / "plans" / f"{name}.json"
         part = Part.from_vertices(vertices, name=name, holes=HOLES.get(name, ()))
-        write_json(plan_tight_only(part, config), path)
+        write_json(plan_tight_only(part, PlannerSettings.from_config(config), config["catalog_dir"]), path)
         paths.append(path)
     speed = write_json({"part": "right_triangle", "speed_limit_mm_s": 210.0}, root / "speed" / "right_triangle.json")
     layout = write_json({"part": "right_triangle", "belt_speed_mm_s": 168.0, "throughput_per_min": 55.5},

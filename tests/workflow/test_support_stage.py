@@ -19,6 +19,7 @@ from pipeline.parts.part import Part
 from pipeline.parts.support import Support, boundary_distance, inside_outline
 from pipeline.parts.support_family import parse_support_family
 from pipeline.present.report import _support_section
+from pipeline.planning import PlannerSettings
 from pipeline.workflow.commands import plan_tight_only
 from pipeline.workflow.supports import studied_parts, support_part, support_summary_text
 
@@ -38,7 +39,7 @@ def stage(tmp_path_factory):
     pc["dynamic"].update(depth=0, speeds=[])
     config["verify"].update(trials=20, rule="point")
     config["support_study"] = {"family": FAMILY, "parts": ["asym_triangle"]}
-    plan_path = write_json(plan_tight_only(TRIANGLE, config), root / "plans" / "asym_triangle.json")
+    plan_path = write_json(plan_tight_only(TRIANGLE, PlannerSettings.from_config(config), config["catalog_dir"]), root / "plans" / "asym_triangle.json")
     out, figure = root / "support" / "asym_triangle.json", root / "figures" / "support_maps_asym_triangle.png"
     result = support_part(plan_path, config, out, figure, progress=None)
     return config, plan_path, out, figure, result

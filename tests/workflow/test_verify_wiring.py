@@ -19,7 +19,7 @@ from types import SimpleNamespace
 import pytest
 
 from conftest import TRIANGLE
-from pipeline.planning.verify import verify_plan
+from pipeline.planning.claims.verify import verify_plan
 
 ROOT = Path(__file__).resolve().parents[2]
 CONFIG_MU = 0.37  # an unusual value: no default or fallback equals it
@@ -64,8 +64,12 @@ def received(monkeypatch):
 
 
 def _config():
-    return {"planner": {"model": "minpower", "mu_c": CONFIG_MU}, "sweep": {"pin_radius": 3.0},
-            "verify": {"trials": 3, "rule": "point"}}
+    from pipeline.config import load_config
+    config = load_config(None)
+    config["planner"].update(model="minpower", mu_c=CONFIG_MU)
+    config["sweep"]["pin_radius"] = 3.0
+    config["verify"].update(trials=3, rule="point")
+    return config
 
 
 def _check(seen):
@@ -78,7 +82,8 @@ def _check(seen):
 
 def test_verify_part_passes_the_planned_friction(received):
     from pipeline.workflow.plan import verify_part
-    verify_part(_plan_result(), _config())
+    from pipeline.planning import PlannerSettings
+    verify_part(_plan_result(), PlannerSettings.from_config(_config()))
     _check(received)
 
 

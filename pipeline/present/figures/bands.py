@@ -20,7 +20,7 @@ from matplotlib.patches import Patch, Rectangle
 
 from kernels.rollout import JAMMED, MISS, OK, TRUNCATED
 
-from pipeline.planning.bands import extract_bands
+from pipeline.planning import extract_bands
 from pipeline.present.figures import circle_axes, save_figure
 
 MIN_THICKNESS = 3.0  # degrees: the thinnest band B_j or kernel K_j drawn

@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from pipeline.parts.part import Part
-from pipeline.planning.verify import DEFAULTS, corner_inputs, perturbed_batch, replay
+from pipeline.planning import VERIFY_DEFAULTS, corner_inputs, perturbed_batch, replay
 from pipeline.present.figures import save_figure
 
 
@@ -39,7 +39,7 @@ def replayed_paths(part: Part, plan: dict, starts: dict, mu_c, pin_radius, model
                    trials=100, kernel=None, belt_speed=None, mu_s=0.5):
     """Per initial state: arrays of theta and y_c (trials x steps) of perturbed replays
     (with the dynamic model at ``belt_speed`` mm/s and belt friction ``mu_s`` if given)."""
-    cfg = dict(DEFAULTS, **(cfg or {}))
+    cfg = dict(VERIFY_DEFAULTS, **(cfg or {}))
     kernel = kernel or {}
     rng = np.random.default_rng(cfg["seed"])
     n = len(plan["pins"])

@@ -13,7 +13,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 from matplotlib.patches import Circle
 
-from pipeline.planning.arcs import format_arcs
+from pipeline.planning import format_arcs
 from pipeline.present.figures import save_figure
 from pipeline.present.figures.outline import PartPatch, posed
 

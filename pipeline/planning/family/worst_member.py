@@ -52,15 +52,15 @@ from pipeline.parts.support import (Support, barycentric, filled_support, materi
                                     point_support, signed_material_distance)
 from pipeline.parts.support_family import (DEFAULT_INSET, MIN_LEG_WEIGHT, WARP_FILL, SupportFamily,
                                            parse_support_family, warp_modes)
-from pipeline.planning import orient
-from pipeline.planning.confidence import DEFAULT_CONFIDENCE
-from pipeline.planning.propagate import resting_states
-from pipeline.planning.settings import nominal_friction
-from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
-from pipeline.planning.verify import corner_inputs, replay, trial_inputs
+from pipeline.planning.claims import orient
+from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE
+from pipeline.planning.core.resting import resting_states
+from pipeline.config import schema_default
+from pipeline.planning.core.settings import PlannerSettings, nominal_friction
+from pipeline.planning.claims.verify import corner_inputs, replay, trial_inputs, verify_dict
 from pipeline.progress import Heartbeat
 
-DEFAULT_BUDGET = 150  # member evaluations per search (planner.worst_member_budget)
+DEFAULT_BUDGET = schema_default("planner", "worst_member_budget")  # member evaluations per search
 JAM_SCORE = 180.0  # deg: a jam is as far outside the set as anything can be
 RANDOM_STARTS = 6  # seeded random members besides the geometric corners
 RANDOM_SHARE = 0.5  # of the budget spent on the starts (corners, then seeded random members)
@@ -314,7 +314,7 @@ class PlanProbe:
     nominal: np.ndarray = field(init=False)
 
     def __post_init__(self):
-        cfg = dict(VERIFY_DEFAULTS, **(self.settings or {}))
+        cfg = verify_dict(self.settings)
         n = len(self.heights)
         rows = []
         for theta, y_c in resting_states(self.part).values():
@@ -488,15 +488,14 @@ class FamilyCheckSettings:
     seed: int = 0
 
     @classmethod
-    def from_config(cls, config: dict, mu_c) -> "FamilyCheckSettings":
-        """The settings of a validated config at friction ``mu_c``."""
-        pc = config["planner"]
-        return cls(mu_c, orient.check_tolerance(pc.get("tolerance_deg", orient.DEFAULT_TOLERANCE)),
-                   orient.check_required(config.get("verify", {}).get("required", orient.DEFAULT_REQUIRED)),
-                   dict(VERIFY_DEFAULTS, **config.get("verify", {})), config["sweep"]["pin_radius"],
-                   pc.get("model", "minpower"), dict(config["sweep"].get("kernel") or {}),
-                   check_budget(pc.get("worst_member_budget", DEFAULT_BUDGET)),
-                   int(config.get("verify", {}).get("seed", 1)))
+    def from_settings(cls, settings: PlannerSettings) -> "FamilyCheckSettings":
+        """The planner's settings at its friction: its claim, its trials (with
+        the claim's confidence and rule), its mechanics and its budget."""
+        search, claims = settings.search, settings.claims
+        verify = dict(settings.verify.as_dict(), confidence=claims.confidence, rule=claims.rule)
+        return cls(settings.friction.value, claims.tolerance_deg, claims.required, verify,
+                   search.pin_radius, search.model, search.kernel_settings,
+                   check_budget(search.worst_member_budget), settings.verify.seed)
 
 
 def claimed_arc(verdict: dict, tolerance: float) -> tuple | None:

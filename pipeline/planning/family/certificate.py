@@ -2,7 +2,7 @@
 
 A plan recommended for a support family passed three checks: the sampled
 verification on the members the family text draws, the worst-member search
-(:mod:`pipeline.planning.worst_member`; worst members that broke the plan
+(:mod:`pipeline.planning.family.worst_member`; worst members that broke the plan
 joined the verification and the plan was judged again), and the fresh sample
 below. The certificate records all three:
 
@@ -15,7 +15,7 @@ below. The certificate records all three:
   each replayed from every resting state nominally and with
   ``FRESH_TRIALS`` perturbed trials: how many members put any trial outside
   the set, and the one-sided 95 % Clopper-Pearson upper bound on the share
-  of such members in the family (:func:`~pipeline.planning.confidence.share_upper_bound`).
+  of such members in the family (:func:`~pipeline.planning.claims.confidence.share_upper_bound`).
 
 The upper bound is a statement about members drawn the way the family text
 draws them (uniform legs in the inset outline, or uniform warp directions);
@@ -25,11 +25,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.planning import orient
-from pipeline.planning.confidence import DEFAULT_CONFIDENCE, share_upper_bound
-from pipeline.planning.propagate import resting_states
-from pipeline.planning.verify import perturbed_batch, replay
-from pipeline.planning.worst_member import JAM_SCORE, member_space, outside
+from pipeline.planning.claims import orient
+from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE, share_upper_bound
+from pipeline.planning.core.resting import resting_states
+from pipeline.planning.core.settings import nominal_friction
+from pipeline.planning.claims.verify import perturbed_batch, replay
+from pipeline.planning.family.worst_member import JAM_SCORE, member_space, outside
 from pipeline.progress import SILENT, Heartbeat, Stretch
 
 MIN_FRESH_MEMBERS = 300
@@ -58,7 +59,7 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
     rows = []
     for theta, y_c in resting_states(part).values():
         th, yc, mu, offs = perturbed_batch(theta, y_c, st.mu_c, n_pins, st.verify, rng, trials * len(members))
-        mid = float(np.mean(st.mu_c)) if isinstance(st.mu_c, (tuple, list)) else float(st.mu_c)
+        mid = nominal_friction(st.mu_c)
         rows.append((np.full(len(members), theta), np.full(len(members), y_c), np.full(len(members), mid),
                      np.zeros((len(members), n_pins)), np.arange(len(members))))
         rows.append((th, yc, mu, offs, np.repeat(np.arange(len(members)), trials)))
@@ -75,7 +76,7 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
 def family_certificate(part, heights, family, check: dict, st, n_members: int = MIN_FRESH_MEMBERS,
                        speeds=(), confidence: float = DEFAULT_CONFIDENCE, progress=None) -> dict:
     """The certificate of a plan (pins at ``heights``) for ``family`` given its
-    worst-member ``check`` (:func:`~pipeline.planning.worst_member.check_plan_for_family`);
+    worst-member ``check`` (:func:`~pipeline.planning.family.worst_member.check_plan_for_family`);
     a JSON-ready dict (see the module docstring). ``progress`` hears how far
     the fresh members' replay has got."""
     n_members = max(int(n_members), MIN_FRESH_MEMBERS)
@@ -136,7 +137,7 @@ _ASSUMES = {
 
 def plan_family_label(source) -> str | None:
     """The support family a stored plan was made for (its label), or None: ``source``
-    is a plan file (:class:`~pipeline.planning.types.PlanFile` or its dict) or one
+    is a plan file (:class:`~pipeline.planning.core.types.PlanFile` or its dict) or one
     of its ``tight`` entries."""
     entries = source.get("tight") if isinstance(source, dict) else getattr(source, "tight", None)
     for entry in (entries if entries is not None else [source]):

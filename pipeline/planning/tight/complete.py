@@ -31,7 +31,7 @@ trying every sequence, level by level:
    lucky does not pass (the winner's curse);
 6. stop at the first level where some sequence is certified.
 
-"Orients" is the claim rule of :mod:`pipeline.planning.orient`: the lower
+"Orients" is the claim rule of :mod:`pipeline.planning.claims.orient`: the lower
 confidence bound on the share of trials in one arc of ``T`` is at least
 ``verify.required`` (``verify.rule: point`` judges by the share alone).
 Among the certified sequences of that level the narrowest held-out width
@@ -67,13 +67,13 @@ import numpy as np
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
 
 from pipeline.parts.part import Part
-from pipeline.planning import orient
-from pipeline.planning.enumerate import Level, NominalTree
-from pipeline.planning.propagate import resting_states
-from pipeline.planning.settings import nominal_friction
-from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
-from pipeline.planning.confidence import DEFAULT_CONFIDENCE, check_confidence
-from pipeline.planning.verify import holdout_settings, replay, trial_inputs
+from pipeline.planning.claims import orient
+from pipeline.planning.tight.enumerate import Level, NominalTree
+from pipeline.planning.core.resting import resting_states
+from pipeline.config import schema_default
+from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
+from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE
+from pipeline.planning.claims.verify import holdout_settings, replay, trial_inputs
 from pipeline.progress import SILENT, Heartbeat, Stretch
 
 SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
@@ -82,7 +82,7 @@ SCREEN = (12, 8)  # random trials and corners per resting state in the screen
 SCREEN_BLOCK = 96  # candidates screened at once
 MAX_ROWS = 150_000  # trials replayed in one batch
 EVIDENCE_PER_LEVEL = 4  # several-set sequences judged per level when nothing orients
-WIDTH_SLACK_DEG = 1.0  # planner.width_slack_deg: a safe margin outranks this much width
+WIDTH_SLACK_DEG = schema_default("planner", "width_slack_deg")  # a safe margin outranks this much width
 
 
 def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None, n_moving: int = 0) -> tuple:
@@ -259,15 +259,14 @@ class FixedPinSearch:
     ----------
     part : the part.
     pins : candidate fixed pins ``{label: height_mm}``.
-    mu_c : a friction value or a range ``(lo, hi)`` (the nominal paths use its
-        middle; the trials sample it as verification does).
-    tolerance : the full width (deg) a final set may have.
-    required : share of trials that must end in the set.
-    verify : the verification settings (trials, perturbation sizes, seed).
-    pin_radius, model, kernel : rollout settings.
-    d_min, d_max : the margin's limits on ``|d|``.
-    belt_speed, mu_s : plan with the dynamic model at this belt speed (mm/s)
-        and belt friction instead of the quasi-static ``model``.
+    friction : a :class:`~pipeline.planning.core.settings.Friction` (or a
+        value or range ``(lo, hi)``; the nominal paths use its middle, the
+        trials sample it as verification does).
+    claims : what "orients" means (tolerance, required share, confidence, rule).
+    verify : the verification's trials (number, perturbation sizes, seed).
+    search : rollout settings (pin radius, model, kernel), the margin's limits
+        on ``|d|``, the belt (the dynamic model at ``belt_speed`` mm/s and
+        ``mu_s`` instead of the quasi-static ``model``) and the ranking slack.
     speeds : ``{label: v_pin / v_b}`` for candidate pins that move (the
         others are fixed); :meth:`run` with a ``prefix`` lets them follow a
         fixed-pin sequence.
@@ -278,31 +277,30 @@ class FixedPinSearch:
         does; ``None``: uniform pressure.
     """
 
-    def __init__(self, part: Part, pins: dict, mu_c, tolerance: float, required: float,
-                 verify: dict, pin_radius: float, model: str = "minpower", kernel: dict | None = None,
-                 d_min: float = 0.1, d_max: float = 0.9, belt_speed: float | None = None,
-                 mu_s: float = 0.5, speeds: dict | None = None, family=None,
-                 width_slack: float = WIDTH_SLACK_DEG):
-        self.part, self.mu_c, self.model = part, mu_c, model
+    def __init__(self, part: Part, pins: dict, friction, claims: ClaimSettings, verify: VerifySettings,
+                 search: SearchSettings, speeds: dict | None = None, family=None):
+        self.friction = Friction.parse(friction, None if isinstance(friction, Friction)
+                                       else verify.perturbation.mu_sigma)
+        self.part, self.mu_c, self.model = part, self.friction.value, search.model
+        belt_speed, mu_s = search.belt_speed, search.mu_s
         self.belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
         self.labels = list(pins)
         self.heights = np.array([float(pins[k]) for k in self.labels])
         self.speeds = np.array([float((speeds or {}).get(k, 0.0)) for k in self.labels])
-        self.tolerance = orient.check_tolerance(tolerance)
-        self.required = orient.check_required(required)
-        self.cfg = dict(VERIFY_DEFAULTS, **(verify or {}))
-        self.confidence = check_confidence(self.cfg.get("confidence", DEFAULT_CONFIDENCE))
-        self.rule = orient.check_rule(self.cfg.get("rule", "bound"))
+        self.tolerance, self.required = claims.tolerance_deg, claims.required
+        self.confidence, self.rule = claims.confidence, claims.rule
+        self.cfg = verify.as_dict()
         self.holdout = holdout_settings(self.cfg)
-        self.width_slack = float(width_slack)
-        self.pin_radius = float(pin_radius)
-        self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **(kernel or {})}
+        self.width_slack = float(search.width_slack_deg)
+        self.pin_radius = float(search.pin_radius)
+        self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **search.kernel_settings}
+        d_min, d_max, model = search.d_min, search.d_max, search.model
         self.order = part.symmetry_order()
         self.states = resting_states(part)
         self.family = None if family is None or family.is_uniform else family
         self.supports = None if self.family is None else self.family.kernel_supports
         nominal = None if self.family is None else [self.supports[k] for k in self.family.representatives]
-        self.tree = NominalTree(part, self.heights, nominal_friction(mu_c), self.pin_radius, model,
+        self.tree = NominalTree(part, self.heights, self.friction.nominal, self.pin_radius, model,
                                 self.kernel, float(self.cfg["pin_halfwidth"]), d_min, d_max,
                                 belt=self.belt, speeds=self.speeds, supports=nominal)
         self.prefix = FixedPlan((), (), 0.0, np.inf)  # the pins every sequence starts with (run)
@@ -371,7 +369,7 @@ class FixedPinSearch:
         n = len(prefix.labels)
         speeds = prefix.speeds or (0.0,) * n
         theta, y_c, jam, _ = replay(self.part, list(prefix.heights), list(speeds), states[:, 0], states[:, 1],
-                                    np.full(len(states), nominal_friction(self.mu_c)), np.zeros((len(states), n)),
+                                    np.full(len(states), self.friction.nominal), np.zeros((len(states), n)),
                                     self.pin_radius, self.model, self.kernel["ds_max"], self.kernel["tol"],
                                     **self.belt, support=self.tree.column_support, supports=self.tree.supports)
         if (jam != "").any():

@@ -23,7 +23,7 @@ import numpy as np
 
 from kernels.rollout import OK
 
-from pipeline.planning.arcs import format_arc, format_arcs, in_arc  # noqa: F401 (re-exported for older callers)
+from pipeline.planning.core.arcs import format_arc, format_arcs, in_arc  # noqa: F401 (re-exported for older callers)
 
 
 @dataclass

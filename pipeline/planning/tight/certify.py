@@ -16,12 +16,12 @@ from __future__ import annotations
 import numpy as np
 
 from pipeline.parts.contact import contact_parameter
-from pipeline.planning.arcs import merge_arcs, merge_modulo
-from pipeline.planning.orient import narrowest_arc
-from pipeline.planning.propagate import friction_interval, resting_states, snapped_state
-from pipeline.planning.search import Step, TightPlan, TightPlanner
-from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
-from pipeline.planning.verify import replay, trial_inputs
+from pipeline.planning.core.arcs import merge_arcs, merge_modulo
+from pipeline.planning.claims.orient import narrowest_arc
+from pipeline.planning.tight.propagate import friction_interval, snapped_state
+from pipeline.planning.core.resting import resting_states
+from pipeline.planning.tight.search import Step, TightPlan, TightPlanner
+from pipeline.planning.claims.verify import replay, trial_inputs, verify_dict
 
 CLUSTER_GAP_DEG = 3.0  # sampled final orientations further apart than this are separate sets
 
@@ -46,7 +46,7 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict, fam
     whose final orientations form one cluster (gaps of more than
     ``CLUSTER_GAP_DEG`` split clusters) are one branch, and each step of a
     branch carries the hull of its trials after that pin."""
-    cfg = dict(VERIFY_DEFAULTS, **(verify or {}))
+    cfg = verify_dict(verify)
     cfg["seed"] = int(cfg["seed"]) + 1
     part, unc = planner.part, planner.unc
     pins = [planner.pins[p] for p in labels]

@@ -24,24 +24,24 @@ from pipeline.checks import FROUDE_MAX, G_MM_S2, check_belt
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import in_arc
+from pipeline.planning.core.arcs import in_arc
+from pipeline.planning.core.settings import TRUNCATE_SIGMA, Perturbation, PlannerSettings, SpeedSettings
 from pipeline.progress import SILENT, Heartbeat, Stretch, prefixed
 
-DEFAULT_SPEEDS = (10.0, 50.0, 100.0, 150.0, 200.0, 300.0, 400.0, 500.0)
+DEFAULT_SPEEDS = SpeedSettings().speeds  # the schema's speed grid, mm/s
 
 
-def perturbation_from_verify(verify: dict) -> dict:
-    """The uniform half-widths of :func:`speed_curve` from a config's ``verify``
-    section: orientation +-2 sigma (verification truncates its normal there),
-    centroid height and pin position as verified."""
-    v = dict(verify or {})
-    return {"theta_deg": 2.0 * v.get("theta_sigma", 1.0), "y_mm": v.get("y_halfwidth", 0.5),
-            "pin_mm": v.get("pin_halfwidth", 0.3)}
+def perturbation_from_verify(perturbation: Perturbation) -> dict:
+    """The uniform half-widths of :func:`speed_curve` from the verification's
+    perturbation sizes: orientation +- ``TRUNCATE_SIGMA`` sigma (verification
+    truncates its normal there), centroid height and pin position as verified."""
+    return {"theta_deg": TRUNCATE_SIGMA * perturbation.theta_sigma, "y_mm": perturbation.y_halfwidth,
+            "pin_mm": perturbation.pin_halfwidth}
 
 
 def _in_arcs(theta_deg, arcs) -> np.ndarray:
     """Whether each orientation (degrees) lies in one of the arcs ``(start, width)``
-    (:func:`~pipeline.planning.arcs.in_arc`, ends included, no tolerance)."""
+    (:func:`~pipeline.planning.core.arcs.in_arc`, ends included, no tolerance)."""
     theta_deg = np.asarray(theta_deg, float)
     inside = np.zeros(theta_deg.shape, bool)
     for start, width in arcs:
@@ -194,13 +194,14 @@ def _speed_limit(frac, grid, required, resolution) -> float:
     return lo
 
 
-def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: float = 0.5,
-                      trials: int = 300, speeds=DEFAULT_SPEEDS, resolution: float = 5.0,
-                      required: float = 0.99, seed: int = 0, progress=None) -> dict:
+def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=None,
+                      mu_s: float = SpeedSettings.mu_s, trials: int = 300, speeds=DEFAULT_SPEEDS,
+                      resolution: float = SpeedSettings.resolution, required: float = SpeedSettings.required,
+                      seed: int = SpeedSettings.seed, progress=None) -> dict:
     """The speed curve and speed limit of a stored tight plan (a plan file's
     ``tight`` entry, see :func:`pick_tight_plan`; ``result`` a
-    :class:`~pipeline.planning.types.PlanFile` or its dict), with the verify stage's
-    perturbation sizes (``config["verify"]``) and the sweep's pin radius.
+    :class:`~pipeline.planning.core.types.PlanFile` or its dict), with the
+    verification's perturbation sizes and the pin radius of ``settings``.
 
     Returns the JSON of ``pinfeed speed`` and the workflow's speed stage:
     ``part``, ``pin_labels``, ``pin_heights_mm``, ``pin_speeds``,
@@ -210,16 +211,16 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
     quasi-static), ``trials``, ``trials_per_speed``, ``seconds`` and ``method``.
     ``progress`` hears about each belt speed tried (:func:`speed_curve`).
     """
-    from pipeline.planning.family_certificate import family_assumption
-    from pipeline.planning.plan import pick_tight_plan
-    from pipeline.planning.settings import friction_label
-    from pipeline.planning.types import as_plan_file
+    from pipeline.planning.family.certificate import family_assumption
+    from pipeline.planning.plans.plan import pick_tight_plan
+    from pipeline.planning.core.settings import friction_label
+    from pipeline.planning.core.types import as_plan_file
     if not (isinstance(trials, int) and trials >= 1):
         raise PinfeedError(f"trials must be a whole number >= 1, got {trials!r}")
     result = as_plan_file(result)
     chosen, mu_c, entry = pick_tight_plan(result, plan, mu_text)
     part = Part.from_dict(result.part, name=result.name)
-    perturb = perturbation_from_verify(config.get("verify", {}))
+    perturb = perturbation_from_verify(settings.verify.perturbation)
     # A tight-only plan file keeps the resting states per friction entry.
     stored_states = entry.initial_states or result.initial_states or {}
     states = [(s.theta, s.y_c) for s in stored_states.values()]
@@ -227,7 +228,7 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
     res = speed_curve(part, chosen.pin_heights_mm, chosen.pin_speeds, states, arcs, mu_c,
                       mu_s=mu_s, perturb=perturb, trials=trials, speeds=speeds,
                       resolution=resolution, required=required,
-                      r_pin=config["sweep"]["pin_radius"], seed=seed, progress=progress)
+                      r_pin=settings.search.pin_radius, seed=seed, progress=progress)
     return {"part": part.name, "pin_labels": list(chosen.pins),
             "pin_heights_mm": list(chosen.pin_heights_mm),
             "pin_speeds": list(chosen.pin_speeds),
@@ -243,20 +244,8 @@ def stored_plan_speed(result, config: dict, plan: int = 1, mu_text=None, mu_s: f
             **family_assumption(entry, "speed limit")}
 
 
-def speed_settings(config: dict) -> dict:
-    """The keyword arguments of :func:`stored_plan_speed` from a config's ``speed``
-    section (``mu_s``, ``trials`` per state, the speed grid, ``resolution``,
-    the ``required`` fraction and the ``seed``): the settings a plan's stored
-    speed limit is computed with."""
-    sc = config.get("speed", {})
-    return {"mu_s": float(sc.get("mu_s", 0.5)), "trials": int(sc.get("trials", 30)),
-            "speeds": [float(v) for v in sc.get("speeds", DEFAULT_SPEEDS)],
-            "resolution": float(sc.get("resolution", 5.0)),
-            "required": float(sc.get("required", 0.99)), "seed": int(sc.get("seed", 0))}
-
-
 def stored_speed_limit(plan) -> dict | None:
-    """The speed limit stored with a tight plan (a :class:`~pipeline.planning.types.Plan`
+    """The speed limit stored with a tight plan (a :class:`~pipeline.planning.core.types.Plan`
     or its dict; see :func:`attach_speed_limits`), or None."""
     extra = plan.get("speed_limit") if isinstance(plan, dict) else plan.extra.get("speed_limit")
     return extra or None
@@ -267,12 +256,12 @@ def speed_label(record: dict) -> str:
     return f"{record['speed_limit_mm_s']:g} mm/s ({record['trials']} trials per state)"
 
 
-def attach_speed_limits(result: dict, config: dict) -> dict:
+def attach_speed_limits(result: dict, settings: PlannerSettings) -> dict:
     """Store in the plan dict ``result`` (what ``pinfeed plan`` and the workflow
     write) the speed limit of the recommended tight plan and of the first tight
     plan of fixed pins (the one a layout uses) at the first planned friction:
     each such plan gets ``speed_limit``, the :func:`stored_plan_speed` result
-    with the config's :func:`speed_settings` (kept under ``settings``), so
+    with the speed settings (``settings.speed``, kept under ``settings``), so
     that the report, ``pinfeed speed`` and ``pinfeed layout`` show one figure
     per plan. A plan whose speed limit cannot be computed (a part any grid
     speed would throw) gets none: the speed stage then says why. Returns
@@ -282,17 +271,17 @@ def attach_speed_limits(result: dict, config: dict) -> dict:
     tight = result.get("tight") or []
     if not tight or not tight[0]["plans"]:
         return result
-    entry, settings = tight[0], speed_settings(config)
+    entry, speed = tight[0], settings.speed.as_kwargs()
     plans = entry["plans"]
     fixed = [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.get("pin_speeds") or ())]
     for number in sorted({1, *fixed[:1]}):
         try:
-            record = stored_plan_speed(result, config, plan=number, **settings,
+            record = stored_plan_speed(result, settings, plan=number, **speed,
                                        progress=prefixed(f"mu_c {entry['friction']}: plan {number}"))
         except PinfeedError:
             continue
         record.pop("seconds", None)  # a timing would make the same plan differ between runs
-        plans[number - 1]["speed_limit"] = dict(record, settings=settings)
+        plans[number - 1]["speed_limit"] = dict(record, settings=speed)
     if entry.get("recommended") is not None and "speed_limit" in plans[0]:
         entry["recommended"]["speed_limit"] = plans[0]["speed_limit"]
     return result

@@ -12,7 +12,7 @@ a warning with the reason is returned instead. Each plan keeps its verdict
 on the trials that chose it apart, as ``verification.selection``.
 
 Outcomes computed for the propagation are kept in the catalog under
-``refine/PART_ID/MODEL/v_pin=V.h5`` (see :mod:`pipeline.planning.lattice_store`) and
+``refine/PART_ID/MODEL/v_pin=V.h5`` (see :mod:`pipeline.planning.tight.store`) and
 reused by later runs.
 
 With ``planner.belt_speed`` (mm/s) set, the planner plans with the dynamic
@@ -28,23 +28,22 @@ from pathlib import Path
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import format_arcs
-from pipeline.planning.certify import carried_plan
-from pipeline.planning.complete import (WIDTH_SLACK_DEG, FixedPinSearch, FixedPlan, FixedSearch,
-                                        orientation_rank, robust_order)
-from pipeline.planning.family import planning_family
-from pipeline.planning.family_certificate import family_certificate
-from pipeline.planning.worst_member import FamilyChecker, FamilyCheckSettings
-from pipeline.planning.lattice_store import load_lattice, save_lattice
-from pipeline.planning.confidence import DEFAULT_CONFIDENCE, check_confidence
-from pipeline.planning.orient import (DEFAULT_REQUIRED, DEFAULT_TOLERANCE, check_required, check_rule,
-                                      check_tolerance, describe_claim, judge_verification)
-from pipeline.planning.propagate import Tolerances, Uncertainty, resting_states
-from pipeline.planning.search import TightPlanner
-from pipeline.planning.settings import candidate_pins, friction_label, parse_friction
-from pipeline.planning.types import Plan, TightEntry, as_plan_file
-from pipeline.planning.verify import DEFAULTS as VERIFY_DEFAULTS
-from pipeline.planning.verify import holdout_settings, verify_plan
+from pipeline.planning.core.arcs import format_arcs
+from pipeline.planning.tight.certify import carried_plan
+from pipeline.planning.tight.complete import (FixedPinSearch, FixedPlan, FixedSearch, orientation_rank,
+                                              robust_order)
+from pipeline.planning.family.members import planning_family
+from pipeline.planning.family.certificate import family_certificate
+from pipeline.planning.family.worst_member import FamilyChecker, FamilyCheckSettings
+from pipeline.planning.tight.store import load_lattice, save_lattice
+from pipeline.planning.claims.orient import describe_claim, judge_verification
+from pipeline.planning.tight.propagate import Tolerances, Uncertainty
+from pipeline.planning.core.resting import resting_states
+from pipeline.planning.tight.search import TightPlanner
+from pipeline.planning.core.settings import (PlannerSettings, SearchSettings, candidate_pins, friction_label,
+                                             parse_friction)
+from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
+from pipeline.planning.claims.verify import holdout_settings, verify_plan
 from pipeline.progress import SILENT, Heartbeat
 
 
@@ -52,21 +51,17 @@ MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its tria
 MOVING_PREFIXES = 3  # best fixed-pin results (besides none) that moving pins may follow
 
 
-def planner_belt(config: dict, part: Part | None = None):
-    """``(belt_speed, mu_s)`` the planner plans at: ``planner.belt_speed`` (mm/s;
-    ``None`` = quasi-static) and ``planner.mu_s`` (default 0.5). With ``part``,
-    a bad belt (speed <= 0, mu_s out of range, a part thrown rather than
-    pushed) raises a one-line :class:`PinfeedError`."""
-    pc = config["planner"]
-    speed = pc.get("belt_speed")
-    mu_s = pc.get("mu_s")
-    mu_s = 0.5 if mu_s is None else mu_s
-    if speed is None:
-        return None, float(mu_s)
+def planner_belt(search: SearchSettings, part: Part | None = None):
+    """``(belt_speed, mu_s)`` the planner plans at: ``belt_speed`` (mm/s;
+    ``None`` = quasi-static) and ``mu_s`` of the search settings. With
+    ``part``, a bad belt (speed <= 0, mu_s out of range, a part thrown rather
+    than pushed) raises a one-line :class:`PinfeedError`."""
+    if search.belt_speed is None:
+        return None, float(search.mu_s)
     if part is not None:
         from pipeline.checks import check_belt
-        check_belt(part, speed, mu_s)
-    return float(speed), float(mu_s)
+        check_belt(part, search.belt_speed, search.mu_s)
+    return float(search.belt_speed), float(search.mu_s)
 
 
 def mechanics_label(model: str, belt_speed: float | None, mu_s: float) -> str:
@@ -74,74 +69,71 @@ def mechanics_label(model: str, belt_speed: float | None, mu_s: float) -> str:
     return model if belt_speed is None else f"dynamic at {belt_speed:g} mm/s, mu_s {mu_s:g}"
 
 
-def planner_for(part: Part, config: dict, mu_c, lattices=None, moving: bool = False) -> TightPlanner:
-    """A :class:`TightPlanner` with the config's pins, limits, model and sizes
-    (and, with ``moving``, every candidate height at every ``planner.dynamic``
-    speed as a moving pin, labelled like ``P23v-2``); at ``planner.belt_speed``
-    when it is set (:func:`planner_belt`)."""
-    pc, sweep = config["planner"], config["sweep"]
-    belt_speed, mu_s = planner_belt(config, part)
-    static = candidate_pins(part, pc)
-    speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if moving else []
+def planner_for(part: Part, settings: PlannerSettings, lattices=None, moving: bool = False) -> TightPlanner:
+    """A :class:`TightPlanner` at ``settings.friction`` with the settings' pins,
+    limits, model and sizes (and, with ``moving``, every candidate height at
+    every moving-pin speed, labelled like ``P23v-2``); at the search's belt
+    speed when it is set (:func:`planner_belt`)."""
+    search = settings.search
+    belt_speed, mu_s = planner_belt(search, part)
+    static = candidate_pins(part, search.pins)
+    speeds = list(search.dynamic_speeds) if moving else []
     moving_pins = {f"{k}v{v:+g}": (y, v) for k, y in static.items() for v in speeds}
-    verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
-    tol = Tolerances(**pc.get("tolerances", {}))
-    return TightPlanner(part, static, pc["d_min"], pc["d_max"], mu_c,
-                        sweep["pin_radius"], pc["model"], Uncertainty.from_verify(verify_cfg), tol,
-                        moving=moving_pins, lattices=lattices, kernel=sweep.get("kernel"),
-                        max_branches=pc.get("max_branches", 4),
-                        hard_limits=pc.get("hard_d_limits", False), belt_speed=belt_speed, mu_s=mu_s)
+    return TightPlanner(part, static, search.d_min, search.d_max, settings.friction.value,
+                        search.pin_radius, search.model, Uncertainty.from_verify(settings.verify),
+                        Tolerances(), moving=moving_pins, lattices=lattices, kernel=search.kernel_settings or None,
+                        max_branches=search.max_branches, hard_limits=search.hard_d_limits,
+                        belt_speed=belt_speed, mu_s=mu_s)
 
 
-def plan_tight(part: Part, config: dict, mu_c, lattices=None, depth: int | None = None,
+def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int | None = None,
                keep: int = 5, progress=None, family=None) -> dict:
-    """Search, verify and rank plans for ``part`` at friction ``mu_c`` (a value
-    or a range); returns a JSON-ready dict (``plans`` best first, each with
-    its ``verification`` and orientation verdict; ``recommended``; ``warning``;
-    ``fixed_pin_search``: what the complete search found, or its evidence that
-    no fixed-pin plan orients the part; search statistics).
+    """Search, verify and rank plans for ``part`` at ``settings.friction`` (a
+    value or a range); returns a JSON-ready dict (``plans`` best first, each
+    with its ``verification`` and orientation verdict; ``recommended``;
+    ``warning``; ``fixed_pin_search``: what the complete search found, or its
+    evidence that no fixed-pin plan orients the part; search statistics).
 
     Fixed pins first, by the complete search (``complete.FixedPinSearch``);
-    only when no fixed-pin sequence of up to ``depth`` pins orients the part
-    within ``planner.tolerance_deg`` do moving pins follow the best fixed-pin
-    prefixes (``planner.dynamic``).
+    only when no fixed-pin sequence of up to ``depth`` pins (default: the
+    search settings') orients the part within the claim's tolerance do
+    moving pins follow the best fixed-pin prefixes.
 
     ``family`` (a :class:`~pipeline.parts.support_family.SupportFamily`, see
-    :func:`pipeline.planning.family.planning_family`): the plans must
+    :func:`pipeline.planning.family.members.planning_family`): the plans must
     orient the part for every member; the search, the carried sets and the
     verification sample its members (``support_family`` in the result).
     ``None``: uniform pressure."""
-    depth = int(depth if depth is not None else config["planner"]["depth"])
+    depth = int(depth if depth is not None else settings.search.depth)
     family = None if family is None or family.is_uniform else family
-    planner = planner_for(part, config, mu_c, lattices)
-    checker = family_checker(part, config, mu_c, family, progress)
-    fixed = _fixed_search(part, config, mu_c, planner, depth, keep, progress, family, checker)
-    verify_cfg = dict(VERIFY_DEFAULTS, **config.get("verify", {}))
+    planner = planner_for(part, settings, lattices)
+    checker = family_checker(part, settings, family, progress)
+    fixed = _fixed_search(part, settings, planner, depth, keep, progress, family, checker)
     # No pin is the plan with the fewest pins: then nothing is certified or recommended.
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
-    candidates = _carried(planner, chosen, verify_cfg, family, progress)
+    candidates = _carried(planner, chosen, settings.verify, family, progress)
     selections = [p.selection or p.verdict for p in chosen]
-    moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, config, mu_c, planner)
+    moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, settings, planner)
     moving_search = None
     if moving is not None:
-        moving_search = _moving_search(part, config, mu_c, moving, chosen, keep, progress, family, checker)
-        candidates += _carried(moving, moving_search.plans, verify_cfg, family, progress)
+        moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker)
+        candidates += _carried(moving, moving_search.plans, settings.verify, family, progress)
         selections += [p.selection or p.verdict for p in moving_search.plans]
         planner = moving
     states = resting_states(part)
-    _verify_candidates(part, config, mu_c, planner, candidates, states, progress, family, selections)
+    _verify_candidates(part, settings, planner, candidates, states, progress, family, selections)
     judge_for_family(candidates, checker)
     candidates = robust_order(candidates, _rank, lambda p: p.verification["orientation"].get("width_deg"),
-                              lambda p: p.margin, planner_width_slack(config))
+                              lambda p: p.margin, settings.search.width_slack_deg)
     good = [p for p in candidates if _acceptable(p)]
-    result = _tight_result(config, mu_c, depth, keep, planner, candidates, good, states, fixed, moving_search)
+    result = _tight_result(settings, depth, keep, planner, candidates, good, states, fixed, moving_search)
     if family is not None:
         result["support_family"] = family.to_dict()
-        certify_for_family(result, part, config, mu_c, family, checker, good)
+        certify_for_family(result, part, settings, family, checker, good)
     return result
 
 
-def _carried(planner, chosen, verify_cfg: dict, family, progress) -> list:
+def _carried(planner, chosen, verify, family, progress) -> list:
     """The carried sets of each chosen plan (``certify.carried_plan``), telling
     ``progress`` how many are done (and, between the propagation's rollout
     batches, that it is still at it)."""
@@ -151,7 +143,7 @@ def _carried(planner, chosen, verify_cfg: dict, family, progress) -> list:
             for p in chosen:
                 for lattice in planner.lattices.values():
                     lattice.stretch = beat.stretch(len(out), len(out))
-                out.append(carried_plan(planner, p.labels, p.margin, verify_cfg, family))
+                out.append(carried_plan(planner, p.labels, p.margin, verify, family))
                 beat.tick(len(out))
         finally:
             for lattice in planner.lattices.values():
@@ -159,86 +151,50 @@ def _carried(planner, chosen, verify_cfg: dict, family, progress) -> list:
     return out
 
 
-def planner_tolerance(config: dict) -> float:
-    """``planner.tolerance_deg`` (default 10), checked: the full width a final set may have."""
-    return check_tolerance(config["planner"].get("tolerance_deg", DEFAULT_TOLERANCE))
-
-
-def verify_required(config: dict) -> float:
-    """``verify.required`` (default 0.995): the share of trials that must end in the set."""
-    return check_required(config.get("verify", {}).get("required", DEFAULT_REQUIRED))
-
-
-def verify_confidence(config: dict) -> float:
-    """``verify.confidence`` (default 0.95): how sure the claim "orients" is."""
-    return check_confidence(config.get("verify", {}).get("confidence", DEFAULT_CONFIDENCE))
-
-
-def verify_rule(config: dict) -> str:
-    """``verify.rule`` (default ``bound``): judge by the confidence bound or the share alone."""
-    return check_rule(config.get("verify", {}).get("rule", "bound"))
-
-
-def planner_width_slack(config: dict) -> float:
-    """``planner.width_slack_deg`` (default 1): how much wider a plan with a safe
-    margin in d may be and still rank before one with a negative margin."""
-    slack = float(config["planner"].get("width_slack_deg", WIDTH_SLACK_DEG))
-    if not slack >= 0.0:
-        raise PinfeedError(f"planner.width_slack_deg must be 0 or more degrees, got {slack!r}")
-    return slack
-
-
-def _pin_search(part, config, mu_c, planner, moving: bool, family=None, checker=None) -> FixedPinSearch:
+def _pin_search(part, settings: PlannerSettings, planner, moving: bool, family=None,
+                checker=None) -> FixedPinSearch:
     """The complete search over the planner's fixed pins (``moving`` False) or
-    its moving pins (True), with the config's tolerance, verification and
-    kernel settings and the planner's belt."""
-    pc, sweep = config["planner"], config["sweep"]
+    its moving pins (True), with the settings' claim, trials and search."""
     pins = {k: p for k, p in planner.pins.items() if bool(p.v_pin) == moving}
-    search = FixedPinSearch(part, {k: p.y for k, p in pins.items()}, mu_c, planner_tolerance(config),
-                          verify_required(config), config.get("verify", {}), sweep["pin_radius"],
-                          pc["model"], sweep.get("kernel"), pc["d_min"], pc["d_max"],
-                          belt_speed=planner.belt_speed, mu_s=planner.mu_s,
-                          speeds={k: p.v_pin for k, p in pins.items()}, family=family,
-                          width_slack=planner_width_slack(config))
+    search = FixedPinSearch(part, {k: p.y for k, p in pins.items()}, settings.friction, settings.claims,
+                            settings.verify, settings.search,
+                            speeds={k: p.v_pin for k, p in pins.items()}, family=family)
     search.member_check = checker
     return search
 
 
-def _fixed_search(part, config, mu_c, planner, depth, keep, progress, family=None,
+def _fixed_search(part, settings: PlannerSettings, planner, depth, keep, progress, family=None,
                   checker=None) -> FixedSearch:
-    """The complete fixed-pin search with the planner's pins and the config's settings."""
-    search = _pin_search(part, config, mu_c, planner, moving=False, family=family, checker=checker)
-    return search.run(depth, candidates=int(config["planner"].get("candidates", 12)), keep=keep,
-                      progress=progress)
+    """The complete fixed-pin search with the planner's pins and the settings."""
+    search = _pin_search(part, settings, planner, moving=False, family=family, checker=checker)
+    return search.run(depth, candidates=settings.search.candidates, keep=keep, progress=progress)
 
 
-def _moving_planner(part, config, mu_c, planner):
-    """The planner with moving pins, if the config allows them (else ``None``)."""
-    dyn = config["planner"].get("dynamic", {})
-    if not (dyn.get("depth", 0) and dyn.get("speeds")):
+def _moving_planner(part, settings: PlannerSettings, planner):
+    """The planner with moving pins, if the settings allow them (else ``None``)."""
+    if not (settings.search.dynamic_depth and settings.search.dynamic_speeds):
         return None
-    return planner_for(part, config, mu_c, planner.lattices, moving=True)
+    return planner_for(part, settings, planner.lattices, moving=True)
 
 
-def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=None,
+def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progress, family=None,
                    checker=None) -> FixedSearch:
-    """Up to ``planner.dynamic.depth`` moving pins after no fixed pin and after
+    """Up to ``search.dynamic_depth`` moving pins after no fixed pin and after
     each of the ``MOVING_PREFIXES`` best fixed-pin results, by the same
     enumeration, screen and judgement as the fixed pins; the orienting plans,
     best first.
 
     A plan that orients ranks before every plan with more pins
-    (:func:`~pipeline.planning.complete.orientation_rank`), so once some
+    (:func:`~pipeline.planning.tight.complete.orientation_rank`), so once some
     sequence orients with ``k`` pins a prefix of ``L`` fixed pins is searched
     only up to ``k - L`` moving pins, and not at all when ``L >= k``
     (``skipped`` in the search's record): the plans left out could only rank
     after the one found."""
-    pc, dyn = config["planner"], config["planner"]["dynamic"]
     if progress:
-        progress(f"mu_c {friction_label(mu_c)}: fixed pins do not orient the part: adding moving pins")
-    search = _pin_search(part, config, mu_c, moving, moving=True, family=family, checker=checker)
-    depth = int(dyn["depth"])
-    total = FixedSearch([], [], depth, planner_tolerance(config), verify_required(config))
+        progress(f"mu_c {settings.friction.label}: fixed pins do not orient the part: adding moving pins")
+    search = _pin_search(part, settings, moving, moving=True, family=family, checker=checker)
+    depth = settings.search.dynamic_depth
+    total = FixedSearch([], [], depth, settings.claims.tolerance_deg, settings.claims.required)
     for prefix in [None, *chosen[:MOVING_PREFIXES]]:
         after = list(prefix.labels) if prefix else []
         room = moving_room(total.plans, len(after), depth)
@@ -246,7 +202,7 @@ def _moving_search(part, config, mu_c, moving, chosen, keep, progress, family=No
             total.skipped.append({"after": after,
                                   "why": f"a plan of {len(after) + room} pins already orients the part"})
             continue
-        res = search.run(room, candidates=int(pc.get("candidates", 12)), keep=keep, progress=progress,
+        res = search.run(room, candidates=settings.search.candidates, keep=keep, progress=progress,
                          prefix=prefix)
         total.plans += res.plans
         total.levels += [dict(lv, after=after) for lv in res.levels]
@@ -280,7 +236,7 @@ def _acceptable(plan) -> bool:
     return verdict["orients"] or v["failures"] <= MAX_FAILURE * v["trials"]
 
 
-def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, states, progress,
+def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidates, states, progress,
                        family=None, selections=None) -> None:
     """Replay each candidate by perturbed full rollouts on the held-out trials
     (``verify_plan`` with ``holdout_settings``) and attach the summary as
@@ -288,19 +244,18 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
     set within the tolerance, with confidence?) as ``orientation`` and the
     verdict on the trials that chose it (``selections``, in order) as
     ``selection``."""
-    pc = config["planner"]
-    verify_cfg = holdout_settings(dict(VERIFY_DEFAULTS, **config.get("verify", {})))
-    tolerance, required = planner_tolerance(config), verify_required(config)
-    confidence, rule = verify_confidence(config), verify_rule(config)
+    verify_cfg = holdout_settings(settings.verify)
+    claims, search = settings.claims, settings.search
     selections = list(selections or []) + [None] * len(candidates)
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
     beat = Heartbeat("verifying the chosen plans on held-out trials", len(candidates), "plan", progress).start()
     for k, (plan, selection) in enumerate(zip(candidates, selections)):
-        res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, mu_c,
-                          config["sweep"]["pin_radius"], pc["model"], verify_cfg, speeds=speeds,
-                          kernel=config["sweep"].get("kernel"), belt_speed=planner.belt_speed,
+        res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, settings.friction.value,
+                          search.pin_radius, search.model, verify_cfg, speeds=speeds,
+                          kernel=search.kernel_settings, belt_speed=planner.belt_speed,
                           mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1))
-        verdict = judge_verification(res, tolerance, planner.order, required, confidence, rule)
+        verdict = judge_verification(res, claims.tolerance_deg, planner.order, claims.required,
+                                     claims.confidence, claims.rule)
         plan.verification = {"held_out": True, "seed": verify_cfg["seed"],
                              "trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
@@ -310,7 +265,7 @@ def _verify_candidates(part: Part, config: dict, mu_c, planner, candidates, stat
                                 if "support_family" in res else {}),
                              "orientation": verdict, "selection": selection}
         if progress:
-            progress(f"mu_c {friction_label(mu_c)}: verified {' '.join(plan.pins)} on held-out trials: "
+            progress(f"mu_c {settings.friction.label}: verified {' '.join(plan.pins)} on held-out trials: "
                      + describe_claim(verdict))
     beat.finish()
 
@@ -342,21 +297,20 @@ def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance
             f"sets of at most {tolerance:g} deg: a sensor must tell them apart")
 
 
-def _tight_result(config: dict, mu_c, depth: int, keep: int, planner, candidates, good, states,
+def _tight_result(settings: PlannerSettings, depth: int, keep: int, planner, candidates, good, states,
                   fixed: FixedSearch, moving: FixedSearch | None = None) -> dict:
     """The JSON-ready tight-planner entry at one friction (the stored format)."""
-    pc = config["planner"]
     recommended = good[0] if good else None
-    tolerance = planner_tolerance(config)
+    tolerance = settings.claims.tolerance_deg
     return {
-        "mu_c": list(mu_c) if isinstance(mu_c, tuple) else mu_c,
-        "friction": friction_label(mu_c),
+        "mu_c": settings.friction.to_json(),
+        "friction": settings.friction.label,
         "belt_speed": planner.belt_speed, "mu_s": planner.mu_s if planner.belt_speed else None,
-        "mechanics": mechanics_label(pc["model"], planner.belt_speed, planner.mu_s),
+        "mechanics": mechanics_label(settings.search.model, planner.belt_speed, planner.mu_s),
         "symmetry_order": planner.order,
         "depth": depth, "complete_depth": depth,
-        "beam": int(pc.get("dynamic", {}).get("beam", 30)),
-        "tolerance_deg": tolerance, "required": verify_required(config),
+        "beam": settings.search.beam,
+        "tolerance_deg": tolerance, "required": settings.claims.required,
         "orients": bool(recommended and recommended.verification["orientation"]["orients"])
         or fixed.needs_no_pin,
         "needs_no_pin": fixed.needs_no_pin,
@@ -428,11 +382,11 @@ def best_fixed_plan(plan_result) -> Plan | None:
     return next((p for p in result.plans or () if not p.n_dynamic_pins), None)
 
 
-def plan_hint(config: dict, name: str, root) -> str:
+def plan_hint(planned_parts, name: str, root) -> str:
     """How to make the stored plan of ``name`` under results folder ``root``: the
-    workflow plans the config's parts; a part planned from --vertices or
-    --outline needs 'pinfeed plan'."""
-    if name in config["planner"]["parts"]:
+    workflow plans its ``planned_parts`` (``PlannerSettings.parts``); a part
+    planned from --vertices or --outline needs 'pinfeed plan'."""
+    if name in planned_parts:
         return "run the workflow ('make run')"
     return f"run 'pinfeed plan --part {name} --out {Path(root) / 'plans' / (name + '.json')}'"
 
@@ -440,37 +394,26 @@ def plan_hint(config: dict, name: str, root) -> str:
 # ---------------------------------------------------------------------- every configured friction
 
 
-def plan_frictions(config: dict) -> list:
-    """The frictions the workflow plans at: ``planner.mu_c`` (a value or a range
-    ``LO:HI``; the recommended plan) first, then each of ``planner.frictions``."""
-    pc = config["planner"]
-    out = [parse_friction(pc["mu_c"])]
-    for f in pc.get("frictions", []):
-        f = parse_friction(f)
-        if f not in out:
-            out.append(f)
-    return out
-
-
-def plan_tight_all(part: Part, config: dict, catalog_root, keep: int = 5, progress=None) -> list:
-    """Tight plans at every friction of :func:`plan_frictions` (the first is the
-    recommended one), at ``planner.belt_speed`` when it is set, for every
-    member of ``planner.support_family`` when it is set (its extremes found
-    at each friction); the planner's rollouts are stored in the catalog
-    (keyed by model, pin speed and belt)."""
-    sweep, model = config["sweep"], config["planner"]["model"]
-    belt_speed, mu_s = planner_belt(config, part)
-    speeds = [0.0] + [float(v) for v in config["planner"].get("dynamic", {}).get("speeds", [])]
-    lattices = {v: load_lattice(catalog_root, part, model, v, sweep["pin_radius"], sweep.get("kernel"),
-                                belt_speed=belt_speed, mu_s=mu_s)
+def plan_tight_all(part: Part, settings: PlannerSettings, catalog_root, keep: int = 5, progress=None) -> list:
+    """Tight plans at every friction of ``settings.frictions`` (the first is the
+    recommended one), at the search's belt speed when it is set, for every
+    member of its support family when it is set (its extremes found at each
+    friction); the planner's rollouts are stored in the catalog (keyed by
+    model, pin speed and belt)."""
+    search = settings.search
+    belt_speed, mu_s = planner_belt(search, part)
+    speeds = [0.0, *search.dynamic_speeds]
+    lattices = {v: load_lattice(catalog_root, part, search.model, v, search.pin_radius,
+                                search.kernel_settings or None, belt_speed=belt_speed, mu_s=mu_s)
                 for v in speeds}
     out = []
     try:
-        for mu_c in plan_frictions(config):
+        for friction in settings.frictions:
             t0 = time.perf_counter()
-            family = planning_family(part, config["planner"].get("support_family") or "uniform", config, mu_c)
-            res = plan_tight(part, config, mu_c, lattices=lattices, keep=keep,
-                             progress=_labelled(progress, f"mu_c {friction_label(mu_c)}"), family=family)
+            at = settings.at(friction)
+            family = planning_family(part, search.support_family or "uniform", at)
+            res = plan_tight(part, at, lattices=lattices, keep=keep,
+                             progress=_labelled(progress, f"mu_c {friction.label}"), family=family)
             res["stats"]["wall_seconds"] = round(time.perf_counter() - t0, 2)  # search, verification and all
             res.pop("lattices")
             out.append(res)
@@ -490,13 +433,13 @@ def _labelled(progress, label: str):
 
 # ---------------------------------------------------------------------- support families: the family's edge
 
-def family_checker(part: Part, config: dict, mu_c, family, progress=None) -> FamilyChecker | None:
+def family_checker(part: Part, settings: PlannerSettings, family, progress=None) -> FamilyChecker | None:
     """The worst-member check for plans for ``family`` (None without a family),
     with the planner's verification settings and ``planner.worst_member_budget``;
     each search tells ``progress`` how far it has got."""
     if family is None or family.is_uniform:
         return None
-    return FamilyChecker(part, family, FamilyCheckSettings.from_config(config, mu_c), progress)
+    return FamilyChecker(part, family, FamilyCheckSettings.from_settings(settings), progress)
 
 
 def judge_for_family(candidates, checker: FamilyChecker | None) -> None:
@@ -518,7 +461,7 @@ def judge_for_family(candidates, checker: FamilyChecker | None) -> None:
                                                     broken_by_worst_member=True)
 
 
-def certify_for_family(result: dict, part: Part, config: dict, mu_c, family, checker, good) -> None:
+def certify_for_family(result: dict, part: Part, settings: PlannerSettings, family, checker, good) -> None:
     """The family certificate of the recommended plan (``family_certificate``
     in ``result`` and in the recommended plan), or, when no plan holds for the
     family, a warning naming the worst member that broke the best one."""

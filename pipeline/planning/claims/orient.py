@@ -6,7 +6,7 @@ final set may have) when, with confidence ``verify.confidence`` (default
 would ever meet end in one arc no wider than ``T``: the one-sided
 Clopper-Pearson lower bound on the share of its trials in the best arc of
 ``T`` (jams count as failures) is at least ``verify.required``
-(:mod:`pipeline.planning.confidence`). The *point rule* (the measured share
+(:mod:`pipeline.planning.claims.confidence`). The *point rule* (the measured share
 itself at least ``verify.required``) is reported beside it: a plan that
 clears the point rule but not the bound is a near miss, ranked after the
 plans that clear both. Orientations are taken on the circle of the part's
@@ -16,7 +16,7 @@ of orientations (degrees) and share nothing with the planner's propagation.
 
 The *verified width* of a set of trials is the width of the narrowest arc
 that holds the required share of them; its bootstrap interval
-(:func:`pipeline.planning.confidence.width_interval`) says how well the
+(:func:`pipeline.planning.claims.confidence.width_interval`) says how well the
 trials pin it down.
 """
 from __future__ import annotations
@@ -25,31 +25,14 @@ import math
 
 import numpy as np
 
+from pipeline.config import schema_default
 from pipeline.errors import PinfeedError
-from pipeline.planning.confidence import (DEFAULT_CONFIDENCE, check_confidence, share_lower_bound,
-                                          width_interval)
+from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE, share_lower_bound, width_interval
+from pipeline.planning.core.settings import (RULES, check_confidence, check_required,  # noqa: F401 (re-exported)
+                                             check_rule, check_tolerance)
 
-DEFAULT_TOLERANCE = 10.0  # deg: planner.tolerance_deg
-DEFAULT_REQUIRED = 0.995  # verify.required: share of trials that must end in the set
-
-
-def check_tolerance(value, what: str = "tolerance (--tolerance, planner.tolerance_deg)") -> float:
-    """The tolerance as a float in (0, 360) degrees, or a one-line :class:`PinfeedError`."""
-    try:
-        tol = float(value)
-    except (TypeError, ValueError):
-        raise PinfeedError(f"{what} {value!r} is not a number; give degrees, e.g. 10") from None
-    if not (math.isfinite(tol) and 0.0 < tol < 360.0):
-        raise PinfeedError(f"{what} must be more than 0 and less than 360 degrees, got {value!r}")
-    return tol
-
-
-def check_required(value) -> float:
-    """``verify.required`` as a share in (0, 1], or a one-line :class:`PinfeedError`."""
-    req = float(value)
-    if not (0.0 < req <= 1.0):
-        raise PinfeedError(f"verify.required must be a share in (0, 1], e.g. 0.995; got {value!r}")
-    return req
+DEFAULT_TOLERANCE = schema_default("planner", "tolerance_deg")  # deg
+DEFAULT_REQUIRED = schema_default("verify", "required")  # share of trials that must end in the set
 
 
 def needed(n_trials: int, required: float) -> int:
@@ -57,15 +40,6 @@ def needed(n_trials: int, required: float) -> int:
     return int(math.ceil(required * n_trials - 1e-9))
 
 
-RULES = ("bound", "point")  # verify.rule
-
-
-def check_rule(value) -> str:
-    """``verify.rule`` (``bound`` or ``point``), or a one-line :class:`PinfeedError`."""
-    if value not in RULES:
-        raise PinfeedError(f"verify.rule must be 'bound' (the confidence bound, default) or 'point' "
-                           f"(the sample's share alone); got {value!r}")
-    return value
 
 
 def max_failures(n_trials: int, required: float, confidence: float = DEFAULT_CONFIDENCE,

@@ -1,6 +1,6 @@
 """Refinement shards: the planner's on-demand rollouts, stored for reuse.
 
-The tight propagation (:mod:`pipeline.planning.propagate`) computes rollouts at points
+The tight propagation (:mod:`pipeline.planning.tight.propagate`) computes rollouts at points
 of a dyadic lattice in ``(theta_i, d, mu_c)`` wherever a state needs them:
 denser maps exactly where neighbouring outcomes disagree. They are stored in
 the catalog like any shard, one self-describing HDF5 file per part, model,
@@ -38,7 +38,7 @@ from pipeline.maps.catalog import REFINE_FOLDER
 from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_atomic
 from pipeline.parts.part import Part
-from pipeline.planning.propagate import UNITS, OutcomeLattice
+from pipeline.planning.tight.propagate import UNITS, OutcomeLattice
 from pipeline.provenance import provenance_attrs
 
 FOLDER = REFINE_FOLDER

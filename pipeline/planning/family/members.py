@@ -16,17 +16,16 @@ from pipeline.errors import PinfeedError
 from pipeline.maps.support_spread import family_spread
 from pipeline.parts.part import Part
 from pipeline.parts.support_family import SupportFamily, parse_support_family
-from pipeline.planning.settings import nominal_friction, parse_friction
+from pipeline.planning.core.settings import PlannerSettings, SearchSettings
 
 EXTREMES_THETA_STEP = 3.0  # deg: the coarse grid the planner's extremes are found on
 
 
-def check_family_mechanics(config: dict) -> None:
+def check_family_mechanics(search: SearchSettings) -> None:
     """Refuse (one line) a family with mechanics that assume uniform pressure."""
-    pc = config["planner"]
-    if pc.get("model", "minpower") != "minpower" or pc.get("belt_speed") is not None:
+    if search.model != "minpower" or search.belt_speed is not None:
         raise PinfeedError(f"a support family needs the quasi-static minpower model (the planner has "
-                           f"model {pc.get('model')!r}, belt speed {pc.get('belt_speed')}); the other "
+                           f"model {search.model!r}, belt speed {search.belt_speed}); the other "
                            f"models assume uniform pressure: use model minpower without a belt speed")
 
 
@@ -35,18 +34,17 @@ def as_family(part: Part, family) -> SupportFamily:
     return family if isinstance(family, SupportFamily) else parse_support_family(family, part)
 
 
-def planning_family(part: Part, family, config: dict, mu_c=None) -> SupportFamily | None:
+def planning_family(part: Part, family, settings: PlannerSettings) -> SupportFamily | None:
     """The family (text or :class:`SupportFamily`) with its extremes found on
     the sweep's ``d`` and every ``EXTREMES_THETA_STEP`` degrees of theta_i at
-    the planner's nominal friction (``mu_c``, default ``planner.mu_c``);
-    ``None`` for uniform pressure alone."""
+    the nominal value of ``settings.friction``; ``None`` for uniform pressure
+    alone."""
     family = as_family(part, family)
     if family.is_uniform:
         return None
-    check_family_mechanics(config)
+    check_family_mechanics(settings.search)
     if family.extremes or len(family) == 1:
         return family if family.extremes else dataclasses.replace(family, extremes=(0,))
-    mu = nominal_friction(parse_friction(config["planner"]["mu_c"]) if mu_c is None else mu_c)
     spread = family_spread(part, family, np.arange(0.0, 360.0, EXTREMES_THETA_STEP),
-                           config["sweep"]["d"], mu, config["sweep"]["pin_radius"])
+                           list(settings.swept_d), settings.friction.nominal, settings.search.pin_radius)
     return dataclasses.replace(family, extremes=spread.extremes)

@@ -18,6 +18,7 @@ and a pin missed, and the part ended elsewhere) and ``other band``.
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 
@@ -29,13 +30,22 @@ from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import in_arc, merge_arcs
+from pipeline.planning.core.arcs import in_arc, merge_arcs
+from pipeline.planning.core.settings import TRUNCATE_SIGMA, Perturbation, VerifySettings
 from pipeline.progress import SILENT, Stretch
 
-PERTURB_DEFAULTS = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
-DEFAULTS = {"trials": 300, "corners": True, **PERTURB_DEFAULTS, "seed": 1}
-TRUNCATE_SIGMA = 2.0
+PERTURB_DEFAULTS = dataclasses.asdict(Perturbation())  # the schema's verify perturbation sizes
+DEFAULTS = VerifySettings().as_dict()  # the schema's verify section (trials, corners, seed, sizes)
 HOLDOUT_STREAM = 4_001  # salt of the held-out trials' seed: a stream no screen or selection draws from
+
+
+def verify_dict(settings) -> dict:
+    """The trial settings as the flat dict the drawing functions read: a
+    :class:`~pipeline.planning.core.settings.VerifySettings`, or a partial
+    dict over the schema's defaults (:data:`DEFAULTS`)."""
+    if isinstance(settings, VerifySettings):
+        return settings.as_dict()
+    return dict(DEFAULTS, **(settings or {}))
 
 
 def holdout_settings(settings: dict, attempt: int = 0) -> dict:
@@ -47,7 +57,7 @@ def holdout_settings(settings: dict, attempt: int = 0) -> dict:
     selection draws from, ``holdout_trials`` per state (default: as many as
     ``trials``; fewer is refused). The same settings give the same held-out
     trials. The box corners are replayed again (they are not random)."""
-    cfg = dict(DEFAULTS, **(settings or {}))
+    cfg = verify_dict(settings)
     n = cfg.get("holdout_trials")
     n = int(cfg["trials"]) if n is None else int(n)
     if n < int(cfg["trials"]):
@@ -115,7 +125,7 @@ def trial_inputs(initial_states: dict, mu_c, n_pins: int, settings: dict, family
     stratified sample: each member ``trials / len(family)`` times, give or take
     one), and the corners are replayed once under each of the family's
     ``representatives``."""
-    cfg = dict(DEFAULTS, **(settings or {}))
+    cfg = verify_dict(settings)
     rng = np.random.default_rng(cfg["seed"])
     members = 1 if family is None else len(family.members)
     reps = (0,) if family is None else family.representatives
@@ -278,7 +288,7 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     trial's outcome. ``stretch`` (:class:`pipeline.progress.Stretch`) is told
     how far the trials have got, each initial state an equal share."""
     speeds = speeds or {}
-    cfg = dict(DEFAULTS, **(settings or {}))
+    cfg = verify_dict(settings)
     kernel = kernel or {}
     labels = list(plan["pins"])
     heights = [float(pins[p]) for p in labels]

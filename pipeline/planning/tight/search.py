@@ -28,8 +28,8 @@ from dataclasses import dataclass
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import merge_arcs, merge_modulo
-from pipeline.planning.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
+from pipeline.planning.core.arcs import merge_arcs, merge_modulo
+from pipeline.planning.tight.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
                         initial_state_sets, propagate)
 
 

@@ -32,20 +32,11 @@ import math
 import numpy as np
 from scipy.stats import beta
 
+from pipeline.config import schema_default
 from pipeline.errors import PinfeedError
+from pipeline.planning.core.settings import check_confidence  # noqa: F401 (re-exported)
 
-DEFAULT_CONFIDENCE = 0.95  # verify.confidence
-
-
-def check_confidence(value, what: str = "verify.confidence") -> float:
-    """A confidence level as a float strictly between 0 and 1, or a one-line error."""
-    try:
-        c = float(value)
-    except (TypeError, ValueError):
-        raise PinfeedError(f"{what} {value!r} is not a number; give a share such as 0.95") from None
-    if not (math.isfinite(c) and 0.0 < c < 1.0):
-        raise PinfeedError(f"{what} must lie strictly between 0 and 1 (e.g. 0.95); got {value!r}")
-    return c
+DEFAULT_CONFIDENCE = schema_default("verify", "confidence")
 
 
 def _counts(k, n) -> tuple[int, int]:

@@ -35,12 +35,11 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from pipeline.errors import PinfeedError
 from pipeline.maps.catalog import Catalog, entry_part
-from pipeline.parts.families import config_part_id
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import arc_within, in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
-from pipeline.planning.bands import band_lookup, extract_bands
-from pipeline.planning.settings import candidate_pins, nominal_friction, parse_friction
+from pipeline.planning.core.arcs import arc_within, in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
+from pipeline.planning.paper.bands import band_lookup, extract_bands
+from pipeline.planning.core.settings import PlannerSettings, candidate_pins
 
 
 @dataclass(frozen=True)
@@ -125,7 +124,7 @@ class Plan:
 
 def load_maps(ds, threshold_T: float, factor_c: float) -> list[MapData]:
     """MapData for every d of a map set (dims ``(d, theta_i)``), sorted by d: the
-    bands (:func:`~pipeline.planning.bands.extract_bands`) of each map with its
+    bands (:func:`~pipeline.planning.paper.bands.extract_bands`) of each map with its
     arrays and band lookup. The one reader of a map set's bands: the planner
     and the bands stage (``workflow.plan.shard_bands``) both call it."""
     out = []
@@ -355,30 +354,29 @@ def catalog_part(cat: Catalog, name: str) -> Part:
     return entry_part(e)
 
 
-def build_planner(cat: Catalog, name: str, config: dict, dynamic: bool = True):
-    """The planner of one catalog part: static maps at the planner's mu_c, plus
-    (``dynamic``) the maps of every moving-pin speed the config allows
-    (``planner.dynamic``)."""
-    pc, bc = config["planner"], config["bands"]
-    name = config_part_id(config, name)
+def build_planner(cat: Catalog, name: str, settings: PlannerSettings, dynamic: bool = True):
+    """The planner of one catalog part (``name``: its id or catalog name):
+    static maps at the nominal value of ``settings.friction``, plus
+    (``dynamic``) the maps of every moving-pin speed of the search settings."""
+    search, bc = settings.search, settings.bands
     part = catalog_part(cat, name)
-    ds = cat.query(name, model=pc["model"], mu_c=nominal_friction(parse_friction(pc["mu_c"])))
+    ds = cat.query(name, model=search.model, mu_c=settings.friction.nominal)
     selection = ds.attrs["selection"]
     mu_used = float(ds["mu_c"][0])
-    maps = load_maps(ds.isel(mu_c=0).load(), bc["threshold_T"], bc["factor_c"])
-    static = candidate_pins(part, pc)
-    speeds = [float(v) for v in pc.get("dynamic", {}).get("speeds", [])] if dynamic else []
+    maps = load_maps(ds.isel(mu_c=0).load(), bc.threshold_T, bc.factor_c)
+    static = candidate_pins(part, search.pins)
+    speeds = list(search.dynamic_speeds) if dynamic else []
     dynamic_maps = {}
     for v in speeds:
-        dv = cat.query(name, model=pc["model"], mu_c=mu_used, v_pin=v)
+        dv = cat.query(name, model=search.model, mu_c=mu_used, v_pin=v)
         if float(dv["mu_c"][0]) != mu_used:
             raise PinfeedError(f"{name}: the maps at v_pin/v_b = {v:g} have no mu_c = {mu_used:g} (the "
                                f"static maps' friction); add it to the sweep or re-run the workflow")
         dv = dv.isel(mu_c=0).load()
-        dynamic_maps[v] = load_maps(dv, bc["threshold_T"], bc["factor_c"])
+        dynamic_maps[v] = load_maps(dv, bc.threshold_T, bc.factor_c)
     moving = {dynamic_label(label, v): (y, v) for label, y in static.items() for v in speeds}
-    planner = Planner(part, maps, static, pc["d_min"], pc["d_max"],
-                      coverage=pc.get("coverage", "bracket"), dynamic=moving,
+    planner = Planner(part, maps, static, search.d_min, search.d_max,
+                      coverage=search.coverage, dynamic=moving,
                       dynamic_maps=dynamic_maps)
     return part, planner, mu_used, selection
 
@@ -388,8 +386,7 @@ def dynamic_label(static_label: str, v_pin: float) -> str:
     return f"{static_label}v{v_pin:+g}"
 
 
-def paper_depth(config: dict) -> int:
-    """Depth of the paper-mode planner: ``planner.paper_depth``, at most
-    ``planner.depth`` (the sensor planner reads the stored tight plans instead)."""
-    pc = config["planner"]
-    return int(min(pc["depth"], pc.get("paper_depth", 3)))
+def paper_depth(search) -> int:
+    """Depth of the paper-mode planner: ``paper_depth`` of the search settings,
+    at most its ``depth`` (the sensor planner reads the stored tight plans instead)."""
+    return int(min(search.depth, search.paper_depth))

@@ -49,7 +49,9 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.arcs import arc_within, merge_arcs
+from pipeline.planning.core.arcs import arc_within, merge_arcs
+from pipeline.planning.core.resting import resting_states
+from pipeline.planning.core.settings import TRUNCATE_SIGMA, Perturbation, VerifySettings
 from pipeline.progress import SILENT
 
 # Lattice units: theta in 1/64 deg, d in 1/3200, mu in 1/1600.
@@ -62,19 +64,23 @@ SNAP_DEG = 0.5  # carried arcs are snapped outward to this grid (exact merging o
 SNAP_Y = 0.1  # carried y_c intervals likewise (mm)
 
 
+_BOX = Perturbation()  # the schema's perturbation sizes
+
+
 @dataclass(frozen=True)
 class Uncertainty:
     """Sizes of the uncertainty the planner must cover (the verify stage's)."""
-    theta_halfwidth: float = 2.0  # deg: 2 sigma of the initial orientation
-    y_halfwidth: float = 0.5  # mm: initial centroid height
-    mu_halfwidth: float = 0.04  # 2 sigma of the friction (a single friction value only)
-    pin_halfwidth: float = 0.3  # mm: every pin's position
+    theta_halfwidth: float = TRUNCATE_SIGMA * _BOX.theta_sigma  # deg: of the initial orientation
+    y_halfwidth: float = _BOX.y_halfwidth  # mm: initial centroid height
+    mu_halfwidth: float = TRUNCATE_SIGMA * _BOX.mu_sigma  # of the friction (a single friction value only)
+    pin_halfwidth: float = _BOX.pin_halfwidth  # mm: every pin's position
 
     @classmethod
-    def from_verify(cls, cfg: dict) -> "Uncertainty":
-        """The box at the verify stage's sizes: 2 sigma for normal errors."""
-        return cls(2.0 * float(cfg.get("theta_sigma", 1.0)), float(cfg.get("y_halfwidth", 0.5)),
-                   2.0 * float(cfg.get("mu_sigma", 0.02)), float(cfg.get("pin_halfwidth", 0.3)))
+    def from_verify(cls, verify: VerifySettings) -> "Uncertainty":
+        """The box at the verification's sizes: ``TRUNCATE_SIGMA`` sigma for
+        normal errors (where the trials' normal draws stop)."""
+        p = verify.perturbation
+        return cls(TRUNCATE_SIGMA * p.theta_sigma, p.y_halfwidth, TRUNCATE_SIGMA * p.mu_sigma, p.pin_halfwidth)
 
 
 @dataclass(frozen=True)
@@ -137,13 +143,6 @@ def friction_interval(mu_c, unc: Uncertainty) -> tuple[float, float]:
         return lo, hi
     mu = float(mu_c)
     return max(0.0, mu - unc.mu_halfwidth), mu + unc.mu_halfwidth
-
-
-def resting_states(part: Part) -> dict[str, tuple[float, float]]:
-    """The resting states against the fence: label ``state k`` -> ``(theta_deg,
-    y_c_mm)``, the labels every planner and the verification share."""
-    return {f"state {k}": (float(theta), float(y_c))
-            for k, (theta, y_c) in enumerate(part.stable_states(), start=1)}
 
 
 def initial_state_sets(part: Part, mu_c, unc: Uncertainty) -> dict[str, StateSet]:

@@ -1,0 +1,129 @@
+"""Record what the planner answers, and compare two records: a refactor's
+witness that no result changed.
+
+    .venv/bin/python benchmarks/plan_record.py record OUT.json [--atlas-plans DIR]
+    .venv/bin/python benchmarks/plan_record.py compare BEFORE.json AFTER.json
+
+``record`` plans, through the ``pinfeed plan`` command line (so the record
+does not depend on any module's internals), the two default triangles on
+the embedded default config (tight and paper modes) and seven parts outside
+the configs: a rectangle, a trapezoid, an irregular pentagon, a plate with
+an off-centre hole, two CAD drawings from the tests' corpus (a holed bracket
+and a gusset), one of them under a tripod support family and one on a
+moving belt. Each run starts from an empty catalog, so the refinement store
+and the maps are computed afresh. ``--atlas-plans DIR`` also adds the plan
+files a workflow run wrote (``results/NAME/plans/*.json``, e.g. the
+working folder of ``benchmarks/family_atlas.py --workdir``).
+
+Every plan file is kept whole except what a rerun changes by itself: the
+time it was made, the code version, and every ``*seconds`` timing. So the
+recommended plan, its pins and margins, the final sets and their widths,
+the claims, the verification counts, the complete search's levels and
+evidence, the carried sets and the warnings are all compared.
+
+``compare`` prints each difference (part, path in the plan file, before,
+after) and exits 1 when there is any, 0 when the two records are identical.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CAD = ROOT / "tests" / "data" / "cad"
+
+# name -> pinfeed plan arguments (besides --out and --catalog)
+RUNS = {
+    "asym_triangle": ["--part", "asym_triangle", "--mode", "both"],
+    "sym_triangle": ["--part", "sym_triangle", "--mode", "both"],
+    "rectangle_50x20": ["--vertices", "0,0 50,0 50,20 0,20", "--mu-c", "0.2"],
+    "trapezoid": ["--vertices", "0,0 70,0 50,25 10,25", "--mu-c", "0.1:0.3", "--depth", "3"],
+    "pentagon": ["--vertices", "0,0 40,0 50,20 20,35 -5,15", "--mu-c", "0.15"],
+    "holed_plate": ["--vertices", "0,0 60,0 60,30 0,30", "--hole", "8,8 20,8 20,20 8,20",
+                    "--mu-c", "0.2"],
+    "holed_bracket_dxf": ["--outline", str(CAD / "holed_bracket.dxf"), "--mu-c", "0.2",
+                          "--support-family", "tripods:3"],
+    "gusset_dxf_belt": ["--outline", str(CAD / "gusset_bracket.dxf"), "--mu-c", "0.2",
+                        "--belt-speed", "150"],
+}
+VOLATILE = {"created", "git_commit", "pinfeed_version"}
+
+
+def stable(value):
+    """``value`` without the keys a rerun changes by itself (times, versions)."""
+    if isinstance(value, dict):
+        return {k: stable(v) for k, v in value.items()
+                if k not in VOLATILE and not k.endswith("seconds")}
+    if isinstance(value, list):
+        return [stable(v) for v in value]
+    return value
+
+
+def plan_one(name: str, args: list, work: Path) -> dict:
+    """The stable plan file of one ``pinfeed plan`` run, from an empty catalog."""
+    out = work / f"{name}.json"
+    named = [] if args[0] == "--part" else ["--name", name]
+    cmd = [sys.executable, "-m", "pipeline.cli", "plan", *args, *named,
+           "--catalog", str(work / f"catalog_{name}"), "--out", str(out)]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"{name}: pinfeed plan failed:\n{done.stderr[-2000:]}")
+    return stable(json.loads(out.read_text()))
+
+
+def record(out: Path, atlas_plans: Path | None) -> None:
+    plans = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, args in RUNS.items():
+            print(f"planning {name} ...", file=sys.stderr, flush=True)
+            plans[name] = plan_one(name, args, Path(tmp))
+    if atlas_plans is not None:
+        for path in sorted(Path(atlas_plans).glob("*.json")):
+            plans[f"atlas/{path.stem}"] = stable(json.loads(path.read_text()))
+    out.write_text(json.dumps(plans, indent=1, sort_keys=True) + "\n")
+    print(f"recorded {len(plans)} plan files in {out}", file=sys.stderr)
+
+
+def differences(before, after, path=""):
+    """Every ``(path, before, after)`` where the two JSON values differ."""
+    if isinstance(before, dict) and isinstance(after, dict):
+        for k in sorted(set(before) | set(after)):
+            yield from differences(before.get(k, "<absent>"), after.get(k, "<absent>"), f"{path}/{k}")
+    elif isinstance(before, list) and isinstance(after, list) and len(before) == len(after):
+        for i, (b, a) in enumerate(zip(before, after)):
+            yield from differences(b, a, f"{path}[{i}]")
+    elif before != after:
+        yield path, before, after
+
+
+def compare(before: Path, after: Path) -> int:
+    old, new = json.loads(before.read_text()), json.loads(after.read_text())
+    diffs = list(differences(old, new))
+    for path, b, a in diffs[:200]:
+        print(f"{path}: {str(b)[:100]} -> {str(a)[:100]}")
+    print(f"{len(old)} plan files before, {len(new)} after; {len(diffs)} differences")
+    return 1 if diffs else 0
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    rec = sub.add_parser("record")
+    rec.add_argument("out", type=Path)
+    rec.add_argument("--atlas-plans", type=Path, default=None)
+    cmp_ = sub.add_parser("compare")
+    cmp_.add_argument("before", type=Path)
+    cmp_.add_argument("after", type=Path)
+    args = ap.parse_args(argv)
+    if args.command == "record":
+        record(args.out, args.atlas_plans)
+        return 0
+    return compare(args.before, args.after)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

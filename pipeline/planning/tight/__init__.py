@@ -1,0 +1,9 @@
+"""The tight planner: state sets pushed through pins, and the complete search.
+
+``propagate`` (a set of states through one pin, on an outcome lattice),
+``store`` (the lattice's outcomes kept in the catalog), ``search`` (the
+branch-and-bound planner over pin sequences), ``enumerate`` (every sequence
+on the pin grid, for the complete search's evidence), ``complete`` (the
+complete fixed-pin search and the ranking of its plans) and ``certify`` (the
+carried sets of a chosen plan). Imports the core and claims wings.
+"""
