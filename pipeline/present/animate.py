@@ -241,7 +241,6 @@ def _chosen_plan(result, plan_index):
     """(:class:`Plan`, friction, description) of ``plan_index`` in the
     :class:`PlanFile` ``result``: None (the recommended plan), ``"tight"``, or
     a 1-based paper-mode index."""
-    from pipeline.planning import Friction
     name = result.name
     if plan_index is None:
         plan_index = recommended_index(result)
@@ -251,7 +250,7 @@ def _chosen_plan(result, plan_index):
         tight = result.tight[0] if result.tight else None
         if not tight or not tight.recommended:
             raise PinfeedError(f"{name}: the stored result has no recommended tight plan")
-        mu = Friction.parse(tight.mu_c).nominal
+        mu = tight.planned_friction.nominal
         return tight.recommended, mu, f"tight plan at mu_c {tight.friction}"
     plans = result.plans or ()
     if not plans:

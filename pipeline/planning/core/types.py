@@ -28,6 +28,7 @@ from pathlib import Path
 
 from pipeline.checks import schema_problem
 from pipeline.errors import PinfeedError
+from pipeline.planning.core.settings import Friction
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "plan.schema.json"
 
@@ -364,6 +365,11 @@ class TightEntry:
             "complete_depth", "beam", "plans", "rejected", "recommended", "warning", "stats",
             "initial_states")
     NULLABLE = ("belt_speed", "mu_s", "recommended", "warning")  # always written, maybe null
+
+    @property
+    def planned_friction(self) -> Friction:
+        """The friction planned for, as a :class:`~pipeline.planning.core.settings.Friction`."""
+        return Friction.parse(self.mu_c)
 
     @classmethod
     def from_dict(cls, d: dict) -> "TightEntry":

@@ -40,8 +40,7 @@ from pipeline.planning.claims.orient import describe_claim, judge_verification
 from pipeline.planning.tight.propagate import Tolerances, Uncertainty
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.tight.search import TightPlanner
-from pipeline.planning.core.settings import (PlannerSettings, SearchSettings, candidate_pins, friction_label,
-                                             parse_friction)
+from pipeline.planning.core.settings import Friction, PlannerSettings, SearchSettings, candidate_pins
 from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.claims.verify import holdout_settings, verify_plan
 from pipeline.progress import SILENT, Heartbeat
@@ -352,7 +351,7 @@ def tight_entry(plan_result, friction=None) -> TightEntry:
                            "(--mode tight or both) or re-run the workflow")
     if friction is None:
         return tight[0]
-    want = friction_label(parse_friction(friction))
+    want = Friction.parse(friction).label
     found = [t for t in tight if t.friction == want]
     if not found:
         raise PinfeedError(f"no stored plan at mu_c {want}; stored: {', '.join(t.friction for t in tight)}")

@@ -22,11 +22,12 @@ from pipeline.planning.tight.propagate import friction_interval, snapped_state
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.tight.search import Step, TightPlan, TightPlanner
 from pipeline.planning.claims.verify import replay, trial_inputs, verify_dict
+from pipeline.planning.core.settings import VerifySettings
 
 CLUSTER_GAP_DEG = 3.0  # sampled final orientations further apart than this are separate sets
 
 
-def carried_plan(planner: TightPlanner, labels, margin: float, verify: dict, family=None) -> TightPlan:
+def carried_plan(planner: TightPlanner, labels, margin: float, verify: VerifySettings, family=None) -> TightPlan:
     """The :class:`TightPlan` of the sequence ``labels``: propagated if the
     tight propagation allows every pin, else sampled (see the module notes).
     With a support ``family`` other than uniform alone the sets are always
@@ -39,7 +40,8 @@ def carried_plan(planner: TightPlanner, labels, margin: float, verify: dict, fam
     return sampled_plan(planner, labels, margin, verify, family)
 
 
-def sampled_plan(planner: TightPlanner, labels, margin: float, verify: dict, family=None) -> TightPlan:
+def sampled_plan(planner: TightPlanner, labels, margin: float, verify: VerifySettings,
+                 family=None) -> TightPlan:
     """A :class:`TightPlan` whose carried sets are sampled: a replay of the
     perturbation box (seed ``verify.seed + 1``; supports sampled from
     ``family`` as the verification does); per initial state, the trials
