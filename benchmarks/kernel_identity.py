@@ -16,8 +16,8 @@ Beyond the quasi-static models on uniform supports: the minpower model on
 point supports (kernel code ``MINPOWER_POINTS``, tables from
 ``support._point_table``) and on a part with a hole (``_prepare_loops``),
 each through the three entry points; the dynamic model
-(``dynamic._dyn_rollout`` with its records, ``_dyn_rollout_grid`` and
-``_dyn_rollout_points``) on a smaller grid; and the support code itself:
+(``dynamic._dyn_rollout`` with its records, ``batch._dyn_rollout_grid`` and
+``points._dyn_rollout_points``) on a smaller grid; and the support code itself:
 ``support._power`` (both branches) and ``support._point_power`` and the
 minimisations ``models._minimise`` and ``models._minimise_points`` at
 seeded random twists and families.
@@ -35,10 +35,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from kernels.batch import _rollout_grid  # noqa: E402
-from kernels.dynamic import _dyn_rollout, _dyn_rollout_grid, _dyn_rollout_points  # noqa: E402
+from kernels.batch import _dyn_rollout_grid, _rollout_grid  # noqa: E402
+from kernels.dynamic import _dyn_rollout  # noqa: E402
 from kernels.models import _minimise, _minimise_points  # noqa: E402
-from kernels.points import _rollout_points  # noqa: E402
+from kernels.points import _dyn_rollout_points, _rollout_points  # noqa: E402
 from kernels.rollout import (_prepare, _prepare_loops, _rollout_budget,  # noqa: E402
                              max_steps_for)
 from kernels.support import _point_power, _point_table, _power, _table_sizes  # noqa: E402
