@@ -1,23 +1,17 @@
 """Parallel grids of rollouts: one part, one model, many (theta_i, d).
 
-Notes
------
-Load balance: the flat grid (``d`` major) is cut into chunks of ``_CHUNK``
-consecutive rollouts, and ``n_blocks`` blocks take the chunks in turn
-(block ``b`` takes chunks ``b, b + n_blocks, ...``). The long rollouts (jams,
-many contact changes) come in runs of neighbouring ``theta_i``; interleaving
-spreads every run over all blocks, where contiguous blocks would give whole
-runs to one thread. Use several blocks per thread (``blocks_for``) so that
-Numba's static split of ``prange`` still evens out. A chunk's results fill
-whole cache lines of the float64 outputs, so threads rarely write to the
-same line. Each block owns its scratch array, and every rollout is computed
-independently, so the result does not depend on the thread count.
+The grid's rollouts (``d`` major) run through ``drive._drive``, in chunks of
+``_CHUNK`` consecutive rollouts that ``n_blocks`` blocks take in turn (see
+``drive`` for the load balance; use several blocks per thread,
+``blocks_for``): ``_rollout_grid`` for the quasi-static models,
+``_dyn_rollout_grid`` for the dynamic one. Every rollout is independent, so
+the result does not depend on the thread count.
 """
 import numpy as np
-from numba import prange
 
-from ._numba import jit_parallel
-from .rollout import _W_COLS, _W_ROWS, _rollout_core, max_steps_for
+from ._numba import jit
+from .drive import DYNAMIC, NO_DYNAMIC, NO_STATIC, STATIC, _as_grid, _drive
+from .rollout import max_steps_for
 from .support import _table_sizes
 
 _CHUNK = 8  # rollouts per chunk: 64 bytes of each float64 output
@@ -29,7 +23,7 @@ def blocks_for(threads, total):
     return max(1, min(int(threads) * BLOCKS_PER_THREAD, -(-int(total) // _CHUNK)))
 
 
-@jit_parallel
+@jit
 def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
                   max_travel, ds_max, tol, n_blocks):
     """Rollouts over the outer product ``d x theta_i`` (radians for theta_i).
@@ -40,32 +34,26 @@ def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     ``contact_travel``, ``feature_changes`` (int32) and ``peak_force``.
     """
     nd, nt = d.shape[0], theta_i.shape[0]
-    total = nd * nt
-    status = np.empty((nd, nt), dtype=np.int8)
-    reason = np.empty((nd, nt), dtype=np.int8)
-    theta_f = np.empty((nd, nt))
-    dy = np.empty((nd, nt))
-    travel = np.empty((nd, nt))
-    changes = np.empty((nd, nt), dtype=np.int32)
-    peak = np.empty((nd, nt))
-    n_chunks = (total + _CHUNK - 1) // _CHUNK
-    n_blocks = max(1, min(n_blocks, n_chunks))
-    max_steps = max_steps_for(_table_sizes(quad)[1])
-    for b in prange(n_blocks):
-        work = np.empty((_W_ROWS, _W_COLS))
-        traj = np.empty((1, 4))
-        force = np.empty((1, 3))
-        for c in range(b, n_chunks, n_blocks):
-            for flat in range(c * _CHUNK, min(total, (c + 1) * _CHUNK)):
-                i, j = flat // nt, flat % nt
-                res = _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin,
-                                    theta_i[j], d[i], v_pin, max_travel, ds_max, tol, False,
-                                    max_steps, work, traj, force)
-                status[i, j] = res[0]
-                reason[i, j] = res[1]
-                theta_f[i, j] = res[2]
-                dy[i, j] = res[3]
-                travel[i, j] = res[4]
-                changes[i, j] = res[5]
-                peak[i, j] = res[6]
-    return status, reason, theta_f, dy, travel, changes, peak
+    prm = (model, r_pin, v_pin, max_travel, ds_max, tol, max_steps_for(_table_sizes(quad)[1]))
+    out = _drive(STATIC, True, nd * nt, _CHUNK, n_blocks, verts, area, a, quad, m_max, convex,
+                 np.full(1, mu_c), theta_i, d, prm, NO_DYNAMIC)
+    return _as_grid(out, nd, nt)
+
+
+@jit
+def _dyn_rollout_grid(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, fr,
+                      restitution, eps, h, max_travel, max_steps, n_blocks):
+    """Dynamic rollouts (``dynamic._dyn_rollout``) over the outer product
+    ``d x theta_i`` (radians).
+
+    ``n_blocks`` as for ``_rollout_grid``; the other arguments as for
+    ``dynamic._dyn_rollout``. Returns ``status``, ``reason`` (int8;
+    ``dynamic.DYN_REASONS``), ``theta_f``, ``dy``, ``contact_travel``,
+    ``feature_changes`` (int32), ``peak_force``, each of shape
+    ``(len(d), len(theta_i))``.
+    """
+    nd, nt = d.shape[0], theta_i.shape[0]
+    prm = (r_pin, v_pin, fr, restitution, eps, h, max_travel, max_steps)
+    out = _drive(DYNAMIC, True, nd * nt, _CHUNK, n_blocks, verts, area, a, quad, 0.0, convex,
+                 np.full(1, mu_c), theta_i, d, NO_STATIC, prm)
+    return _as_grid(out, nd, nt)

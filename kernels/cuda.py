@@ -1,9 +1,11 @@
 """GPU backend: the rollout grid on an NVIDIA GPU through numba-cuda.
 
-The CUDA kernel runs ``rollout._rollout_core`` - the same scalar code the CPU
-grid runs, compiled for the GPU (numba-cuda compiles the ``@jit`` kernels it
-calls as device functions); there is no second copy of the physics. One
-thread computes one rollout of the grid, final state only (no trajectory).
+The CUDA kernel runs ``drive._static_rollout`` - the same scalar code the CPU
+driver runs for each rollout of a grid (its cell, ``rollout._rollout_core``,
+where its results go), compiled for the GPU (numba-cuda compiles the ``@jit``
+kernels it calls as device functions); there is no second copy of the
+physics or of the driver's bookkeeping. One thread computes one rollout of
+the grid, final state only (no trajectory).
 
 Scratch: each thread holds a fixed-size local array of ``_W_ROWS x _W_COLS``
 float64 (19 x 29, 4.3 KiB) that does not depend on the polygon; the polygon, its
@@ -22,17 +24,19 @@ import math
 import numpy as np
 from numba import config, cuda, float64
 
+from .drive import _outputs
+from .drive import _static_rollout as _rollout
 from .rollout import _W_COLS, _W_ROWS
-from .rollout import _rollout_core as _core
 
 if config.ENABLE_CUDASIM:  # pragma: no cover - exercised in a subprocess by the tests
     # Under numba's CUDA simulator the kernel body runs in Python and calls
-    # the compiled CPU ``_rollout_core``, which cannot unbox the simulator's
-    # device arrays: hand it the NumPy arrays they wrap.
-    def _rollout_core(*args):
-        return _core(*[getattr(x, "_ary", x) for x in args])
+    # the compiled CPU ``_static_rollout``, which cannot unbox the simulator's
+    # device arrays: hand it the NumPy arrays they wrap (it writes its
+    # results into them).
+    def _static_rollout(*args):
+        return _rollout(*[getattr(x, "_ary", x) for x in args])
 else:
-    _rollout_core = _core
+    _static_rollout = _rollout
 
 THREADS_PER_BLOCK = 128
 
@@ -40,24 +44,16 @@ THREADS_PER_BLOCK = 128
 def _grid_kernel(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
                  max_travel, ds_max, tol, max_steps, status, reason, theta_f, dy, travel,
                  changes, peak):
-    """One rollout per thread over the flat ``d x theta_i`` grid."""
+    """One rollout per thread over the flat ``d x theta_i`` grid
+    (``drive._static_rollout``, as on the CPU; ``mu_c`` an array of one)."""
     k = cuda.grid(1)
-    nt = theta_i.shape[0]
-    if k >= d.shape[0] * nt:
+    if k >= d.shape[0] * theta_i.shape[0]:
         return
-    i = k // nt
-    j = k - i * nt
     work = cuda.local.array((_W_ROWS, _W_COLS), float64)
     rec = cuda.local.array((1, 4), float64)
-    res = _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i[j],
-                        d[i], v_pin, max_travel, ds_max, tol, False, max_steps, work, rec, rec)
-    status[i, j] = res[0]
-    reason[i, j] = res[1]
-    theta_f[i, j] = res[2]
-    dy[i, j] = res[3]
-    travel[i, j] = res[4]
-    changes[i, j] = res[5]
-    peak[i, j] = res[6]
+    _static_rollout(k, True, verts, area, a, quad, m_max, convex, mu_c, theta_i, d,
+                    (model, r_pin, v_pin, max_travel, ds_max, tol, max_steps), work, rec, rec,
+                    status, reason, theta_f, dy, travel, changes, peak)
 
 
 _kernel = cuda.jit(_grid_kernel)
@@ -66,9 +62,9 @@ def kernel_signature():
     """The Numba signature of ``_grid_kernel`` for the arrays ``rollout_grid`` passes."""
     from numba import types
     f8, i8 = types.float64, types.int64
-    return (f8[:, ::1], f8, f8, f8[:, ::1], f8, types.boolean, i8, f8, f8, f8[::1], f8[::1],
-            f8, f8, f8, f8, i8, types.int8[:, ::1], types.int8[:, ::1], f8[:, ::1],
-            f8[:, ::1], f8[:, ::1], types.int32[:, ::1], f8[:, ::1])
+    return (f8[:, ::1], f8, f8, f8[:, ::1], f8, types.boolean, i8, f8[::1], f8, f8[::1],
+            f8[::1], f8, f8, f8, f8, i8, types.int8[::1], types.int8[::1], f8[::1], f8[::1],
+            f8[::1], types.int32[::1], f8[::1])
 
 
 def available():
@@ -86,17 +82,16 @@ def rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_
     theta_i = np.ascontiguousarray(theta_i, dtype=np.float64)
     d = np.ascontiguousarray(d, dtype=np.float64)
     nd, nt = d.shape[0], theta_i.shape[0]
-    out = (np.empty((nd, nt), np.int8), np.empty((nd, nt), np.int8), np.empty((nd, nt)),
-           np.empty((nd, nt)), np.empty((nd, nt)), np.empty((nd, nt), np.int32),
-           np.empty((nd, nt)))
     total = nd * nt
+    out = _outputs(total)
     if total == 0:
-        return out
+        return tuple(x.reshape(nd, nt) for x in out)
     dev_out = [cuda.to_device(x) for x in out]
     blocks = math.ceil(total / THREADS_PER_BLOCK)
     _kernel[blocks, THREADS_PER_BLOCK](
         cuda.to_device(np.ascontiguousarray(verts)), float(area), float(a),
         cuda.to_device(np.ascontiguousarray(quad)), float(m_max), bool(convex), int(model),
-        float(mu_c), float(r_pin), cuda.to_device(theta_i), cuda.to_device(d), float(v_pin),
-        float(max_travel), float(ds_max), float(tol), int(max_steps), *dev_out)
-    return tuple(x.copy_to_host() for x in dev_out)
+        cuda.to_device(np.full(1, float(mu_c))), float(r_pin), cuda.to_device(theta_i),
+        cuda.to_device(d), float(v_pin), float(max_travel), float(ds_max), float(tol),
+        int(max_steps), *dev_out)
+    return tuple(x.copy_to_host().reshape(nd, nt) for x in dev_out)

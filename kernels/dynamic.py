@@ -81,14 +81,17 @@ contact), a second contact (notch), pin travel in contact past 50 a. A step
 budget ends a runaway passage with status truncated (reason
 ``step budget``); ``max_travel`` (belt travel since first contact) with
 status truncated.
+
+**Many passages.** The parallel grid and points kernels of this model are
+``batch._dyn_rollout_grid`` and ``points._dyn_rollout_points``; they run
+``_dyn_rollout`` through the driver loop the quasi-static kernels share
+(``drive``).
 """
 import math
 
 import numpy as np
 
-from numba import prange
-
-from ._numba import jit, jit_parallel
+from ._numba import jit
 from .geometry import _closest_feature, _other_contact_gap, _ray_first_contact
 from .support import _power, _table_sizes
 
@@ -387,83 +390,3 @@ def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, f
         status = MISS
     return (status, reason, th % two_pi, Y * a, travel * a, changes, peak,
             traj[:n_rec].copy(), force[:n_rec].copy(), twist[:n_rec].copy())
-
-
-@jit_parallel
-def _dyn_rollout_grid(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, fr,
-                      restitution, eps, h, max_travel, max_steps, n_blocks):
-    """Dynamic rollouts over the outer product ``d x theta_i`` (radians).
-
-    Contiguous blocks per thread as in ``batch._rollout_grid``; every rollout
-    is independent, so the result does not depend on the thread count.
-    Returns ``status``, ``reason`` (int8; ``DYN_REASONS``), ``theta_f``,
-    ``dy``, ``contact_travel``, ``feature_changes`` (int32), ``peak_force``,
-    each of shape ``(len(d), len(theta_i))``.
-    """
-    nd, nt = d.shape[0], theta_i.shape[0]
-    total = nd * nt
-    status = np.empty((nd, nt), dtype=np.int8)
-    reason = np.empty((nd, nt), dtype=np.int8)
-    theta_f = np.empty((nd, nt))
-    dy = np.empty((nd, nt))
-    travel = np.empty((nd, nt))
-    changes = np.empty((nd, nt), dtype=np.int32)
-    peak = np.empty((nd, nt))
-    n_blocks = max(1, min(n_blocks, total))
-    for b in prange(n_blocks):
-        start = b * total // n_blocks
-        stop = (b + 1) * total // n_blocks
-        for flat in range(start, stop):
-            i, j = flat // nt, flat % nt
-            res = _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i[j], d[i],
-                               v_pin, fr, restitution, eps, h, max_travel, max_steps, False)
-            status[i, j] = res[0]
-            reason[i, j] = res[1]
-            theta_f[i, j] = res[2]
-            dy[i, j] = res[3]
-            travel[i, j] = res[4]
-            changes[i, j] = res[5]
-            peak[i, j] = res[6]
-    return status, reason, theta_f, dy, travel, changes, peak
-
-
-@jit_parallel
-def _dyn_rollout_points(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, fr,
-                        restitution, eps, h, max_travel, max_steps, n_threads):
-    """Dynamic rollouts at scattered points ``(theta_i[k], d[k], mu_c[k])``.
-
-    The belt-speed twin of ``points._rollout_points``: the planner's
-    propagation and the verification replay at a belt speed need rollouts at
-    points that do not form a grid. Points go to threads in interleaved
-    chunks (``k, k + n_threads, ...``) so that long rollouts spread over
-    every thread; each point is independent, so the result does not depend
-    on the thread count.
-
-    Parameters
-    ----------
-    verts, area, a, quad, convex : from ``rollout._prepare``.
-    mu_c, theta_i, d : 1-D float64 arrays of equal length (theta_i in radians).
-    r_pin, v_pin, fr, restitution, eps, h, max_travel, max_steps : as for
-        :func:`_dyn_rollout`.
-    n_threads : number of interleaved chunks (use the thread count).
-
-    Returns
-    -------
-    (status, reason, theta_f, dy)
-        int8, int8 (``DYN_REASONS``), float64 (radians), float64 (part's unit).
-    """
-    n = theta_i.shape[0]
-    status = np.empty(n, dtype=np.int8)
-    reason = np.empty(n, dtype=np.int8)
-    theta_f = np.empty(n)
-    dy = np.empty(n)
-    n_threads = max(1, min(n_threads, n))
-    for t in prange(n_threads):
-        for k in range(t, n, n_threads):
-            res = _dyn_rollout(verts, area, a, quad, convex, mu_c[k], r_pin, theta_i[k], d[k],
-                               v_pin, fr, restitution, eps, h, max_travel, max_steps, False)
-            status[k] = res[0]
-            reason[k] = res[1]
-            theta_f[k] = res[2]
-            dy[k] = res[3]
-    return status, reason, theta_f, dy

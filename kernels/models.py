@@ -140,6 +140,52 @@ def _model_step(model, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2):
     return y1, y2
 
 
+@jit_inline
+def _evaluate(points, quad, area, m, vx, vy, om):
+    """P, its gradient and Hessian at the twist ``(vx, vy, om)``, laid out as
+    ``support._point_power`` returns them: over the ``m`` points of the
+    point support in ``quad`` if ``points``, else over the uniform support
+    ``(quad, area)`` (``support._power``, with no nearest point: ``jmin``
+    -1, ``rmin`` and ``umin`` inf)."""
+    if points:
+        return _point_power(quad, m, vx, vy, om, -1)
+    return _power(quad, area, vx, vy, om) + (-1, math.inf, math.inf)
+
+
+@jit_inline
+def _line_search(points, quad, area, m, x0, x1, x2, b0, b1, b2, c0, c1, c2, y1, y2, d1, d2, p,
+                 dec):
+    """Armijo backtracking from ``y`` along the Newton direction ``d`` of
+    ``_minimise`` and ``_minimise_points`` (support as for ``_evaluate``).
+
+    Returns ``(accepted, t, y1, y2, vx, vy, om, r)``: whether a step was
+    accepted, its length ``t``, the parameters and twist there and
+    ``_evaluate`` there (the last ones tried if none was accepted).
+
+    Notes
+    -----
+    From ``t = 1``, halving down to ``1e-12``, the step is accepted when
+    ``P(y + t d) <= P(y) - 1e-4 t lambda^2 + 1e-12 P(y)`` (``dec`` =
+    ``lambda^2``, the Newton decrement). The slack is above the rounding
+    noise of P (sums of closed forms with cancellation, ~1e-14 relative):
+    near the minimum the Armijo decrease is unmeasurable and must not block
+    the last Newton step.
+    """
+    t = 1.0
+    while True:
+        ty1 = y1 + t * d1
+        ty2 = y2 + t * d2
+        vx = x0 + ty1 * b0 + ty2 * c0
+        vy = x1 + ty1 * b1 + ty2 * c1
+        om = x2 + ty1 * b2 + ty2 * c2
+        r = _evaluate(points, quad, area, m, vx, vy, om)
+        if r[0] <= p - 1e-4 * t * dec + 1e-12 * p:
+            return True, t, ty1, ty2, vx, vy, om, r
+        t *= 0.5
+        if not t > 1e-12:
+            return False, t, ty1, ty2, vx, vy, om, r
+
+
 @jit
 def _minimise(quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
     """Minimise ``P(x + y1 b + y2 c)`` over ``y`` (``k`` = 1 or 2 unknowns).
@@ -165,9 +211,9 @@ def _minimise(quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
     -----
     P is convex and positively homogeneous in the twist, and strictly convex
     on these affine families, which do not contain the origin. Newton's
-    method with an Armijo backtracking line search converges from any start;
-    warm-started from the previous integration stages it needs one to three
-    iterations. The stopping test is the Newton decrement ``lambda^2 = -g . d``:
+    method with an Armijo backtracking line search (``_line_search``)
+    converges from any start; warm-started from the previous integration
+    stages it needs one to three iterations. The stopping test is the Newton decrement ``lambda^2 = -g . d``:
     at rounding level, or below ``take * P``, when the relative error of
     the iterate is about ``sqrt(lambda^2 / P)`` (1e-6 for ``_DEC_TAKE``) and
     one more full step, taken without a confirming evaluation, brings it to
@@ -202,27 +248,14 @@ def _minimise(quad, area, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
             g2 += h02 * s0 + h12 * s1 + h22 * s2
             converged = True
             break
-        t = 1.0
-        accepted = False
-        while t > 1e-12:
-            ty1 = y1 + t * d1
-            ty2 = y2 + t * d2
-            vx = x0 + ty1 * b0 + ty2 * c0
-            vy = x1 + ty1 * b1 + ty2 * c1
-            om = x2 + ty1 * b2 + ty2 * c2
-            res = _power(quad, area, vx, vy, om)
-            # The slack is above the rounding noise of P (sums of closed forms
-            # with cancellation, ~1e-14 relative): near the minimum the Armijo
-            # decrease is unmeasurable and must not block the last Newton step.
-            if res[0] <= p - 1e-4 * t * dec + 1e-12 * p:
-                accepted = True
-                break
-            t *= 0.5
+        accepted, t, y1n, y2n, _, _, _, r = _line_search(False, quad, area, 0, x0, x1, x2, b0,
+                                                         b1, b2, c0, c1, c2, y1, y2, d1, d2, p,
+                                                         dec)
         if not accepted:
             converged = dec <= 1e-20 * (p + 1e-300)
             break
-        y1, y2 = ty1, ty2
-        p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = res
+        y1, y2 = y1n, y2n
+        p, g0, g1, g2, h00, h01, h02, h11, h12, h22 = r[:10]
         if t * (abs(d1) + abs(d2)) <= 1e-15 * (1.0 + abs(y1) + abs(y2)):
             converged = True
             break
@@ -359,17 +392,17 @@ def _minimise_points(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
     the family that turns about that point (``_kink``). Its minimiser is
     either a kink at which 0 lies in the subdifferential, or a smooth point
     with zero gradient. The solve is damped Newton with an Armijo line search
-    (as ``_minimise``) on the smooth part, and at every iterate it checks
-    the kink of the point nearest to turning (smallest ``|u_j| / w_j``), once
-    per point and solve, when the iterate is near it (``_KINK_TEST``):
-    Newton iterates that head for a kink make that point the nearest, and
-    the check then returns the kink exactly (the centre of rotation on the
-    point to rounding). An iterate stuck at the apex of a kink that is not
-    optimal leaves it along its steepest way out (``_KINK_NEAR``). A smooth
-    minimum ends on the Newton decrement, as in ``_minimise``: the last step,
-    once the decrement is below ``take * P``, is taken unchecked when no
-    point's slip can reach zero within it, else checked by an evaluation. If
-    Newton stalls, every kink is checked.
+    (``_line_search``, as ``_minimise``) on the smooth part, and at every
+    iterate it checks the kink of the point nearest to turning (smallest
+    ``|u_j| / w_j``), once per point and solve, when the iterate is near it
+    (``_KINK_TEST``): Newton iterates that head for a kink make that point
+    the nearest, and the check then returns the kink exactly (the centre of
+    rotation on the point to rounding). An iterate stuck at the apex of a
+    kink that is not optimal leaves it along its steepest way out
+    (``_KINK_NEAR``). A smooth minimum ends on the Newton decrement, as in
+    ``_minimise``: the last step, once the decrement is below ``take * P``,
+    is taken unchecked when no point's slip can reach zero within it, else
+    checked by an evaluation. If Newton stalls, every kink is checked.
     The family's parameters are exact at a kink; no smoothing of ``|u|`` is
     used anywhere.
     """
@@ -435,23 +468,13 @@ def _minimise_points(quad, x0, x1, x2, b0, b1, b2, c0, c1, c2, k, y1, y2, take):
             g2 += h02 * s0 + h12 * s1 + h22 * s2
             converged = True
             break
-        t = 1.0
-        accepted = False
-        while t > 1e-12:
-            ty1 = y1 + t * d1
-            ty2 = y2 + t * d2
-            vx = x0 + ty1 * b0 + ty2 * c0
-            vy = x1 + ty1 * b1 + ty2 * c1
-            om = x2 + ty1 * b2 + ty2 * c2
-            res = _point_power(quad, m, vx, vy, om, -1)
-            if res[0] <= p - 1e-4 * t * dec + 1e-12 * p:
-                accepted = True
-                break
-            t *= 0.5
+        accepted, t, y1n, y2n, vx, vy, om, res = _line_search(True, quad, 1.0, m, x0, x1, x2,
+                                                              b0, b1, b2, c0, c1, c2, y1, y2,
+                                                              d1, d2, p, dec)
         if not accepted:
             converged = dec <= 1e-20 * (p + 1e-300)
             break
-        y1, y2, r = ty1, ty2, res
+        y1, y2, r = y1n, y2n, res
         p, g0, g1, g2 = r[0], r[1], r[2], r[3]
         h00, h01, h02, h11, h12, h22 = r[4], r[5], r[6], r[7], r[8], r[9]
         jmin = r[10]

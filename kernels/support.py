@@ -33,14 +33,14 @@ smooth there.
 
 A point support replaces the area integral by a weighted sum over
 K points, ``P = sum_k w_k |u(p_k)|``: ``_point_power`` at the end of this
-module (the same sums as the quadrature branch, with the kinks of P at the
-points left to ``models._minimise_points``).
+module (the quadrature branch's sums, one loop for both: ``_point_sums``;
+the kinks of P at the points are left to ``models._minimise_points``).
 """
 import math
 
 import numpy as np
 
-from ._numba import jit
+from ._numba import jit, jit_inline
 
 # Centre-of-rotation distance (in units of a) beyond which the power uses the
 # smooth quadrature instead of the closed forms (see module notes).
@@ -258,31 +258,11 @@ def _power(quad, area, vx, vy, om):
         npy = nxy * px + nyy * py
         return (p_val, g0, g1, g2, k * nxx, k * nxy, k * npx, k * nyy, k * npy,
                 k * (px * npx + py * npy))
-    p_val = g0 = g1 = g2 = 0.0
-    h00 = h01 = h02 = h11 = h12 = h22 = 0.0
-    for i in range(_table_sizes(quad)[0]):  # the quadrature rows
-        wx, wy, wt = quad[i, 0], quad[i, 1], quad[i, 2]
-        ux = vx - om * wy
-        uy = vy + om * wx
-        nu = math.sqrt(ux * ux + uy * uy)
-        p_val += wt * nu
-        hx, hy = ux / nu, uy / nu
-        g0 += wt * hx
-        g1 += wt * hy
-        g2 += wt * (wx * hy - wy * hx)
-        # (I - u u^T)/|u| = p p^T/|u| with p the unit perpendicular.
-        ax, ay = -hy, hx
-        aw = wx * ay - wy * ax
-        c = wt / nu
-        h00 += c * ax * ax
-        h01 += c * ax * ay
-        h02 += c * ax * aw
-        h11 += c * ay * ay
-        h12 += c * ay * aw
-        h22 += c * aw * aw
+    # The quadrature rows as weighted points (no point skipped: a tiny of -1).
+    r = _point_sums(quad, _table_sizes(quad)[0], vx, vy, om, -1, -1.0)
     f = 1.0 / area
-    return (f * p_val, f * g0, f * g1, f * g2, f * h00, f * h01, f * h02, f * h11,
-            f * h12, f * h22)
+    return (f * r[0], f * r[1], f * r[2], f * r[3], f * r[4], f * r[5], f * r[6], f * r[7],
+            f * r[8], f * r[9])
 
 
 @jit
@@ -325,16 +305,36 @@ def _point_power(pts, m, vx, vy, om, skip):
         grad P = sum_j w_j J_j^T u_j / |u_j|,     J_j = [[1, 0, -y_j], [0, 1, x_j]]
         Hess P = sum_j (w_j / |u_j|) a_j a_j^T,   a_j = J_j^T (z x u_j / |u_j|)
 
-    (the same sums as ``_power``'s quadrature branch, with the points as the
-    rule). A point with ``u_j = 0`` (the centre of rotation on it) is a kink
-    of P: it adds nothing to P, and the zero vector of its subdifferential
-    ``w_j J_j^T B`` (B the unit disc) to the gradient; it is left out of the
-    Hessian, where its term is unbounded. ``models._minimise_points`` picks
-    the element of B that the optimality condition needs.
+    (the sums of ``_power``'s quadrature branch, with the points as the
+    rule: both are ``_point_sums``). A point with ``u_j = 0`` (the centre of
+    rotation on it) is a kink of P: it adds nothing to P, and the zero
+    vector of its subdifferential ``w_j J_j^T B`` (B the unit disc) to the
+    gradient; it is left out of the Hessian, where its term is unbounded.
+    ``models._minimise_points`` picks the element of B that the optimality
+    condition needs.
+    """
+    return _point_sums(pts, m, vx, vy, om, skip, 1e-15 * (abs(vx) + abs(vy) + abs(om)))
+
+
+@jit_inline
+def _point_sums(pts, m, vx, vy, om, skip, tiny):
+    """The sums of ``_point_power`` over the first ``m`` rows ``(x, y, w)`` of
+    ``pts``, leaving out point ``skip`` and the points whose slip speed is at
+    most ``tiny`` (none for a negative ``tiny``); the one loop that
+    accumulates P, its gradient and Hessian, for a point support and for
+    ``_power``'s quadrature rule (signed weights, not normalised; the
+    caller divides by the area).
+
+    Returns ``_point_power``'s 13 values.
+
+    Notes
+    -----
+    Per point, ``h = u / |u|`` and the unit perpendicular ``p = z x h``:
+    ``(I - h h^T) / |u| = p p^T / |u|``, so the Hessian term is
+    ``(w / |u|) a a^T`` with ``a = J^T p`` (``_point_power``'s notes).
     """
     p_val = g0 = g1 = g2 = 0.0
     h00 = h01 = h02 = h11 = h12 = h22 = 0.0
-    tiny = 1e-15 * (abs(vx) + abs(vy) + abs(om))
     jmin = -1
     rmin = math.inf
     umin = math.inf

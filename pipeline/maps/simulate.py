@@ -379,13 +379,14 @@ def _check_map_inputs(part, mu_c, pin_radius, model, v_pin, max_travel, ds_max, 
 
 def _dynamic_grid(part, mu_c, pin_radius, th, dd, v_pin, fr, belt_speed, cap, threads):
     """The dynamic model's grid kernel over ``d x theta_i`` (``th`` in degrees)."""
-    from kernels.dynamic import DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG, _dyn_rollout_grid
+    from kernels.batch import _dyn_rollout_grid
+    from kernels.dynamic import DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG
     verts, area, a, quad, _, convex = part.prepared()
     with _threads(threads) as n:
         return _dyn_rollout_grid(
             verts, area, a, quad, convex, float(mu_c), float(pin_radius), np.radians(th), dd,
             float(v_pin), fr, 0.0, DEFAULT_V_REG / float(belt_speed), DEFAULT_H, cap,
-            DEFAULT_MAX_STEPS, n)
+            DEFAULT_MAX_STEPS, blocks_for(n, th.size * dd.size))
 
 
 def _dynamic_jam_attrs() -> dict:
@@ -459,8 +460,8 @@ def rollout_points(part: Part, theta_i, d, mu_c, pin_radius: float, model: str =
     mu, th, dd = np.ascontiguousarray(mu), np.radians(th), np.ascontiguousarray(dd)
     with _threads(threads) as n:
         if dynamic:
-            from kernels.dynamic import (DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG,
-                                         _dyn_rollout_points)
+            from kernels.dynamic import DEFAULT_H, DEFAULT_MAX_STEPS, DEFAULT_V_REG
+            from kernels.points import _dyn_rollout_points
             verts, area, a, quad, _, convex = part.prepared()
 
             def kernel(rows):

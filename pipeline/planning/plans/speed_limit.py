@@ -77,7 +77,7 @@ def success_fraction(part: Part, pin_heights, pin_speed_ratios, draws, final_arc
 
     Every trial of every initial state is rolled past pin 1, then the
     survivors past pin 2, and so on, one parallel batch per pin
-    (``kernels.dynamic._dyn_rollout_points`` through
+    (``kernels.points._dyn_rollout_points`` through
     :func:`pipeline.maps.simulate.rollout_points`); a jammed or truncated passage
     fails the trial, a miss leaves the part as it was. ``stretch`` is told
     how far the trials have got, each pin an equal share.
