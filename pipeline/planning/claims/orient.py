@@ -26,7 +26,6 @@ import math
 import numpy as np
 
 from pipeline.config import schema_default
-from pipeline.errors import PinfeedError
 from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE, share_lower_bound, width_interval
 from pipeline.planning.core.settings import (RULES, check_confidence, check_required,  # noqa: F401 (re-exported)
                                              check_rule, check_tolerance)
