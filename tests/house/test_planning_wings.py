@@ -92,3 +92,30 @@ def test_the_check_would_fail(tmp_path):
     probe.write_text("from pipeline.planning.tight.propagate import propagate\n")
     with pytest.raises(AssertionError, match="front door"):
         test_outside_code_uses_the_front_door(probe)
+
+
+def config_parameters(path: Path) -> list[str]:
+    """Functions of ``path`` with a parameter named ``config`` (a loose config dict)."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            args = node.args.posonlyargs + node.args.args + node.args.kwonlyargs
+            if any(a.arg == "config" for a in args):
+                found.append(f"line {node.lineno}: {node.name}")
+    return found
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if wing(m) in WINGS))
+def test_planning_takes_settings_not_the_config_dict(module):
+    # The config dict is read once, by PlannerSettings.from_config; everything
+    # else in planning takes the typed settings or their parts.
+    found = config_parameters(MODULES[module])
+    if module == "pipeline.planning.core.settings":
+        found = [f for f in found if not f.endswith(": from_config")]
+    assert not found, f"{module} takes a config dict: {found}; take PlannerSettings or a part of it"
+
+
+def test_the_config_check_would_fail(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text("def plan(part, config):\n    return config['planner']\n")
+    assert config_parameters(probe) == ["line 1: plan"]
