@@ -3,7 +3,7 @@
 The replay checks below rebuild the world-frame motion of two consecutive
 parts past two consecutive pins from the public rollout API, with their own
 first-touch search and their own polygon/disc intersection tests (a simple
-reference, independent of ``pipeline.present.layout``'s slab and reach geometry).
+reference, independent of ``pipeline.planning.feeder.layout``'s slab and reach geometry).
 """
 import json
 import math
@@ -17,7 +17,7 @@ from pipeline.config import load_config
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.present.layout import check_layout_settings, layout_stored
+from pipeline.planning import check_layout_settings, layout_stored
 
 TRIANGLE = "0,0 60,0 15,35"
 SPEED = 100.0
