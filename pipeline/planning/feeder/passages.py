@@ -201,7 +201,7 @@ class StationScene:
 def station_scene(part, layout: dict, states: dict, mu_c, n_parts: int | None = None) -> StationScene:
     """Replay one nominal passage per initial state with the layout's model (the
     dynamic model at its belt speed and ``mu_s`` when the layout used it, else
-    its quasi-static model: ``lanes.run_trials(nominal=True)``, the kernels'
+    its quasi-static model: :func:`~pipeline.planning.feeder.lanes.run_trials` with ``nominal``, the kernels'
     trajectories) past the layout's stations, and set up the stream of parts.
 
     ``layout``: the JSON of ``pinfeed layout`` (``stations``, ``pitch_mm``,
