@@ -128,7 +128,8 @@ def run_part(name: str, work: Path) -> None:
 
     from pipeline.config import load_config
     from pipeline.maps.io import write_json
-    from pipeline.present.animate import station_figure, station_scene, station_title
+    from pipeline.planning import station_scene
+    from pipeline.present.animate import station_figure, station_title
     from pipeline.present.figures.feeder import feeder_figure
     from pipeline.workflow.commands import named_part, plan_command, planner_settings
     from pipeline.workflow.layout import layout

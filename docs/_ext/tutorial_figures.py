@@ -146,7 +146,8 @@ def layout_drawing(source: str):
 def layout_frame(source: str, at: float = 0.55):
     """A still of the stored layout's animation (``pinfeed animate --layout``),
     at ``at`` of the belt travel it shows: parts before, at and after the pins."""
-    from pipeline.present.animate import station_figure, station_scene, station_title
+    from pipeline.planning import station_scene
+    from pipeline.present.animate import station_figure, station_title
     part = tutorial_part(source)
     layout = stored_layout(part.name)
     scene = station_scene(part, layout, _resting_states(part), layout["mu_c"])

@@ -15,13 +15,15 @@ import os
 import matplotlib.pyplot as plt
 
 from pipeline.parts.part import Part
-from pipeline.present.coarse_plans import best_coarse_plan_figure
+from pipeline.planning import best_coarse_plan, coarse_plan_paths
+from pipeline.present.coarse_plans import coarse_plan_figure
 
 # A coarser grid (e.g. PINFEED_EXAMPLE_THETA_STEP=6) runs faster; the tests use it.
 THETA_STEP = float(os.environ.get("PINFEED_EXAMPLE_THETA_STEP", "2"))
 
 part = Part.from_vertices([(0, 0), (60, 0), (15, 35)], name="asym_triangle")
-fig, plan = best_coarse_plan_figure(part, theta_step=THETA_STEP)
+planner, pins, plan = best_coarse_plan(part, theta_step=THETA_STEP)
+fig = coarse_plan_figure(part, plan, pins, coarse_plan_paths(part, planner, pins, plan), THETA_STEP)
 sets = ", ".join(f"{s['start']:.1f} deg + {s['width']:.1f}" for s in plan["final_sets"])
 print("pins", " -> ".join(plan["pins"]), "| final sets (start + width):", sets)
 plt.show()

@@ -15,8 +15,7 @@ import os
 import matplotlib.pyplot as plt
 
 from pipeline.parts.part import Part
-from pipeline.planning import verify_plan
-from pipeline.present.coarse_plans import MU_C, PIN_RADIUS, best_coarse_plan
+from pipeline.planning import COARSE_MU_C as MU_C, COARSE_PIN_RADIUS as PIN_RADIUS, best_coarse_plan, verify_plan
 from pipeline.present.figures.tables import FAIL_COLOUR, HEADER, verification_rows
 
 # A coarser grid (e.g. PINFEED_EXAMPLE_THETA_STEP=6) runs faster; the tests use it.

@@ -39,7 +39,8 @@ def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.checks import check_out_path
     from pipeline.config import load_config
-    from pipeline.present.layout import check_drawing_path, layout_stored, write_drawing
+    from pipeline.planning import PlannerSettings, layout_stored
+    from pipeline.present.layout import check_drawing_path, write_drawing
     from pipeline.workflow.commands import layout_settings, stored_plan
     config = load_config(args.config)
     as_json = args.out is not None and Path(args.out).suffix.lower() == ".json"
@@ -47,8 +48,9 @@ def cmd_layout(args):
         check_out_path(args.out, (".json",)) if as_json else check_drawing_path(args.out)
     settings = layout_settings(args.margin, args.trials)
     result, _ = stored_plan(config, results_arg(args, config), args.part, args.config)
-    out = layout_stored(result, config, args.plan, args.mu_c, belt_speed=args.belt_speed,
-                        mu_s=args.mu_s, quasi_static=args.quasi_static, settings=settings)
+    out = layout_stored(result, PlannerSettings.from_config(config), args.plan, args.mu_c,
+                        belt_speed=args.belt_speed, mu_s=args.mu_s, quasi_static=args.quasi_static,
+                        settings={**config.get("layout", {}), **settings})
     for warning in out["warnings"]:
         print(f"pinfeed: warning: {warning}", file=sys.stderr)
     if as_json:
@@ -87,8 +89,7 @@ def _print_layout(out: dict):
 def cmd_animate(args):
     """Animate a stored plan: every initial state past the pins on the moving belt."""
     from pipeline.config import load_config
-    from pipeline.present.animate import animate_stored
-    from pipeline.workflow.commands import animation_inputs, stored_plan
+    from pipeline.workflow.commands import animate_stored, animation_inputs, stored_plan
     config = load_config(args.config)
     result, path = stored_plan(config, results_arg(args, config), args.part, args.config)
     stored_layout = path.parent.parent / f"layout_{args.part}.json"

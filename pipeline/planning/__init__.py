@@ -1,6 +1,6 @@
 """Planning: which pins, in which order, orient a part - and how sure we are.
 
-The package is five wings behind this front door; code outside planning
+The package is seven wings behind this front door; code outside planning
 imports only the names in :data:`__all__` from here (``tests/house`` checks
 it), so a wing can change inside without touching its callers.
 
@@ -20,15 +20,22 @@ it), so a wing can change inside without touching its callers.
 ``plans``
     the front of the planner: plan, verify and recommend a part at each
     friction; speed limits; support studies.
+``feeder``
+    what a feeder's drawings need from the physics: trials past the pins on
+    the belt's clock (lanes), the layout (stations, pitch, belt width,
+    throughput) of a stored plan, the passages an animation draws, the
+    set-up of one pin contact. ``pipeline.present`` draws these and replays
+    nothing itself (``tests/house/test_present_draws.py``).
 
-Wings import downwards only (core < claims < tight < family < plans; paper
-uses the core alone). The package imports maps, parts, ``config`` and the
+Wings import downwards only (core < claims < tight < family < plans <
+feeder; paper uses the core alone). The package imports maps, parts, ``config`` and the
 utilities; never sensing, present or workflow.
 """
 from pipeline.planning.claims.orient import check_tolerance, describe_claim, min_trials, narrowest_arc
 from pipeline.planning.claims.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.claims.verify import (PERTURB_DEFAULTS, corner_inputs, perturbed_batch,
-                                             perturbed_inputs, predicted_sets, replay, verify_plan)
+                                             perturbed_inputs, predicted_sets, replay, replayed_paths,
+                                             verify_plan)
 from pipeline.planning.core.arcs import arc_within, format_arcs, merge_arcs, merge_modulo
 from pipeline.planning.core.settings import (BandSettings, ClaimSettings, Friction, Perturbation,
                                              PlannerSettings, SearchSettings, SpeedSettings, VerifySettings,
@@ -37,7 +44,16 @@ from pipeline.planning.core.settings import (BandSettings, ClaimSettings, Fricti
 from pipeline.planning.core.types import PlanFile, as_plan_file, load_plan, validate_plan_file
 from pipeline.planning.family.certificate import family_assumption, family_certificate_line
 from pipeline.planning.family.members import check_family_mechanics
+from pipeline.planning.feeder.contact import mechanics_scene
+from pipeline.planning.feeder.lanes import Lane, Trial, pin_height, pin_reach, run_trials, trial_lanes
+from pipeline.planning.feeder.layout import LAYOUT_DEFAULTS, check_layout_settings, layout_plan
+from pipeline.planning.feeder.passages import (StationScene, layout_inputs, plan_inputs, recommended_index,
+                                               roll_plan, station_scene)
+from pipeline.planning.feeder.stored import final_sets_warning, layout_stored
 from pipeline.planning.paper.bands import extract_bands
+from pipeline.planning.paper.coarse import MU_C as COARSE_MU_C
+from pipeline.planning.paper.coarse import PIN_RADIUS as COARSE_PIN_RADIUS
+from pipeline.planning.paper.coarse import best_coarse_plan, coarse_plan_paths
 from pipeline.planning.paper.planner import Planner, build_planner, load_maps, paper_depth
 from pipeline.planning.plans.plan import (best_fixed_plan, mechanics_label, pick_tight_plan, plan_hint,
                                           plan_tight_all, planner_belt, tight_entry)
@@ -56,12 +72,13 @@ __all__ = [
     "candidate_pins", "fitted_pins", "friction_label", "nominal_friction", "parse_friction",
     # claims
     "VERIFY_DEFAULTS", "PERTURB_DEFAULTS", "corner_inputs", "perturbed_batch", "perturbed_inputs",
-    "predicted_sets", "replay", "verify_plan",
+    "predicted_sets", "replay", "replayed_paths", "verify_plan",
     "check_tolerance", "describe_claim", "min_trials", "narrowest_arc",
     # tight
     "margin_text",
     # paper
     "extract_bands", "Planner", "build_planner", "load_maps", "paper_depth",
+    "COARSE_MU_C", "COARSE_PIN_RADIUS", "best_coarse_plan", "coarse_plan_paths",
     # family
     "check_family_mechanics", "family_assumption", "family_certificate_line",
     # plans
@@ -70,4 +87,9 @@ __all__ = [
     "DEFAULT_SPEEDS", "attach_speed_limits", "perturbation_from_verify", "speed_curve",
     "speed_label", "stored_plan_speed", "stored_speed_limit",
     "support_study",
+    # feeder
+    "Lane", "Trial", "pin_height", "pin_reach", "run_trials", "trial_lanes",
+    "LAYOUT_DEFAULTS", "check_layout_settings", "layout_plan", "final_sets_warning", "layout_stored",
+    "StationScene", "layout_inputs", "plan_inputs", "recommended_index", "roll_plan", "station_scene",
+    "mechanics_scene",
 ]

@@ -1,41 +1,22 @@
-"""Coarse plans for the gallery: a part's maps on a coarse grid, the paper's
-fixed-pins planner on them, and the nominal path of every resting state
-through the best plan, drawn as the paper's pin-sequence figure.
+"""Coarse plans for the gallery, drawn: the paper's pin-sequence figure of the
+best plan on coarse maps, one row per resting state.
 
-The gallery's pin-sequence examples (Fig. 2, Fig. 9, Table 2) call these, so
-a downloaded example needs only the installed package. ``make run`` plans on
-the full grid with the complete search instead.
+The plan and its nominal paths come from the planner
+(:func:`pipeline.planning.best_coarse_plan`,
+:func:`pipeline.planning.coarse_plan_paths`); the gallery's pin-sequence
+examples (Fig. 2, Fig. 9) call those and draw the result here, so a
+downloaded example needs only the installed package.
 """
 from __future__ import annotations
 
-import numpy as np
-
-from pipeline.maps import simulate
-from pipeline.planning import Planner, load_maps
-from pipeline.planning import candidate_pins
+from pipeline.planning import COARSE_MU_C, COARSE_PIN_RADIUS
 from pipeline.present.figures.sequence import sequence_figure
 
-MU_C, PIN_RADIUS, THRESHOLD_T, FACTOR_C = 0.15, 3.0, 5.0, 2.0
-D_VALUES = [float(d) for d in np.round(np.arange(-0.9, 0.91, 0.1), 1) if d != 0]
 
-
-def best_coarse_plan(part, depth: int = 3, theta_step: float = 2.0):
-    """The paper planner's best fixed-pin plan of ``part`` on maps with
-    ``theta_step``-degree steps of theta_i (friction ``MU_C``, pin radius
-    ``PIN_RADIUS``): returns ``(planner, candidate pins, plan dict)``."""
-    maps = simulate.compute_map(part, theta_i=np.arange(0, 360, theta_step), d=D_VALUES,
-                                mu_c=MU_C, pin_radius=PIN_RADIUS)
-    pins = candidate_pins(part, {"pins": "auto"})
-    planner = Planner(part, load_maps(maps, THRESHOLD_T, FACTOR_C), pins, d_min=0.1, d_max=0.9)
-    return planner, pins, planner.search(depth, keep=1)[0].to_dict()
-
-
-def best_coarse_plan_figure(part, depth: int = 3, theta_step: float = 2.0):
-    """:func:`best_coarse_plan` drawn as the paper's pin-sequence figure, one
-    row per resting state; returns ``(figure, plan dict)``."""
-    planner, pins, plan = best_coarse_plan(part, depth, theta_step)
-    heights = [pins[pin] for pin in plan["pins"]]
-    paths = {label: simulate.nominal_path(part, state.arc[0], state.y_lo, heights, MU_C, PIN_RADIUS)
-             for label, state in planner.initial_states().items()}
-    title = f"{part.name}: best fixed-pin plan on a {theta_step:g}-degree grid, mu_c {MU_C:g}"
-    return sequence_figure(part, plan, pins, paths, PIN_RADIUS, title), plan
+def coarse_plan_figure(part, plan: dict, pins: dict, paths: dict, theta_step: float = 2.0):
+    """The coarse ``plan`` (:func:`pipeline.planning.best_coarse_plan`, on maps
+    with ``theta_step``-degree steps) drawn as the paper's pin-sequence figure,
+    one row per resting state: ``pins`` (label -> height, mm) and ``paths``
+    (:func:`pipeline.planning.coarse_plan_paths`). Returns the figure."""
+    title = f"{part.name}: best fixed-pin plan on a {theta_step:g}-degree grid, mu_c {COARSE_MU_C:g}"
+    return sequence_figure(part, plan, pins, paths, COARSE_PIN_RADIUS, title)

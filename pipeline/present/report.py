@@ -14,7 +14,7 @@ from pathlib import Path
 from pipeline import __version__
 from pipeline.config import config_hash
 from pipeline.maps.io import write_text_atomic
-from pipeline.planning import format_arcs
+from pipeline.planning import PlannerSettings, format_arcs
 from pipeline.present.atlas_section import atlas_section
 from pipeline.present.figures.tables import HEADER, verification_rows
 from pipeline.present.layout import speed_limit_text
@@ -247,7 +247,7 @@ def _animation(res: dict, files: dict, base, config: dict, layout: dict | None) 
     from pipeline.present.animate import animation_subject
     if "animation" not in files:
         return ["<p>No animation.</p>"]
-    what = animation_subject(res, config, layout)
+    what = animation_subject(res, PlannerSettings.from_config(config), layout)
     src = _rel(files["animation"], base)
     return [f"<p class=\"caption\">Every initial state past the pins of {html.escape(what)}; "
             f"'pinfeed animate --part {html.escape(res['part']['name'])}' makes a smoother one.</p>",

@@ -307,9 +307,9 @@ def animation_inputs(result: dict, config: dict, part_name: str, plan, layout, s
     from pathlib import Path
 
     from pipeline.maps.io import read_json
-    from pipeline.present.animate import layout_inputs, plan_inputs
+    from pipeline.planning import layout_inputs, plan_inputs
     if layout is None:
-        return plan_inputs(result, plan, config), None
+        return plan_inputs(result, plan, PlannerSettings.from_config(config)), None
     if plan is not None:
         raise PinfeedError("--layout animates the layout's own plan; leave out --plan")
     layout_path = stored_layout if layout == "auto" else Path(layout)
@@ -317,6 +317,38 @@ def animation_inputs(result: dict, config: dict, part_name: str, plan, layout, s
         raise PinfeedError(f"no layout at {layout_path}; {layout_hint(result, part_name, layout_path, hint_opts)}")
     stored = read_json(layout_path)
     return layout_inputs(result, stored), stored
+
+
+def animate_stored(result, config: dict, out, plan_index=None, frames: int = 120,
+                   fps: int = 20, layout: dict | None = None) -> dict:
+    """Animate a plan of a stored plan result (``plan_index`` as in
+    :func:`pipeline.planning.plan_inputs`; what ``pinfeed animate`` and the
+    workflow's animate rule call): the passages rolled by the planner
+    (:func:`pipeline.planning.roll_plan`), drawn by
+    :func:`pipeline.present.animate.animate_plan`. Returns its summary plus the inputs.
+
+    With ``layout`` (``pinfeed layout``'s JSON for this part) the layout's own
+    plan is animated on one belt instead (:func:`pipeline.planning.station_scene`,
+    :func:`pipeline.present.animate.animate_layout`): pins at the stations, parts
+    arriving at the layout's pitch; ``plan_index`` is then not used."""
+    from pipeline.planning import as_plan_file, layout_inputs, plan_inputs, roll_plan, station_scene
+    from pipeline.present.animate import animate_layout, animate_plan, check_animation_out
+    check_animation_out(out, frames, fps)  # before any rollout
+    result = as_plan_file(result)
+    part = Part.from_dict(result.part, name=result.name)
+    if layout is not None:
+        inputs = layout_inputs(result, layout)
+        scene = station_scene(part, layout, inputs["states"], inputs["mu_c"])
+        done = animate_layout(scene, out, frames=frames, fps=fps,
+                              what=f"{inputs['what']}, pins {' → '.join(inputs['labels'])}")
+        return {**done, **inputs}
+    inputs = plan_inputs(result, plan_index, PlannerSettings.from_config(config))
+    lanes, stations, b_end = roll_plan(part, inputs["heights"], inputs["speeds"], inputs["states"],
+                                       inputs["mu_c"], inputs["model"], inputs["pin_radius"])
+    done = animate_plan(part, lanes, stations, b_end, inputs["heights"], inputs["speeds"],
+                        inputs["pin_radius"], out, labels=inputs["labels"], frames=frames, fps=fps,
+                        title=f"{part.name}: {inputs['what']}, pins {' → '.join(inputs['labels'])}")
+    return {**done, **inputs}
 
 
 def layout_hint(result, part_name: str, layout_path, hint_opts=None) -> str:

@@ -12,15 +12,15 @@ from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_source
 from pipeline.parts.part import Part
 from pipeline.planning import Friction
-from pipeline.planning import PlanFile, validate_plan_file
-from pipeline.present.animate import animate_stored, recommended_index
+from pipeline.planning import PlanFile, recommended_index, replayed_paths, validate_plan_file
 from pipeline.present.figures import placeholder, placeholder_gif
 from pipeline.present.figures.bands import plot_band_maps
-from pipeline.present.figures.carried import plot_carried, replayed_paths
+from pipeline.present.figures.carried import plot_carried
 from pipeline.present.figures.outline import plot_outline
 from pipeline.present.figures.sequence import plot_sequence
 from pipeline.present.figures.tables import markdown_table, plot_table, plot_verification, verification_rows
 from pipeline.present.report import write_report
+from pipeline.workflow.commands import animate_stored
 from pipeline.workflow.plan import plans_to_check
 
 

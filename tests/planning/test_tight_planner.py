@@ -232,6 +232,6 @@ def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys, monkeypa
     assert main(["speed", "--part", "tri", "--results", str(tmp_path / "res"), "--mu-c", "0.2"]) == 2
     # A tight-only plan file animates too (its resting states live in the friction entry).
     from pipeline.config import load_config
-    from pipeline.present.animate import plan_inputs
-    inputs = plan_inputs(json.loads(stored.read_text()), None, load_config(None))
+    from pipeline.planning import PlannerSettings, plan_inputs
+    inputs = plan_inputs(json.loads(stored.read_text()), None, PlannerSettings.from_config(load_config(None)))
     assert inputs["labels"] == out["plans"][0]["pins"] and len(inputs["states"]) == 3

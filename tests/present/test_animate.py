@@ -6,8 +6,9 @@ import pytest
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
-from pipeline.present.animate import animate_plan, plan_inputs, roll_plan
-from pipeline.present.lanes import gap as point_gap, rotated
+from pipeline.planning import plan_inputs, roll_plan
+from pipeline.planning.feeder.lanes import gap as point_gap, rotated
+from pipeline.present.animate import animate_plan
 
 PART = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 STATES = {f"state {k}": (float(th), float(y)) for k, (th, y) in enumerate(PART.stable_states(), 1)}
@@ -38,7 +39,8 @@ def test_lanes_follow_the_kernel_and_touch_the_pins():
 def test_gif_has_the_frames_asked_for(tmp_path):
     from PIL import Image
     out = tmp_path / "plan.gif"
-    res = animate_plan(PART, [10.0], [0.0], STATES, 0.15, "minpower", 3.0, out, frames=4, fps=5)
+    lanes, stations, b_end = roll_plan(PART, [10.0], [0.0], STATES, 0.15, "minpower", 3.0)
+    res = animate_plan(PART, lanes, stations, b_end, [10.0], [0.0], 3.0, out, frames=4, fps=5)
     assert res["frames"] == 4
     with Image.open(out) as im:
         assert im.format == "GIF" and im.n_frames == 4
@@ -46,11 +48,16 @@ def test_gif_has_the_frames_asked_for(tmp_path):
 
 def test_mp4_without_ffmpeg_and_bad_outputs(tmp_path):
     from matplotlib import animation
+
+    from pipeline.workflow.commands import animate_stored
+    lanes, stations, b_end = roll_plan(PART, [10.0], [0.0], STATES, 0.15, "minpower", 3.0)
     if not animation.writers.is_available("ffmpeg"):
         with pytest.raises(PinfeedError, match="MP4 needs ffmpeg"):
-            animate_plan(PART, [10.0], [0.0], STATES, 0.15, "minpower", 3.0, tmp_path / "p.mp4")
+            animate_plan(PART, lanes, stations, b_end, [10.0], [0.0], 3.0, tmp_path / "p.mp4")
     with pytest.raises(PinfeedError, match="gif or an .mp4"):
-        animate_plan(PART, [10.0], [0.0], STATES, 0.15, "minpower", 3.0, tmp_path / "p.avi")
+        animate_plan(PART, lanes, stations, b_end, [10.0], [0.0], 3.0, tmp_path / "p.avi")
+    with pytest.raises(PinfeedError, match="gif or an .mp4"):  # before any rollout
+        animate_stored(_stored(True), {"sweep": {"pin_radius": 3.0}}, tmp_path / "p.avi", 1)
 
 
 def _stored(with_heights=False):
@@ -61,8 +68,14 @@ def _stored(with_heights=False):
             "initial_states": {k: {"theta": t, "y_c": y} for k, (t, y) in STATES.items()}}
 
 
+def _planner(pins):
+    """The planner's settings with these configured pin heights and a 3 mm pin."""
+    from pipeline.planning import PlannerSettings, SearchSettings
+    return PlannerSettings(SearchSettings(3.0, pins=tuple(pins)))
+
+
 def test_plan_inputs_heights_from_plan_or_config():
-    config = {"planner": {"pins": [0.0, 5.0, 10.0, 15.0, 20.0]}, "sweep": {"pin_radius": 3.0}}
+    config = _planner([0.0, 5.0, 10.0, 15.0, 20.0])
     got = plan_inputs(_stored(), 1, config)
     assert got["heights"] == [5.0, 20.0] and got["speeds"] == [0.0, 2.0] and got["pin_radius"] == 3.0
     assert plan_inputs(_stored(True), 1, config)["heights"] == [7.0, 11.0]
@@ -76,8 +89,8 @@ def test_plan_inputs_heights_from_plan_or_config():
 def test_plan_inputs_prefers_the_tight_recommended_plan():
     """The recommended plan is the tight planner's (first friction): its own
     heights, speeds and the friction range's middle."""
-    from pipeline.present.animate import recommended_index
-    config = {"planner": {"pins": [0.0, 5.0, 10.0, 15.0, 20.0]}, "sweep": {"pin_radius": 3.0}}
+    from pipeline.planning import recommended_index
+    config = _planner([0.0, 5.0, 10.0, 15.0, 20.0])
     stored = _stored()
     stored["tight"] = [{"friction": "0.1:0.3", "mu_c": [0.1, 0.3], "plans": [],
                         "recommended": {"pins": ["P7", "P9"], "pin_heights_mm": [12.5, 30.0],
@@ -114,7 +127,7 @@ def test_cli_animate(tmp_path, capsys):
 
 
 def test_moving_pin_touches_at_its_height_on_the_clock():
-    from pipeline.present.lanes import pin_height
+    from pipeline.planning import pin_height
     speeds = [0.0, 1.0]
     lanes, stations, _ = roll_plan(PART, HEIGHTS, speeds, STATES, 0.15, "minpower", 3.0)
     touched = 0

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from pipeline.maps import simulate
-from pipeline.present.animate import animate_layout, station_figure, station_scene
-from pipeline.present.lanes import gap as point_gap, rotated
+from pipeline.planning import station_scene
+from pipeline.planning.feeder.lanes import gap as point_gap, rotated
+from pipeline.present.animate import animate_layout, station_figure
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 
@@ -99,7 +100,7 @@ def test_each_part_replays_its_passage_past_the_stations(scene):
 def test_gif_frames_title_and_model(tmp_path, monkeypatch):
     from PIL import Image
     out = tmp_path / "feeder.gif"
-    res = animate_layout(PART, _layout(), STATES, MU, out, frames=4, fps=4)
+    res = animate_layout(station_scene(PART, _layout(), STATES, MU), out, frames=4, fps=4)
     assert res["frames"] == 4 and res["pitch_mm"] == 130.0 and res["model"] == "minpower"
     with Image.open(out) as im:
         assert im.format == "GIF" and im.n_frames == 4
@@ -110,7 +111,7 @@ def test_gif_frames_title_and_model(tmp_path, monkeypatch):
         seen.update(kw, heights=list(heights), model=model)
         raise RuntimeError("stop")
 
-    monkeypatch.setattr("pipeline.present.lanes.run_trials", spy)
+    monkeypatch.setattr("pipeline.planning.feeder.passages.run_trials", spy)
     with pytest.raises(RuntimeError, match="stop"):
         station_scene(PART, _layout(model="dynamic", speed=150.0), STATES, MU)
     assert seen["belt_speed"] == 150.0 and seen["mu_s"] == 0.5 and seen["nominal"]
@@ -120,7 +121,8 @@ def test_gif_frames_title_and_model(tmp_path, monkeypatch):
 
 
 def test_title_says_how_the_passages_were_replayed():
-    from pipeline.present.animate import StationScene, station_title
+    from pipeline.planning import StationScene
+    from pipeline.present.animate import station_title
     sc = StationScene(PART, [], [], 130.0, 40.0, 3, 0.0, -30.0, (0.0, 50.0), 150.0, "dynamic")
     assert station_title("tri", sc) == "tri; belt 150 mm/s (dynamic model); pitch 130.0 mm"
     sc.model, sc.belt_speed = "minpower", None

@@ -151,7 +151,7 @@ def test_sequence_figure_draws_the_holes_at_each_pose():
 
 def _lane(label, theta, y, x0=0.0, length=100.0):
     """A hand-made lane (no rollout): the part rides the belt at constant pose."""
-    from pipeline.present.lanes import Lane
+    from pipeline.planning import Lane
     return Lane(label, np.array([0.0, length]), np.array([x0, x0 + length]), np.array([y, y]),
                 np.array([theta, theta]))
 
@@ -177,7 +177,8 @@ def test_plan_animation_frame_draws_the_holes():
 
 
 def test_layout_animation_frame_draws_the_holes():
-    from pipeline.present.animate import StationScene, station_figure
+    from pipeline.planning import StationScene
+    from pipeline.present.animate import station_figure
     lanes = [_lane("state 1", 0.0, 25.0, x0=-150.0, length=300.0),
              _lane("state 2", 120.0, 24.0, x0=-150.0, length=300.0)]
     stations = [{"label": "P1", "x_mm": 60.0, "y_mm": 5.0, "radius_mm": 3.0}]
@@ -198,10 +199,10 @@ def test_layout_animation_frame_draws_the_holes():
 
 def _drawing_layout():
     """A layout with its drawing made by the layout's own code, from hand-made lanes."""
-    from pipeline.present.layout import _drawing
+    from pipeline.planning.feeder.layout import entry_exit_outlines
     states = {"state 1": (0.0, 20.0), "state 2": (90.0, 25.0)}
     nominal = [_lane("state 1", 0.0, 20.0), _lane("state 2", 200.0, 26.0)]
-    drawing = _drawing(PART, states, nominal, [0.0, 60.0], 110.0, 60.0, 3.0, 5.0)
+    drawing = entry_exit_outlines(PART, states, nominal, [0.0, 60.0], 110.0, 60.0, 3.0, 5.0)
     return {"part": "plate", "pins": ["P1", "P2"],
             "stations": [{"label": "P1", "x_mm": 0.0, "y_mm": 5.0, "radius_mm": 3.0},
                          {"label": "P2", "x_mm": 60.0, "y_mm": 30.0, "radius_mm": 3.0}],
@@ -223,9 +224,9 @@ def test_layout_drawing_keeps_the_holes_at_each_pose():
         for hole, body in zip(p["holes"], PART.holes):
             assert np.allclose(hole, posed(body, p["theta_deg"], p["x_mm"], p["y_mm"]))
     solid = Part.from_vertices(PART.vertices, name="solid")
-    from pipeline.present.layout import _drawing
-    plain = _drawing(solid, {"state 1": (0.0, 20.0)}, [_lane("state 1", 0.0, 20.0)], [0.0], 110.0, 60.0,
-                     3.0, 5.0)
+    from pipeline.planning.feeder.layout import entry_exit_outlines
+    plain = entry_exit_outlines(solid, {"state 1": (0.0, 20.0)}, [_lane("state 1", 0.0, 20.0)], [0.0], 110.0,
+                                60.0, 3.0, 5.0)
     assert "holes" not in plain["entry_parts"][0]  # a solid part's layout JSON as before
 
 

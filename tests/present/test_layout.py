@@ -3,7 +3,7 @@
 The replay checks below rebuild the world-frame motion of two consecutive
 parts past two consecutive pins from the public rollout API, with their own
 first-touch search and their own polygon/disc intersection tests (a simple
-reference, independent of ``pipeline.present.layout``'s slab and reach geometry).
+reference, independent of ``pipeline.planning.feeder.layout``'s slab and reach geometry).
 """
 import json
 import math
@@ -17,7 +17,7 @@ from pipeline.config import load_config
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.present.layout import check_layout_settings, layout_stored
+from pipeline.planning import check_layout_settings, layout_stored
 
 TRIANGLE = "0,0 60,0 15,35"
 SPEED = 100.0
@@ -128,7 +128,8 @@ def stored(tmp_path_factory):
                  "--out", str(plan)]) == 0
     result = json.loads(plan.read_text())
     config = load_config()
-    layout = layout_stored(result, config, belt_speed=SPEED, quasi_static=True,
+    from pipeline.planning import PlannerSettings
+    layout = layout_stored(result, PlannerSettings.from_config(config), belt_speed=SPEED, quasi_static=True,
                            settings={"trials": 4, "speed_trials": 3})
     return {"root": root, "results": root / "results", "result": result, "layout": layout,
             "config": config}

@@ -14,6 +14,7 @@ from matplotlib.text import Text
 from pipeline.maps.simulate import contact_motion
 from pipeline.parts.part import Part
 from pipeline.present.figures import text_problems
+from pipeline.planning import mechanics_scene
 from pipeline.present.figures.diagrams import mechanics_diagram
 
 TRIANGLE = [(0, 0), (60, 0), (15, 35)]
@@ -21,7 +22,7 @@ TRIANGLE = [(0, 0), (60, 0), (15, 35)]
 
 @pytest.fixture(scope="module", params=[0.3, -0.3], ids=["d=+0.3", "d=-0.3"])
 def drawn(request):
-    fig = mechanics_diagram(d=request.param)
+    fig = mechanics_diagram(mechanics_scene(d=request.param))
     yield request.param, fig
     plt.close(fig)
 

@@ -6,11 +6,11 @@ import pytest
 import xarray as xr
 
 from pipeline.parts.part import Part
-from pipeline.present.animate import station_figure, station_scene
+from pipeline.planning import final_sets_warning, station_scene
+from pipeline.present.animate import station_figure
 from pipeline.present.figures import text_problems
 from pipeline.present.figures.bands import band_maps_figure
 from pipeline.present.figures.feeder import ALERT_COLOUR, feeder_figure
-from pipeline.present.layout import final_sets_warning
 
 PART = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 STATES = {f"state {k}": (float(th), float(y)) for k, (th, y) in enumerate(PART.stable_states(), 1)}

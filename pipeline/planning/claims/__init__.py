@@ -1,6 +1,7 @@
 """Claims about a plan, from perturbed full rollouts.
 
-``verify`` (held-out trials, replayed through the whole pin sequence),
+``verify`` (held-out trials, replayed through the whole pin sequence; the
+replays the carried-sets figure draws),
 ``orient`` (judging a verification: does the plan orient the part within the
 tolerance, and how it is said) and ``confidence`` (bounds on a share and a
 width from a finite number of trials). Imports the core wing only.

@@ -325,3 +325,28 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
             "model": model if belt_speed is None else "dynamic", **belt, "rows": rows,
             **({} if family is None else {"support_family": family.label}),
             **total, "trials_detail": trials}
+
+
+def replayed_paths(part: Part, plan: dict, starts: dict, mu_c, pin_radius, model, cfg=None,
+                   trials=100, kernel=None, belt_speed=None, mu_s=0.5):
+    """Per initial state: arrays of theta and y_c (trials x steps) of perturbed replays
+    (with the dynamic model at ``belt_speed`` mm/s and belt friction ``mu_s`` if given):
+    ``trials`` random trials and every corner of the perturbation box, replayed through
+    the plan's pins (:func:`replay` with a path). The carried-sets figure
+    (:func:`pipeline.present.figures.carried.plot_carried`) draws them."""
+    cfg = dict(DEFAULTS, **(cfg or {}))
+    kernel = kernel or {}
+    rng = np.random.default_rng(cfg["seed"])
+    n = len(plan["pins"])
+    out = {}
+    for label, (theta, y_c) in starts.items():
+        th, yc, mu, offs = perturbed_batch(theta, y_c, mu_c, n, cfg, rng, trials)
+        corners = corner_inputs(theta, y_c, mu_c, n, cfg)
+        th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), corners[:3]))
+        offs = np.concatenate([offs, corners[3]])
+        path = [(th % 360.0, yc.copy())]
+        replay(part, plan["pin_heights_mm"], plan["pin_speeds"], th, yc, mu, offs, pin_radius, model,
+               path=path, belt_speed=belt_speed, mu_s=mu_s,
+               **{k: v for k, v in kernel.items() if k in ("ds_max", "tol")})
+        out[label] = (np.stack([p[0] for p in path], axis=1), np.stack([p[1] for p in path], axis=1))
+    return out

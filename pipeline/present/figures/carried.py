@@ -5,7 +5,8 @@ planner carries after each pin (bars; several bars where a state branched)
 and the orientations of replayed, perturbed full rollouts after each pin
 (dots). Bottom row: the same for the centroid height y_c. A sound
 propagation has every dot inside a bar; a tight one has bars little wider
-than the dots' spread.
+than the dots' spread. The replays are computed by the planner
+(:func:`pipeline.planning.replayed_paths`); this module draws them.
 """
 from __future__ import annotations
 
@@ -14,8 +15,6 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from pipeline.parts.part import Part
-from pipeline.planning import VERIFY_DEFAULTS, corner_inputs, perturbed_batch, replay
 from pipeline.present.figures import save_figure
 
 
@@ -33,28 +32,6 @@ def carried_by_step(plan: dict, label: str) -> list[list[dict]]:
                 row.append(st)
         steps.append(row)
     return steps
-
-
-def replayed_paths(part: Part, plan: dict, starts: dict, mu_c, pin_radius, model, cfg=None,
-                   trials=100, kernel=None, belt_speed=None, mu_s=0.5):
-    """Per initial state: arrays of theta and y_c (trials x steps) of perturbed replays
-    (with the dynamic model at ``belt_speed`` mm/s and belt friction ``mu_s`` if given)."""
-    cfg = dict(VERIFY_DEFAULTS, **(cfg or {}))
-    kernel = kernel or {}
-    rng = np.random.default_rng(cfg["seed"])
-    n = len(plan["pins"])
-    out = {}
-    for label, (theta, y_c) in starts.items():
-        th, yc, mu, offs = perturbed_batch(theta, y_c, mu_c, n, cfg, rng, trials)
-        corners = corner_inputs(theta, y_c, mu_c, n, cfg)
-        th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), corners[:3]))
-        offs = np.concatenate([offs, corners[3]])
-        path = [(th % 360.0, yc.copy())]
-        replay(part, plan["pin_heights_mm"], plan["pin_speeds"], th, yc, mu, offs, pin_radius, model,
-               path=path, belt_speed=belt_speed, mu_s=mu_s,
-               **{k: v for k, v in kernel.items() if k in ("ds_max", "tol")})
-        out[label] = (np.stack([p[0] for p in path], axis=1), np.stack([p[1] for p in path], axis=1))
-    return out
 
 
 def _unwrap_near(values, centre):

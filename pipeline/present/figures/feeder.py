@@ -1,4 +1,5 @@
-"""The feeder drawing of a layout (``pipeline.present.layout``): a top view to build from.
+"""The feeder drawing of a layout (:func:`pipeline.planning.layout_stored`'s dict,
+written by ``pipeline.present.layout``): a top view to build from.
 
 One geometry (:func:`drawing_items`), two writers: :func:`draw_feeder`
 (matplotlib: PNG or SVG) and :func:`write_dxf` (ezdxf, millimetres, layers

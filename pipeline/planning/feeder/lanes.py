@@ -1,7 +1,9 @@
 """Parts on the belt's clock: the passages of a plan placed in the world frame.
 
-Shared by the animations (:mod:`pipeline.present.animate`) and the feeder
-layout (:mod:`pipeline.present.layout`), so that both draw the same course:
+Shared by the feeder layout (:mod:`pipeline.planning.feeder.layout`) and the
+animations' passages (:mod:`pipeline.planning.feeder.passages`), so that the
+drawings (:mod:`pipeline.present.layout`, :mod:`pipeline.present.animate`)
+show the same course:
 
 - a :class:`Lane` is one part's centroid and orientation against the belt
   travel B (mm), built from the rollout kernel's own trajectories
@@ -20,8 +22,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pipeline.maps import simulate
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
+from pipeline.planning.claims.verify import PERTURB_DEFAULTS, corner_inputs, perturbed_batch
+from pipeline.planning.core.settings import nominal_friction
+from pipeline.progress import Heartbeat
 
 
 @dataclass
@@ -217,9 +223,6 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
     How far the trials have got goes to the progress report of
     :func:`pipeline.progress.reporting`, if any.
     """
-    from pipeline.planning import nominal_friction
-    from pipeline.planning import PERTURB_DEFAULTS, corner_inputs, perturbed_batch
-    from pipeline.progress import Heartbeat
     cfg = dict(PERTURB_DEFAULTS, **(perturb or {}))
     rng = np.random.default_rng(seed)
     heights = np.asarray(heights, float)
@@ -248,7 +251,6 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
 
 def _roll_trial(part: Part, trial: Trial, pin_radius: float, belt: dict) -> Trial:
     """``trial`` rolled past its pins in turn (with trajectories), up to a jam."""
-    from pipeline.maps import simulate
     theta, y = trial.theta, trial.y_c
     for k, h in enumerate(trial.heights):
         ds = simulate.rollout(part, theta, contact_parameter(h, y, part.a), trial.mu_c, pin_radius,
