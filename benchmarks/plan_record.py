@@ -23,10 +23,15 @@ evidence, the carried sets and the warnings are all compared.
 
 ``compare`` prints each difference (part, path in the plan file, before,
 after) and exits 1 when there is any, 0 when the two records are identical.
+Either record may be gzipped. ``benchmarks/records/plans_before_house.json.gz``
+is the record made before the planner's house was rebuilt (wings, typed
+settings, one kernel driver): compare a new record with it to show that a
+change of the house changed no plan.
 """
 from __future__ import annotations
 
 import argparse
+import gzip
 import json
 import subprocess
 import sys
@@ -100,8 +105,14 @@ def differences(before, after, path=""):
         yield path, before, after
 
 
+def load(path: Path) -> dict:
+    """A record (``.json`` or ``.json.gz``)."""
+    data = gzip.decompress(path.read_bytes()) if path.suffix == ".gz" else path.read_bytes()
+    return json.loads(data)
+
+
 def compare(before: Path, after: Path) -> int:
-    old, new = json.loads(before.read_text()), json.loads(after.read_text())
+    old, new = load(before), load(after)
     diffs = list(differences(old, new))
     for path, b, a in diffs[:200]:
         print(f"{path}: {str(b)[:100]} -> {str(a)[:100]}")
