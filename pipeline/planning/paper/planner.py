@@ -16,7 +16,9 @@ interval of the whole band kernel K_j of each band hit (``com="kernel"``); K_j
 often spans 100+ degrees of theta_i whose dy spread tens of millimetres, so
 the literal rule makes nearly every second pin metastable.
 
-The search is complete up to ``depth``: every pin sequence is tried, and
+``Planner`` answers the transitions of one state at one pin;
+``SequenceSearch`` (what ``Planner.search`` runs) searches the pin
+sequences. The search is complete up to ``depth``: every pin sequence is tried, and
 sequences that reach a joint state (the states of all initial states) already
 reached are merged. Plans are ranked by the number of final orientation sets
 (clusters of overlapping final arcs over all branches of all initial
@@ -139,7 +141,10 @@ def load_maps(ds, threshold_T: float, factor_c: float) -> list[MapData]:
 
 
 class Planner:
-    """Global pins for one part, from its stored maps.
+    """Global pins for one part, from its stored maps: the transitions of
+    uncertain states through the pins (:meth:`transition`, by map lookup);
+    :meth:`search` runs the breadth-first search over pin sequences
+    (:class:`SequenceSearch`) on them.
 
     ``pins`` maps labels to heights (mm above the fence) of static pins.
     ``dynamic`` optionally adds moving pins: a dict ``label -> (y, v_pin)``
@@ -263,7 +268,7 @@ class Planner:
 
     def search(self, depth: int, keep: int = 10, dynamic_depth: int = 0,
                dynamic_beam: int = 50) -> list[Plan]:
-        """The ``keep`` best plans, best first.
+        """The ``keep`` best plans, best first (:meth:`SequenceSearch.run`).
 
         Static pins: every sequence up to ``depth`` (complete; sequences that
         reach a joint state already reached are merged). Dynamic pins come
@@ -271,19 +276,45 @@ class Planner:
         the ``dynamic_beam`` best plans of the previous level (a beam search:
         complete for one dynamic pin after the beam's plans, not beyond).
         """
-        starts = self.initial_states()
+        return SequenceSearch(self).run(depth, keep, dynamic_depth, dynamic_beam)
+
+
+class SequenceSearch:
+    """The breadth-first search over pin sequences through a planner's
+    transitions.
+
+    A node is a pin sequence with its joint state (for every initial state,
+    in order, the states its branches may be in), its margin and the number
+    of orientation sets after each pin. Each level follows every node of the
+    previous one by every pin (:meth:`Planner.transition`); a joint state
+    reached before is not expanded again.
+
+    Parameters
+    ----------
+    planner : the :class:`Planner` whose pins and transitions are searched.
+    """
+
+    def __init__(self, planner: Planner):
+        self.planner = planner
+
+    def run(self, depth: int, keep: int = 10, dynamic_depth: int = 0, dynamic_beam: int = 50) -> list[Plan]:
+        """The ``keep`` best plans, best first: every static sequence up to
+        ``depth``, then up to ``dynamic_depth`` moving pins after the
+        ``dynamic_beam`` best nodes of the previous level (:meth:`Planner.search`)."""
+        planner = self.planner
+        starts = planner.initial_states()
         labels = list(starts)
         root = ((), tuple((starts[lab],) for lab in labels), math.inf, ())
         seen = {self._joint_key(root[1])}
         nodes, frontier = [], [root]
         for _ in range(depth):
-            frontier = self._expand(frontier, self.static_labels, seen)
+            frontier = self._expand(frontier, planner.static_labels, seen)
             nodes.extend(frontier)
-        if dynamic_depth and self.dynamic_labels:
+        if dynamic_depth and planner.dynamic_labels:
             beam = [root] + nodes
             for _ in range(dynamic_depth):
                 beam.sort(key=lambda node: self._node_rank(node))
-                grown = self._expand(beam[:dynamic_beam], self.dynamic_labels, seen)
+                grown = self._expand(beam[:dynamic_beam], planner.dynamic_labels, seen)
                 nodes.extend(grown)
                 beam = grown
         plans = [self._plan(node, labels) for node in nodes]
@@ -299,7 +330,7 @@ class Planner:
                 for branch_states in joint:
                     children = []
                     for st in branch_states:
-                        res = self.transition(st, pin)
+                        res = self.planner.transition(st, pin)
                         if res is None:
                             break
                         children.extend(res[0])
@@ -332,7 +363,7 @@ class Planner:
         seq, joint, margin, sets_after = node
         finals = merge_arcs([st.arc for states in joint for st in states])
         branches = {label: [list(st.history) for st in states] for label, states in zip(labels, joint)}
-        n_dynamic = sum(1 for p in seq if self.speeds[p] != 0.0)
+        n_dynamic = sum(1 for p in seq if self.planner.speeds[p] != 0.0)
         return Plan(seq, len(finals), finals, float(margin), branches, sets_after, n_dynamic)
 
 

@@ -2,8 +2,11 @@
 
 ``propagate`` (a set of states through one pin, on an outcome lattice),
 ``store`` (the lattice's outcomes kept in the catalog), ``search`` (the
-branch-and-bound planner over pin sequences), ``enumerate`` (every sequence
-on the pin grid, for the complete search's evidence), ``complete`` (the
-complete fixed-pin search and the ranking of its plans) and ``certify`` (the
-carried sets of a chosen plan). Imports the core and claims wings.
+transitions of state sets through pins, and the carried sets of one given
+pin sequence), ``enumerate`` (every sequence on the pin grid, for the
+complete search's evidence), ``complete`` (the complete fixed-pin search and
+the ranking of its plans), ``judge`` (candidate sequences replayed and judged
+on the verification's trials, and certified on held-out ones) and
+``certify`` (the carried sets of a chosen plan). Imports the core and claims
+wings.
 """

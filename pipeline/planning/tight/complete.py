@@ -56,6 +56,13 @@ and judged, and the best fixed-pin results found (the most trials in one set,
 and the fewest sets within ``T``) among the judged sequences and the
 ``EVIDENCE_PER_LEVEL`` sequences of each level whose nominal finals fall
 into the fewest clusters.
+
+Who does what. :class:`FixedPinSearch` drives the levels (steps 1 and 6, the
+ranking and the evidence); a :class:`LevelScreen` takes one level through
+steps 2 to 5; :class:`~pipeline.planning.tight.judge.TrialBench` replays and
+judges sequences on the trials, and
+:class:`~pipeline.planning.tight.judge.Certifier` checks the orienting ones
+against the support family and the held-out trials (``judge.py``).
 """
 from __future__ import annotations
 
@@ -64,23 +71,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
-
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
 from pipeline.planning.tight.enumerate import Level, NominalTree
-from pipeline.planning.core.resting import resting_states
+from pipeline.planning.tight.judge import MAX_ROWS, Certifier, TrialBench, stack
 from pipeline.config import schema_default
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
 from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE
-from pipeline.planning.claims.verify import holdout_settings, replay, trial_inputs
-from pipeline.progress import SILENT, Heartbeat, Stretch
+from pipeline.planning.claims.verify import replay
+from pipeline.progress import Heartbeat
 
 SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
 PROBE = (6, 2)  # random trials and corners per resting state that order the candidates
 SCREEN = (12, 8)  # random trials and corners per resting state in the screen
 SCREEN_BLOCK = 96  # candidates screened at once
-MAX_ROWS = 150_000  # trials replayed in one batch
 EVIDENCE_PER_LEVEL = 4  # several-set sequences judged per level when nothing orients
 WIDTH_SLACK_DEG = schema_default("planner", "width_slack_deg")  # a safe margin outranks this much width
 
@@ -252,8 +256,164 @@ class FixedSearch:
                                  **b.verdict} for b in self.best_effort]}
 
 
+@dataclass(eq=False)
+class CandidatePins:
+    """The candidate pins of a search: ``labels``, ``heights`` (mm) and
+    ``speeds`` (``v_pin / v_b``, 0 for a fixed pin), indexed alike; the rows
+    of a level's ``seq`` index them."""
+    labels: list
+    heights: np.ndarray
+    speeds: np.ndarray
+
+    def rows(self, prefix: FixedPlan, seq) -> tuple:
+        """``(heights, speeds)``, one row per sequence: the pins of ``prefix``
+        followed by those the rows of ``seq`` index."""
+        n = seq.shape[0]
+        pre_speeds = prefix.speeds or (0.0,) * len(prefix.labels)
+        return (np.hstack([np.tile(prefix.heights, (n, 1)), self.heights[seq]]),
+                np.hstack([np.tile(pre_speeds, (n, 1)), self.speeds[seq]]))
+
+    def plan(self, prefix: FixedPlan, seq, span, margin, verdict) -> FixedPlan:
+        """The plan of ``prefix`` followed by the pins the row ``seq`` indexes,
+        with its nominal span, margin in d and verdict."""
+        return FixedPlan(prefix.labels + tuple(self.labels[i] for i in seq),
+                         prefix.heights + tuple(float(self.heights[i]) for i in seq),
+                         float(span), float(margin), verdict,
+                         (prefix.speeds or (0.0,) * len(prefix.labels)) + tuple(float(self.speeds[i]) for i in seq))
+
+
+class LevelScreen:
+    """One level of the complete search: its sequences (the rows of
+    ``level.seq``, after the pins of ``prefix``) kept by their nominal span,
+    screened, judged and certified (steps 2 to 5 of the module's search).
+
+    Parameters
+    ----------
+    level : the level's nominal paths (``enumerate.Level``).
+    n_pins : the pins of each of its sequences, the prefix's included.
+    prefix : the plan every sequence starts with (no pin: an empty plan).
+    pins : the search's :class:`CandidatePins`.
+    bench : the :class:`~pipeline.planning.tight.judge.TrialBench` that replays and judges.
+    certifier : the :class:`~pipeline.planning.tight.judge.Certifier` of orienting verdicts.
+    name : the level for people (progress lines).
+    """
+
+    def __init__(self, level: Level, n_pins: int, prefix: FixedPlan, pins: CandidatePins, bench: TrialBench,
+                 certifier: Certifier, name: str):
+        self.level, self.n_pins, self.prefix, self.pins = level, n_pins, prefix, pins
+        self.bench, self.certifier, self.name = bench, certifier, name
+
+    def sequences(self, idx) -> tuple:
+        """``(heights, speeds)`` of the level's rows ``idx`` (:meth:`CandidatePins.rows`)."""
+        return self.pins.rows(self.prefix, self.level.seq[idx])
+
+    def plan(self, idx, span, verdict) -> FixedPlan:
+        """The plan of the level's row ``idx``, with its nominal span and verdict."""
+        return self.pins.plan(self.prefix, self.level.seq[idx], span, self.level.margin[idx], verdict)
+
+    def search(self, candidates: int, progress=None):
+        """``(orienting plans, every judged plan, the level's counts)``; each
+        stage tells ``progress`` how far it has got."""
+        level, bench = self.level, self.bench
+        record = {"sequences": level.size, "nominal_within": 0, "screened_out": 0, "judged": 0,
+                  "orienting": 0, "not_screened": 0, "held_out": 0, "certified": 0}
+        if level.size == 0:
+            return [], [], record
+        inputs = bench.trials(self.n_pins)
+        n_total = sum(x[0].size for x in inputs)
+        allowed = bench.allowed_failures(n_total)
+        if allowed < 0:  # no plan of this length can be claimed, however it ends
+            record["too_few_trials"] = n_total
+        span = orient.row_spans(level.theta, bench.order)
+        within = np.flatnonzero(span <= bench.tolerance + SLACK_DEG)
+        within = within[np.lexsort((-level.margin[within], span[within]))]
+        record["nominal_within"] = int(within.size)
+        if within.size == 0:
+            return [], [], record
+        # A probe of a few trials per state orders the candidates (most promising
+        # first) and already rejects the hopeless ones.
+        with Heartbeat(f"{self.name}: first screen", within.size, "sequence", progress) as beat:
+            probe_fails = bench.failures(*self.sequences(within), bench.screen_rows(inputs, *PROBE),
+                                         beat.stretch(0, within.size))
+        order = within[probe_fails <= allowed][np.argsort(probe_fails[probe_fails <= allowed], kind="stable")]
+        record["screened_out"] = int(within.size - order.size)
+        with Heartbeat(f"{self.name}: screening and judging", order.size, "sequence", progress) as beat:
+            found, found_idx, judged = self._screen_and_judge(order, inputs, allowed, span, candidates,
+                                                              record, beat)
+        record["judged"], record["orienting"] = len(judged), len(found)
+        certified = self.certifier.certify(
+            found, *self.sequences(np.asarray(found_idx, dtype=int)), self.n_pins,
+            Heartbeat(f"{self.name}: held-out trials", len(found), "sequence", progress))
+        record["held_out"], record["certified"] = len(found), len(certified)
+        return certified, judged, record
+
+    def _screen_and_judge(self, order, inputs, allowed, span, candidates, record, beat):
+        """Screen the sequences ``order`` (level rows, most promising first) in
+        blocks of ``SCREEN_BLOCK`` and judge the survivors on all the trials
+        ``inputs``, until ``candidates`` are judged and one orients;
+        ``(orienting plans, their rows, every judged plan)``. Adds the
+        screened-out and not-screened counts to ``record``; ``beat`` is
+        ticked with the sequences done."""
+        bench = self.bench
+        screen, full = bench.screen_rows(inputs, *SCREEN), stack(inputs)
+        share = screen[0].size / (screen[0].size + full[0].size)  # the screen's share of a block's work
+        found, found_idx, judged = [], [], []
+        step = max(1, min(candidates, MAX_ROWS // full[0].size))
+        done = 0
+        while done < order.size and not (found and len(judged) >= candidates):
+            block = order[done:done + SCREEN_BLOCK]
+            fails = bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
+            alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
+            record["screened_out"] += int(block.size - alive.size)
+            judging = beat.stretch(done + share * block.size, done + block.size)
+            done += block.size
+            for start in range(0, alive.size, step):
+                chunk = alive[start:start + step]
+                verdicts = bench.judge(*self.sequences(chunk), full, stretch=judging.part(
+                    start / alive.size, (start + chunk.size) / alive.size))
+                for idx, verdict in zip(chunk, verdicts):
+                    plan = self.plan(idx, span[idx], verdict)
+                    judged.append(plan)
+                    if verdict["orients"] and self.certifier.holds_for_family(plan):
+                        found.append(plan)
+                        found_idx.append(idx)
+                if found and len(judged) >= candidates:
+                    break
+            beat.tick(done)
+        record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
+        if done < order.size:
+            beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
+        return found, found_idx, judged
+
+    def several_sets(self, candidates: int, progress=None) -> list:
+        """The level's sequences whose nominal finals fall into the fewest
+        clusters (gaps over the tolerance), judged in full (telling
+        ``progress``): the evidence when nothing orients."""
+        level, bench = self.level, self.bench
+        if level.size == 0:
+            return []
+        period = 360.0 / bench.order
+        x = np.sort(np.mod(level.theta, period), axis=1)
+        gaps = np.diff(np.concatenate([x, x[:, :1] + period], axis=1), axis=1)
+        clusters = np.maximum(1, (gaps > bench.tolerance).sum(axis=1))
+        spread = period - gaps.max(axis=1)
+        best = np.lexsort((-level.margin, spread, clusters))[:candidates]
+        inputs = bench.trials(self.n_pins)
+        with Heartbeat(f"{self.name}: judging the fewest-set sequences for the evidence", best.size,
+                       "sequence", progress) as beat:
+            verdicts = bench.judge(*self.sequences(best), stack(inputs), stretch=beat.stretch(0, best.size))
+            return [self.plan(i, spread[i], v) for i, v in zip(best, verdicts)]
+
+
 class FixedPinSearch:
     """The complete search over ``pins`` (label -> height, mm) for one part and friction.
+
+    The search drives the levels: it enumerates each level's nominal paths
+    (``enumerate.NominalTree``), hands them to a :class:`LevelScreen`, stops at
+    the first level with a certified plan and, when none orients, gathers the
+    evidence. A :class:`~pipeline.planning.tight.judge.TrialBench` replays
+    and judges the sequences; a :class:`~pipeline.planning.tight.judge.Certifier`
+    checks the orienting ones (support family, held-out trials).
 
     Parameters
     ----------
@@ -281,30 +441,28 @@ class FixedPinSearch:
                  search: SearchSettings, speeds: dict | None = None, family=None):
         self.friction = Friction.parse(friction, None if isinstance(friction, Friction)
                                        else verify.perturbation.mu_sigma)
-        self.part, self.mu_c, self.model = part, self.friction.value, search.model
-        belt_speed, mu_s = search.belt_speed, search.mu_s
-        self.belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
-        self.labels = list(pins)
-        self.heights = np.array([float(pins[k]) for k in self.labels])
-        self.speeds = np.array([float((speeds or {}).get(k, 0.0)) for k in self.labels])
-        self.tolerance, self.required = claims.tolerance_deg, claims.required
-        self.confidence, self.rule = claims.confidence, claims.rule
-        self.cfg = verify.as_dict()
-        self.holdout = holdout_settings(self.cfg)
+        self.bench = bench = TrialBench(part, self.friction, claims, verify, search, family)
+        self.certifier = Certifier(bench)
+        labels = list(pins)
+        self.pins = CandidatePins(labels, np.array([float(pins[k]) for k in labels]),
+                                  np.array([float((speeds or {}).get(k, 0.0)) for k in labels]))
         self.width_slack = float(search.width_slack_deg)
-        self.pin_radius = float(search.pin_radius)
-        self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **search.kernel_settings}
-        d_min, d_max, model = search.d_min, search.d_max, search.model
-        self.order = part.symmetry_order()
-        self.states = resting_states(part)
-        self.family = None if family is None or family.is_uniform else family
-        self.supports = None if self.family is None else self.family.kernel_supports
-        nominal = None if self.family is None else [self.supports[k] for k in self.family.representatives]
-        self.tree = NominalTree(part, self.heights, self.friction.nominal, self.pin_radius, model,
-                                self.kernel, float(self.cfg["pin_halfwidth"]), d_min, d_max,
-                                belt=self.belt, speeds=self.speeds, supports=nominal)
+        nominal = None if bench.family is None else [bench.supports[k] for k in bench.family.representatives]
+        self.tree = NominalTree(part, self.pins.heights, self.friction.nominal, bench.pin_radius, search.model,
+                                bench.kernel, float(bench.cfg["pin_halfwidth"]), search.d_min, search.d_max,
+                                belt=bench.belt, speeds=self.pins.speeds, supports=nominal)
         self.prefix = FixedPlan((), (), 0.0, np.inf)  # the pins every sequence starts with (run)
-        self.member_check = None  # with a family: worst_member.FamilyChecker (set by the planner)
+
+    @property
+    def member_check(self):
+        """With a family: the check of a plan against the family's worst member
+        (``worst_member.FamilyChecker``, set by the planner); else ``None``."""
+        return self.certifier.member_check
+
+    @member_check.setter
+    def member_check(self, check) -> None:
+        """Hand the family check to the certifier (``None``: no check)."""
+        self.certifier.member_check = check
 
     def run(self, depth: int, candidates: int = 12, keep: int = 5, progress=None,
             prefix: FixedPlan | None = None) -> FixedSearch:
@@ -314,8 +472,9 @@ class FixedPinSearch:
         about each level and, at most every few seconds, how far each stage
         of a level has got (:class:`pipeline.progress.Heartbeat`)."""
         t0 = time.perf_counter()
-        result = FixedSearch([], [], int(depth), self.tolerance, self.required,
-                             confidence=self.confidence, rule=self.rule)
+        bench = self.bench
+        result = FixedSearch([], [], int(depth), bench.tolerance, bench.required,
+                             confidence=bench.confidence, rule=bench.rule)
         runners_up, levels = [], []
         self.prefix, root = prefix or FixedPlan((), (), 0.0, np.inf), None
         if prefix is not None:
@@ -324,28 +483,29 @@ class FixedPinSearch:
                 return result
         else:  # no pin at all: the resting states' own spread (a symmetric part may need none)
             empty = self.tree.root()
-            result.resting = next(self._judge(empty, np.array([0]),
-                                              self._stack(self._trials(0))))
+            result.resting = next(bench.judge(*self.pins.rows(self.prefix, empty.seq[np.array([0])]),
+                                              stack(bench.trials(0))))
         def enumeration(length, n):
             return Heartbeat(f"{self._name(len(self.prefix.labels) + length)}: nominal paths", n,
                              "candidate sequence", progress)
 
         for level in self.tree.levels(int(depth), root, enumeration):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
-            found, judged, record = self._level(level, candidates, progress)
+            screen = LevelScreen(level, n_pins, self.prefix, self.pins, bench, self.certifier, self._name(n_pins))
+            found, judged, record = screen.search(candidates, progress)
             result.levels.append({"pins": n_pins, **record})
             if progress:
                 progress(f"{self._name(n_pins)}: {record['sequences']} sequences, "
-                         f"{record['nominal_within']} within {self.tolerance:g} deg nominally, "
+                         f"{record['nominal_within']} within {bench.tolerance:g} deg nominally, "
                          f"{record['judged']} replayed in full, {record['orienting']} orient the part")
             runners_up.extend(judged)
             if found:
                 result.plans = self.ranked(found)[:keep]
                 break
-            levels.append(level)
+            levels.append(screen)
         if not result.plans:  # the evidence: the best several-set results of every level
-            for level in levels:
-                runners_up.extend(self._several_sets(level, min(candidates, EVIDENCE_PER_LEVEL), progress))
+            for screen in levels:
+                runners_up.extend(screen.several_sets(min(candidates, EVIDENCE_PER_LEVEL), progress))
             result.best_effort = self.ranked(_distinct(runners_up))[:keep]
         result.rollouts = self.tree.rollouts
         result.seconds = time.perf_counter() - t0
@@ -353,7 +513,7 @@ class FixedPinSearch:
 
     def _name(self, n_pins: int) -> str:
         """A level of the search for people: ``3 fixed pin(s)``, or its moving pins after the prefix."""
-        if not self.speeds.any():
+        if not self.pins.speeds.any():
             return f"{n_pins} fixed pin(s)"
         after = " ".join(self.prefix.labels) or "no fixed pin"
         return f"{n_pins - len(self.prefix.labels)} moving pin(s) after {after}"
@@ -365,205 +525,14 @@ class FixedPinSearch:
     def _after(self, prefix: FixedPlan):
         """The nominal level after ``prefix`` (its pins replayed exactly from the
         resting states at the middle friction), or None if it jams."""
+        bench = self.bench
         states = self.tree.start_poses()
         n = len(prefix.labels)
         speeds = prefix.speeds or (0.0,) * n
-        theta, y_c, jam, _ = replay(self.part, list(prefix.heights), list(speeds), states[:, 0], states[:, 1],
+        theta, y_c, jam, _ = replay(bench.part, list(prefix.heights), list(speeds), states[:, 0], states[:, 1],
                                     np.full(len(states), self.friction.nominal), np.zeros((len(states), n)),
-                                    self.pin_radius, self.model, self.kernel["ds_max"], self.kernel["tol"],
-                                    **self.belt, support=self.tree.column_support, supports=self.tree.supports)
+                                    bench.pin_radius, bench.model, bench.kernel["ds_max"], bench.kernel["tol"],
+                                    **bench.belt, support=self.tree.column_support, supports=self.tree.supports)
         if (jam != "").any():
             return None
         return Level(np.zeros((1, 0), dtype=np.int16), theta[None, :], y_c[None, :], np.array([prefix.margin]))
-
-    # ------------------------------------------------------------------ one level
-
-    def _level(self, level, candidates, progress=None):
-        """``(orienting plans, every judged plan, the level's counts)``; each
-        stage tells ``progress`` how far it has got."""
-        record = {"sequences": level.size, "nominal_within": 0, "screened_out": 0, "judged": 0,
-                  "orienting": 0, "not_screened": 0, "held_out": 0, "certified": 0}
-        if level.size == 0:
-            return [], [], record
-        n_pins = len(self.prefix.labels) + level.seq.shape[1]
-        inputs = self._trials(n_pins)
-        n_total = sum(x[0].size for x in inputs)
-        allowed = orient.max_failures(n_total, self.required, self.confidence, self.rule)
-        if allowed < 0:  # no plan of this length can be claimed, however it ends
-            record["too_few_trials"] = n_total
-        span = orient.row_spans(level.theta, self.order)
-        within = np.flatnonzero(span <= self.tolerance + SLACK_DEG)
-        within = within[np.lexsort((-level.margin[within], span[within]))]
-        record["nominal_within"] = int(within.size)
-        if within.size == 0:
-            return [], [], record
-        # A probe of a few trials per state orders the candidates (most promising
-        # first) and already rejects the hopeless ones.
-        name = self._name(n_pins)
-        with Heartbeat(f"{name}: first screen", within.size, "sequence", progress) as beat:
-            probe_fails = self._failures(level, within, self._screen_rows(inputs, *PROBE),
-                                         beat.stretch(0, within.size))
-        order = within[probe_fails <= allowed][np.argsort(probe_fails[probe_fails <= allowed], kind="stable")]
-        record["screened_out"] = int(within.size - order.size)
-        with Heartbeat(f"{name}: screening and judging", order.size, "sequence", progress) as beat:
-            found, found_idx, judged = self._screen_and_judge(level, order, inputs, allowed, span, candidates,
-                                                              record, beat)
-        record["judged"], record["orienting"] = len(judged), len(found)
-        certified = self._certify(level, found, np.asarray(found_idx, dtype=int), n_pins,
-                                  Heartbeat(f"{name}: held-out trials", len(found), "sequence", progress))
-        record["held_out"], record["certified"] = len(found), len(certified)
-        return certified, judged, record
-
-    def _screen_and_judge(self, level, order, inputs, allowed, span, candidates, record, beat):
-        """Screen the sequences ``order`` (level rows, most promising first) in
-        blocks of ``SCREEN_BLOCK`` and judge the survivors on all the trials
-        ``inputs``, until ``candidates`` are judged and one orients;
-        ``(orienting plans, their rows, every judged plan)``. Adds the
-        screened-out and not-screened counts to ``record``; ``beat`` is
-        ticked with the sequences done."""
-        screen, full = self._screen_rows(inputs, *SCREEN), self._stack(inputs)
-        share = screen[0].size / (screen[0].size + full[0].size)  # the screen's share of a block's work
-        found, found_idx, judged = [], [], []
-        step = max(1, min(candidates, MAX_ROWS // full[0].size))
-        done = 0
-        while done < order.size and not (found and len(judged) >= candidates):
-            block = order[done:done + SCREEN_BLOCK]
-            fails = self._failures(level, block, screen, beat.stretch(done, done + share * block.size))
-            alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
-            record["screened_out"] += int(block.size - alive.size)
-            judging = beat.stretch(done + share * block.size, done + block.size)
-            done += block.size
-            for start in range(0, alive.size, step):
-                chunk = alive[start:start + step]
-                verdicts = self._judge(level, chunk, full, stretch=judging.part(
-                    start / alive.size, (start + chunk.size) / alive.size))
-                for idx, verdict in zip(chunk, verdicts):
-                    plan = self._plan(level, idx, span[idx], verdict)
-                    judged.append(plan)
-                    if verdict["orients"] and self._holds_for_family(plan):
-                        found.append(plan)
-                        found_idx.append(idx)
-                if found and len(judged) >= candidates:
-                    break
-            beat.tick(done)
-        record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
-        if done < order.size:
-            beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
-        return found, found_idx, judged
-
-    def _certify(self, level, found, idx, n_pins, beat: Heartbeat) -> list:
-        """The plans of ``found`` (level rows ``idx``) whose verdict on the held-out
-        trials orients the part; each plan's ``verdict`` becomes its held-out
-        verdict (with the width's bootstrap interval) and ``selection`` keeps
-        the verdict on the trials that chose it. ``beat`` hears how far it got."""
-        if not found:
-            return []
-        rows = self._stack(trial_inputs(self.states, self.mu_c, n_pins, self.holdout, self.family))
-        out = []
-        step = max(1, MAX_ROWS // rows[0].size)
-        with beat:
-            for start in range(0, idx.size, step):
-                chunk = idx[start:start + step]
-                verdicts = self._judge(level, chunk, rows, interval=True,
-                                       stretch=beat.stretch(start, start + chunk.size))
-                for plan, held in zip(found[start:start + step], verdicts):
-                    plan.selection, plan.verdict = plan.verdict, held
-                    if held["orients"]:
-                        out.append(plan)
-        return out
-
-    def _holds_for_family(self, plan: FixedPlan) -> bool:
-        """True without a family check; else whether the family's worst member
-        found by ``member_check`` leaves the plan's set (a plan it breaks no
-        longer orients: the search goes on as after a failed verification)."""
-        if self.member_check is None:
-            return True
-        if self.member_check(plan.labels, plan.heights, plan.verdict, plan.speeds):
-            return True
-        plan.verdict = dict(plan.verdict, orients=False, broken_by_worst_member=True)
-        return False
-
-    def _plan(self, level, idx, span, verdict) -> FixedPlan:
-        seq, pre = level.seq[idx], self.prefix
-        return FixedPlan(pre.labels + tuple(self.labels[i] for i in seq),
-                         pre.heights + tuple(float(self.heights[i]) for i in seq),
-                         float(span), float(level.margin[idx]), verdict,
-                         (pre.speeds or (0.0,) * len(pre.labels)) + tuple(float(self.speeds[i]) for i in seq))
-
-    def _screen_rows(self, inputs, n_first: int, n_corners_wanted: int):
-        """A subset of the verification trials: the first ``n_first`` random trials
-        and ``n_corners_wanted`` evenly spread corners of each state."""
-        n_random = int(self.cfg["trials"])
-        rows = []
-        for trials in inputs:
-            n_corners = trials[0].size - n_random
-            pick = list(range(min(n_first, n_random)))
-            if n_corners:
-                step = max(1, n_corners // n_corners_wanted)
-                pick += list(range(n_random, trials[0].size, step))[:n_corners_wanted]
-            rows.append(tuple(x[pick] for x in trials))
-        return self._stack(rows)
-
-    def _trials(self, n_pins: int) -> list:
-        """The verification's trials for plans of ``n_pins`` pins (``verify.trial_inputs``)."""
-        return trial_inputs(self.states, self.mu_c, n_pins, self.cfg, self.family)
-
-    @staticmethod
-    def _stack(rows):
-        return tuple(np.concatenate([r[k] for r in rows]) for k in range(5))
-
-    def _replay(self, level, idx, rows, stretch: Stretch = SILENT):
-        """Final orientations ``(len(idx), trials)`` and jam flags of plans ``idx`` on ``rows``
-        (``stretch`` is told how far the replay has got)."""
-        th, yc, mu, offs, sup = rows
-        n_trials, n_plans = th.size, idx.size
-        pre = self.prefix
-        pre_speeds = pre.speeds or (0.0,) * len(pre.labels)
-        heights = np.hstack([np.tile(pre.heights, (n_plans, 1)), self.heights[level.seq[idx]]])
-        speeds = np.hstack([np.tile(pre_speeds, (n_plans, 1)), self.speeds[level.seq[idx]]])
-        tf, _, jam, _ = replay(self.part, np.repeat(heights, n_trials, axis=0),
-                               np.repeat(speeds, n_trials, axis=0), np.tile(th, n_plans), np.tile(yc, n_plans),
-                               np.tile(mu, n_plans), np.tile(offs, (n_plans, 1)), self.pin_radius,
-                               self.model, self.kernel["ds_max"], self.kernel["tol"], **self.belt,
-                               support=np.tile(sup, n_plans), supports=self.supports, stretch=stretch)
-        return tf.reshape(n_plans, n_trials), (jam != "").reshape(n_plans, n_trials)
-
-    def _failures(self, level, idx, rows, stretch: Stretch = SILENT):
-        """Trials of ``rows`` that no one arc of the tolerance can hold, per plan
-        (``stretch`` is told the share of plans done)."""
-        out = np.empty(idx.size, dtype=int)
-        step = max(1, MAX_ROWS // rows[0].size)
-        for start in range(0, idx.size, step):
-            chunk = idx[start:start + step]
-            tf, jam = self._replay(level, chunk, rows,
-                                   stretch.part(start / idx.size, (start + chunk.size) / idx.size))
-            for k in range(chunk.size):
-                held, _ = orient.best_arc(tf[k][~jam[k]], self.tolerance, self.order)
-                out[start + k] = rows[0].size - held
-        return out
-
-    def _judge(self, level, idx, rows, interval: bool = False, stretch: Stretch = SILENT):
-        tf, jam = self._replay(level, idx, rows, stretch)
-        for k in range(idx.size):
-            yield orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order, self.required,
-                               self.confidence, interval, self.rule)
-
-    # ------------------------------------------------------------------ when nothing orients
-
-    def _several_sets(self, level, candidates, progress=None):
-        """The level's sequences whose nominal finals fall into the fewest
-        clusters (gaps over the tolerance), judged in full (telling ``progress``)."""
-        if level.size == 0:
-            return []
-        period = 360.0 / self.order
-        x = np.sort(np.mod(level.theta, period), axis=1)
-        gaps = np.diff(np.concatenate([x, x[:, :1] + period], axis=1), axis=1)
-        clusters = np.maximum(1, (gaps > self.tolerance).sum(axis=1))
-        spread = period - gaps.max(axis=1)
-        best = np.lexsort((-level.margin, spread, clusters))[:candidates]
-        n_pins = len(self.prefix.labels) + level.seq.shape[1]
-        inputs = self._trials(n_pins)
-        with Heartbeat(f"{self._name(n_pins)}: judging the fewest-set sequences for the evidence", best.size,
-                       "sequence", progress) as beat:
-            verdicts = self._judge(level, best, self._stack(inputs), stretch=beat.stretch(0, best.size))
-            return [self._plan(level, i, spread[i], v) for i, v in zip(best, verdicts)]

@@ -9,9 +9,11 @@ centroid (the pin never passes it on either side) and no jam is reachable;
 ``hard_limits``; a pin that the state misses leaves it as it is (that is
 part of the propagation). A pin sequence is the same for every initial state.
 
-``TightPlanner.follow`` carries the sets of one given sequence of fixed
-or moving pins; the complete search (``complete.py``) chooses the
-sequences.
+``TightPlanner`` pushes one state set through one pin (``transition``, with
+its stored outcomes and a cache); ``SequenceFollower`` (what
+``TightPlanner.follow`` uses) carries the sets of one given sequence of fixed
+or moving pins through those transitions and builds its ``TightPlan``; the
+complete search (``complete.py``) chooses the sequences.
 
 ``TightPlan.rank_key`` orders propagated plans by (1) the number of final
 orientation sets, counted modulo the part's rotational symmetry; (2) the
@@ -129,7 +131,9 @@ class SearchStats:
 
 
 class TightPlanner:
-    """Pin sequences for one part under a stated uncertainty.
+    """The transitions of state sets through the pins, for one part under a
+    stated uncertainty (:meth:`transition`); :meth:`follow` carries one pin
+    sequence through them (:class:`SequenceFollower`).
 
     Parameters
     ----------
@@ -225,15 +229,37 @@ class TightPlanner:
         margin = min(near - self.d_min, self.d_max - far) if res.touched else math.inf
         return res.children, margin, d_lo, d_hi, res.jump
 
-    # ------------------------------------------------------------------ search
-
     def follow(self, seq) -> TightPlan | None:
         """The tight plan of one given pin sequence (its carried sets, no search),
         or ``None`` if the propagation forbids one of its pins for some branch
         (a reachable jam, a pin passing a centroid on both sides, too many
-        branches or jumps)."""
-        starts = self.initial_states()
-        self.labels = list(starts)
+        branches or jumps); see :class:`SequenceFollower`."""
+        return SequenceFollower(self).follow(seq)
+
+
+class SequenceFollower:
+    """One pin sequence followed through a planner's transitions, and the
+    :class:`TightPlan` it ends in.
+
+    The joint state holds, for every initial state (in order), its branches:
+    each a state set with the steps that led to it. A pin moves every branch
+    through :meth:`TightPlanner.transition`; it is forbidden for the whole
+    sequence when it is forbidden for one branch, or when an initial state
+    ends with more than the planner's ``max_branches`` branches (counted in
+    its ``stats.pruned_branching``).
+
+    Parameters
+    ----------
+    planner : the :class:`TightPlanner` whose pins, transitions and symmetry are used.
+    """
+
+    def __init__(self, planner: TightPlanner):
+        self.planner = planner
+
+    def follow(self, seq) -> TightPlan | None:
+        """The tight plan of the pin sequence ``seq`` (labels), or ``None`` if
+        one of its pins is forbidden for some branch."""
+        starts = self.planner.initial_states()
         node = self._root(starts)
         for label in seq:
             node = self._step(node, label)
@@ -241,7 +267,8 @@ class TightPlanner:
                 return None
         return self._plan(node, starts)
 
-    def _root(self, starts):
+    @staticmethod
+    def _root(starts):
         return ((), tuple(((st, ()),) for st in starts.values()), math.inf, 0, ())
 
     def _step(self, node, label):
@@ -256,12 +283,13 @@ class TightPlanner:
 
     def _apply(self, joint, label):
         """The joint state after pin ``label``, or None if forbidden for a branch."""
-        pin = self.pins[label]
+        planner = self.planner
+        pin = planner.pins[label]
         new_joint, margin, jumps = [], math.inf, 0
         for branches in joint:
             children = {}
             for state, history in branches:
-                res = self.transition(state, label)
+                res = planner.transition(state, label)
                 if res is None:
                     return None
                 kids, m, d_lo, d_hi, jump = res
@@ -269,21 +297,21 @@ class TightPlanner:
                 for kid in kids:
                     children.setdefault(kid, history + (Step(label, pin.y, pin.v_pin, d_lo, d_hi,
                                                              kid),))
-            if len(children) > self.max_branches:
-                self.stats.pruned_branching += 1
+            if len(children) > planner.max_branches:
+                planner.stats.pruned_branching += 1
                 return None
             new_joint.append(tuple(sorted(children.items())))
         return tuple(new_joint), margin, jumps
 
     def _count_sets(self, joint) -> int:
-        return len(merge_modulo([st.arc for branches in joint for st, _ in branches], self.order))
+        return len(merge_modulo([st.arc for branches in joint for st, _ in branches], self.planner.order))
 
     def _plan(self, node, starts) -> TightPlan:
         seq, joint, margin, jumps, sets_after = node
         finals = merge_arcs([st.arc for branches in joint for st, _ in branches])
         branches = {label: [list(history) for _, history in brs]
-                    for label, brs in zip(self.labels, joint)}
-        pins = [self.pins[p] for p in seq]
+                    for label, brs in zip(starts, joint)}
+        pins = [self.planner.pins[p] for p in seq]
         return TightPlan(seq, tuple(p.y for p in pins), tuple(p.v_pin for p in pins), finals,
                          self._count_sets(joint), float(margin), int(jumps), branches,
                          dict(starts), sets_after)

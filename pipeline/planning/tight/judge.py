@@ -1,0 +1,196 @@
+"""Candidate pin sequences replayed on the verification's trials and judged;
+the orienting ones certified.
+
+The complete search (``complete.FixedPinSearch``) decides which sequences to
+try and in what order; this module answers, for any batch of them, what the
+trials say.
+
+:class:`TrialBench` holds everything a judgement needs besides the pins
+themselves: the part and its resting states, the rollout settings (pin
+radius, model, kernel, belt, support family), the verification's trials
+(``verify.trial_inputs``; its held-out trials, ``verify.holdout_settings``)
+and the claim (tolerance, required share, confidence, rule). It replays
+sequences given as arrays of pin heights and speeds (one row per sequence)
+on rows of trials, counts the trials no one arc of the tolerance can hold
+(the screen), and judges the outcome by the claim rule
+(:func:`pipeline.planning.claims.orient.judge`).
+
+:class:`Certifier` decides which orienting verdicts count: a sequence must
+hold for the support family's worst member (``member_check``, set by the
+planner) and orient the part on the held-out trials as well.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
+
+from pipeline.parts.part import Part
+from pipeline.planning.claims import orient
+from pipeline.planning.claims.verify import holdout_settings, replay, trial_inputs
+from pipeline.planning.core.resting import resting_states
+from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
+from pipeline.progress import SILENT, Heartbeat, Stretch
+
+MAX_ROWS = 150_000  # trials replayed in one batch
+
+
+def stack(rows) -> tuple:
+    """Per-state trial arrays ``(theta, y_c, mu, offsets, support)`` joined into one set of rows."""
+    return tuple(np.concatenate([r[k] for r in rows]) for k in range(5))
+
+
+class TrialBench:
+    """The trials that judge candidate pin sequences for one part and friction.
+
+    Parameters
+    ----------
+    part : the part.
+    friction : a :class:`~pipeline.planning.core.settings.Friction`; the
+        trials sample it as verification does.
+    claims : what "orients" means (tolerance, required share, confidence, rule).
+    verify : the verification's trials (number, perturbation sizes, seed).
+    search : rollout settings (pin radius, model, kernel) and the belt (the
+        dynamic model at ``belt_speed`` mm/s and ``mu_s`` instead of the
+        quasi-static ``model``).
+    family : a :class:`~pipeline.parts.support_family.SupportFamily` whose
+        members the trials sample (``None`` or a uniform one: uniform pressure).
+
+    A sequence is a row of ``heights`` (mm) and of ``speeds`` (``v_pin /
+    v_b``, 0 for a fixed pin); a set of trial *rows* is what :func:`stack`
+    makes of :meth:`trials`.
+    """
+
+    def __init__(self, part: Part, friction: Friction, claims: ClaimSettings, verify: VerifySettings,
+                 search: SearchSettings, family=None):
+        self.part, self.mu_c, self.model = part, friction.value, search.model
+        belt_speed, mu_s = search.belt_speed, search.mu_s
+        self.belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
+        self.tolerance, self.required = claims.tolerance_deg, claims.required
+        self.confidence, self.rule = claims.confidence, claims.rule
+        self.cfg = verify.as_dict()
+        self.holdout = holdout_settings(self.cfg)
+        self.pin_radius = float(search.pin_radius)
+        self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **search.kernel_settings}
+        self.order = part.symmetry_order()
+        self.states = resting_states(part)
+        self.family = None if family is None or family.is_uniform else family
+        self.supports = None if self.family is None else self.family.kernel_supports
+
+    def trials(self, n_pins: int) -> list:
+        """The verification's trials for plans of ``n_pins`` pins (``verify.trial_inputs``), per state."""
+        return trial_inputs(self.states, self.mu_c, n_pins, self.cfg, self.family)
+
+    def held_out(self, n_pins: int) -> tuple:
+        """The held-out trials for plans of ``n_pins`` pins, as rows (``verify.holdout_settings``)."""
+        return stack(trial_inputs(self.states, self.mu_c, n_pins, self.holdout, self.family))
+
+    def allowed_failures(self, n_trials: int) -> int:
+        """The most failures of ``n_trials`` trials a plan may have and still
+        orient the part (negative: no plan can be claimed on so few trials)."""
+        return orient.max_failures(n_trials, self.required, self.confidence, self.rule)
+
+    def screen_rows(self, inputs, n_first: int, n_corners_wanted: int) -> tuple:
+        """A subset of the trials ``inputs`` (per state), as rows: the first
+        ``n_first`` random trials and ``n_corners_wanted`` evenly spread corners
+        of each state."""
+        n_random = int(self.cfg["trials"])
+        rows = []
+        for trials in inputs:
+            n_corners = trials[0].size - n_random
+            pick = list(range(min(n_first, n_random)))
+            if n_corners:
+                step = max(1, n_corners // n_corners_wanted)
+                pick += list(range(n_random, trials[0].size, step))[:n_corners_wanted]
+            rows.append(tuple(x[pick] for x in trials))
+        return stack(rows)
+
+    def replay(self, heights, speeds, rows, stretch: Stretch = SILENT):
+        """Final orientations ``(sequences, trials)`` and jam flags of the
+        sequences ``heights``, ``speeds`` on ``rows`` (``stretch`` is told how
+        far the replay has got)."""
+        th, yc, mu, offs, sup = rows
+        n_trials, n_plans = th.size, heights.shape[0]
+        tf, _, jam, _ = replay(self.part, np.repeat(heights, n_trials, axis=0),
+                               np.repeat(speeds, n_trials, axis=0), np.tile(th, n_plans), np.tile(yc, n_plans),
+                               np.tile(mu, n_plans), np.tile(offs, (n_plans, 1)), self.pin_radius,
+                               self.model, self.kernel["ds_max"], self.kernel["tol"], **self.belt,
+                               support=np.tile(sup, n_plans), supports=self.supports, stretch=stretch)
+        return tf.reshape(n_plans, n_trials), (jam != "").reshape(n_plans, n_trials)
+
+    def failures(self, heights, speeds, rows, stretch: Stretch = SILENT) -> np.ndarray:
+        """Trials of ``rows`` that no one arc of the tolerance can hold, per
+        sequence, in batches of at most ``MAX_ROWS`` replays (``stretch`` is
+        told the share of sequences done)."""
+        n = heights.shape[0]
+        out = np.empty(n, dtype=int)
+        step = max(1, MAX_ROWS // rows[0].size)
+        for start in range(0, n, step):
+            stop = min(n, start + step)
+            tf, jam = self.replay(heights[start:stop], speeds[start:stop], rows, stretch.part(start / n, stop / n))
+            for k in range(stop - start):
+                held, _ = orient.best_arc(tf[k][~jam[k]], self.tolerance, self.order)
+                out[start + k] = rows[0].size - held
+        return out
+
+    def judge(self, heights, speeds, rows, interval: bool = False, stretch: Stretch = SILENT):
+        """The claim's verdict (:func:`~pipeline.planning.claims.orient.judge`)
+        of each sequence on ``rows``, one at a time; ``interval`` adds the
+        width's bootstrap interval. The replay runs when the first is asked for."""
+        tf, jam = self.replay(heights, speeds, rows, stretch)
+        for k in range(heights.shape[0]):
+            yield orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order, self.required,
+                               self.confidence, interval, self.rule)
+
+
+class Certifier:
+    """Which orienting verdicts count: those that hold for the support
+    family's worst member and are confirmed on held-out trials.
+
+    Parameters
+    ----------
+    bench : the :class:`TrialBench` whose held-out trials certify.
+
+    ``member_check`` is ``None`` (no family check) or a function of a plan's
+    ``(labels, heights, verdict, speeds)`` that is True when the family's
+    worst member keeps the plan in its set (``worst_member.FamilyChecker``,
+    set by the planner).
+    """
+
+    def __init__(self, bench: TrialBench):
+        self.bench = bench
+        self.member_check = None
+
+    def holds_for_family(self, plan) -> bool:
+        """True without a family check; else whether the family's worst member
+        found by ``member_check`` leaves the plan's set (a plan it breaks no
+        longer orients: its verdict says so, and the search goes on as after a
+        failed verification)."""
+        if self.member_check is None:
+            return True
+        if self.member_check(plan.labels, plan.heights, plan.verdict, plan.speeds):
+            return True
+        plan.verdict = dict(plan.verdict, orients=False, broken_by_worst_member=True)
+        return False
+
+    def certify(self, found: list, heights, speeds, n_pins: int, beat: Heartbeat) -> list:
+        """The plans of ``found`` (whose pins are the rows of ``heights`` and
+        ``speeds``) whose verdict on the held-out trials orients the part; each
+        plan's ``verdict`` becomes its held-out verdict (with the width's
+        bootstrap interval) and ``selection`` keeps the verdict on the trials
+        that chose it. ``beat`` hears how far it got."""
+        if not found:
+            return []
+        rows = self.bench.held_out(n_pins)
+        out = []
+        step = max(1, MAX_ROWS // rows[0].size)
+        with beat:
+            for start in range(0, len(found), step):
+                stop = min(len(found), start + step)
+                verdicts = self.bench.judge(heights[start:stop], speeds[start:stop], rows, interval=True,
+                                            stretch=beat.stretch(start, stop))
+                for plan, held in zip(found[start:start + step], verdicts):
+                    plan.selection, plan.verdict = plan.verdict, held
+                    if held["orients"]:
+                        out.append(plan)
+        return out
