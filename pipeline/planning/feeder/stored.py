@@ -59,7 +59,7 @@ def layout_stored(result, planner: PlannerSettings, plan_number: int = 1, mu_tex
                                                                     quasi_static)
     out = layout_plan(part, list(plan.pins), heights, states, mu_c, pin_radius, model=result.model,
                       belt_speed=None if quasi_static else belt_speed, mu_s=mu_s, settings=cfg,
-                      perturb=planner.verify.as_dict())
+                      perturb=_verify_section(planner))
     out["belt_speed_mm_s"] = None if belt_speed is None else float(belt_speed)
     out["mu_s"] = mu_s
     out["throughput_per_min"] = None if belt_speed is None else 60.0 * belt_speed / out["pitch_mm"]
@@ -101,6 +101,15 @@ def _record_speed_limit(out: dict, curve: dict, trials: int, stored: dict | None
         "source": "stored with the plan" if curve is stored else "computed for this layout",
         "required_fraction": 0.99, "speeds_mm_s": list(DEFAULT_SPEEDS), "bisection_mm_s": 5.0,
         "curve": curve["curve"]}
+
+
+def _verify_section(planner: PlannerSettings) -> dict:
+    """The verification's settings as the config's ``verify`` section gives them
+    (the trials' sizes and the claim's share, confidence and rule): the
+    perturbation the layout's trials draw, recorded whole in its ``method``."""
+    claims = planner.claims
+    return dict(planner.verify.as_dict(), required=claims.required, confidence=claims.confidence,
+                rule=claims.rule)
 
 
 def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, planner, cfg) -> tuple:
