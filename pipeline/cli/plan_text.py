@@ -66,6 +66,7 @@ def plan_json(result, mode) -> dict:
                    support_family=(first.get("support_family") or {}).get("label", "uniform"),
                    orients=first.get("orients"), pins_used=first.get("pins_used"),
                    family_certificate=first.get("family_certificate"),
+                   nearest_yes=first.get("nearest_yes"),
                    evidence=(first.get("fixed_pin_search") or {}).get("evidence"),
                    recommended=_plan_summary(first["recommended"]) if first["recommended"] else None,
                    plans=[_plan_summary(p) for p in first["plans"]],
@@ -109,6 +110,11 @@ def print_plan_result(result, part, config, mode):
             print(f"  {family_certificate_line(cert)}")
         if t.warning:
             print(f"  WARNING: {t.warning}")
+        nearest = t.extra.get("nearest_yes")
+        if nearest:
+            from pipeline.planning import nearest_yes_lines
+            for line in nearest_yes_lines(nearest):
+                print(f"  {line}")
         for k, plan in enumerate(t.plans, start=1):
             v = plan.verification
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))

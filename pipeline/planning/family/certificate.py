@@ -105,7 +105,33 @@ def family_certificate(part, heights, family, check: dict, st, n_members: int = 
                   "share_outside_upper_bound": round(share_upper_bound(leaving, len(members), confidence), 5),
                   "in_tolerance": verdict["in_tolerance"], "width_deg": verdict["width_deg"],
                   "orients": verdict["orients"]},
+        "claim": scenario_claim(leaving, len(members), confidence),
     }
+
+
+def scenario_claim(violations: int, members: int, confidence: float = DEFAULT_CONFIDENCE) -> dict:
+    """What the fresh members support, as epsilon and beta: with confidence
+    ``1 - beta``, a member drawn the way the family text draws them puts a
+    final outside the set with probability at most ``epsilon`` (the one-sided
+    Clopper-Pearson bound of ``violations`` in ``members``; with none, the
+    scenario approach's ``members >= ln(1/beta) / -ln(1 - epsilon)``, Campi
+    and Garatti). The worst-member search adds no probability: it is a
+    heuristic, evidence about the family's edge, not a proof."""
+    epsilon = share_upper_bound(violations, members, confidence)
+    beta = 1.0 - confidence
+    return {"epsilon": round(epsilon, 5), "beta": round(beta, 6), "members": int(members),
+            "violations": int(violations),
+            "statement": (f"with confidence {1 - beta:.4g}, a member drawn as the family text draws them ends "
+                          f"outside the set with probability at most {100 * epsilon:.2f} % ({violations} of "
+                          f"{members} fresh members did)"),
+            "search": ("the worst-member search is a heuristic (multi-start Nelder-Mead from the family's "
+                       "corners): finding no member outside is evidence about the family's edge, not a proof")}
+
+
+def members_needed(epsilon: float, beta: float) -> int:
+    """Members with no violation needed for ``epsilon`` at confidence ``1 - beta``:
+    ``ceil(ln(1/beta) / -ln(1 - epsilon))`` (299 for 1 % at 0.05)."""
+    return int(np.ceil(np.log(1.0 / beta) / -np.log1p(-epsilon)))
 
 
 def family_certificate_line(cert: dict) -> str:
@@ -119,7 +145,8 @@ def family_certificate_line(cert: dict) -> str:
             f"{where} {abs(w.get('outside_deg') or 0):.2f} deg); {f['members_outside']} of {f['members']} "
             f"fresh members leave the set (share <= {100 * f['share_outside_upper_bound']:.2f} % at "
             f"{100 * f['confidence']:g} % confidence), {f['in_tolerance']} of {f['trials']} fresh trials "
-            f"in one set of {cert['tolerance_deg']:g} deg")
+            f"in one set of {cert['tolerance_deg']:g} deg; epsilon {100 * cert['claim']['epsilon']:.2f} %, "
+            f"beta {cert['claim']['beta']:g}; the worst-member search is a heuristic")
 
 
 # --------------------------------------------------------------------------- what downstream stages assume

@@ -69,6 +69,7 @@ EDGE_POINTS = 5  # points per inset edge (besides its corner) the largest triang
 MAX_ROUNDS = 3  # worst member found -> joins the verification -> searched again
 _PENALTY = 1.0e3
 _POOL = 20_000
+PRESCREEN_ROWS = 200_000  # rollouts per batch of the kept breakers' prescreen
 
 
 # --------------------------------------------------------------------------- parameter spaces
@@ -563,26 +564,123 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
             "members": len(joined.members), "trials": verdict["trials"],
             "verdict": verdict, "set_deg": None if arc is None else [round(arc[0] % period, 3), round(arc[1], 3)],
             "worst_member": None if worst is None else worst.to_dict(), "rounds": rounds,
-            "_family": joined}
+            "_family": joined, "_worst": worst}
 
 
 class FamilyChecker:
     """What the complete search asks of a plan that passed its sampled
     verification: does the worst member of the family break it?
     Results are kept per pin sequence (``results``); each search tells
-    ``progress`` (a function of one line) how far it has got."""
+    ``progress`` (a function of one line) how far it has got.
+
+    The worst members that broke a plan are kept (``breakers``): a member
+    that breaks one plan often breaks its neighbours. Before a search, each
+    kept member is replayed on the new plan's probe (the resting states'
+    nominal rollouts and the perturbation box's corners); one whose finals
+    leave the plan's set breaks it without a search. :meth:`prescreen` asks
+    the same of many sequences at once before they are judged, with no set
+    yet: when the kept members' probe finals together fit in no arc of the
+    tolerance, no set can hold them and the sequence is broken. Both are
+    exact for the members they replay (a sequence they reject is broken by a
+    member of the family, shown by rollouts); they spare the searches and
+    the verifications, and a member that breaks every candidate of a level
+    ends that level before its sequences are judged.
+    """
 
     def __init__(self, part, family: SupportFamily, settings: FamilyCheckSettings, progress=None):
         self.part, self.family, self.settings, self.progress = part, family, settings, progress
         member_space(part, family)  # an empty space is an error before any search
         self.results: dict = {}
+        self.breakers: list = []
+        self.spared = {"searches": 0, "sequences": 0}
 
     def __call__(self, labels, heights, verdict: dict | None = None, speeds=()) -> bool:
         key = self.key(labels, heights)
         if key not in self.results:
-            self.results[key] = check_plan_for_family(self.part, heights, self.family, self.settings,
-                                                      verdict, speeds, self.progress, " ".join(labels))
+            known = self._known_breaker(heights, verdict, speeds)
+            if known is not None:
+                self.results[key] = known
+                self.spared["searches"] += 1
+            else:
+                self.results[key] = check_plan_for_family(self.part, heights, self.family, self.settings,
+                                                          verdict, speeds, self.progress, " ".join(labels))
+                worst = self.results[key]["_worst"]
+                if worst is not None and worst.breaks:
+                    self.breakers.append(worst.support)
+            self.results[key]["_speeds"] = tuple(float(v) for v in speeds)
         return self.results[key]["holds"]
+
+    def _known_breaker(self, heights, verdict, speeds) -> dict | None:
+        """The check's record when a kept breaker leaves the plan's claimed set
+        (``verdict``'s set widened to the tolerance); else None."""
+        arc = None if verdict is None else claimed_arc(verdict, self.settings.tolerance)
+        if not self.breakers or arc is None:
+            return None
+        st = self.settings
+        probe = PlanProbe(self.part, tuple(float(h) for h in heights), st.mu_c, st.verify, st.pin_radius,
+                          st.model, st.kernel, tuple(float(v) for v in speeds))
+        period = 360.0 / self.part.symmetry_order()
+        for k, support in enumerate(self.breakers):
+            obj, tf = score(probe, support, arc, period)
+            if obj > 0:
+                worst = WorstMember(support, {"member": support.label}, obj, tf, 1,
+                                    f"worst member kept from an earlier plan ({k + 1} of {len(self.breakers)})",
+                                    probe.nominal)
+                return {"holds": False, "space": member_space(self.part, self.family).describe(),
+                        "budget": st.budget, "members": len(self.family.members),
+                        "trials": verdict["trials"], "verdict": verdict,
+                        "set_deg": [round(arc[0] % period, 3), round(arc[1], 3)],
+                        "worst_member": worst.to_dict(), "rounds": [], "_family": self.family,
+                        "_worst": worst}
+        return None
+
+    def prescreen(self, heights: np.ndarray, speeds: np.ndarray, tolerance: float) -> np.ndarray:
+        """True for each sequence (rows of ``heights``, ``speeds``) that a kept
+        breakers break whatever the sequence's set: one of their probe rollouts
+        jams, or their probe finals together fit in no arc of ``tolerance`` degrees.
+
+        In two stages, each exact: the resting states' nominal rollouts first
+        (if they alone fit in no arc, the whole probe does not), then the
+        whole probe for the sequences left."""
+        heights, speeds = np.atleast_2d(heights), np.atleast_2d(speeds)
+        broken = np.zeros(heights.shape[0], bool)
+        if not self.breakers or heights.size == 0:
+            return broken
+        st = self.settings
+        probe = PlanProbe(self.part, (0.0,) * heights.shape[1], st.mu_c, st.verify, st.pin_radius, st.model,
+                          st.kernel)
+        nominal = tuple(x[probe.nominal] for x in probe.inputs)
+        for rows in (nominal, probe.inputs):
+            left = np.flatnonzero(~broken)
+            if left.size == 0:
+                break
+            broken[left] = self._unfit(heights[left], speeds[left], rows, tolerance)
+        self.spared["sequences"] += int(broken.sum())
+        return broken
+
+    def _unfit(self, heights, speeds, rows, tolerance) -> np.ndarray:
+        """True per sequence where the kept breakers' finals on ``rows``
+        (``theta, y_c, mu, offsets``) jam or, all together, fit in no arc of
+        ``tolerance`` (the claimed set must hold every member's)."""
+        st, members = self.settings, len(self.breakers)
+        th, yc, mu, offs = rows
+        per = members * th.size  # rollouts per sequence
+        order = self.part.symmetry_order()
+        kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
+        out = np.zeros(heights.shape[0], bool)
+        step = max(1, PRESCREEN_ROWS // per)
+        for start in range(0, heights.shape[0], step):
+            h, v = heights[start:start + step], speeds[start:start + step]
+            n = h.shape[0] * members
+            tf, _, jam, _ = replay(self.part, np.repeat(h, per, axis=0), np.repeat(v, per, axis=0),
+                                   np.tile(th, n), np.tile(yc, n), np.tile(mu, n), np.tile(offs, (n, 1)),
+                                   st.pin_radius, st.model, **kw,
+                                   support=np.tile(np.repeat(np.arange(members), th.size), h.shape[0]),
+                                   supports=list(self.breakers))
+            tf, jam = tf.reshape(h.shape[0], per), (jam != "").reshape(h.shape[0], per)
+            for i in range(h.shape[0]):  # every kept member's finals must lie in the one claimed arc
+                out[start + i] = jam[i].any() or orient.best_arc(tf[i], tolerance, order)[0] < per
+        return out
 
     @staticmethod
     def key(labels, heights) -> tuple:

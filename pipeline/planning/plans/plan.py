@@ -34,6 +34,7 @@ from pipeline.planning.tight.complete import (FixedPinSearch, FixedPlan, FixedSe
                                               robust_order)
 from pipeline.planning.family.members import planning_family
 from pipeline.planning.family.certificate import family_certificate
+from pipeline.planning.family.nearest import nearest_yes
 from pipeline.planning.family.worst_member import FamilyChecker, FamilyCheckSettings
 from pipeline.planning.tight.store import load_lattice, save_lattice
 from pipeline.planning.claims.orient import describe_claim, judge_verification
@@ -487,3 +488,5 @@ def certify_for_family(result: dict, part: Part, settings: PlannerSettings, fami
             f"{len(broken)} plan(s) that passed the sampled verification are broken by a worst member "
             f"(e.g. {worst['parameters']}, nominal finals {worst['nominal_finals_deg']} deg, "
             f"{worst['outside_deg']:.2f} deg outside the set)")
+    result["nearest_yes"] = nearest_yes(part, family, checker, result,
+                                        lambda text: planning_family(part, text, settings), checker.progress)

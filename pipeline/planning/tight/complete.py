@@ -365,6 +365,7 @@ class LevelScreen:
             fails = bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
             alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
             record["screened_out"] += int(block.size - alive.size)
+            alive = self._drop_known_broken(alive, record)
             judging = beat.stretch(done + share * block.size, done + block.size)
             done += block.size
             for start in range(0, alive.size, step):
@@ -384,6 +385,16 @@ class LevelScreen:
         if done < order.size:
             beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
         return found, found_idx, judged
+
+    def _drop_known_broken(self, alive, record):
+        """``alive`` without the sequences a worst member kept from earlier
+        plans breaks (``Certifier.broken_by_known_members``): with a support
+        family, a member that broke every candidate so far ends the level
+        without judging the rest. Counted in ``record``."""
+        broken = self.certifier.broken_by_known_members(*self.sequences(alive))
+        if broken.any():
+            record["broken_by_known_member"] = record.get("broken_by_known_member", 0) + int(broken.sum())
+        return alive[~broken]
 
     def several_sets(self, candidates: int, progress=None) -> list:
         """The level's sequences whose nominal finals fall into the fewest

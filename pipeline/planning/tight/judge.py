@@ -173,6 +173,15 @@ class Certifier:
         plan.verdict = dict(plan.verdict, orients=False, broken_by_worst_member=True)
         return False
 
+    def broken_by_known_members(self, heights, speeds) -> np.ndarray:
+        """True for each sequence (rows of ``heights``, ``speeds``) that a worst
+        member kept from earlier plans breaks whatever its set
+        (``FamilyChecker.prescreen``); all False without a family check."""
+        prescreen = getattr(self.member_check, "prescreen", None)
+        if prescreen is None:
+            return np.zeros(np.atleast_2d(heights).shape[0], bool)
+        return prescreen(heights, speeds, self.bench.tolerance)
+
     def certify(self, found: list, heights, speeds, n_pins: int, beat: Heartbeat) -> list:
         """The plans of ``found`` (whose pins are the rows of ``heights`` and
         ``speeds``) whose verdict on the held-out trials orients the part; each

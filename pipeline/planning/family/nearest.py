@@ -1,0 +1,245 @@
+"""The nearest "yes" when no plan holds for a support family.
+
+When the complete search finds no plan of up to ``N`` pins that holds for a
+family, an engineer asks what would make it hold. This module answers along
+each axis that applies, starting from the plans the search had to reject
+(those that passed the sampled verification and that a worst member broke,
+best first), and verifies each answer the way any family plan is verified:
+the worst-member search with the breaking members joining the verification
+(:func:`~pipeline.planning.family.worst_member.check_plan_for_family`), then
+a certificate on fresh members (:func:`~pipeline.planning.family.certificate.family_certificate`).
+
+The axes:
+
+* **the largest certified sub-family** in the family's own terms:
+
+  - ``tripods``: the smallest leg inset (legs at least ``F a`` inside the
+    outline) for which a plan holds, the family as given otherwise;
+  - ``friction``: the widest friction range about the middle of a range
+    ``lo:hi`` for which a plan holds (the family as given);
+
+* **a looser tolerance**: the smallest ``tolerance_deg`` for which a plan
+  holds for the whole family;
+* **moving pins**: what the search's moving-pin stage found (it runs when
+  pin speeds are configured and no fixed-pin plan holds);
+* **more pins or a wider pin grid**: not searched here (a deeper complete
+  search costs more than the rest together); the entry says how to run it.
+
+Each number is found by bisection (``STEPS`` halvings) on the assumption
+that holding is monotone along the axis (a smaller family or a looser
+tolerance does not break a plan that held): an assumption of the search,
+not a guarantee; the certificate at the answer is the evidence.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+
+from pipeline.errors import PinfeedError
+from pipeline.parts.support_family import DEFAULT_INSET
+from pipeline.planning.family.certificate import family_certificate
+from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family, member_space
+
+STEPS = 5  # bisection halvings per axis
+PLANS_TRIED = 3  # rejected plans tried on each axis, best first
+MAX_TOLERANCE = 45.0  # deg: the loosest tolerance asked about
+INSET_RESOLUTION = 0.005  # of a: the largest inset with a member is found to this
+
+
+def rejected_plans(checker: FamilyChecker, n: int = PLANS_TRIED) -> list:
+    """The plans a worst member broke after they passed the sampled
+    verification, most trials in one set first: ``(labels, heights, speeds)``."""
+    broken = [(key, r) for key, r in checker.results.items()
+              if not r["holds"] and r.get("verdict", {}).get("orients")]
+    broken.sort(key=lambda kr: -kr[1]["verdict"]["in_tolerance"])
+    return [(key[0], key[1], r.get("_speeds", ())) for key, r in broken[:n]]
+
+
+def _holds(part, plans, family, st, progress) -> tuple | None:
+    """The first of ``plans`` that holds for ``family`` under ``st``:
+    ``(plan, check)``, or None."""
+    for labels, heights, speeds in plans:
+        check = check_plan_for_family(part, heights, family, st, None, speeds, progress, " ".join(labels))
+        if check["holds"]:
+            return (labels, heights, speeds), check
+    return None
+
+
+def _bisect(holds_at, lo: float, hi: float, steps: int = STEPS):
+    """``(x, found)`` with ``x`` the smallest value in ``[lo, hi]`` found to
+    hold (``holds_at(x)`` not None), assuming it holds from some value on;
+    ``found`` is ``holds_at``'s answer there. ``(None, None)`` when ``hi``
+    does not hold."""
+    top = holds_at(hi)
+    if top is None:
+        return None, None
+    best = (hi, top)
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        got = holds_at(mid)
+        if got is None:
+            lo = mid
+        else:
+            hi, best = mid, (mid, got)
+    return best
+
+
+def _answer(axis: str, value, unit: str, words: str, part, found, family, st, progress) -> dict:
+    """The record of one axis's answer, with its certificate on fresh members."""
+    (labels, heights, speeds), check = found
+    cert = family_certificate(part, heights, family, check, st, speeds=speeds, progress=progress)
+    return {"axis": axis, "found": True, "value": value, "unit": unit, "family": family.label,
+            "statement": words, "plan": list(labels), "pin_heights_mm": [float(h) for h in heights],
+            "pin_speeds": [float(v) for v in speeds], "holds": bool(cert["holds"]),
+            "certificate": cert}
+
+
+def _not_found(axis: str, words: str) -> dict:
+    return {"axis": axis, "found": False, "statement": words}
+
+
+def _with_inset(label: str, inset: float) -> str:
+    """The family text ``label`` with its tripods' inset set to ``inset``."""
+    def one(item: str) -> str:
+        item = item.strip()
+        if not item.startswith("tripods"):
+            return item
+        fields = [f for f in item.split(":") if not f.startswith("inset=")]
+        return ":".join(fields + [f"inset={inset:.4g}"])
+    return ";".join(one(i) for i in label.split(";"))
+
+
+def _tripod_inset(label: str) -> float | None:
+    """The tripods' inset of family text ``label`` (None: no tripods item)."""
+    for item in label.split(";"):
+        if item.strip().startswith("tripods"):
+            m = re.search(r"inset=([0-9.eE+-]+)", item)
+            return float(m.group(1)) if m else DEFAULT_INSET
+    return None
+
+
+def largest_inset(part, label: str, lo: float) -> float:
+    """The largest tripod inset (share of ``a``) that still has a member, to
+    ``INSET_RESOLUTION``, searched above ``lo``."""
+    def has_member(f):
+        try:
+            member_space(part, _with_inset(label, f))
+            return True
+        except PinfeedError:
+            return False
+    hi = lo
+    while has_member(hi + 0.05) and hi < 1.0:
+        hi += 0.05
+    top = hi + 0.05
+    while top - hi > INSET_RESOLUTION:
+        mid = 0.5 * (hi + top)
+        hi, top = (mid, top) if has_member(mid) else (hi, mid)
+    return hi
+
+
+def inset_axis(part, family, plans, st, make_family, progress=None) -> dict:
+    """The smallest tripod inset for which one of ``plans`` holds (the
+    largest sub-family of legs far enough inside the outline)."""
+    inset0 = _tripod_inset(family.label)
+    if inset0 is None:
+        return _not_found("inset", "the family has no tripods: no inset to narrow")
+    top = largest_inset(part, family.label, inset0)
+    families = {}
+
+    def holds_at(f):
+        key = round(f, 4)
+        families[key] = families.get(key) or make_family(_with_inset(family.label, key))
+        return _holds(part, plans, families[key], st, progress)
+    value, found = _bisect(holds_at, inset0, top)
+    if found is None:
+        return _not_found("inset", f"no plan tried holds even for tripods at the largest inset with a "
+                                   f"member ({top:.3f} a)")
+    value = round(value, 4)
+    return _answer("inset", value, "a", f"tripods whose legs stay at least {value:.3f} a "
+                   f"({value * part.a:.2f} mm) inside the {'material' if part.holes else 'outline'}",
+                   part, found, families[value], st, progress)
+
+
+def friction_axis(part, family, plans, st, progress=None) -> dict:
+    """The widest friction range about the middle of ``st.mu_c`` for which one of ``plans`` holds."""
+    if not isinstance(st.mu_c, (tuple, list)):
+        return _not_found("friction", f"the friction is one value ({st.mu_c:g}): no range to narrow")
+    lo, hi = (float(x) for x in st.mu_c)
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+
+    def at(h):  # h: the share of the half-width given up
+        w = half * (1.0 - h)
+        return (round(mid - w, 4), round(mid + w, 4)) if w > 1e-9 else round(mid, 4)
+
+    def holds_at(h):
+        return _holds(part, plans, family, dataclasses.replace(st, mu_c=at(h)), progress)
+    value, found = _bisect(holds_at, 0.0, 1.0)
+    if found is None:
+        return _not_found("friction", f"no plan tried holds even at the middle friction {mid:g}")
+    mu = at(value)
+    text = f"{mu[0]:g}:{mu[1]:g}" if isinstance(mu, tuple) else f"{mu:g}"
+    return _answer("friction", text, "", f"a friction range {text} (the family as given)", part, found,
+                   family, dataclasses.replace(st, mu_c=mu), progress)
+
+
+def tolerance_axis(part, family, plans, st, progress=None) -> dict:
+    """The smallest tolerance (deg, to 0.5 deg) for which one of ``plans`` holds for the whole family."""
+    top = min(MAX_TOLERANCE, 180.0 / part.symmetry_order())
+
+    def holds_at(t):
+        return _holds(part, plans, family, dataclasses.replace(st, tolerance=math.ceil(2 * t) / 2), progress)
+    value, found = _bisect(holds_at, st.tolerance, top)
+    if found is None:
+        return _not_found("tolerance", f"no plan tried holds for the family within {top:g} deg")
+    value = math.ceil(2 * value) / 2
+    return _answer("tolerance", value, "deg", f"a tolerance of {value:g} deg (the family as given)", part,
+                   found, family, dataclasses.replace(st, tolerance=value), progress)
+
+
+def moving_axis(result: dict) -> dict:
+    """What the search's moving-pin stage found for the family."""
+    stage = result.get("moving_pin_search")
+    if not stage:
+        return _not_found("moving pins", "not searched: no pin speeds configured (planner.dynamic.speeds)")
+    return _not_found("moving pins", "searched after the fixed pins: no moving-pin plan holds for the family "
+                                     "either")
+
+
+def nearest_yes(part, family, checker: FamilyChecker, result: dict, make_family, progress=None) -> dict:
+    """Every axis's nearest "yes" for a family no plan holds for (see the
+    module docstring); ``make_family`` turns family text into the planning
+    family (with its extremes)."""
+    plans = rejected_plans(checker)
+    st = checker.settings
+    if not plans:
+        return {"plans_tried": [], "axes": [_not_found(a, "no plan passed the sampled verification: nothing "
+                                                         "to loosen") for a in ("inset", "friction", "tolerance")]
+                + [moving_axis(result), _more_pins(result)]}
+    axes = [inset_axis(part, family, plans, st, make_family, progress),
+            friction_axis(part, family, plans, st, progress),
+            tolerance_axis(part, family, plans, st, progress),
+            moving_axis(result), _more_pins(result)]
+    return {"plans_tried": [list(p[0]) for p in plans], "steps": STEPS,
+            "assumes": "holding is monotone along each axis (bisection)", "axes": axes}
+
+
+def _more_pins(result: dict) -> dict:
+    depth = result.get("depth")
+    return _not_found("more pins", f"not searched (a deeper complete search costs more than the rest): "
+                                   f"run with --depth {depth + 1 if depth else 'N+1'} or a finer --pins grid")
+
+
+def nearest_yes_lines(nearest: dict) -> list[str]:
+    """The nearest "yes" for people: a heading and one line per axis."""
+    out = ["the nearest \"yes\" (each verified: worst-member search, then fresh members):"]
+    for axis in nearest["axes"]:
+        if not axis["found"]:
+            out.append(f"  {axis['axis']}: {axis['statement']}")
+            continue
+        claim = axis["certificate"]["claim"]
+        verdict = "holds" if axis["holds"] else "does NOT hold on fresh members"
+        out.append(f"  {axis['axis']}: {axis['statement']}: {' '.join(axis['plan'])} {verdict} "
+                   f"(epsilon {100 * claim['epsilon']:.2f} % at beta {claim['beta']:g}, "
+                   f"{claim['violations']} of {claim['members']} fresh members outside)")
+    return out
