@@ -94,3 +94,42 @@ def test_the_claim_states_epsilon_and_beta():
     assert "heuristic" in claim["search"] and "not a proof" in claim["search"]
     with_one = scenario_claim(1, 300, 0.95)
     assert with_one["epsilon"] > claim["epsilon"]
+
+
+def _arc_holds_brute(must, tolerance, others, jammed, allowed, period=360.0):
+    """Every start on a 0.01-degree grid (and at every angle) tried."""
+    need = len(others) - allowed
+    starts = np.concatenate([np.arange(0.0, period, 0.01), np.mod(must, period), np.mod(others, period),
+                             np.mod(np.asarray(others) - tolerance, period)])
+    for s in starts:
+        if np.all(np.mod(np.asarray(must) - s, period) <= tolerance + 1e-9):
+            held = np.sum((np.mod(np.asarray(others) - s, period) <= tolerance + 1e-9) & ~np.asarray(jammed))
+            if held >= need:
+                return True
+    return False
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_arc_holds_matches_trying_every_start(seed):
+    from pipeline.planning.family.worst_member import arc_holds
+    rng = np.random.default_rng(seed)
+    centre = rng.uniform(0, 360)
+    must = centre + rng.uniform(-5, 5, rng.integers(1, 5))
+    others = centre + rng.normal(0, 3, 15)
+    jammed = rng.random(15) < 0.1
+    allowed = int(rng.integers(0, 4))
+    expect = _arc_holds_brute(must, 10.0, others, jammed, allowed)
+    assert arc_holds(must, 10.0, 1, (others, jammed), allowed) == expect
+    assert arc_holds(must, 10.0) == _arc_holds_brute(must, 10.0, np.zeros(0), np.zeros(0, bool), 0)
+
+
+def test_the_random_arcs_have_both_answers():
+    from pipeline.planning.family.worst_member import arc_holds
+    answers = set()
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        centre = rng.uniform(0, 360)
+        must = centre + rng.uniform(-5, 5, rng.integers(1, 5))
+        others = centre + rng.normal(0, 3, 15)
+        answers.add(arc_holds(must, 10.0, 1, (others, rng.random(15) < 0.1), int(rng.integers(0, 4))))
+    assert answers == {True, False}

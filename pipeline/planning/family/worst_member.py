@@ -567,6 +567,36 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
             "_family": joined, "_worst": worst}
 
 
+def arc_holds(must, tolerance: float, order: int = 1, others=None, allowed: int = 0) -> bool:
+    """Whether one arc of ``tolerance`` degrees (modulo ``360 / order``) holds
+    every angle of ``must`` and all but ``allowed`` of ``others`` (``(angles,
+    jammed)``; a jammed one is never held)."""
+    period = 360.0 / order
+    x = np.sort(np.mod(np.asarray(must, float), period))
+    if x.size == 0:
+        return True
+    gaps = np.diff(np.concatenate([x, [x[0] + period]]))
+    k = int(np.argmax(gaps))
+    first, span = x[(k + 1) % x.size], period - gaps[k]  # the smallest arc holding ``must``
+    if span > tolerance + 1e-9:
+        return False
+    if others is None:
+        return True
+    theta, jammed = np.asarray(others[0], float)[~np.asarray(others[1], bool)], others[1]
+    need = len(jammed) - int(allowed)
+    if need <= 0:
+        return True
+    # Arcs that hold ``must`` start in [first - slack, first]; the count of
+    # ``others`` held changes only where an arc's end reaches one of them or its
+    # start passes one, so those starts and the range's ends are enough.
+    slack = tolerance - span
+    rel = np.mod(theta - (first - slack), period)
+    ends = rel - tolerance
+    starts = np.concatenate([[0.0, slack], rel[rel <= slack], ends[(ends >= 0.0) & (ends <= slack)]])
+    held = ((np.mod(rel[None, :] - starts[:, None], period) <= tolerance + 1e-9).sum(axis=1))
+    return bool(held.max() >= need)
+
+
 class FamilyChecker:
     """What the complete search asks of a plan that passed its sampled
     verification: does the worst member of the family break it?
@@ -589,7 +619,7 @@ class FamilyChecker:
 
     def __init__(self, part, family: SupportFamily, settings: FamilyCheckSettings, progress=None):
         self.part, self.family, self.settings, self.progress = part, family, settings, progress
-        member_space(part, family)  # an empty space is an error before any search
+        self.space = member_space(part, family).describe()  # an empty space is an error before any search
         self.results: dict = {}
         self.breakers: list = []
         self.spared = {"searches": 0, "sequences": 0}
@@ -626,7 +656,7 @@ class FamilyChecker:
                 worst = WorstMember(support, {"member": support.label}, obj, tf, 1,
                                     f"worst member kept from an earlier plan ({k + 1} of {len(self.breakers)})",
                                     probe.nominal)
-                return {"holds": False, "space": member_space(self.part, self.family).describe(),
+                return {"holds": False, "space": self.space,
                         "budget": st.budget, "members": len(self.family.members),
                         "trials": verdict["trials"], "verdict": verdict,
                         "set_deg": [round(arc[0] % period, 3), round(arc[1], 3)],
@@ -634,14 +664,22 @@ class FamilyChecker:
                         "_worst": worst}
         return None
 
-    def prescreen(self, heights: np.ndarray, speeds: np.ndarray, tolerance: float) -> np.ndarray:
-        """True for each sequence (rows of ``heights``, ``speeds``) that a kept
-        breakers break whatever the sequence's set: one of their probe rollouts
-        jams, or their probe finals together fit in no arc of ``tolerance`` degrees.
+    def prescreen(self, heights: np.ndarray, speeds: np.ndarray, tolerance: float, screened=None,
+                  allowed: int = 0) -> np.ndarray:
+        """True for each sequence (rows of ``heights``, ``speeds``) that the kept
+        breakers break whatever the sequence's set.
 
-        In two stages, each exact: the resting states' nominal rollouts first
-        (if they alone fit in no arc, the whole probe does not), then the
-        whole probe for the sequences left."""
+        A plan for the family claims one arc of ``tolerance`` degrees that holds
+        every kept member's probe finals (the resting states' nominal rollouts
+        and the perturbation box's corners) and all but ``allowed`` of its
+        verification trials. ``screened``, ``(finals, jammed)`` arrays
+        ``(sequences, k)`` of some of those trials, makes the test sharper: no
+        arc may then leave out more than ``allowed`` of them. A sequence is
+        broken when a kept member's probe rollout jams or no such arc exists.
+
+        In two stages, each exact: the nominal rollouts first (if no arc holds
+        them, none holds the whole probe), then the whole probe for the
+        sequences left."""
         heights, speeds = np.atleast_2d(heights), np.atleast_2d(speeds)
         broken = np.zeros(heights.shape[0], bool)
         if not self.breakers or heights.size == 0:
@@ -654,20 +692,22 @@ class FamilyChecker:
             left = np.flatnonzero(~broken)
             if left.size == 0:
                 break
-            broken[left] = self._unfit(heights[left], speeds[left], rows, tolerance)
+            tf, jam = self._probe_finals(heights[left], speeds[left], rows)
+            for j, i in enumerate(left):
+                others = None if screened is None else (screened[0][i], screened[1][i])
+                broken[i] = jam[j].any() or not arc_holds(tf[j], tolerance, self.part.symmetry_order(),
+                                                          others, allowed)
         self.spared["sequences"] += int(broken.sum())
         return broken
 
-    def _unfit(self, heights, speeds, rows, tolerance) -> np.ndarray:
-        """True per sequence where the kept breakers' finals on ``rows``
-        (``theta, y_c, mu, offsets``) jam or, all together, fit in no arc of
-        ``tolerance`` (the claimed set must hold every member's)."""
+    def _probe_finals(self, heights, speeds, rows) -> tuple[np.ndarray, np.ndarray]:
+        """Finals and jam flags ``(sequences, members * rows)`` of every kept
+        breaker on ``rows`` (``theta, y_c, mu, offsets``) past each sequence."""
         st, members = self.settings, len(self.breakers)
         th, yc, mu, offs = rows
         per = members * th.size  # rollouts per sequence
-        order = self.part.symmetry_order()
         kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
-        out = np.zeros(heights.shape[0], bool)
+        tfs, jams = [], []
         step = max(1, PRESCREEN_ROWS // per)
         for start in range(0, heights.shape[0], step):
             h, v = heights[start:start + step], speeds[start:start + step]
@@ -677,10 +717,9 @@ class FamilyChecker:
                                    st.pin_radius, st.model, **kw,
                                    support=np.tile(np.repeat(np.arange(members), th.size), h.shape[0]),
                                    supports=list(self.breakers))
-            tf, jam = tf.reshape(h.shape[0], per), (jam != "").reshape(h.shape[0], per)
-            for i in range(h.shape[0]):  # every kept member's finals must lie in the one claimed arc
-                out[start + i] = jam[i].any() or orient.best_arc(tf[i], tolerance, order)[0] < per
-        return out
+            tfs.append(tf.reshape(h.shape[0], per))
+            jams.append((jam != "").reshape(h.shape[0], per))
+        return np.concatenate(tfs), np.concatenate(jams)
 
     @staticmethod
     def key(labels, heights) -> tuple:

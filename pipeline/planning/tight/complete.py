@@ -365,7 +365,7 @@ class LevelScreen:
             fails = bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
             alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
             record["screened_out"] += int(block.size - alive.size)
-            alive = self._drop_known_broken(alive, record)
+            alive = self._drop_known_broken(alive, screen, allowed, record)
             judging = beat.stretch(done + share * block.size, done + block.size)
             done += block.size
             for start in range(0, alive.size, step):
@@ -386,12 +386,18 @@ class LevelScreen:
             beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
         return found, found_idx, judged
 
-    def _drop_known_broken(self, alive, record):
-        """``alive`` without the sequences a worst member kept from earlier
-        plans breaks (``Certifier.broken_by_known_members``): with a support
-        family, a member that broke every candidate so far ends the level
-        without judging the rest. Counted in ``record``."""
-        broken = self.certifier.broken_by_known_members(*self.sequences(alive))
+    def _drop_known_broken(self, alive, screen, allowed: int, record):
+        """``alive`` without the sequences the worst members kept from earlier
+        plans break (``Certifier.broken_by_known_members``, sharpened by their
+        finals on the ``screen`` trials, of which a plan may leave out at most
+        ``allowed``): with a support family, a member that broke every
+        candidate so far ends the level without judging the rest. Counted
+        in ``record``."""
+        if alive.size == 0 or not self.certifier.keeps_members:
+            return alive
+        heights, speeds = self.sequences(alive)
+        broken = self.certifier.broken_by_known_members(heights, speeds, self.bench.replay(heights, speeds, screen),
+                                                        allowed)
         if broken.any():
             record["broken_by_known_member"] = record.get("broken_by_known_member", 0) + int(broken.sum())
         return alive[~broken]

@@ -173,14 +173,21 @@ class Certifier:
         plan.verdict = dict(plan.verdict, orients=False, broken_by_worst_member=True)
         return False
 
-    def broken_by_known_members(self, heights, speeds) -> np.ndarray:
+    @property
+    def keeps_members(self) -> bool:
+        """True when the family check keeps worst members that broke earlier plans."""
+        return bool(getattr(self.member_check, "breakers", None))
+
+    def broken_by_known_members(self, heights, speeds, screened=None, allowed: int = 0) -> np.ndarray:
         """True for each sequence (rows of ``heights``, ``speeds``) that a worst
         member kept from earlier plans breaks whatever its set
-        (``FamilyChecker.prescreen``); all False without a family check."""
+        (``FamilyChecker.prescreen``; ``screened``: the sequences' finals and
+        jams on some of the trials, of which at most ``allowed`` may fall
+        outside the set); all False without a family check."""
         prescreen = getattr(self.member_check, "prescreen", None)
         if prescreen is None:
             return np.zeros(np.atleast_2d(heights).shape[0], bool)
-        return prescreen(heights, speeds, self.bench.tolerance)
+        return prescreen(heights, speeds, self.bench.tolerance, screened, allowed)
 
     def certify(self, found: list, heights, speeds, n_pins: int, beat: Heartbeat) -> list:
         """The plans of ``found`` (whose pins are the rows of ``heights`` and
