@@ -108,6 +108,12 @@ class TripodSpace:
                 "weights": None if lam is None else np.round(lam, 4).tolist()}
 
     def corners(self) -> list[np.ndarray]:
+        """The starts of :meth:`_corners`, found once per space (copies)."""
+        if "_starts" not in self.__dict__:
+            self.__dict__["_starts"] = self._corners()
+        return [x.copy() for x in self.__dict__["_starts"]]
+
+    def _corners(self) -> list[np.ndarray]:
         """Legs at the inset outline's corners (every triple that holds the
         centroid), the ``LARGEST_STARTS`` largest leg triangles with legs on
         the inset outline (corners and ``EDGE_POINTS`` points along each
@@ -277,6 +283,17 @@ def member_space(part, family) -> MemberSpace:
         three points that hold the centroid with every leg >= 5 %).
     """
     label = family.label if isinstance(family, SupportFamily) else str(family)
+    key = (getattr(part, "id", id(part)), label)
+    if key not in _SPACES:
+        _SPACES[key] = _member_space(part, label)
+    return _SPACES[key]
+
+
+_SPACES: dict = {}  # (part id, family text) -> MemberSpace: its starts are found once
+
+
+def _member_space(part, label: str) -> MemberSpace:
+    """The parameter space of the family text ``label`` (see :func:`member_space`)."""
     spaces, fixed = [], []
     for item in label.split(";"):
         item = item.strip()
@@ -525,8 +542,21 @@ def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings
                         st.verify.get("confidence", DEFAULT_CONFIDENCE), rule=st.verify.get("rule", "bound"))
 
 
+def known_member(probe: PlanProbe, members, arc: tuple, period: float) -> WorstMember | None:
+    """The first of ``members`` (worst members kept from earlier plans) whose
+    probe finals leave ``arc``, as a :class:`WorstMember`; else None."""
+    for k, support in enumerate(members):
+        obj, tf = score(probe, support, arc, period)
+        if obj > 0:
+            return WorstMember(support, {"member": support.label}, obj, tf, 1,
+                               f"worst member kept from an earlier plan ({k + 1} of {len(members)})",
+                               probe.nominal)
+    return None
+
+
 def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckSettings,
-                          verdict: dict | None = None, speeds=(), progress=None, name: str = "the plan") -> dict:
+                          verdict: dict | None = None, speeds=(), progress=None, name: str = "the plan",
+                          known=()) -> dict:
     """Search the worst member of ``family`` for the plan of pins at ``heights``
     (mm); when it breaks the plan, the member joins the verification's members
     and the plan is judged again, up to ``MAX_ROUNDS`` times.
@@ -536,7 +566,9 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
     ``worst_member`` (:meth:`WorstMember.to_dict`), ``members`` and ``trials``
     of the last verification, ``rounds`` (what each search found), the
     ``verdict`` and ``set_deg`` the claim rests on, ``space``. ``progress``
-    hears how far each search and verification has got (the plan called ``name``)."""
+    hears how far each search and verification has got (the plan called ``name``).
+    ``known``: members kept from earlier checks; the first round tries them
+    first and searches only when none leaves the plan's set."""
     space = member_space(part, family)
     probe = PlanProbe(part, tuple(float(h) for h in heights), st.mu_c, st.verify, st.pin_radius,
                       st.model, st.kernel, tuple(float(v) for v in speeds))
@@ -548,8 +580,10 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
         arc = claimed_arc(verdict, st.tolerance)
         if not verdict["orients"] or arc is None:
             break
-        beat = Heartbeat(f"{what}: search {k + 1}", st.budget, "member evaluation", progress)
-        worst = search_worst_member(probe, space, arc, period, st.budget, st.seed + k, beat=beat)
+        worst = known_member(probe, known, arc, period) if k == 0 and known else None
+        if worst is None:
+            beat = Heartbeat(f"{what}: search {k + 1}", st.budget, "member evaluation", progress)
+            worst = search_worst_member(probe, space, arc, period, st.budget, st.seed + k, beat=beat)
         rounds.append({"set_deg": [round(arc[0] % period, 3), round(arc[1], 3)], **worst.to_dict()})
         if not worst.breaks:
             break
@@ -604,17 +638,18 @@ class FamilyChecker:
     ``progress`` (a function of one line) how far it has got.
 
     The worst members that broke a plan are kept (``breakers``): a member
-    that breaks one plan often breaks its neighbours. Before a search, each
-    kept member is replayed on the new plan's probe (the resting states'
-    nominal rollouts and the perturbation box's corners); one whose finals
-    leave the plan's set breaks it without a search. :meth:`prescreen` asks
-    the same of many sequences at once before they are judged, with no set
-    yet: when the kept members' probe finals together fit in no arc of the
-    tolerance, no set can hold them and the sequence is broken. Both are
-    exact for the members they replay (a sequence they reject is broken by a
-    member of the family, shown by rollouts); they spare the searches and
-    the verifications, and a member that breaks every candidate of a level
-    ends that level before its sequences are judged.
+    that breaks one plan often breaks its neighbours. A new plan's check
+    tries the kept members first, in the first round of
+    :func:`check_plan_for_family` (one that leaves the set joins the
+    verification as a found one would, so the claim is the same), and
+    searches only when none does. :meth:`prescreen` asks of many sequences
+    at once, before they are judged, whether the kept members break them
+    whatever their sets: when the kept members' probe finals and the screen
+    trials leave no arc of the tolerance that could be claimed, no plan of
+    the sequence holds for the family. That is exact for the members it
+    replays (a family member shown by rollouts to end outside every possible
+    set), and a member that breaks every candidate of a level ends that
+    level before its sequences are judged.
     """
 
     def __init__(self, part, family: SupportFamily, settings: FamilyCheckSettings, progress=None):
@@ -627,42 +662,17 @@ class FamilyChecker:
     def __call__(self, labels, heights, verdict: dict | None = None, speeds=()) -> bool:
         key = self.key(labels, heights)
         if key not in self.results:
-            known = self._known_breaker(heights, verdict, speeds)
-            if known is not None:
-                self.results[key] = known
+            self.results[key] = check_plan_for_family(self.part, heights, self.family, self.settings,
+                                                      verdict, speeds, self.progress, " ".join(labels),
+                                                      known=tuple(self.breakers))
+            rounds = self.results[key]["rounds"]
+            if rounds and rounds[0]["found_by"].startswith("worst member kept"):
                 self.spared["searches"] += 1
-            else:
-                self.results[key] = check_plan_for_family(self.part, heights, self.family, self.settings,
-                                                          verdict, speeds, self.progress, " ".join(labels))
-                worst = self.results[key]["_worst"]
-                if worst is not None and worst.breaks:
-                    self.breakers.append(worst.support)
+            worst = self.results[key]["_worst"]
+            if worst is not None and worst.breaks and not any(worst.support is b for b in self.breakers):
+                self.breakers.append(worst.support)
             self.results[key]["_speeds"] = tuple(float(v) for v in speeds)
         return self.results[key]["holds"]
-
-    def _known_breaker(self, heights, verdict, speeds) -> dict | None:
-        """The check's record when a kept breaker leaves the plan's claimed set
-        (``verdict``'s set widened to the tolerance); else None."""
-        arc = None if verdict is None else claimed_arc(verdict, self.settings.tolerance)
-        if not self.breakers or arc is None:
-            return None
-        st = self.settings
-        probe = PlanProbe(self.part, tuple(float(h) for h in heights), st.mu_c, st.verify, st.pin_radius,
-                          st.model, st.kernel, tuple(float(v) for v in speeds))
-        period = 360.0 / self.part.symmetry_order()
-        for k, support in enumerate(self.breakers):
-            obj, tf = score(probe, support, arc, period)
-            if obj > 0:
-                worst = WorstMember(support, {"member": support.label}, obj, tf, 1,
-                                    f"worst member kept from an earlier plan ({k + 1} of {len(self.breakers)})",
-                                    probe.nominal)
-                return {"holds": False, "space": self.space,
-                        "budget": st.budget, "members": len(self.family.members),
-                        "trials": verdict["trials"], "verdict": verdict,
-                        "set_deg": [round(arc[0] % period, 3), round(arc[1], 3)],
-                        "worst_member": worst.to_dict(), "rounds": [], "_family": self.family,
-                        "_worst": worst}
-        return None
 
     def prescreen(self, heights: np.ndarray, speeds: np.ndarray, tolerance: float, screened=None,
                   allowed: int = 0) -> np.ndarray:
