@@ -23,9 +23,11 @@ UNTRUNCATED_STREAM = 4_002  # salt of the untruncated trials' seed: no selection
 
 
 def untruncated_settings(settings, trials_per_state: int) -> dict:
-    """The verification settings of the untruncated trials: ``trials_per_state``
-    random trials per initial state (no box corners: the box has no edge),
-    normals not cut, seed derived from ``(seed, UNTRUNCATED_STREAM)``."""
+    """The verification settings of the untruncated trials, from the
+    verification's (selection) ``settings``: ``trials_per_state`` random
+    trials per initial state (no box corners: the box has no edge), normals
+    not cut, seed derived from ``(seed, UNTRUNCATED_STREAM)``, which neither
+    the selection nor the held-out trials draw from."""
     cfg = verify_dict(settings)
     seed = int(np.random.SeedSequence([int(cfg["seed"]), UNTRUNCATED_STREAM]).generate_state(1)[0])
     return dict(cfg, trials=int(trials_per_state), seed=seed, corners=False, truncate_sigma=None,
