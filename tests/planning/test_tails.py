@@ -156,3 +156,16 @@ def test_the_untruncated_line_says_a_friction_range_stays_uniform():
                            "990/996 in one set of 10 deg, at least 98.84 % with 95 % confidence; width 8.4 deg "
                            "(95 % bootstrap interval 8.1-8.9 deg)")
     assert line.endswith("clears the point rule but not its confidence bound")
+
+
+def test_the_report_shows_the_untruncated_width_beside_the_claimed_one(planned):
+    from pipeline.present.report import _width_cell
+    _, plan_file, _ = planned
+    plan = plan_file["tight"][0]["recommended"]
+    o, u = plan["verification"]["orientation"], plan["verification"]["untruncated"]
+    cell = _width_cell(plan)
+    assert cell.split(">", 1)[1].startswith(f"{o['width_deg']:.1f}: {o['in_tolerance']}/{o['trials']} in 10 deg (")
+    lo, hi = u["width_interval_deg"]
+    assert "theta, mu_c normals cut at 2 sigma" in cell
+    assert (f"untruncated normals: width {u['width_deg']:.1f} deg ({lo:.1f}-{hi:.1f}), "
+            f"{u['in_one_set']}/{u['trials']} in one set") in cell
