@@ -259,7 +259,20 @@ def _numbers(row: dict, work: Path) -> dict:
         "throughput": fmt(row["throughput_per_min"], ".0f"), "pitch": fmt(feeder.get("pitch_mm"), ".0f"),
         "belt_width": fmt(feeder.get("belt_width_mm"), ".0f"),
         "planning_seconds": fmt(row["planning_seconds"], ".0f"),
+        **_untruncated_numbers(work / "plans" / f"{row['part']}.json", fmt),
     }
+
+
+def _untruncated_numbers(plan_path: Path, fmt) -> dict:
+    """The recommended plan's replay on untruncated normals, formatted as pages show it."""
+    stored = json.loads(plan_path.read_text()) if plan_path.exists() else {}
+    tight = stored.get("tight") or [{}]
+    u = ((tight[0].get("recommended") or {}).get("verification") or {}).get("untruncated") or {}
+    iv = u.get("width_interval_deg") or [None, None]
+    return {"untruncated_in_set": f"{u['in_one_set']}/{u['trials']}" if u else "-",
+            "untruncated_width": fmt(u.get("width_deg"), ".1f"),
+            "untruncated_interval": "-" if None in iv else f"{iv[0]:.1f}-{iv[1]:.1f}",
+            "untruncated_orients": "-" if not u else ("orients" if u["orients"] else "does not orient")}
 
 
 def _machine() -> str:

@@ -30,6 +30,8 @@ def _plan_summary(plan, pins=None) -> dict:
             "verified_width_deg": orientation["width_deg"] if orientation else None,
             "orients": orientation["orients"] if orientation else None,
             **_claim_numbers(orientation),
+            "truncation_sigma": (plan.get("verification") or {}).get("truncation_sigma"),
+            "untruncated": (plan.get("verification") or {}).get("untruncated"),
             "selection": _selection_counts(plan),
             "verification": _verification_counts(plan)}
 
@@ -123,7 +125,7 @@ def print_plan_result(result, part, config, mode):
                   f"({plan.extra.get('claim', 'propagated')}): {sets_text(plan.final_arcs, order)}; "
                   f"{_orientation_text(v)}; margin in d "
                   + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
-            _print_claim(plan)
+            _print_claim(plan, isinstance(t.mu_c, (tuple, list)))
     if mode == "tight" or result.plans is None:
         return
     print(f"paper-mode planner (adjusted bands), {result.extra['selection']}:")
@@ -148,15 +150,20 @@ def sets_text(arcs, order: int) -> str:
     return f"{format_arcs(merge_modulo(pairs, order))} (x{order} by symmetry)"
 
 
-def _print_claim(plan) -> None:
-    """The held-out claim with its uncertainty, the selection trials apart, the margin in words."""
-    from pipeline.planning import margin_text
-    from pipeline.planning import describe_claim
+def _print_claim(plan, mu_range: bool = False) -> None:
+    """The held-out claim with its uncertainty and how its trials were drawn,
+    the untruncated replay beside it, the selection trials apart, the margin
+    in words (``mu_range``: the friction is a range, drawn uniformly)."""
+    from pipeline.planning import describe_claim, describe_untruncated, margin_text, truncation_text
     v = plan.verification
     o = v.extra.get("orientation") if v else None
     if o and "share_lower_bound" in o:
         where = "held-out trials" if v.extra.get("held_out") else "trials"
-        print(f"      {where}: {describe_claim(o)}")
+        sigma = v.extra.get("truncation_sigma")
+        drawn = "" if sigma is None else f" ({truncation_text(sigma, mu_range)})"
+        print(f"      {where}: {describe_claim(o)}{drawn}")
+        if v.extra.get("untruncated"):
+            print(f"      {describe_untruncated(v.extra['untruncated'], sigma)}")
         sel = v.extra.get("selection")
         if sel:
             print(f"      selection trials (chose the plan; no claim): {sel['in_tolerance']}/{sel['trials']} "

@@ -31,6 +31,7 @@ Wings import downwards only (core < claims < tight < family < plans <
 feeder; paper uses the core alone). The package imports maps, parts, ``config`` and the
 utilities; never sensing, present or workflow.
 """
+from pipeline.planning.claims.tails import describe_untruncated, truncation_text, untruncated_check
 from pipeline.planning.claims.orient import check_tolerance, describe_claim, min_trials, narrowest_arc
 from pipeline.planning.claims.verify import DEFAULTS as VERIFY_DEFAULTS
 from pipeline.planning.claims.verify import (PERTURB_DEFAULTS, corner_inputs, perturbed_batch,
@@ -75,6 +76,7 @@ __all__ = [
     "VERIFY_DEFAULTS", "PERTURB_DEFAULTS", "corner_inputs", "perturbed_batch", "perturbed_inputs",
     "predicted_sets", "replay", "replayed_paths", "verify_plan",
     "check_tolerance", "describe_claim", "min_trials", "narrowest_arc",
+    "describe_untruncated", "truncation_text", "untruncated_check",
     # tight
     "margin_text",
     # paper

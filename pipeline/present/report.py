@@ -318,12 +318,31 @@ def _width_cell(plan: dict) -> str:
         notes.append(f"width {100 * o['confidence']:g} % interval {iv[0]:.1f}-{iv[1]:.1f} deg")
     if "share_lower_bound" in o:
         notes.append(f"share >= {100 * o['share_lower_bound']:.2f} % at {100 * o['confidence']:g} % confidence")
+    notes += _tails_notes(plan.get("verification") or {})
     if not o["orients"]:
         notes.append("near miss: clears the point rule only" if o.get("point_rule")
                      else f"does not orient: {o['sets_within_tolerance']} sets")
     text = (f"{width}: {o['in_tolerance']}/{o['trials']} in {o['tolerance_deg']:g} deg"
             + (f" ({'; '.join(notes)})" if notes else ""))
     return f"<td>{html.escape(text)}</td>" if o["orients"] else f"<td style='color:#b00'>{html.escape(text)}</td>"
+
+
+def _tails_notes(verification: dict) -> list[str]:
+    """Where the claim's normals were cut, and the width on untruncated normals beside it."""
+    sigma = verification.get("truncation_sigma")
+    if sigma is None:
+        return []
+    u = verification.get("untruncated")
+    notes = [f"{', '.join(u['normal']) if u else 'theta, mu_c'} normals cut at {sigma:g} sigma"]
+    if u:
+        width = "n/a" if u["width_deg"] is None else f"{u['width_deg']:.1f} deg"
+        iv = u.get("width_interval_deg") or [None, None]
+        if None not in iv:
+            width += f" ({iv[0]:.1f}-{iv[1]:.1f})"
+        verdict = "orients" if u["orients"] else "does not orient"
+        notes.append(f"untruncated normals: width {width}, {u['in_one_set']}/{u['trials']} in one set, "
+                     f"{verdict}")
+    return notes
 
 
 def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> list[str]:

@@ -2,7 +2,9 @@
 
 ``verify`` (held-out trials, replayed through the whole pin sequence; the
 replays the carried-sets figure draws),
-``orient`` (judging a verification: does the plan orient the part within the
-tolerance, and how it is said) and ``confidence`` (bounds on a share and a
-width from a finite number of trials). Imports the core wing only.
+``tails`` (the recommended plan replayed once more with its normals not
+cut at 2 sigma), ``orient`` (judging a verification: does the plan orient
+the part within the tolerance, and how it is said) and ``confidence``
+(bounds on a share and a width from a finite number of trials). Imports the
+core wing only.
 """

@@ -8,8 +8,9 @@ over from one pin to the next. The perturbation box is the planner's
 configured sigma, truncated at 2 sigma (a friction range ``(lo, hi)`` is
 sampled uniformly); centroid height and pin positions are uniform within
 their half-widths. Besides the random trials, every corner of the box is
-replayed (``corners``). This shares no arithmetic with the planner: it calls
-the public rollout API only.
+replayed (``corners``). What a plan does beyond the cut, on normals that
+are not cut, is :mod:`pipeline.planning.claims.tails`. This shares no
+arithmetic with the planner: it calls the public rollout API only.
 
 A trial succeeds when the final orientation lies in the final orientation
 sets the plan predicts for that initial state. Failures are counted by
@@ -67,12 +68,17 @@ def holdout_settings(settings: dict, attempt: int = 0) -> dict:
     return dict(cfg, trials=n, seed=seed, holdout=True)
 
 
-def _truncated_normal(rng, sigma, n):
+def normal_draws(rng, sigma, n, truncate=TRUNCATE_SIGMA):
+    """``n`` draws of a normal with mean 0 and spread ``sigma``, cut at
+    ``truncate`` sigma (a draw beyond is drawn again); ``truncate`` ``None``:
+    not cut (the tails of :mod:`pipeline.planning.claims.tails`)."""
     out = rng.normal(0.0, sigma, n)
-    bad = np.abs(out) > TRUNCATE_SIGMA * sigma
+    if truncate is None:
+        return out
+    bad = np.abs(out) > truncate * sigma
     while np.any(bad):
         out[bad] = rng.normal(0.0, sigma, int(bad.sum()))
-        bad = np.abs(out) > TRUNCATE_SIGMA * sigma
+        bad = np.abs(out) > truncate * sigma
     return out
 
 
@@ -85,13 +91,16 @@ def perturbed_inputs(theta, y_c, mu_c, n_pins, cfg, rng):
 
 def perturbed_batch(theta, y_c, mu_c, n_pins, cfg, rng, n):
     """``n`` trials' inputs as arrays ``(theta (n,), y_c (n,), mu (n,), offsets (n, n_pins))``.
-    ``mu_c`` is a value (normal, truncated at 2 sigma, clipped at 0) or a range ``(lo, hi)``."""
-    th = theta + _truncated_normal(rng, cfg["theta_sigma"], n)
+    ``mu_c`` is a value (normal, truncated at 2 sigma, clipped at 0) or a range ``(lo, hi)``.
+    ``cfg["truncate_sigma"]`` (absent: ``TRUNCATE_SIGMA``; ``None``: not cut)
+    is where the normals of theta and mu_c are cut."""
+    cut = cfg.get("truncate_sigma", TRUNCATE_SIGMA)
+    th = theta + normal_draws(rng, cfg["theta_sigma"], n, cut)
     yc = y_c + rng.uniform(-cfg["y_halfwidth"], cfg["y_halfwidth"], n)
     if isinstance(mu_c, (tuple, list)):
         mu = rng.uniform(float(mu_c[0]), float(mu_c[1]), n)
     else:
-        mu = np.maximum(0.0, mu_c + _truncated_normal(rng, cfg["mu_sigma"], n))
+        mu = np.maximum(0.0, mu_c + normal_draws(rng, cfg["mu_sigma"], n, cut))
     offs = rng.uniform(-cfg["pin_halfwidth"], cfg["pin_halfwidth"], (n, n_pins))
     return th, yc, mu, offs
 

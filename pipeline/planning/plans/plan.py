@@ -41,9 +41,11 @@ from pipeline.planning.claims.orient import describe_claim, judge_verification
 from pipeline.planning.tight.propagate import Tolerances, Uncertainty
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.tight.search import TightPlanner
-from pipeline.planning.core.settings import Friction, PlannerSettings, SearchSettings, candidate_pins
+from pipeline.planning.core.settings import (TRUNCATE_SIGMA, Friction, PlannerSettings, SearchSettings,
+                                             candidate_pins)
 from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.claims.verify import holdout_settings, verify_plan
+from pipeline.planning.claims.tails import describe_untruncated, untruncated_check
 from pipeline.progress import SILENT, Heartbeat
 
 
@@ -126,6 +128,7 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     candidates = robust_order(candidates, _rank, lambda p: p.verification["orientation"].get("width_deg"),
                               lambda p: p.margin, settings.search.width_slack_deg)
     good = [p for p in candidates if _acceptable(p)]
+    _check_tails(part, settings, planner, good[0] if good else None, states, progress, family)
     result = _tight_result(settings, depth, keep, planner, candidates, good, states, fixed, moving_search)
     if family is not None:
         result["support_family"] = family.to_dict()
@@ -263,11 +266,34 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
                                 if "belt_speed" in res else {}),
                              **({"support_family": res["support_family"]}
                                 if "support_family" in res else {}),
-                             "orientation": verdict, "selection": selection}
+                             "orientation": verdict, "truncation_sigma": TRUNCATE_SIGMA,
+                             "selection": selection}
         if progress:
             progress(f"mu_c {settings.friction.label}: verified {' '.join(plan.pins)} on held-out trials: "
                      + describe_claim(verdict))
     beat.finish()
+
+
+def _check_tails(part: Part, settings: PlannerSettings, planner, plan, states, progress=None,
+                 family=None) -> None:
+    """Replay the recommended ``plan`` (``None``: nothing) on untruncated
+    normals (``tails.untruncated_check``), as many trials per initial state
+    as its held-out trials, and keep the verdict beside its claim as
+    ``verification["untruncated"]``."""
+    if plan is None:
+        return
+    search = settings.search
+    speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
+    per_state = max(row["trials"] for row in plan.verification["rows"])
+    record = untruncated_check(part, plan.to_dict(), planner_pin_heights(planner), states,
+                               settings.friction.value, search.pin_radius, search.model, settings.verify,
+                               per_state, settings.claims, planner.order, speeds=speeds,
+                               kernel=search.kernel_settings, belt_speed=planner.belt_speed,
+                               mu_s=planner.mu_s, family=family)
+    plan.verification["untruncated"] = record
+    if progress:
+        progress(f"mu_c {settings.friction.label}: {' '.join(plan.pins)} on "
+                 + describe_untruncated(record, TRUNCATE_SIGMA))
 
 
 def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance: float,
