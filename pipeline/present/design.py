@@ -56,6 +56,7 @@ def draw_design(result: dict, out) -> Path:
         ax.plot(*_closed(changed).T, color="tab:red", lw=2.0, label=f"changed: {chosen['description']}")
     _number_edges(ax, original)
     ax.set_aspect("equal")
+    ax.margins(0.08)  # room for the edge numbers outside the outline
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.set_title(design_title(result), fontsize=10)
