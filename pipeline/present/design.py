@@ -5,7 +5,8 @@ frame, edges numbered as ``--keep-edges`` counts them) as a PNG or SVG;
 :func:`write_design_dxf` writes them to a DXF for CAD, the original on layer
 ORIGINAL and the changed outline on layer MODIFIED (each with the part's
 holes), so that ``pinfeed plan --outline FILE --layer MODIFIED`` reads the
-changed part back. The search itself (:func:`pipeline.planning.design_part`)
+changed part back. The same design gives the same files: the DXF apart
+from its time stamps and the version GUID that every save renews. The search itself (:func:`pipeline.planning.design_part`)
 computes everything drawn here.
 """
 from __future__ import annotations
@@ -65,7 +66,7 @@ def draw_design(result: dict, out) -> Path:
     plan = _plan_line(result)
     if plan:
         fig.text(0.01, 0.01, plan, fontsize=8)
-    with atomic_target(out) as tmp:
+    with atomic_target(out) as tmp, plt.rc_context({"svg.hashsalt": "pinfeed-design"}):  # fixed SVG ids
         save_figure(fig, tmp, format=out.suffix.lstrip(".").lower(),
                     metadata={"Date": None} if out.suffix.lower() == ".svg" else None)
     return out
@@ -115,6 +116,19 @@ def write_design_dxf(result: dict, out) -> Path:
     size = float(np.ptp(original, axis=0).max())
     msp.add_text(design_title(result), height=0.04 * size, dxfattribs={"layer": "NOTES"}).set_placement(
         (low[0], low[1] - 0.12 * size))
+    _fixed_guids(doc, result)
     with atomic_target(out) as tmp:
         doc.saveas(tmp)
     return out
+
+
+def _fixed_guids(doc, result: dict) -> None:
+    """The drawing's GUIDs from its content, not random: the same design gives
+    the same DXF apart from its time stamps ($TDCREATE, $TDUPDATE)."""
+    import hashlib
+    import json
+    import uuid
+    loops = [result["original"]["vertices"], (result.get("chosen") or {}).get("vertices")]
+    digest = hashlib.sha256(json.dumps(loops).encode()).digest()
+    doc.header["$FINGERPRINTGUID"] = "{" + str(uuid.UUID(bytes=digest[:16])).upper() + "}"
+    doc.header["$VERSIONGUID"] = "{" + str(uuid.UUID(bytes=digest[16:])).upper() + "}"

@@ -44,3 +44,40 @@ def test_no_change_within_the_limits_says_so_and_exits_0(capsys, tmp_path):
     assert stored["outcome"] == "no change helps" and stored["config_hash"] and stored["git_commit"]
     assert (tmp_path / "d" / "trap.dxf").is_file() and (tmp_path / "d" / "trap.png").is_file()
     assert "edge 3: (10, 25) to (0, 0) mm" in err
+
+
+def test_the_same_inputs_give_the_same_files(capsys, tmp_path):
+    """Two runs write the same JSON apart from its time stamp, the same figure,
+    and the same DXF apart from its time stamps and per-save version GUID."""
+    config = small_config_file(tmp_path)
+    outputs = []
+    for run in ("a", "b"):
+        code, _, err = run_cli(capsys, ["design", "--vertices", TRAPEZOID, "--name", "trap", "--config", str(config),
+                                        "--catalog", str(tmp_path / "catalog"), "--depth", "1", "--mu-c", "0.2",
+                                        "--kinds", "chamfer", "--chamfer", "0.1", "--max-change", "0.001",
+                                        "--out", str(tmp_path / run)])
+        assert code == 0, err
+        stored = json.loads((tmp_path / run / "trap.json").read_text())
+        stored.pop("created")
+        stored.pop("files")
+        dxf = (tmp_path / run / "trap.dxf").read_text().splitlines()
+        outputs.append((stored, (tmp_path / run / "trap.png").read_bytes(), dxf))
+    (json_a, png_a, dxf_a), (json_b, png_b, dxf_b) = outputs
+    assert json_a == json_b and png_a == png_b
+    differ = [k for k, (x, y) in enumerate(zip(dxf_a, dxf_b)) if x != y]
+    stamps = ("$TDCREATE", "$TDUCREATE", "$TDUPDATE", "$TDUUPDATE", "$VERSIONGUID")
+    assert all(any(s in dxf_a[k - 2] for s in stamps) or " @ " in dxf_a[k] for k in differ), \
+        [dxf_a[k - 2:k + 1] for k in differ]
+
+
+def test_the_workflow_rule_skips_a_part_whose_plan_orients(tmp_path):
+    from pipeline.config import load_config
+    from pipeline.workflow.design import design_rule
+    config = load_config()
+    plan = tmp_path / "asym_triangle.json"
+    plan.write_text(json.dumps({"tight": [{"orients": True, "recommended": {"pins": ["P14", "P6"]}}]}))
+    out = tmp_path / "designs" / "asym_triangle.json"
+    result = design_rule(config, "asym_triangle", plan, out)
+    assert result["outcome"] == "already orients" and result["tried"] == []
+    assert json.loads(out.read_text())["original"]["pins"] == ["P14", "P6"]
+    assert out.with_suffix(".dxf").is_file() and out.with_suffix(".png").is_file()
