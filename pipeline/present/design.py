@@ -1,7 +1,7 @@
 """The drawings of a design for feeding: the part before and after its change.
 
 :func:`draw_design` draws both outlines on one set of axes (mm, the drawing
-frame, edges numbered as ``--keep-edges`` counts them) as a PNG or SVG;
+frame, edges and corners numbered as ``--keep-edges`` and the changes count them) as a PNG or SVG;
 :func:`write_design_dxf` writes them to a DXF for CAD, the original on layer
 ORIGINAL and the changed outline on layer MODIFIED (each with the part's
 holes), so that ``pinfeed plan --outline FILE --layer MODIFIED`` reads the
@@ -57,17 +57,16 @@ def draw_design(result: dict, out) -> Path:
         ax.plot(*_closed(changed).T, color="tab:red", lw=2.0, label=f"changed: {chosen['description']}")
     _number_edges(ax, original)
     ax.set_aspect("equal")
-    ax.margins(0.08)  # room for the edge numbers outside the outline
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.set_title(design_title(result), fontsize=10)
     ax.grid(True, lw=0.3)
-    ax.legend(loc="best", fontsize=8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8, frameon=False)
     plan = _plan_line(result)
     if plan:
-        fig.text(0.01, 0.01, plan, fontsize=8)
+        ax.annotate(plan, (0.5, -0.3), xycoords="axes fraction", ha="center", fontsize=8)
     with atomic_target(out) as tmp, plt.rc_context({"svg.hashsalt": "pinfeed-design"}):  # fixed SVG ids
-        save_figure(fig, tmp, format=out.suffix.lstrip(".").lower(),
+        save_figure(fig, tmp, format=out.suffix.lstrip(".").lower(), bbox_inches="tight",
                     metadata={"Date": None} if out.suffix.lower() == ".svg" else None)
     return out
 
@@ -84,13 +83,22 @@ def _plan_line(result: dict) -> str:
 
 
 def _number_edges(ax, xy: np.ndarray) -> None:
-    """Each edge's number at its middle, just outside the outline."""
+    """Each edge's number (``e0``...) at its middle, just outside the outline,
+    and each corner's (``c0``...) beside it."""
     nxt = np.roll(xy, -1, axis=0)
     size = float(np.ptp(xy, axis=0).max())
     for k, (p, q) in enumerate(zip(xy, nxt)):
         t = (q - p) / max(np.linalg.norm(q - p), 1e-12)
         at = 0.5 * (p + q) + np.array([t[1], -t[0]]) * 0.04 * size  # right of a ccw edge: outside
         ax.annotate(f"e{k}", at, ha="center", va="center", fontsize=7, color="0.3")
+        ax.update_datalim([at])  # the axes make room for the number
+    centre = xy.mean(axis=0)
+    for k, p in enumerate(xy):  # corner k, where edge k starts
+        away = (p - centre) / max(np.linalg.norm(p - centre), 1e-12)
+        at = p + away * 0.035 * size
+        ax.annotate(f"c{k}", at, ha="center", va="center", fontsize=7, color="tab:blue")
+        ax.update_datalim([at])
+    ax.autoscale_view()
 
 
 def write_design_dxf(result: dict, out) -> Path:

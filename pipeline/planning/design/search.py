@@ -167,26 +167,33 @@ def design_part(outline, holes, name: str, settings: PlannerSettings, design: De
     if first["orients"]:
         result.update(outcome="already orients", original_plan=[stored_entry(e) for e in entries])
         return result
-    candidates, refused = allowed_candidates(xy, holes, original, design)
-    result["refused"] = refused
-    say(f"{len(candidates)} changes within the limits ({len(refused)} refused), smallest area share first")
+    candidates, result["refused"] = allowed_candidates(xy, holes, original, design)
+    say(f"{len(candidates)} changes within the limits ({len(result['refused'])} refused), "
+        f"smallest area share first")
     for k, cand in enumerate(candidates, start=1):
-        t0 = time.perf_counter()
-        entries = plan_entries(Part.from_vertices(cand.vertices, name=name, holes=holes), settings, catalog_root)
-        verdict = verdict_of(entries)
-        seconds = time.perf_counter() - t0
+        record, entries = _try(cand, holes, name, settings, catalog_root)
+        seconds = record.pop("seconds")  # said, not stored: it differs from run to run
         say(f"[{k}/{len(candidates)}] {cand.change.describe()} ({cand.share:.2%} of the area): "
-            f"{verdict['summary']} ({seconds:.0f} s)")
-        result["tried"].append({**cand.change.to_dict(), "description": cand.change.describe(),
-                                "area_mm2": round(cand.area_mm2, 6), "share": round(cand.share, 8), **verdict})
-        if verdict["orients"]:
+            f"{record['summary']} ({seconds:.0f} s)")
+        result["tried"].append(record)
+        if record["orients"]:
             result.update(outcome="changed", chosen={
-                **cand.change.to_dict(), "description": cand.change.describe(),
-                "area_mm2": round(cand.area_mm2, 6), "share": round(cand.share, 8),
+                **{k: v for k, v in record.items() if k not in ("orients", "pins", "summary")},
                 "vertices": cand.vertices.round(9).tolist(), "plan": [stored_entry(e) for e in entries]})
             return result
     result["outcome"] = "no change helps"
     return result
+
+
+def _try(cand: Candidate, holes, name: str, settings: PlannerSettings, catalog_root) -> tuple[dict, list]:
+    """Plan the changed part of ``cand``: its record (change, area, share,
+    verdict, seconds) and the planner's entries."""
+    t0 = time.perf_counter()
+    entries = plan_entries(Part.from_vertices(cand.vertices, name=name, holes=holes), settings, catalog_root)
+    record = {**cand.change.to_dict(), "description": cand.change.describe(),
+              "area_mm2": round(cand.area_mm2, 6), "share": round(cand.share, 8), **verdict_of(entries),
+              "seconds": time.perf_counter() - t0}
+    return record, entries
 
 
 def _with_depth(settings: PlannerSettings, depth: int) -> PlannerSettings:
