@@ -3,6 +3,7 @@
 #
 #   snakemake --cores all                       # default config (the paper's set-up)
 #   snakemake --cores all support_study         # + the support-family study (long; not in 'all')
+#   snakemake --cores all design                # + design for feeding (not in 'all')
 #   snakemake --cores 16 --configfile config/workstation.yaml
 import os
 import sys
@@ -55,6 +56,8 @@ include: "rules/atlas.smk"
 include: "rules/report.smk"
 # the support study: its own target (rule support_study), after the report it extends
 include: "rules/support.smk"
+# design for feeding: its own target (rule design), for the parts pins do not orient
+include: "rules/design.smk"
 
 
 rule all:

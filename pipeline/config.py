@@ -282,6 +282,11 @@ def load_config(path=None) -> dict:
 HASH_NEUTRAL_DEFAULTS = {("sweep", "supports"): ["uniform"],
                          ("planner", "support_family"): None,
                          ("support_study",): {"family": None, "parts": []},
+                         # design for feeding: a config that leaves it alone keeps its hash
+                         ("design",): {"kinds": ["chamfer", "notch", "tab"], "chamfer": [0.05, 0.1, 0.15, 0.2],
+                                       "notch": [[0.1, 0.05], [0.2, 0.1]], "tab": [[0.1, 0.05], [0.2, 0.1]],
+                                       "positions": [0.5], "min_wall_mm": 1.0, "max_change": 0.1,
+                                       "depth": None},
                          # the claim's settings: a config that leaves them alone keeps its hash
                          # (and its shards' recorded hash); the code version records the change
                          ("verify", "confidence"): 0.95, ("verify", "rule"): "bound",

@@ -16,6 +16,7 @@ module          verbs
 ``sense``       ``sense classify``
 ``support``     ``support fit``
 ``feeder``      ``speed``, ``layout``, ``animate``
+``design``      ``design`` (the smallest outline change fixed pins orient)
 ``options``     the option groups they share
 ==============  =======================================================
 
@@ -30,7 +31,7 @@ import re
 import sys
 
 from pipeline import __version__
-from pipeline.cli import catalog, feeder, maps, plans, sense, support
+from pipeline.cli import catalog, design, feeder, maps, plans, sense, support
 from pipeline.cli.maps import DEFAULT_TRIANGLE, PAPER_D
 from pipeline.cli.options import parse_values, progress_line
 from pipeline.cli.plan_text import print_plan_result as _print_plan_result
@@ -82,6 +83,7 @@ def build_parser() -> argparse.ArgumentParser:
     support.add_support_commands(sub)
     feeder.add_stored_plan_commands(sub)
     feeder.add_layout_commands(sub)
+    design.add_design_command(sub)
     maps.add_demo_command(sub)
     sub.choices["plan"].set_defaults(func=_plan)
     return parser

@@ -1,6 +1,6 @@
 """Planning: which pins, in which order, orient a part - and how sure we are.
 
-The package is seven wings behind this front door; code outside planning
+The package is eight wings behind this front door; code outside planning
 imports only the names in :data:`__all__` from here (``tests/house`` checks
 it), so a wing can change inside without touching its callers.
 
@@ -20,6 +20,10 @@ it), so a wing can change inside without touching its callers.
 ``plans``
     the front of the planner: plan, verify and recommend a part at each
     friction; speed limits; support studies.
+``design``
+    design for feeding: the smallest chamfer, notch or tab that lets fixed
+    pins orient a part that they do not (the planner of ``plans`` tries each
+    changed outline, smallest change first).
 ``feeder``
     what a feeder's drawings need from the physics: trials past the pins on
     the belt's clock (lanes), the layout (stations, pitch, belt width,
@@ -28,7 +32,7 @@ it), so a wing can change inside without touching its callers.
     nothing itself (``tests/house/test_present_draws.py``).
 
 Wings import downwards only (core < claims < tight < family < plans <
-feeder; paper uses the core alone). The package imports maps, parts, ``config`` and the
+feeder, and design beside feeder, on plans; paper uses the core alone). The package imports maps, parts, ``config`` and the
 utilities; never sensing, present or workflow.
 """
 from pipeline.planning.claims.tails import describe_untruncated, truncation_text, untruncated_check
@@ -43,6 +47,9 @@ from pipeline.planning.core.settings import (BandSettings, ClaimSettings, Fricti
                                              candidate_pins, fitted_pins, friction_label, nominal_friction,
                                              parse_friction)
 from pipeline.planning.core.types import PlanFile, as_plan_file, load_plan, validate_plan_file
+from pipeline.planning.design.edits import (KINDS as DESIGN_KINDS, ChangeRefused, DesignGrid, OutlineChange,
+                                            apply_change, ccw_outline, changed_area, edge_lengths)
+from pipeline.planning.design.search import DesignLimits, DesignSettings, design_part
 from pipeline.planning.family.certificate import family_assumption, family_certificate_line
 from pipeline.planning.family.members import check_family_mechanics
 from pipeline.planning.family.nearest import nearest_yes_lines
@@ -90,6 +97,9 @@ __all__ = [
     "DEFAULT_SPEEDS", "attach_speed_limits", "perturbation_from_verify", "speed_curve",
     "speed_label", "stored_plan_speed", "stored_speed_limit",
     "support_study",
+    # design
+    "DESIGN_KINDS", "ChangeRefused", "DesignGrid", "DesignLimits", "DesignSettings", "OutlineChange",
+    "apply_change", "ccw_outline", "changed_area", "design_part", "edge_lengths",
     # feeder
     "Lane", "Trial", "pin_height", "pin_reach", "run_trials", "trial_lanes",
     "LAYOUT_DEFAULTS", "check_layout_settings", "layout_plan", "final_sets_warning", "layout_stored",
