@@ -1,13 +1,13 @@
 """The nearest "yes" for a family no plan holds for.
 
-The plan P11 P3 P11 P19 (15, -5, 15, 35 mm) is broken by the widest tripod
-of ``tripods:12`` on the default asymmetric triangle at a friction range
-0.1:0.3 within 10 deg. The tolerance axis answers the smallest tolerance
-(to 0.5 deg) at which it holds for the family. Checked here: the answer is
-the smallest on the 0.5-degree ladder (it holds there, not half a degree
-tighter), and the family's tripods on a dense grid of leg positions, replayed
-by the public rollout API alone, all end inside the claimed set at the
-answer. The bisection is checked against a sweep of a monotone predicate;
+The rectangle's plan Q5 Q1 Q5 holds for ``tripods:4`` within 30 deg but
+not within 10. The tolerance axis answers the smallest tolerance (to 0.5
+deg) at which it holds for the family with no fresh member outside. Checked
+here: the answer is the smallest on the 0.5-degree ladder (a "yes" there,
+not half a degree tighter), and the family's tripods on a grid of leg
+positions, replayed by the public rollout API alone, all end inside the
+claimed set at the answer. On the triangle's plan P11 P3 P11 P19 a fresh
+tripod jams: no tolerance is a "yes", and the axis says so. The bisection is checked against a sweep of a monotone predicate;
 the inset text and the largest inset with members against brute force.
 """
 import numpy as np
@@ -19,37 +19,45 @@ from pipeline.parts.support_family import parse_support_family
 from pipeline.planning.family import nearest
 from pipeline.planning.family.worst_member import FamilyCheckSettings, check_plan_for_family, member_space
 
-from test_worst_member import _corner_finals, _grid_tripods, _outside
+from test_worst_member import RECTANGLE, _corner_finals, _grid_tripods, _outside, _pins, _settings
 
 TRIANGLE = Part.from_vertices([(0, 0), (60, 0), (15, 35)], "asym_triangle")
 BOX = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 HEIGHTS = (15.0, -5.0, 15.0, 35.0)
 
 
-def _settings(tolerance=10.0):
-    return FamilyCheckSettings((0.1, 0.3), tolerance, 0.995, {**BOX, "trials": 100, "seed": 3, "corners": True},
-                               3.0, "minpower", {}, 40, 3)
-
-
 def test_the_smallest_tolerance_holds_and_half_a_degree_less_does_not():
     import dataclasses
-    family = parse_support_family("tripods:12", TRIANGLE)
-    st = _settings()
-    plans = [(("P11", "P3", "P11", "P19"), HEIGHTS, ())]
-    answer = nearest.tolerance_axis(TRIANGLE, family, plans, st)
+    family = parse_support_family("tripods:4", RECTANGLE)
+    st = _settings((0.1, 0.2), 10.0, 20, budget=40)
+    pins = _pins(RECTANGLE, 6)
+    heights = (pins["Q5"], pins["Q1"], pins["Q5"])
+    plans = [(("Q5", "Q1", "Q5"), heights, ())]
+    answer = nearest.tolerance_axis(RECTANGLE, family, plans, st)
     assert answer["found"] and answer["holds"], answer["statement"]
     value = answer["value"]
     assert 10.0 < value <= nearest.MAX_TOLERANCE
-    tighter = check_plan_for_family(TRIANGLE, HEIGHTS, family, dataclasses.replace(st, tolerance=value - 0.5))
-    assert not tighter["holds"]
+    # the smallest on the half-degree ladder: half a degree tighter is not a "yes"
+    assert nearest._holds(RECTANGLE, plans, family, dataclasses.replace(st, tolerance=value - 0.5), None) is None
     claim = answer["certificate"]["claim"]
     assert claim["violations"] == 0 and claim["members"] >= 300  # a "yes" has no fresh member outside
-    # the grid: every tripod 0.2 a inside, replayed without the planner's code
+    # the grid: every tripod 0.2 a inside, replayed without the planner's code, ends in the claimed set
     start, width = answer["certificate"]["set_deg"]
-    worst = max(float(_outside(_corner_finals(TRIANGLE, HEIGHTS, point_support(TRIANGLE, legs, w), (0.1, 0.3)),
-                               start, width).max())
-                for legs, w in _grid_tripods(TRIANGLE, 0.2, TRIANGLE.a / 6))
+    period = 360.0 / RECTANGLE.symmetry_order()
+    grid = _grid_tripods(RECTANGLE, 0.2, RECTANGLE.a / 5)
+    assert len(grid) >= 50
+    worst = max(float(_outside(_corner_finals(RECTANGLE, heights, point_support(RECTANGLE, legs, w), (0.1, 0.2)),
+                               start, width, period).max()) for legs, w in grid)
     assert worst == 0.0
+
+
+def test_a_jam_is_never_a_yes():
+    """On the triangle's plan P11 P3 P11 P19 one fresh tripod jams: no tolerance makes it a "yes"."""
+    family = parse_support_family("tripods:12", TRIANGLE)
+    st = FamilyCheckSettings((0.1, 0.3), 10.0, 0.995, {**BOX, "trials": 100, "seed": 3, "corners": True},
+                             3.0, "minpower", {}, 40, 3)
+    answer = nearest.tolerance_axis(TRIANGLE, family, [(("P11", "P3", "P11", "P19"), HEIGHTS, ())], st)
+    assert not answer["found"] and "45 deg" in answer["statement"]
 
 
 @pytest.mark.parametrize("threshold", [0.0, 0.13, 0.5, 0.77, 0.99])
