@@ -365,11 +365,13 @@ class LevelScreen:
             fails = bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
             alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
             record["screened_out"] += int(block.size - alive.size)
-            alive = self._drop_known_broken(alive, screen, allowed, record)
             judging = beat.stretch(done + share * block.size, done + block.size)
             done += block.size
             for start in range(0, alive.size, step):
-                chunk = alive[start:start + step]
+                # members kept from this block's earlier plans already count
+                chunk = self._drop_known_broken(alive[start:start + step], screen, allowed, record)
+                if chunk.size == 0:
+                    continue
                 verdicts = bench.judge(*self.sequences(chunk), full, stretch=judging.part(
                     start / alive.size, (start + chunk.size) / alive.size))
                 for idx, verdict in zip(chunk, verdicts):
