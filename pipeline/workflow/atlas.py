@@ -15,6 +15,11 @@ resting states are already one orientation within the tolerance, as for a
 regular polygon, and no pin plan does better), ``sensor`` (no plan of up to
 the depth orients it: a sensor or a person must finish), ``no plan``
 (nothing passed verification).
+
+For a part planned for a support family that no plan holds for, the
+``nearest_*`` columns give the nearest "yes" of its plan file on each axis
+(the smallest tripod inset, the widest friction range, the smallest
+tolerance, moving pins): the value, or ``none`` when that axis found none.
 """
 from __future__ import annotations
 
@@ -32,7 +37,10 @@ from pipeline.provenance import provenance_attrs
 COLUMNS = ("part", "part_id", "outcome", "orients", "tolerance_deg", "fixed_pins", "moving_pins",
            "sensor_needed", "verified_width_deg", "width_low_deg", "width_high_deg", "sets", "trials",
            "in_set", "share", "share_lower_bound", "confidence", "plan", "mu_c",
-           "speed_limit_mm_s", "belt_speed_mm_s", "throughput_per_min", "planning_seconds", "evidence")
+           "speed_limit_mm_s", "belt_speed_mm_s", "throughput_per_min", "planning_seconds", "evidence",
+           "nearest_inset_a", "nearest_mu_c", "nearest_tolerance_deg", "nearest_moving_pins")
+NEAREST = {"nearest_inset_a": "inset", "nearest_mu_c": "friction", "nearest_tolerance_deg": "tolerance",
+           "nearest_moving_pins": "moving pins"}  # column -> the nearest "yes" axis it shows
 
 
 def _outcome(orients: bool, plan: dict | None, needs_no_pin: bool = False) -> str:
@@ -75,7 +83,18 @@ def atlas_row(plan_result: dict, speed: dict | None = None, layout: dict | None 
         "throughput_per_min": (layout or {}).get("throughput_per_min"),
         "planning_seconds": (entry.get("stats") or {}).get("wall_seconds"),
         "evidence": search.get("evidence") or entry.get("warning"),
+        **{column: _nearest(entry, axis) for column, axis in NEAREST.items()},
     }
+
+
+def _nearest(entry: dict, axis: str):
+    """The nearest "yes" on ``axis`` of a family no plan holds for: its value,
+    ``"none"`` when the axis found none, ``None`` when the question was not
+    asked (a plan holds, or no support family)."""
+    for answer in (entry.get("nearest_yes") or {}).get("axes", []):
+        if answer["axis"] == axis:
+            return answer["value"] if answer["found"] else "none"
+    return None
 
 
 def build_atlas(config: dict, plan_paths, speed_paths=(), layout_paths=()) -> dict:

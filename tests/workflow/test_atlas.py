@@ -154,3 +154,16 @@ def test_report_atlas_grid_links_colours_and_labels(planned):
         assert COLOURS[row["outcome"]] in tile["style"]
         words = f"{row['verified_width_deg']:.1f} deg" if row["orients"] else f"{row['sets']} sets"
         assert words in html_text
+
+
+def test_the_nearest_yes_columns_read_the_plan_file():
+    from pipeline.workflow.atlas import atlas_row
+    axes = [{"axis": "inset", "found": True, "value": 0.26}, {"axis": "friction", "found": False},
+            {"axis": "tolerance", "found": True, "value": 17.5}, {"axis": "moving pins", "found": False}]
+    plan_file = {"part": {"name": "p", "id": "p-1"},
+                 "tight": [{"recommended": None, "fixed_pin_search": {}, "nearest_yes": {"axes": axes}}]}
+    row = atlas_row(plan_file)
+    assert (row["nearest_inset_a"], row["nearest_mu_c"], row["nearest_tolerance_deg"],
+            row["nearest_moving_pins"]) == (0.26, "none", 17.5, "none")
+    plan_file["tight"][0].pop("nearest_yes")
+    assert atlas_row(plan_file)["nearest_tolerance_deg"] is None
