@@ -14,7 +14,7 @@ from pathlib import Path
 from pipeline import __version__
 from pipeline.config import config_hash
 from pipeline.maps.io import write_text_atomic
-from pipeline.planning import PlannerSettings, format_arcs
+from pipeline.planning import PlannerSettings, format_arcs, nearest_yes_lines
 from pipeline.present.atlas_section import atlas_section
 from pipeline.present.figures.tables import HEADER, verification_rows
 from pipeline.present.layout import speed_limit_text
@@ -184,6 +184,10 @@ def _support_section(res: dict, files: dict, base) -> list[str]:
         else:
             p.append(f'<li class="warn">No plan orients the part for every member: '
                      f"{html.escape(fp.get('warning') or fp['evidence'])}</li>")
+            if fp.get("nearest_yes"):
+                head, *lines = nearest_yes_lines(fp["nearest_yes"])
+                p.append(f"<li>{html.escape(head)}<ul>"
+                         + "".join(f"<li>{html.escape(line.strip())}</li>" for line in lines) + "</ul></li>")
     p.append("</ul>")
     return p + _figure(files, "support_maps", base, "Configuration maps: uniform (black), the family (grey), "
                        "its extremes (colours)")
