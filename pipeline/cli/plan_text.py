@@ -68,7 +68,7 @@ def plan_json(result, mode) -> dict:
                    support_family=(first.get("support_family") or {}).get("label", "uniform"),
                    orients=first.get("orients"), pins_used=first.get("pins_used"),
                    family_certificate=first.get("family_certificate"),
-                   nearest_yes=first.get("nearest_yes"),
+                   nearest_yes=first.get("nearest_yes"), shape_tolerance=first.get("shape_tolerance"),
                    evidence=(first.get("fixed_pin_search") or {}).get("evidence"),
                    recommended=_plan_summary(first["recommended"]) if first["recommended"] else None,
                    plans=[_plan_summary(p) for p in first["plans"]],
@@ -112,6 +112,10 @@ def print_plan_result(result, part, config, mode):
             print(f"  {family_certificate_line(cert)}")
         if t.warning:
             print(f"  WARNING: {t.warning}")
+        shape = t.extra.get("shape_tolerance")
+        if shape:
+            from pipeline.planning import shape_line
+            print(f"  {shape_line(shape)}")
         nearest = t.extra.get("nearest_yes")
         if nearest:
             from pipeline.planning import nearest_yes_lines

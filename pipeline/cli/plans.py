@@ -48,7 +48,13 @@ def cmd_plan(args, print_result=print_plan_result):
                               support_family=args.support_family)
     part = plan_part_arg(args, config)
     out = plan_store_path(config, part.name, args.out)  # checked before any work
+    if args.shape_tolerance is not None and not args.shape_tolerance > 0:
+        raise PinfeedError(f"--shape-tolerance must be a length > 0 mm, got {args.shape_tolerance:g}")
     result = plan_command(part, config, args.mode, progress=progress_line)
+    if args.shape_tolerance is not None:
+        from pipeline.planning import PlannerSettings, attach_shape_tolerance
+        attach_shape_tolerance(result, part, PlannerSettings.from_config(config), args.shape_tolerance,
+                               progress_line)
     if out is not None:
         from pipeline.maps.io import write_json
         write_json(result, out)
@@ -142,6 +148,10 @@ def add_plan_commands(sub) -> None:
                    help="supports the plan must hold for: 'tripods:N[:inset=F][:seed=S]', "
                         "'warp:AMP[:N]', a support ('tripod', 'rim:N', 'points:x,y,w ...') or a list "
                         "'SPEC; SPEC'; 'uniform' for none (default: planner.support_family)")
+    p.add_argument("--shape-tolerance", dest="shape_tolerance", type=float, default=None, metavar="MM",
+                   help="certify the recommended fixed-pin plan for every part whose outline vertices lie "
+                        "within MM of the drawing (a worst-member search and 300 fresh members); when it "
+                        "does not hold, its certified radius (the largest tolerance that does)")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"],
                    help="paper mode only: which stored maps stand for an uncertain state; bracket "
                         "(the d maps around its d range and one theta_i step either side; "

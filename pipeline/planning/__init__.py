@@ -53,6 +53,7 @@ from pipeline.planning.design.search import DesignLimits, DesignSettings, design
 from pipeline.planning.family.certificate import family_assumption, family_certificate_line
 from pipeline.planning.family.members import check_family_mechanics
 from pipeline.planning.family.nearest import nearest_yes_lines
+from pipeline.planning.family.shape import attach_shape_tolerance, shape_line
 from pipeline.planning.feeder.contact import mechanics_scene
 from pipeline.planning.feeder.lanes import Lane, Trial, pin_height, pin_reach, run_trials, trial_lanes
 from pipeline.planning.feeder.layout import LAYOUT_DEFAULTS, check_layout_settings, layout_plan
@@ -90,7 +91,7 @@ __all__ = [
     "extract_bands", "Planner", "build_planner", "load_maps", "paper_depth",
     "COARSE_MU_C", "COARSE_PIN_RADIUS", "best_coarse_plan", "coarse_plan_paths",
     # family
-    "check_family_mechanics", "family_assumption", "family_certificate_line", "nearest_yes_lines",
+    "check_family_mechanics", "family_assumption", "family_certificate_line", "nearest_yes_lines", "attach_shape_tolerance", "shape_line",
     # plans
     "best_fixed_plan", "mechanics_label", "pick_tight_plan", "plan_hint", "plan_tight_all",
     "planner_belt", "tight_entry",
