@@ -542,13 +542,15 @@ def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings
                         st.verify.get("confidence", DEFAULT_CONFIDENCE), rule=st.verify.get("rule", "bound"))
 
 
-def known_member(probe: PlanProbe, members, arc: tuple, period: float) -> WorstMember | None:
+def known_member(probe: PlanProbe, members, arc: tuple, period: float, params=()) -> WorstMember | None:
     """The first of ``members`` (worst members kept from earlier plans) whose
-    probe finals leave ``arc``, as a :class:`WorstMember`; else None."""
+    probe finals leave ``arc``, as a :class:`WorstMember` with its search
+    parameters from ``params`` (one dict per member, when known); else None."""
     for k, support in enumerate(members):
         obj, tf = score(probe, support, arc, period)
         if obj > 0:
-            return WorstMember(support, {"member": support.label}, obj, tf, 1,
+            found = params[k] if k < len(params) else {"member": support.label}
+            return WorstMember(support, found, obj, tf, 1,
                                f"worst member kept from an earlier plan ({k + 1} of {len(members)})",
                                probe.nominal)
     return None
@@ -556,7 +558,7 @@ def known_member(probe: PlanProbe, members, arc: tuple, period: float) -> WorstM
 
 def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckSettings,
                           verdict: dict | None = None, speeds=(), progress=None, name: str = "the plan",
-                          known=()) -> dict:
+                          known=(), known_params=()) -> dict:
     """Search the worst member of ``family`` for the plan of pins at ``heights``
     (mm); when it breaks the plan, the member joins the verification's members
     and the plan is judged again, up to ``MAX_ROUNDS`` times.
@@ -580,7 +582,7 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
         arc = claimed_arc(verdict, st.tolerance)
         if not verdict["orients"] or arc is None:
             break
-        worst = known_member(probe, known, arc, period) if k == 0 and known else None
+        worst = known_member(probe, known, arc, period, known_params) if k == 0 and known else None
         if worst is None:
             beat = Heartbeat(f"{what}: search {k + 1}", st.budget, "member evaluation", progress)
             worst = search_worst_member(probe, space, arc, period, st.budget, st.seed + k, beat=beat)
@@ -657,6 +659,7 @@ class FamilyChecker:
         self.space = member_space(part, family).describe()  # an empty space is an error before any search
         self.results: dict = {}
         self.breakers: list = []
+        self.breaker_params: list = []  # each kept member's parameters (legs, coefficients)
         self.spared = {"searches": 0, "sequences": 0}
 
     def __call__(self, labels, heights, verdict: dict | None = None, speeds=()) -> bool:
@@ -664,13 +667,15 @@ class FamilyChecker:
         if key not in self.results:
             self.results[key] = check_plan_for_family(self.part, heights, self.family, self.settings,
                                                       verdict, speeds, self.progress, " ".join(labels),
-                                                      known=tuple(self.breakers))
+                                                      known=tuple(self.breakers),
+                                                      known_params=tuple(self.breaker_params))
             rounds = self.results[key]["rounds"]
             if rounds and rounds[0]["found_by"].startswith("worst member kept"):
                 self.spared["searches"] += 1
             worst = self.results[key]["_worst"]
             if worst is not None and worst.breaks and not any(worst.support is b for b in self.breakers):
                 self.breakers.append(worst.support)
+                self.breaker_params.append(worst.params)
             self.results[key]["_speeds"] = tuple(float(v) for v in speeds)
         return self.results[key]["holds"]
 
