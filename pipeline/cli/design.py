@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sys
 
-from pipeline.cli.options import add_config_option, add_outline_args, parse_values, plan_part_arg, progress_line
+from pipeline.cli.options import add_part_options, parse_values, plan_part_arg, progress_line
 from pipeline.errors import PinfeedError
 
 
@@ -137,12 +137,7 @@ def add_design_command(sub) -> None:
     """``design``: the smallest chamfer, notch or tab that lets fixed pins orient a part."""
     p = sub.add_parser("design", help="design for feeding: the smallest chamfer, notch or tab that lets "
                        "fixed pins orient a part they do not")
-    p.add_argument("--part", default=None, help="part name or id from the config or catalog")
-    add_outline_args(p, required=False)
-    add_config_option(p)
-    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
-    p.add_argument("--mu-c", dest="mu_c", default=None,
-                   help="friction the plan must work for: a value X or a range LO:HI (default: the config's)")
+    add_part_options(p)
     p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"],
                    help="quasi-static contact model (default: the config's planner.model)")
     p.add_argument("--depth", type=int, default=None, help="largest number of fixed pins (>= 1; default: "

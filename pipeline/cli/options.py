@@ -152,6 +152,17 @@ def add_config_option(p) -> None:
     p.add_argument("--config", default=None, help=CONFIG_HELP)
 
 
+def add_part_options(p) -> None:
+    """The options that name a part and what it is planned at: ``--part`` or an
+    outline, ``--config``, ``--catalog`` and ``--mu-c`` (``plan``, ``design``)."""
+    p.add_argument("--part", default=None, help="part name or id from the config or catalog")
+    add_outline_args(p, required=False)
+    add_config_option(p)
+    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
+    p.add_argument("--mu-c", dest="mu_c", default=None,
+                   help="friction the plan must work for: a value X or a range LO:HI (default: the config's)")
+
+
 def add_results_option(p, holding: str = "plans/") -> None:
     """``--results``: the results folder holding ``holding``."""
     p.add_argument("--results", default=None, help=f"results folder holding {holding} "

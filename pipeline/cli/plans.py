@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 
 from pipeline.cli.next_steps import print_next_steps
-from pipeline.cli.options import (add_config_option, add_json_option, add_outline_args, parse_values,
+from pipeline.cli.options import (add_config_option, add_json_option, add_part_options, parse_values,
                                   plan_part_arg, print_json, progress_line)
 from pipeline.cli.plan_text import plan_json, print_plan_result
 from pipeline.errors import PinfeedError
@@ -126,12 +126,7 @@ def add_sweep_commands(sub) -> None:
 def add_plan_commands(sub) -> None:
     """``plan`` (pin sequences for a part) and ``atlas`` (the planned parts)."""
     p = sub.add_parser("plan", help="plan fixed pins for a part (computes missing maps)")
-    p.add_argument("--part", default=None, help="part name or id from the config or catalog")
-    add_outline_args(p, required=False)
-    add_config_option(p)
-    p.add_argument("--catalog", default=None, help="catalog folder (default: the config's)")
-    p.add_argument("--mu-c", dest="mu_c", default=None,
-                   help="friction the plan must work for: a value X or a range LO:HI (default: the config's)")
+    add_part_options(p)
     p.add_argument("--mode", default="tight", choices=["tight", "paper", "both"],
                    help="tight propagation (default), the paper's adjusted bands, or both side by side")
     p.add_argument("--model", default=None, choices=["minpower", "tip", "ellipsoid"],

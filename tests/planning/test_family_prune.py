@@ -8,40 +8,21 @@ every corner of the perturbation box) pin by pin through the public
 on every sequence, with both answers present. The certificate's epsilon and
 beta are checked against the scenario approach's closed form.
 """
-import itertools
 
 import numpy as np
 import pytest
 
-from kernels.rollout import JAMMED, TRUNCATED
 
-from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.parts.support_family import parse_support_family
 from pipeline.planning.family.certificate import members_needed, scenario_claim
 from pipeline.planning.family.worst_member import FamilyChecker, FamilyCheckSettings, member_space
 
+from test_worst_member import _corner_finals
+
 TRIANGLE = Part.from_vertices([(0, 0), (60, 0), (15, 35)], "asym_triangle")
 BOX = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 MU = (0.1, 0.3)
-
-
-def _finals(part, heights, support, mu):
-    """Nominal and box-corner finals of every resting state; a jam is NaN."""
-    starts = []
-    for theta, y_c in part.stable_states():
-        starts.append((theta, y_c, sum(mu) / 2, (0.0,) * len(heights)))
-        for c in itertools.product((-2.0, 2.0), (-0.5, 0.5), mu, *[(-0.3, 0.3)] * len(heights)):
-            starts.append((theta + c[0], y_c + c[1], c[2], c[3:]))
-    th = np.array([s[0] for s in starts])
-    yc = np.array([s[1] for s in starts])
-    mus = np.array([s[2] for s in starts])
-    for k, h in enumerate(heights):
-        d = (h + np.array([s[3][k] for s in starts]) - yc) / part.a
-        res = simulate.rollout_points(part, th, d, mus, 3.0, support=support)
-        stuck = (res["status"] == JAMMED) | (res["status"] == TRUNCATED)
-        th, yc = np.where(stuck, np.nan, res["theta_f"]), yc + res["dy"]
-    return np.mod(th, 360.0)
 
 
 def _fits(theta, width):
@@ -66,7 +47,7 @@ def test_the_prescreen_agrees_with_an_independent_replay():
                           (5.0, 10.0, 20.0, 35.0), (-5.0, 15.0, -5.0, 15.0), (35.0, 15.0, -5.0, 15.0),
                           (10.0, 25.0, 0.0, 20.0), (25.0, 5.0, 30.0, -5.0)])
     broken = checker.prescreen(sequences, np.zeros_like(sequences), 10.0)
-    reference = np.array([not _fits(_finals(TRIANGLE, h, widest, MU), 10.0) for h in sequences])
+    reference = np.array([not _fits(_corner_finals(TRIANGLE, h, widest, MU), 10.0) for h in sequences])
     assert broken.tolist() == reference.tolist()
     assert reference.any() and not reference.all(), reference  # both answers are tested
     assert checker.spared["sequences"] == int(reference.sum())
