@@ -30,12 +30,10 @@ import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
-from pipeline.planning.claims.verify import corner_inputs, replay, verify_dict
-from pipeline.planning.core.resting import resting_states
-from pipeline.planning.core.settings import nominal_friction
+from pipeline.planning.claims.verify import replay, verify_dict
 from pipeline.planning.family.certificate import scenario_claim
 from pipeline.planning.family.worst_member import (FamilyCheckSettings, MemberSpace, WorstMember, claimed_arc,
-                                                   outside, search_worst_member)
+                                                   outside, probe_inputs, search_worst_member)
 
 FRESH_MEMBERS = 300
 STEPS = 5
@@ -68,18 +66,9 @@ class ShapeProbe:
         if member is None:
             return np.array([np.nan]), np.array([True])
         n = len(self.heights)
-        rows, nominal, at = [], [], 0
-        for theta, y_c in resting_states(member).values():
-            rows.append((np.array([theta]), np.array([y_c]), np.array([nominal_friction(self.mu_c)]),
-                         np.zeros((1, n))))
-            corners = corner_inputs(theta, y_c, self.mu_c, n, self.cfg)
-            rows.append(corners)
-            nominal.append(at)
-            at += 1 + corners[0].size
-        th, yc, mu, offs = (np.concatenate([r[k] for r in rows]) for k in range(4))
+        (th, yc, mu, offs), self.nominal = probe_inputs(member, self.mu_c, n, self.cfg)
         tf, _, jam, _ = replay(member, list(self.heights), [0.0] * n, th, yc, mu, offs, self.pin_radius,
                                self.model, **self.kernel)
-        self.nominal = np.asarray(nominal, int)
         return tf, jam != ""
 
 

@@ -316,6 +316,20 @@ def _member_space(part, label: str) -> MemberSpace:
 
 # --------------------------------------------------------------------------- the objective
 
+def probe_inputs(part, mu_c, n_pins: int, cfg: dict) -> tuple[tuple, np.ndarray]:
+    """The probe's starts for plans of ``n_pins`` pins: every resting state of
+    ``part`` at the middle friction, then at every corner of the perturbation
+    box (``cfg``); ``((theta, y_c, mu, offsets), each state's nominal row)``."""
+    rows = []
+    for theta, y_c in resting_states(part).values():
+        rows.append((np.array([theta]), np.array([y_c]), np.array([nominal_friction(mu_c)]),
+                     np.zeros((1, n_pins))))
+        rows.append(corner_inputs(theta, y_c, mu_c, n_pins, cfg))
+    inputs = tuple(np.concatenate([r[k] for r in rows]) for k in range(4))
+    sizes = np.array([r[0].size for r in rows])
+    return inputs, np.concatenate([[0], np.cumsum(sizes)[:-1]])[0::2]
+
+
 @dataclass
 class PlanProbe:
     """What a member is scored on: a plan's pins and the trials that probe it."""
@@ -332,16 +346,7 @@ class PlanProbe:
     nominal: np.ndarray = field(init=False)
 
     def __post_init__(self):
-        cfg = verify_dict(self.settings)
-        n = len(self.heights)
-        rows = []
-        for theta, y_c in resting_states(self.part).values():
-            rows.append((np.array([theta]), np.array([y_c]), np.array([nominal_friction(self.mu_c)]),
-                         np.zeros((1, n))))
-            rows.append(corner_inputs(theta, y_c, self.mu_c, n, cfg))
-        self.inputs = tuple(np.concatenate([r[k] for r in rows]) for k in range(4))
-        sizes = np.array([r[0].size for r in rows])
-        self.nominal = np.concatenate([[0], np.cumsum(sizes)[:-1]])[0::2]  # each state's nominal row
+        self.inputs, self.nominal = probe_inputs(self.part, self.mu_c, len(self.heights), verify_dict(self.settings))
 
     def finals(self, support: Support | None, inputs=None) -> tuple[np.ndarray, np.ndarray]:
         """``(theta_f, jammed)`` of every probe trial resting on ``support``."""
