@@ -84,6 +84,12 @@ from pipeline.progress import Heartbeat
 SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
 PROBE = (6, 2)  # random trials and corners per resting state that order the candidates
 SCREEN = (12, 8)  # random trials and corners per resting state in the screen
+# Then larger subsets, each about four times the last, before the full trials:
+# a sequence that fails more than the allowed trials of a subset fails at
+# least as many of the full set (the best arc of the full set holds no more
+# of the subset than the subset's best arc), so each stage rejects exactly
+# what the full judgement would, at a fraction of its cost.
+CASCADE = ((48, 64), (150, 384))
 SCREEN_BLOCK = 96  # candidates screened at once
 EVIDENCE_PER_LEVEL = 4  # several-set sequences judged per level when nothing orients
 WIDTH_SLACK_DEG = schema_default("planner", "width_slack_deg")  # a safe margin outranks this much width
@@ -353,14 +359,21 @@ class LevelScreen:
         ``inputs``, until ``candidates`` are judged and one orients;
         ``(orienting plans, their rows, every judged plan)``. Adds the
         screened-out and not-screened counts to ``record``; ``beat`` is
-        ticked with the sequences done."""
+        ticked with the sequences done.
+
+        After the first ``candidates`` judged in full (the evidence's best
+        results come from those), a survivor passes the ``CASCADE`` of larger
+        subsets first: one rejected there fails the full trials as well, so
+        it counts as judged (and not orienting) without its full replay."""
         bench = self.bench
         screen, full = bench.screen_rows(inputs, *SCREEN), stack(inputs)
+        cascade = [rows for rows in (bench.screen_rows(inputs, *c) for c in CASCADE)
+                   if screen[0].size < rows[0].size < full[0].size // 2]
         share = screen[0].size / (screen[0].size + full[0].size)  # the screen's share of a block's work
         found, found_idx, judged = [], [], []
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
-        done = 0
-        while done < order.size and not (found and len(judged) >= candidates):
+        done = cascaded = 0
+        while done < order.size and not (found and len(judged) + cascaded >= candidates):
             block = order[done:done + SCREEN_BLOCK]
             fails = bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
             alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
@@ -370,6 +383,10 @@ class LevelScreen:
             for start in range(0, alive.size, step):
                 # members kept from this block's earlier plans already count
                 chunk = self._drop_known_broken(alive[start:start + step], screen, allowed, record)
+                if len(judged) >= candidates:  # the first ones are judged in full, for the evidence
+                    size = chunk.size
+                    chunk = self._cascade(chunk, cascade, allowed, record)
+                    cascaded += size - chunk.size
                 if chunk.size == 0:
                     continue
                 verdicts = bench.judge(*self.sequences(chunk), full, stretch=judging.part(
@@ -380,13 +397,26 @@ class LevelScreen:
                     if verdict["orients"] and self.certifier.holds_for_family(plan):
                         found.append(plan)
                         found_idx.append(idx)
-                if found and len(judged) >= candidates:
+                if found and len(judged) + cascaded >= candidates:
                     break
             beat.tick(done)
         record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
         if done < order.size:
             beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
         return found, found_idx, judged
+
+    def _cascade(self, alive, cascade, allowed: int, record):
+        """``alive`` without the sequences that fail more than ``allowed`` trials
+        of one of the growing subsets ``cascade`` (rows; see ``CASCADE``), in
+        turn; the rejected ones are counted as screened out in ``record``."""
+        for rows in cascade:
+            if alive.size == 0:
+                break
+            fails = self.bench.failures(*self.sequences(alive), rows)
+            record["screened_out"] += int((fails > allowed).sum())
+            record["cascade_out"] = record.get("cascade_out", 0) + int((fails > allowed).sum())
+            alive = alive[fails <= allowed]
+        return alive
 
     def _drop_known_broken(self, alive, screen, allowed: int, record):
         """``alive`` without the sequences the worst members kept from earlier
