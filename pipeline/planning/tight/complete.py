@@ -21,7 +21,9 @@ trying every sequence, level by level:
    by its failures; then, in blocks of ``SCREEN_BLOCK`` in that order, a larger
    subset (``SCREEN``: 12 and 8). A sequence whose subset already has more
    failures than the whole verification allows is rejected (exact: more
-   trials cannot mend it);
+   trials cannot mend it); after the first ``candidates`` survivors of a
+   level, two more subsets, each about four times the last (``CASCADE``),
+   reject the same way before the full replay;
 4. replay all the verification trials for the survivors and judge them
    (the *selection* trials);
 5. certify each sequence that orients on them on *held-out* trials
