@@ -195,3 +195,33 @@ def test_downstream_stages_say_they_assume_uniform_pressure():
         assert note["assumes"] == "uniform pressure" and "tripods:12" in note["assumption"]
         assert "\n" not in note["assumption"]
     assert family_assumption({"tight": [{}]}, "speed limit") == {}
+
+
+def test_the_search_scores_members_on_a_subset_of_a_many_pin_probe():
+    """Plans of many pins: the search's rows are a subset of the probe with
+    each state's nominal row and the pins' diagonal corners, at most
+    SEARCH_CORNERS corners a state; a member's objective there never exceeds
+    its objective on the full probe (so a break found there is a break)."""
+    import numpy as np
+    from pipeline.parts.part import Part
+    from pipeline.parts.support_family import parse_support_family
+    from pipeline.planning.family.worst_member import (SEARCH_CORNERS, PlanProbe, coarse_rows, member_space,
+                                                       score)
+    part = Part.from_vertices([[0, 0], [60, 0], [45, 50]])
+    probe = PlanProbe(part, (8.0, 20.0, 30.0, 12.0, 25.0), (0.1, 0.3), {"trials": 10})
+    offsets = probe.inputs[3]
+    rows = coarse_rows(offsets, probe.nominal, SEARCH_CORNERS)
+    assert probe.coarse is not None and probe.coarse[0].size == rows.size
+    assert set(probe.nominal.tolist()) <= set(rows.tolist())
+    assert np.unique(rows).size == rows.size
+    n_states = probe.nominal.size
+    assert rows.size == n_states * (1 + SEARCH_CORNERS)
+    diagonal = np.flatnonzero(offsets.min(axis=1) == offsets.max(axis=1))
+    assert set(diagonal.tolist()) - set(probe.nominal.tolist()) <= set(rows.tolist())
+    family = parse_support_family("tripods:6", part)
+    arc = (0.0, 10.0)
+    for member in family.members[:4]:
+        coarse, _ = score(probe, member, arc, 360.0, coarse=True)
+        full, _ = score(probe, member, arc, 360.0)
+        assert coarse <= full + 1e-12
+    assert member_space(part, family).describe()

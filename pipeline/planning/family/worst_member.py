@@ -30,7 +30,13 @@ family's geometric corners (legs at the inset outline's corners, every
 triple of them for an outline with more than 3 corners; the smallest leg
 triangle about the centroid; the warp modes at full amplitude, both signs)
 and from seeded random members. It stops as soon as a member breaks the plan
-or the budget (rollout evaluations of one member) is spent.
+or the budget (rollout evaluations of one member) is spent. A plan of many
+pins has many corners (``2**(3 + pins)`` per resting state); the search
+then scores members on at most ``SEARCH_CORNERS`` of them per state
+(:func:`coarse_rows`: the pins' diagonal, then seeded random ones) and the
+member it ends with on all of them. A member that breaks a plan on that
+subset breaks it on the full probe too; one that only breaks it on corners
+left out is found only if it is the member the search ends with.
 
 :func:`check_plan_for_family` judges a plan again with the worst members
 found joining the verification; :class:`FamilyChecker` is what the complete
@@ -70,6 +76,7 @@ MAX_ROUNDS = 3  # worst member found -> joins the verification -> searched again
 _PENALTY = 1.0e3
 _POOL = 20_000
 PRESCREEN_ROWS = 200_000  # rollouts per batch of the kept breakers' prescreen
+SEARCH_CORNERS = 64  # corners per resting state a member is scored on during the search
 
 
 # --------------------------------------------------------------------------- parameter spaces
@@ -330,6 +337,32 @@ def probe_inputs(part, mu_c, n_pins: int, cfg: dict) -> tuple[tuple, np.ndarray]
     return inputs, np.concatenate([[0], np.cumsum(sizes)[:-1]])[0::2]
 
 
+def coarse_rows(offsets: np.ndarray, nominal: np.ndarray, corners: int = SEARCH_CORNERS) -> np.ndarray:
+    """The probe rows a search scores members on: per resting state its
+    nominal row and at most ``corners`` of its corners, namely every corner
+    whose pins are all offset the same way (the box's diagonal in the pins'
+    offsets) and then seeded random ones; all rows when a state has no more.
+
+    A member's objective on these rows is at most its objective on the full
+    probe (a maximum over a subset), so a member that breaks a plan here
+    breaks it on the full probe too."""
+    rng = np.random.default_rng(17)
+    ends = [*nominal[1:], offsets.shape[0]]
+    picked = []
+    for start, end in zip(nominal, ends):
+        corner = np.arange(start + 1, end)
+        picked.append([start])
+        if corner.size <= corners:
+            picked.append(corner)
+            continue
+        offs = offsets[corner]
+        diagonal = corner[offs.min(axis=1) == offs.max(axis=1)][:corners]
+        rest = np.setdiff1d(corner, diagonal)
+        extra = rng.choice(rest, size=max(0, corners - diagonal.size), replace=False)
+        picked.append(np.sort(np.concatenate([diagonal, extra])))
+    return np.concatenate(picked).astype(int)
+
+
 @dataclass
 class PlanProbe:
     """What a member is scored on: a plan's pins and the trials that probe it."""
@@ -344,9 +377,12 @@ class PlanProbe:
     speeds: tuple = ()
     inputs: tuple = field(init=False)
     nominal: np.ndarray = field(init=False)
+    coarse: tuple | None = field(init=False)
 
     def __post_init__(self):
         self.inputs, self.nominal = probe_inputs(self.part, self.mu_c, len(self.heights), verify_dict(self.settings))
+        rows = coarse_rows(self.inputs[3], self.nominal, SEARCH_CORNERS)
+        self.coarse = None if rows.size == self.inputs[0].size else tuple(x[rows] for x in self.inputs)
 
     def finals(self, support: Support | None, inputs=None) -> tuple[np.ndarray, np.ndarray]:
         """``(theta_f, jammed)`` of every probe trial resting on ``support``."""
@@ -369,9 +405,10 @@ def outside(theta, arc: tuple, period: float = 360.0) -> np.ndarray:
     return np.where(inside, -np.minimum(rel, width - rel), beyond)
 
 
-def score(probe: PlanProbe, support, arc, period: float) -> tuple[float, np.ndarray]:
-    """``(objective, finals)`` of one member (see the module docstring)."""
-    tf, jam = probe.finals(support)
+def score(probe: PlanProbe, support, arc, period: float, coarse: bool = False) -> tuple[float, np.ndarray]:
+    """``(objective, finals)`` of one member (see the module docstring), on the
+    full probe or (``coarse``) on its :func:`coarse_rows`."""
+    tf, jam = probe.finals(support, probe.coarse if coarse else None)
     dist = np.where(jam, JAM_SCORE, outside(tf, arc, period))
     return float(dist.max()), tf
 
@@ -443,7 +480,7 @@ def search_worst_member(probe: PlanProbe, space: MemberSpace, arc: tuple, period
             best.update(obj=obj, tf=tf, support=support, params=params, source=source)
 
     for m in space.fixed:
-        obj, tf = score(probe, None if m.is_uniform else m, arc, period)
+        obj, tf = score(probe, None if m.is_uniform else m, arc, period, coarse=True)
         used[0] += 1
         keep(obj, tf, m, {"member": m.label}, "listed member")
     rng = np.random.default_rng([int(seed), 33])
@@ -454,6 +491,9 @@ def search_worst_member(probe: PlanProbe, space: MemberSpace, arc: tuple, period
             break
     if best["obj"] == -np.inf:
         raise PinfeedError(f"support family {space.label!r} has no member to search")
+    if probe.coarse is not None:  # the member found, on the full probe (it can only score higher)
+        member = None if getattr(best["support"], "is_uniform", False) else best["support"]
+        best["obj"], best["tf"] = score(probe, member, arc, period)
     beat.finish(used[0], "a member breaks the plan" if best["obj"] > 0 else "")
     return WorstMember(best["support"], best["params"], float(best["obj"]), best["tf"], used[0],
                        best["source"], probe.nominal)
@@ -472,7 +512,7 @@ def _search_space(probe, space, arc, period, budget, rng, keep, used, stop_when_
         spent[0] += 1
         used[0] += 1
         support = space.member(x, f"worst {space.kind} member")
-        obj, tf = score(probe, support, arc, period)
+        obj, tf = score(probe, support, arc, period, coarse=True)
         keep(obj, tf, support, space.params(x), source)
         if stop_when_broken and obj > 0:
             raise _Stop

@@ -372,7 +372,8 @@ class LevelScreen:
         cascade = [rows for rows in (bench.screen_rows(inputs, *c) for c in CASCADE)
                    if screen[0].size < rows[0].size < full[0].size // 2]
         share = screen[0].size / (screen[0].size + full[0].size)  # the screen's share of a block's work
-        found, found_idx, judged = [], [], []
+        found, found_idx, judged, pending = [], [], [], []
+        lazy = self.certifier.member_check is not None  # family checks wait for the ranking
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
         done = cascaded = 0
         while done < order.size and not (found and len(judged) + cascaded >= candidates):
@@ -396,16 +397,45 @@ class LevelScreen:
                 for idx, verdict in zip(chunk, verdicts):
                     plan = self.plan(idx, span[idx], verdict)
                     judged.append(plan)
-                    if verdict["orients"] and self.certifier.holds_for_family(plan):
-                        found.append(plan)
-                        found_idx.append(idx)
+                    if verdict["orients"]:
+                        pending.append((idx, plan))
+                if pending and (not lazy or len(judged) + cascaded >= candidates):
+                    self._check_family(pending, found, found_idx, record)
                 if found and len(judged) + cascaded >= candidates:
                     break
             beat.tick(done)
+        self._check_family(pending, found, found_idx, record)
         record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
         if done < order.size:
             beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
         return found, found_idx, judged
+
+    def _check_family(self, pending, found, found_idx, record) -> None:
+        """Move the plans of ``pending`` (``(row, plan)``, orienting on the
+        selection trials) that hold for the support family to ``found``
+        (``found_idx``: their rows), emptying ``pending``.
+
+        Without a family every plan holds. With one, each check is a
+        worst-member search, the dearest step of the search: the plans are
+        checked best first (their rank on the selection trials) up to the
+        first that holds, and the ones ranked after it are left unchecked
+        (``family_unchecked`` in their verdict and in ``record``): they
+        could only be alternatives to it."""
+        if self.certifier.member_check is None:
+            found += [plan for _, plan in pending]
+            found_idx += [idx for idx, _ in pending]
+            pending.clear()
+            return
+        pending.sort(key=lambda item: item[1].rank_key())
+        for k, (idx, plan) in enumerate(pending):
+            if self.certifier.holds_for_family(plan):
+                found.append(plan)
+                found_idx.append(idx)
+                for _, rest in pending[k + 1:]:
+                    rest.verdict = dict(rest.verdict, family_unchecked=True)
+                record["family_unchecked"] = record.get("family_unchecked", 0) + len(pending) - k - 1
+                break
+        pending.clear()
 
     def _cascade(self, alive, cascade, allowed: int, record):
         """``alive`` without the sequences that fail more than ``allowed`` trials
