@@ -88,3 +88,25 @@ def test_the_largest_inset_with_members_against_brute_force():
         except Exception:
             return False
     assert has(top) and not has(top + 2 * nearest.INSET_RESOLUTION)
+
+
+def test_a_moving_plan_that_holds_is_the_moving_axis_and_the_rest_ask_without_it():
+    """When a moving-pin plan holds for the family, the moving-pins axis is
+    that plan with its certificate; the other axes start from the fixed-pin
+    plans a worst member broke, never from a broken moving-pin plan."""
+    from types import SimpleNamespace
+    verdict = {"orients": True, "in_tolerance": 10}
+    results = {(("P1", "P2"), (1.0, 2.0)): {"holds": False, "verdict": dict(verdict, in_tolerance=30),
+                                            "_speeds": (0.0, -1.0)},
+               (("P3", "P4"), (3.0, 4.0)): {"holds": False, "verdict": verdict, "_speeds": (0.0, 0.0)},
+               (("P5",), (5.0,)): {"holds": False, "verdict": dict(verdict, in_tolerance=20)},
+               (("P6",), (6.0,)): {"holds": True, "verdict": dict(verdict, in_tolerance=99)}}
+    checker = SimpleNamespace(results=results)
+    assert [p[0] for p in nearest.rejected_plans(checker)] == [("P1", "P2"), ("P5",), ("P3", "P4")]
+    assert [p[0] for p in nearest.rejected_plans(checker, fixed_only=True)] == [("P5",), ("P3", "P4")]
+    cert = {"holds": True, "claim": {"epsilon": 0.01, "beta": 0.05, "violations": 0, "members": 299}}
+    moving = {"labels": ("P1", "P2v-1"), "heights": (1.0, 2.0), "speeds": (0.0, -1.0), "certificate": cert}
+    axis = nearest.moving_axis({"support_family": {"label": "tripods:12"}}, moving)
+    assert axis["found"] and axis["holds"] and axis["value"] == 1 and axis["plan"] == ["P1", "P2v-1"]
+    assert "holds" in nearest.nearest_yes_lines({"axes": [axis]})[1]
+    assert not nearest.moving_axis({"moving_pin_search": {"levels": []}})["found"]

@@ -49,11 +49,13 @@ MAX_TOLERANCE = 45.0  # deg: the loosest tolerance asked about
 INSET_RESOLUTION = 0.005  # of a: the largest inset with a member is found to this
 
 
-def rejected_plans(checker: FamilyChecker, n: int = PLANS_TRIED) -> list:
+def rejected_plans(checker: FamilyChecker, n: int = PLANS_TRIED, fixed_only: bool = False) -> list:
     """The plans a worst member broke after they passed the sampled
-    verification, most trials in one set first: ``(labels, heights, speeds)``."""
+    verification, most trials in one set first: ``(labels, heights, speeds)``
+    (``fixed_only``: those without a moving pin)."""
     broken = [(key, r) for key, r in checker.results.items()
-              if not r["holds"] and r.get("verdict", {}).get("orients")]
+              if not r["holds"] and r.get("verdict", {}).get("orients")
+              and not (fixed_only and any(r.get("_speeds", ())))]
     broken.sort(key=lambda kr: -kr[1]["verdict"]["in_tolerance"])
     return [(key[0], key[1], r.get("_speeds", ())) for key, r in broken[:n]]
 
@@ -203,8 +205,18 @@ def tolerance_axis(part, family, plans, st, progress=None) -> dict:
                    family)
 
 
-def moving_axis(result: dict) -> dict:
-    """What the search's moving-pin stage found for the family."""
+def moving_axis(result: dict, moving_yes: dict | None = None) -> dict:
+    """What the search's moving-pin stage found for the family: ``moving_yes``,
+    the recommended moving-pin plan with its check and certificate, when one
+    holds."""
+    if moving_yes is not None:
+        cert = moving_yes["certificate"]
+        return {"axis": "moving pins", "found": True, "holds": bool(cert["holds"]),
+                "value": int(sum(1 for v in moving_yes["speeds"] if v)), "unit": "moving pins",
+                "statement": f"the same family with {sum(1 for v in moving_yes['speeds'] if v)} moving pin(s)",
+                "plan": list(moving_yes["labels"]), "pin_heights_mm": list(moving_yes["heights"]),
+                "pin_speeds": list(moving_yes["speeds"]), "family": result.get("support_family", {}).get("label"),
+                "certificate": cert}
     stage = result.get("moving_pin_search")
     if not stage:
         return _not_found("moving pins", "not searched: no pin speeds configured (planner.dynamic.speeds)")
@@ -212,20 +224,24 @@ def moving_axis(result: dict) -> dict:
                                      "either")
 
 
-def nearest_yes(part, family, checker: FamilyChecker, result: dict, make_family, progress=None) -> dict:
-    """Every axis's nearest "yes" for a family no plan holds for (see the
-    module docstring); ``make_family`` turns family text into the planning
-    family (with its extremes)."""
-    plans = rejected_plans(checker)
+def nearest_yes(part, family, checker: FamilyChecker, result: dict, make_family, progress=None,
+                moving_yes: dict | None = None) -> dict:
+    """Every axis's nearest "yes" for a family no fixed-pin plan holds for (see
+    the module docstring); ``make_family`` turns family text into the planning
+    family (with its extremes). ``moving_yes`` (``labels``, ``heights``,
+    ``speeds``, ``certificate``): the moving-pin plan that holds, when the
+    search found one; the other axes then start from the fixed-pin plans a
+    worst member broke (the answer without a moving pin)."""
+    plans = rejected_plans(checker, fixed_only=moving_yes is not None)
     st = checker.settings
     if not plans:
         return {"plans_tried": [], "axes": [_not_found(a, "no plan passed the sampled verification: nothing "
                                                          "to loosen") for a in ("inset", "friction", "tolerance")]
-                + [moving_axis(result), _more_pins(result)]}
+                + [moving_axis(result, moving_yes), _more_pins(result)]}
     axes = [inset_axis(part, family, plans, st, make_family, progress),
             friction_axis(part, family, plans, st, progress),
             tolerance_axis(part, family, plans, st, progress),
-            moving_axis(result), _more_pins(result)]
+            moving_axis(result, moving_yes), _more_pins(result)]
     return {"plans_tried": [list(p[0]) for p in plans], "steps": STEPS,
             "assumes": "holding is monotone along each axis (bisection)", "axes": axes}
 

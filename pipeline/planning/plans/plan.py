@@ -495,14 +495,19 @@ def certify_for_family(result: dict, part: Part, settings: PlannerSettings, fami
         return
     rec = good[0] if good else None
     check = rec and rec.verification.get("family_check")
+    moving_yes = None
     if check and check["holds"]:
         cert = family_certificate(part, rec.pin_heights_mm, family, check, checker.settings,
                                   speeds=rec.pin_speeds, progress=checker.progress)
         result["family_certificate"] = cert
         result["recommended"]["family_certificate"] = cert
-        return
+        if not any(rec.pin_speeds or ()):
+            return
+        # A moving-pin plan holds: the nearest "yes" without one is still asked for.
+        moving_yes = {"labels": rec.pins, "heights": rec.pin_heights_mm, "speeds": rec.pin_speeds or (),
+                      "certificate": cert}
     broken = [(key, r) for key, r in checker.results.items() if not r["holds"] and r["worst_member"]]
-    if broken:
+    if broken and moving_yes is None:
         (labels, heights), record = max(broken, key=lambda kr: kr[1]["verdict"]["in_tolerance"])
         worst = record["worst_member"]
         result["family_certificate"] = None
@@ -515,4 +520,5 @@ def certify_for_family(result: dict, part: Part, settings: PlannerSettings, fami
             f"(e.g. {worst['parameters']}, nominal finals {worst['nominal_finals_deg']} deg, "
             f"{worst['outside_deg']:.2f} deg outside the set)")
     result["nearest_yes"] = nearest_yes(part, family, checker, result,
-                                        lambda text: planning_family(part, text, settings), checker.progress)
+                                        lambda text: planning_family(part, text, settings), checker.progress,
+                                        moving_yes)
