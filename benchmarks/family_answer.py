@@ -15,7 +15,7 @@ The target is a family answer, with its nearest "yes", within 5 minutes on
 2 cores. Results go on the performance page with the date and the machine.
 
     .venv/bin/python benchmarks/family_answer.py [--part asym_triangle]
-        [--mu-c 0.1:0.3] [--family tripods:12] [--limit 3600]
+        [--mu-c 0.1:0.3] [--family tripods:12] [--limit 3600] [--log FILE]
 """
 import argparse
 import datetime
@@ -33,7 +33,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def run(part: str, mu_c: str, family: str, limit: float, workdir: Path) -> dict:
+def run(part: str, mu_c: str, family: str, limit: float, workdir: Path, log: Path | None = None) -> dict:
     """Run the plan command under ``limit`` seconds; its timings and its output's summary."""
     out = workdir / "plan.json"
     cmd = [sys.executable, "-m", "pipeline.cli", "plan", "--part", part, "--mu-c", mu_c,
@@ -46,6 +46,9 @@ def run(part: str, mu_c: str, family: str, limit: float, workdir: Path) -> dict:
         try:
             for line in proc.stdout:
                 _stamp(stamps, line, time.perf_counter() - t0)
+                if log is not None:
+                    with open(log, "a") as f:
+                        f.write(f"{time.perf_counter() - t0:8.1f} s {line}")
                 if time.perf_counter() - t0 > limit:
                     proc.kill()
                     stamps["stopped_at_limit"] = True
@@ -80,6 +83,7 @@ def _plan_summary(plan: dict) -> dict:
     cert = tight.get("family_certificate") or {}
     levels = (tight.get("fixed_pin_search") or {}).get("levels") or []
     return {"orients_for_family": bool(cert.get("holds")), "claim": cert.get("claim"),
+            "recommended": (tight.get("recommended") or {}).get("pins"),
             "levels": [{k: lv.get(k) for k in ("sequences", "judged", "broken_by_known_member")} for lv in levels],
             "nearest_yes": [{k: a.get(k) for k in ("axis", "found", "value", "statement")}
                             for a in (tight.get("nearest_yes") or {}).get("axes", [])]}
@@ -91,9 +95,10 @@ def main(argv=None) -> int:
     ap.add_argument("--mu-c", default="0.1:0.3")
     ap.add_argument("--family", default="tripods:12")
     ap.add_argument("--limit", type=float, default=3600.0, help="seconds before the run is stopped")
+    ap.add_argument("--log", type=Path, help="also write the run's progress lines here, with their times")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
-        summary = run(args.part, args.mu_c, args.family, args.limit, Path(tmp))
+        summary = run(args.part, args.mu_c, args.family, args.limit, Path(tmp), args.log)
     summary.update(date=datetime.date.today().isoformat(), machine=f"{platform.node()} ({os.cpu_count()} CPUs)",
                    load=os.getloadavg(), part=args.part, mu_c=args.mu_c, family=args.family)
     print(json.dumps(summary, indent=1))
