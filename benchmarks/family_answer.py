@@ -42,7 +42,7 @@ def run(part: str, mu_c: str, family: str, limit: float, workdir: Path, log: Pat
     t0 = time.perf_counter()
     stamps = {}
     with subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=ROOT,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)}) as proc:
+                          env={**os.environ, "PYTHONPATH": str(ROOT), "PYTHONUNBUFFERED": "1"}) as proc:
         try:
             for line in proc.stdout:
                 _stamp(stamps, line, time.perf_counter() - t0)
