@@ -291,7 +291,7 @@ HASH_NEUTRAL_DEFAULTS = {("sweep", "supports"): ["uniform"],
                          # (and its shards' recorded hash); the code version records the change
                          ("verify", "confidence"): 0.95, ("verify", "rule"): "bound",
                          ("verify", "holdout_trials"): None, ("planner", "width_slack_deg"): 1.0,
-                         ("planner", "worst_member_budget"): 150}
+                         ("planner", "worst_member_budget"): 150, ("planner", "shape_tolerance_mm"): None}
 
 
 def config_hash(config: dict) -> str:

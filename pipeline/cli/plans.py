@@ -45,16 +45,10 @@ def cmd_plan(args, print_result=print_plan_result):
                               depth=args.depth, model=args.model, coverage=args.coverage, speeds=speeds,
                               dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
                               mu_s=args.mu_s, tolerance=args.tolerance,
-                              support_family=args.support_family)
+                              support_family=args.support_family, shape_tolerance=args.shape_tolerance)
     part = plan_part_arg(args, config)
     out = plan_store_path(config, part.name, args.out)  # checked before any work
-    if args.shape_tolerance is not None and not args.shape_tolerance > 0:
-        raise PinfeedError(f"--shape-tolerance must be a length > 0 mm, got {args.shape_tolerance:g}")
     result = plan_command(part, config, args.mode, progress=progress_line)
-    if args.shape_tolerance is not None:
-        from pipeline.planning import PlannerSettings, attach_shape_tolerance
-        attach_shape_tolerance(result, part, PlannerSettings.from_config(config), args.shape_tolerance,
-                               progress_line)
     if out is not None:
         from pipeline.maps.io import write_json
         write_json(result, out)
@@ -146,7 +140,8 @@ def add_plan_commands(sub) -> None:
     p.add_argument("--shape-tolerance", dest="shape_tolerance", type=float, default=None, metavar="MM",
                    help="certify the recommended fixed-pin plan for every part whose outline vertices lie "
                         "within MM of the drawing (a worst-member search and 300 fresh members); when it "
-                        "does not hold, its certified radius (the largest tolerance that does)")
+                        "does not hold, its certified radius (the largest tolerance that does); default: "
+                        "the config's planner.shape_tolerance_mm")
     p.add_argument("--coverage", default=None, choices=["bracket", "nearest"],
                    help="paper mode only: which stored maps stand for an uncertain state; bracket "
                         "(the d maps around its d range and one theta_i step either side; "

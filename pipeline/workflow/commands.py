@@ -19,7 +19,7 @@ from pipeline.provenance import provenance_attrs
 
 def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model=None, coverage=None,
                      speeds=None, dynamic_depth=None, pins=None, belt_speed=None, mu_s=None,
-                     tolerance=None, support_family=None) -> dict:
+                     tolerance=None, support_family=None, shape_tolerance=None) -> dict:
     """A copy of ``config`` with ``pinfeed plan``'s overrides applied, each checked.
 
     ``None`` leaves the config's value. ``catalog``: the catalog folder;
@@ -30,7 +30,8 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
     ``pins``: candidate pin heights (mm); ``belt_speed`` (mm/s) and ``mu_s``
     (only with a belt speed); ``tolerance``: the full width (deg) a final set
     may have, in (0, 360); ``support_family``: the supports plans must hold
-    for (``planner.support_family``; ``"uniform"`` for none). Raises
+    for (``planner.support_family``; ``"uniform"`` for none); ``shape_tolerance``:
+    the outline's tolerance, mm (``planner.shape_tolerance_mm``, > 0). Raises
     :class:`PinfeedError` on a bad value before any work."""
     config = copy.deepcopy(config)
     if catalog:
@@ -50,6 +51,10 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
         pc["pins"] = [float(x) for x in pins]
     if tolerance is not None:
         pc["tolerance_deg"] = check_tolerance(tolerance)
+    if shape_tolerance is not None:
+        if not float(shape_tolerance) > 0:
+            raise PinfeedError(f"--shape-tolerance must be a length > 0 mm, got {float(shape_tolerance):g}")
+        pc["shape_tolerance_mm"] = float(shape_tolerance)
     if support_family is not None:
         if not support_family.strip():
             raise PinfeedError("--support-family is empty; give a family such as 'tripods:12' or "
@@ -124,8 +129,10 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
         parse_support_family(family, part)  # a bad family: a one-line error before any work
     from pipeline.planning import attach_speed_limits
     if mode == "tight":
-        return attach_speed_limits(plan_tight_only(part, settings, config["catalog_dir"], progress=progress),
-                                   settings)
+        result = attach_speed_limits(plan_tight_only(part, settings, config["catalog_dir"], progress=progress),
+                                     settings)
+        from pipeline.workflow.plan import with_shape_tolerance
+        return with_shape_tolerance(result, part, settings, progress)
     from pipeline.workflow.plan import ensure_maps, plan_part
     cat = ensure_maps(config, part)
     result = plan_part(cat, part.id, settings, progress=progress, tight=mode == "both")

@@ -18,8 +18,8 @@ from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
 from pipeline.parts.support import support_key
 from pipeline.parts.families import config_part_id
-from pipeline.planning import (PlanFile, PlannerSettings, attach_speed_limits, build_planner, load_maps,
-                               paper_depth, plan_tight_all, validate_plan_file, verify_plan)
+from pipeline.planning import (PlanFile, PlannerSettings, attach_shape_tolerance, attach_speed_limits,
+                               build_planner, load_maps, paper_depth, plan_tight_all, validate_plan_file, verify_plan)
 from pipeline.progress import Heartbeat
 from pipeline.provenance import provenance_attrs
 
@@ -188,7 +188,18 @@ def plan(config: dict, name: str, out, shards=None) -> dict:
         cat = Catalog.of_files(root, shards)
     settings = PlannerSettings.from_config(config)
     result = attach_speed_limits(plan_part(cat, config_part_id(config, name), settings), settings)
+    if settings.search.shape_tolerance_mm is not None:
+        with_shape_tolerance(result, Part.from_dict(result["part"]), settings)
     write_json(result, out)
+    return result
+
+
+def with_shape_tolerance(result: dict, part: Part, settings: PlannerSettings, progress=None) -> dict:
+    """``result`` with its tight entries' ``shape_tolerance`` when the settings
+    give the outline's tolerance (``planner.shape_tolerance_mm``)."""
+    tol = settings.search.shape_tolerance_mm
+    if tol is not None and result.get("tight"):
+        attach_shape_tolerance(result, part, settings, float(tol), progress)
     return result
 
 

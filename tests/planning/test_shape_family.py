@@ -112,3 +112,31 @@ def test_a_result_without_a_fixed_pin_plan_gets_a_note():
     assert entry["radius_mm"] is None and "nothing to certify" in shape_line(entry)
     with pytest.raises(PinfeedError, match="--shape-tolerance must be a length"):
         attach_shape_tolerance(result, TRIANGLE, settings, -0.2)
+
+
+def test_the_config_gives_the_shape_tolerance_and_the_command_line_overrides_it():
+    """``planner.shape_tolerance_mm`` reaches the settings; ``--shape-tolerance``
+    (``planner_settings``) replaces it, and a length that is not > 0 is a
+    one-line error; the workflow's plan attaches the check only when it is set;
+    the key at its default leaves the config hash alone."""
+    from pipeline.config import config_hash, load_config, validate_config
+    from pipeline.planning import PlannerSettings
+    from pipeline.workflow.commands import planner_settings
+    from pipeline.workflow.plan import with_shape_tolerance
+    config = load_config(None)
+    assert PlannerSettings.from_config(config).search.shape_tolerance_mm is None
+    assert config_hash(config) == config_hash({**config, "planner": {
+        k: v for k, v in config["planner"].items() if k != "shape_tolerance_mm"}})
+    set_ = planner_settings(config, shape_tolerance=0.2)
+    assert PlannerSettings.from_config(set_).search.shape_tolerance_mm == 0.2
+    assert config_hash(set_) != config_hash(config)
+    for bad in (0.0, -0.1, float("nan")):
+        with pytest.raises(PinfeedError, match="--shape-tolerance must be a length > 0 mm"):
+            planner_settings(config, shape_tolerance=bad)
+    with pytest.raises(Exception):
+        validate_config({**config, "planner": {**config["planner"], "shape_tolerance_mm": -1.0}})
+    result = {"tight": [{"recommended": None, "mu_c": [0.1, 0.3], "friction": "0.1:0.3"}]}
+    with_shape_tolerance(result, TRIANGLE, PlannerSettings.from_config(config))
+    assert "shape_tolerance" not in result["tight"][0]
+    with_shape_tolerance(result, TRIANGLE, PlannerSettings.from_config(set_))
+    assert result["tight"][0]["shape_tolerance"]["requested_mm"] == 0.2

@@ -275,8 +275,9 @@ class SearchSettings:
     fitted to the part), ``depth``, the contact-parameter limits, the
     mechanics (``model``, ``pin_radius``, kernel step ``ds_max`` and ``tol``),
     the belt (``belt_speed`` mm/s, ``None`` quasi-static; ``mu_s``), moving
-    pins (``dynamic_speeds``, ``dynamic_depth``, ``beam``), and the search's
-    sizes and ranking slack."""
+    pins (``dynamic_speeds``, ``dynamic_depth``, ``beam``), the search's
+    sizes and ranking slack, the support family and the outline's shape
+    tolerance (mm; ``None``: no shape check)."""
 
     pin_radius: float  # sweep.pin_radius (mm), which the config must give
     pins: object = _default("planner", "pins")
@@ -298,6 +299,7 @@ class SearchSettings:
     paper_depth: int = _default("planner", "paper_depth")
     coverage: str = _default("planner", "coverage")
     support_family: object = _default("planner", "support_family")
+    shape_tolerance_mm: float | None = _default("planner", "shape_tolerance_mm")
 
     @property
     def kernel_settings(self) -> dict:
@@ -382,7 +384,8 @@ class PlannerSettings:
             dynamic_speeds=tuple(float(v) for v in dyn["speeds"]), dynamic_depth=int(dyn["depth"]),
             beam=int(dyn["beam"]), candidates=int(pc["candidates"]), max_branches=int(pc["max_branches"]),
             width_slack_deg=float(pc["width_slack_deg"]), worst_member_budget=int(pc["worst_member_budget"]),
-            paper_depth=int(pc["paper_depth"]), coverage=pc["coverage"], support_family=pc.get("support_family"))
+            paper_depth=int(pc["paper_depth"]), coverage=pc["coverage"], support_family=pc.get("support_family"),
+            shape_tolerance_mm=pc.get("shape_tolerance_mm"))
         claims = ClaimSettings(pc["tolerance_deg"], vc["required"], vc["confidence"], vc["rule"])
         verify = VerifySettings(int(vc["trials"]), bool(vc["corners"]), int(vc["seed"]), vc["holdout_trials"],
                                 Perturbation(float(vc["theta_sigma"]), float(vc["y_halfwidth"]), sigma,
