@@ -265,6 +265,9 @@ def _warnings(plans: dict, verifications: dict) -> list[str]:
         for t in res.get("tight", []):
             if t.get("warning"):
                 items.append(f"{name}, tight planner at mu_c {t['friction']}: {t['warning']}")
+            if t.get("nearest_yes"):  # what would make it a "yes", axis by axis
+                head, *lines = nearest_yes_lines(t["nearest_yes"])
+                items += [f"{name}, {head.rstrip(':')}: {line.strip()}" for line in lines]
     for name, ver in verifications.items():
         for check in ver.get("checks", []):
             for r in check["rows"]:

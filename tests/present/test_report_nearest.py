@@ -24,3 +24,18 @@ def test_each_axis_is_a_line_of_the_report():
 
 def test_no_nearest_yes_no_line():
     assert "nearest" not in "\n".join(_support_section(_study(None), {}, "."))
+
+
+def test_a_part_without_a_plan_lists_its_nearest_yes_among_the_warnings():
+    from pipeline.present.report import _warnings
+    verdict = {"in_tolerance": 186, "trials": 186}
+    nearest = {"axes": [
+        {"axis": "tolerance", "found": True, "statement": "a tolerance of 30 deg (asked: 6 deg)",
+         "plan": ["P14", "P2"], "verdict": verdict},
+        {"axis": "sensor", "found": True, "statement": "a force/torque-sensing pin after P14 tells its 4 sets apart"},
+        {"axis": "more pins", "found": False, "statement": "not searched"}]}
+    plans = {"trapezoid": {"tight": [{"friction": "0.2", "warning": "no plan", "nearest_yes": nearest}]}}
+    text = "\n".join(_warnings(plans, {}))
+    assert "tolerance: a tolerance of 30 deg (asked: 6 deg): P14 P2 holds 186 of 186 trials in one set" in text
+    assert "sensor: a force/torque-sensing pin after P14 tells its 4 sets apart" in text
+    assert "verified by full rollouts" in text

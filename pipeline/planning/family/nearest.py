@@ -254,10 +254,15 @@ def _more_pins(result: dict) -> dict:
 
 def nearest_yes_lines(nearest: dict) -> list[str]:
     """The nearest "yes" for people: a heading and one line per axis."""
-    out = ["the nearest \"yes\" (each verified: worst-member search, then fresh members):"]
+    family = any("certificate" in axis for axis in nearest["axes"]) or "steps" in nearest
+    out = ["the nearest \"yes\" (each verified: worst-member search, then fresh members):" if family
+           else "the nearest \"yes\" (each verified by full rollouts):"]
     for axis in nearest["axes"]:
-        if not axis["found"]:
-            out.append(f"  {axis['axis']}: {axis['statement']}")
+        if not axis["found"] or "certificate" not in axis:
+            verdict = axis.get("verdict") if axis["found"] else None
+            tail = (f": {' '.join(axis['plan'])} holds {verdict['in_tolerance']} of {verdict['trials']} "
+                    f"trials in one set" if verdict and axis.get("plan") else "")
+            out.append(f"  {axis['axis']}: {axis['statement']}{tail}")
             continue
         claim = axis["certificate"]["claim"]
         verdict = "holds" if axis["holds"] else "does NOT hold on fresh members"

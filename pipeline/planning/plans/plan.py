@@ -35,6 +35,7 @@ from pipeline.planning.tight.complete import (FixedPinSearch, FixedPlan, FixedSe
 from pipeline.planning.family.members import planning_family
 from pipeline.planning.family.certificate import family_certificate
 from pipeline.planning.family.nearest import nearest_yes
+from pipeline.planning.plans.nearest_part import part_nearest_yes
 from pipeline.planning.family.worst_member import FamilyChecker, FamilyCheckSettings
 from pipeline.planning.tight.store import load_lattice, save_lattice
 from pipeline.planning.claims.orient import describe_claim, judge_verification
@@ -133,6 +134,10 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     if family is not None:
         result["support_family"] = family.to_dict()
         certify_for_family(result, part, settings, family, checker, good)
+    elif not result["orients"] and candidates:
+        kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in candidates[:keep]]
+        fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
+        result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins)
     return result
 
 

@@ -1,0 +1,166 @@
+"""The nearest "yes" for one part (uniform pressure) that no plan orients.
+
+When the complete search finds no plan of up to ``N`` pins whose final set
+fits the tolerance, the engineer asks what would. For one part the axes are:
+
+* **a looser tolerance**: the smallest ``tolerance_deg`` (on a half-degree
+  ladder, up to ``MAX_TOLERANCE``) at which one of the plans the search
+  kept (the recommended one and the other verified candidates) orients the
+  part on *held-out* trials: trials from a seed no search or selection drew
+  from (``verify.holdout_settings``). For each plan the answer is the
+  narrowest arc that holds the claim's count of those trials (the rule's
+  ``max_failures`` left out), rounded up to the ladder, and the verdict at
+  that tolerance is the claim's own judgement of the same finals. When no
+  kept plan gets there (they end in several sets far apart), the complete
+  fixed-pin search runs again at looser tolerances, by bisection, and its
+  plan (certified on held-out trials) is the answer;
+* **moving pins**: what the search's moving-pin stage found (it runs when
+  pin speeds are configured and fixed pins do not orient the part);
+* **a sensor**: when the recommended plan ends in a few sets within the
+  tolerance, a force/torque-sensing pin that tells them apart finishes the
+  job (``pinfeed sense``);
+* **more pins or a wider pin grid**: not searched here; the line says how.
+
+The tolerance answer is a statement about that plan at that tolerance on
+trials it was not chosen on; a search at the looser tolerance may find a
+plan with fewer pins, which this does not look for.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pipeline.planning.claims import orient
+from pipeline.planning.tight.judge import TrialBench
+
+MAX_TOLERANCE = 45.0  # deg: the loosest tolerance asked about
+LADDER = 0.5  # deg: tolerances are answered on this ladder
+
+
+def _axis(axis: str, found: bool, statement: str, **extra) -> dict:
+    return {"axis": axis, "found": found, "holds": found, "statement": statement, **extra}
+
+
+def loosest_needed(finals, jammed, n_trials: int, order: int, required: float, confidence: float,
+                   rule: str) -> float | None:
+    """The smallest tolerance (deg, on the ``LADDER``) whose claim the finals
+    meet: the narrowest arc holding all but the allowed failures; None when
+    no tolerance up to ``MAX_TOLERANCE`` does (or too few trials)."""
+    keep = np.asarray(finals)[~np.asarray(jammed)]
+    allowed = orient.max_failures(n_trials, required, confidence, rule)
+    arc = None if allowed < 0 else orient.narrowest_arc(keep, n_trials - allowed, order)
+    if arc is None:
+        return None
+    tol = max(LADDER, math.ceil(arc[1] / LADDER - 1e-9) * LADDER)
+    while tol <= MAX_TOLERANCE:  # the claim's own judgement at that tolerance
+        if orient.judge(keep, n_trials, tol, order, required, confidence, rule=rule)["orients"]:
+            return float(tol)
+        tol += LADDER
+    return None
+
+
+def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int) -> tuple | None:
+    """``(tolerance, plan)``: the smallest tolerance on the ``LADDER`` up to
+    ``MAX_TOLERANCE`` at which the complete fixed-pin search over ``pins``
+    (label -> height, mm) finds a plan of up to ``depth`` pins, certified on
+    its held-out trials, by bisection; None when none does at ``MAX_TOLERANCE``.
+
+    Exact bisection: on the same trials, a sequence that orients within ``t``
+    orients within any looser tolerance, and its nominal finals pass the
+    looser filter too, so "some plan orients" is monotone in ``t``."""
+    import dataclasses
+
+    from pipeline.planning.tight.complete import FixedPinSearch
+
+    def found(t):
+        claims = dataclasses.replace(settings.claims, tolerance_deg=float(t))
+        search = FixedPinSearch(part, pins, settings.friction, claims, settings.verify, settings.search)
+        plans = search.run(depth, candidates=candidates, keep=1).plans
+        return plans[0] if plans else None
+
+    lo = math.floor(settings.claims.tolerance_deg / LADDER) * LADDER  # does not orient (the question)
+    hi = MAX_TOLERANCE
+    best = found(hi)
+    if best is None:
+        return None
+    while hi - lo > LADDER + 1e-9:
+        mid = math.floor((lo + hi) / 2 / LADDER) * LADDER
+        plan = found(mid)
+        if plan is None:
+            lo = mid
+        else:
+            hi, best = mid, plan
+    return hi, best
+
+
+def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None) -> dict:
+    """The smallest tolerance at which one of ``plans`` (``(labels, heights,
+    speeds)``) orients ``part`` on held-out trials; when none does within
+    ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
+    complete search over them finds a plan (:func:`searched_tolerance`)."""
+    bench = TrialBench(part, settings.friction, settings.claims, settings.verify, settings.search)
+    claims = settings.claims
+    best = None
+    for labels, heights, speeds in plans:
+        rows = bench.held_out(len(heights))
+        tf, jam = bench.replay(np.atleast_2d(np.asarray(heights, float)),
+                               np.atleast_2d(np.asarray(speeds or [0.0] * len(heights), float)), rows)
+        tol = loosest_needed(tf[0], jam[0], rows[0].size, bench.order, claims.required, claims.confidence,
+                             claims.rule)
+        if tol is not None and (best is None or tol < best[0]):
+            verdict = orient.judge(tf[0][~jam[0]], rows[0].size, tol, bench.order, claims.required,
+                                   claims.confidence, rule=claims.rule)
+            best = (tol, labels, heights, speeds, verdict)
+    if best is None and pins:
+        searched = searched_tolerance(part, settings, pins, depth or settings.search.depth,
+                                      settings.search.candidates)
+        if searched is not None:
+            tol, plan = searched
+            best = (tol, plan.labels, plan.heights, plan.speeds, plan.verdict)
+    if best is None:
+        return _axis("tolerance", False, f"no plan of up to {depth or settings.search.depth} fixed pins orients "
+                                         f"the part within {MAX_TOLERANCE:g} deg on held-out trials")
+    tol, labels, heights, speeds, verdict = best
+    return _axis("tolerance", True, f"a tolerance of {tol:g} deg (asked: {claims.tolerance_deg:g} deg)",
+                 value=tol, unit="deg", plan=list(labels), pin_heights_mm=[float(h) for h in heights],
+                 pin_speeds=[float(v) for v in (speeds or ())], verdict=verdict)
+
+
+def moving_axis(entry: dict) -> dict:
+    """What the moving-pin stage found for the part."""
+    stage = entry.get("moving_pin_search")
+    if not stage:
+        return _axis("moving pins", False, "not searched: no pin speeds configured (planner.dynamic.speeds)")
+    rec = entry.get("recommended") or {}
+    if stage.get("orients") and any(rec.get("pin_speeds") or ()):
+        n = sum(1 for v in rec["pin_speeds"] if v)
+        return _axis("moving pins", True, f"{n} moving pin(s)", value=n, unit="moving pins",
+                     plan=list(rec["pins"]), verdict=(rec.get("verification") or {}).get("orientation"))
+    return _axis("moving pins", False, "searched after the fixed pins: no moving-pin plan orients the part either")
+
+
+def sensor_axis(entry: dict) -> dict:
+    """A force/torque-sensing pin after the recommended plan, when it ends in a few sets."""
+    rec = entry.get("recommended") or {}
+    verdict = (rec.get("verification") or {}).get("orientation") or {}
+    sets = verdict.get("sets_within_tolerance")
+    if rec and sets and sets > 1:
+        return _axis("sensor", True, f"a force/torque-sensing pin after {' '.join(rec['pins'])} tells its "
+                                     f"{sets} sets apart (pinfeed sense)", value=int(sets), unit="sets",
+                     plan=list(rec["pins"]))
+    return _axis("sensor", False, "no recommended plan ends in a few sets for a sensor to tell apart")
+
+
+def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = None) -> dict:
+    """The nearest "yes" on each axis for a part no plan orients (see the
+    module docstring); ``entry``: its tight entry; ``plans``: the kept plans
+    ``(labels, heights, speeds)``, best first; ``pins``: the fixed pins the
+    search chose from (label -> height, mm), searched again at looser
+    tolerances when no kept plan answers."""
+    depth = entry.get("depth")
+    return {"plans_tried": [list(p[0]) for p in plans],
+            "axes": [tolerance_axis(part, settings, plans, pins, depth), moving_axis(entry), sensor_axis(entry),
+                     _axis("more pins", False, f"not searched (a deeper complete search costs more than the "
+                                               f"rest): run with --depth {depth + 1 if depth else 'N+1'} or "
+                                               f"a finer --pins grid")]}
