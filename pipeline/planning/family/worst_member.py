@@ -77,6 +77,7 @@ _PENALTY = 1.0e3
 _POOL = 20_000
 PRESCREEN_ROWS = 200_000  # rollouts per batch of the kept breakers' prescreen
 SEARCH_CORNERS = 64  # corners per resting state a member is scored on during the search
+PRESCREEN_CORNERS = 16  # corners per resting state in the kept members' middle prescreen stage
 
 
 # --------------------------------------------------------------------------- parameter spaces
@@ -737,10 +738,11 @@ class FamilyChecker:
         arc may then leave out more than ``allowed`` of them. A sequence is
         broken when a kept member's probe rollout jams or no such arc exists.
 
-        In two stages, each exact: the nominal rollouts first (if no arc holds
-        them, none holds the whole probe), then, for the sequences left, the
-        whole probe, or for a plan of many pins the rows the worst-member
-        search scores on (:func:`coarse_rows`): a subset rejects less, never
+        In stages, each exact: the nominal rollouts first (if no arc holds
+        them, none holds the whole probe), then ``PRESCREEN_CORNERS`` corners
+        a state (the pins' diagonal), then, for the sequences left, the whole
+        probe, or for a plan of many pins the rows the worst-member search
+        scores on (:func:`coarse_rows`): a subset rejects less, never
         wrongly, at a fraction of the whole probe's cost."""
         heights, speeds = np.atleast_2d(heights), np.atleast_2d(speeds)
         broken = np.zeros(heights.shape[0], bool)
@@ -750,7 +752,10 @@ class FamilyChecker:
         probe = PlanProbe(self.part, (0.0,) * heights.shape[1], st.mu_c, st.verify, st.pin_radius, st.model,
                           st.kernel)
         nominal = tuple(x[probe.nominal] for x in probe.inputs)
-        for rows in (nominal, probe.inputs if probe.coarse is None else probe.coarse):
+        last = probe.inputs if probe.coarse is None else probe.coarse
+        few = tuple(x[coarse_rows(probe.inputs[3], probe.nominal, PRESCREEN_CORNERS)] for x in probe.inputs)
+        stages = [nominal, few, last] if few[0].size < last[0].size else [nominal, last]
+        for rows in stages:
             left = np.flatnonzero(~broken)
             if left.size == 0:
                 break
