@@ -219,7 +219,7 @@ def moving_axis(result: dict, moving_yes: dict | None = None) -> dict:
                 "certificate": cert}
     stage = result.get("moving_pin_search")
     if not stage:
-        return _not_found("moving pins", "not searched: no pin speeds configured (planner.dynamic.speeds)")
+        return _not_found("moving pins", "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
     return _not_found("moving pins", "searched after the fixed pins: no moving-pin plan holds for the family "
                                      "either")
 

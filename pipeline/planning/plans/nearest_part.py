@@ -131,7 +131,7 @@ def moving_axis(entry: dict) -> dict:
     """What the moving-pin stage found for the part."""
     stage = entry.get("moving_pin_search")
     if not stage:
-        return _axis("moving pins", False, "not searched: no pin speeds configured (planner.dynamic.speeds)")
+        return _axis("moving pins", False, "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
     rec = entry.get("recommended") or {}
     if stage.get("orients") and any(rec.get("pin_speeds") or ()):
         n = sum(1 for v in rec["pin_speeds"] if v)
