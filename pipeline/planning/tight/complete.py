@@ -366,17 +366,26 @@ class LevelScreen:
         After the first ``candidates`` judged in full (the evidence's best
         results come from those), a survivor passes the ``CASCADE`` of larger
         subsets first: one rejected there fails the full trials as well, so
-        it counts as judged (and not orienting) without its full replay."""
+        it counts as judged (and not orienting) without its full replay.
+
+        With a support family, the orienting plans of a block are checked
+        against it at the end of the block, best first, and the level ends
+        with the first block where one holds (``_check_family``): each check
+        is a worst-member search, dearer than a wider ranking is worth."""
         bench = self.bench
         screen, full = bench.screen_rows(inputs, *SCREEN), stack(inputs)
         cascade = [rows for rows in (bench.screen_rows(inputs, *c) for c in CASCADE)
                    if screen[0].size < rows[0].size < full[0].size // 2]
         share = screen[0].size / (screen[0].size + full[0].size)  # the screen's share of a block's work
         found, found_idx, judged, pending = [], [], [], []
-        lazy = self.certifier.member_check is not None  # family checks wait for the ranking
+        lazy = self.certifier.member_check is not None  # family checks: once per block, best first
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
         done = cascaded = 0
-        while done < order.size and not (found and len(judged) + cascaded >= candidates):
+
+        def enough() -> bool:
+            return bool(found) and (lazy or len(judged) + cascaded >= candidates)
+
+        while done < order.size and not enough():
             block = order[done:done + SCREEN_BLOCK]
             fails = bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
             alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
@@ -399,12 +408,13 @@ class LevelScreen:
                     judged.append(plan)
                     if verdict["orients"]:
                         pending.append((idx, plan))
-                if pending and (not lazy or len(judged) + cascaded >= candidates):
+                if not lazy:
                     self._check_family(pending, found, found_idx, record)
-                if found and len(judged) + cascaded >= candidates:
+                if enough():
                     break
+            if lazy:
+                self._check_family(pending, found, found_idx, record)
             beat.tick(done)
-        self._check_family(pending, found, found_idx, record)
         record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
         if done < order.size:
             beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
