@@ -413,14 +413,14 @@ class LevelScreen:
                 if enough():
                     break
             if lazy:
-                self._check_family(pending, found, found_idx, record)
+                self._check_family(pending, found, found_idx, record, screen, allowed)
             beat.tick(done)
         record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
         if done < order.size:
             beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
         return found, found_idx, judged
 
-    def _check_family(self, pending, found, found_idx, record) -> None:
+    def _check_family(self, pending, found, found_idx, record, screen=None, allowed: int = 0) -> None:
         """Move the plans of ``pending`` (``(row, plan)``, orienting on the
         selection trials) that hold for the support family to ``found``
         (``found_idx``: their rows), emptying ``pending``.
@@ -430,22 +430,32 @@ class LevelScreen:
         checked best first (their rank on the selection trials) up to the
         first that holds, and the ones ranked after it are left unchecked
         (``family_unchecked`` in their verdict and in ``record``): they
-        could only be alternatives to it."""
+        could only be alternatives to it. After a plan fails, the members
+        kept so far prescreen the rest (``_drop_known_broken`` on the
+        ``screen`` rows) before the next is checked."""
         if self.certifier.member_check is None:
             found += [plan for _, plan in pending]
             found_idx += [idx for idx, _ in pending]
             pending.clear()
             return
-        pending.sort(key=lambda item: item[1].rank_key())
-        for k, (idx, plan) in enumerate(pending):
+        queue = sorted(pending, key=lambda item: item[1].rank_key())
+        pending.clear()
+        while queue:
+            idx, plan = queue.pop(0)
             if self.certifier.holds_for_family(plan):
                 found.append(plan)
                 found_idx.append(idx)
-                for _, rest in pending[k + 1:]:
+                for _, rest in queue:
                     rest.verdict = dict(rest.verdict, family_unchecked=True)
-                record["family_unchecked"] = record.get("family_unchecked", 0) + len(pending) - k - 1
-                break
-        pending.clear()
+                record["family_unchecked"] = record.get("family_unchecked", 0) + len(queue)
+                return
+            if queue and screen is not None:
+                left = set(self._drop_known_broken(np.array([i for i, _ in queue]), screen, allowed,
+                                                   record).tolist())
+                for i, rest in queue:
+                    if i not in left:
+                        rest.verdict = dict(rest.verdict, orients=False, broken_by_known_member=True)
+                queue = [(i, rest) for i, rest in queue if i in left]
 
     def _cascade(self, alive, cascade, allowed: int, record):
         """``alive`` without the sequences that fail more than ``allowed`` trials
