@@ -223,7 +223,7 @@ def _thin_triangle_entry(depth: int, prune: bool, monkeypatch):
     part = Part.from_vertices([[0, 0], [60, 0], [0, 20]], name="thin_triangle")
     with monkeypatch.context() as patch:
         if not prune:
-            patch.setattr(plan_module, "moving_room", lambda found, n_prefix, depth: depth)
+            patch.setattr(plan_module, "moving_room", lambda found, n_prefix, depth, **kw: depth)
         return plan_module.plan_tight(part, PlannerSettings.from_config(config).at(0.15))
 
 
@@ -261,3 +261,14 @@ def test_best_fixed_pin_results_name_each_sequence_once():
     best = plan_tight(part, PlannerSettings.from_config(config).at(0.15))["fixed_pin_search"]["best_effort"]
     assert len(best) == 5 and all(len(b["pins"]) == 3 for b in best[:2])
     assert len({tuple(b["pins"]) for b in best}) == len(best)
+
+
+def test_with_a_family_later_prefixes_look_only_for_fewer_pins():
+    """moving_room: without a family a later prefix may tie the shortest plan
+    found (same pins, maybe narrower); with one it must beat it."""
+    from types import SimpleNamespace
+    from pipeline.planning.plans.plan import moving_room
+    found = [SimpleNamespace(labels=("P1", "P2", "P3v-1"))]
+    assert moving_room([], 2, 2) == 2
+    assert moving_room(found, 2, 2) == 1 and moving_room(found, 2, 2, fewer=True) == 0
+    assert moving_room(found, 1, 2, fewer=True) == 1

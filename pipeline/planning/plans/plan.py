@@ -205,10 +205,11 @@ def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progre
     total = FixedSearch([], [], depth, settings.claims.tolerance_deg, settings.claims.required)
     for prefix in [None, *chosen[:MOVING_PREFIXES]]:
         after = list(prefix.labels) if prefix else []
-        room = moving_room(total.plans, len(after), depth)
-        if room < 1:  # then room = (pins of the shortest plan found) - len(after)
+        room = moving_room(total.plans, len(after), depth, fewer=family is not None)
+        if room < 1:  # then room = (pins of the shortest plan found) - len(after), less one with a family
             total.skipped.append({"after": after,
-                                  "why": f"a plan of {len(after) + room} pins already orients the part"})
+                                  "why": f"a plan of {len(after) + room + (family is not None)} pins already "
+                                         f"orients the part" + (" for the family" if family is not None else "")})
             continue
         res = search.run(room, candidates=settings.search.candidates, keep=keep, progress=progress,
                          prefix=prefix)
@@ -220,12 +221,14 @@ def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progre
     return total
 
 
-def moving_room(found: list, n_prefix: int, depth: int) -> int:
+def moving_room(found: list, n_prefix: int, depth: int, fewer: bool = False) -> int:
     """How many moving pins to try after a prefix of ``n_prefix`` fixed pins:
     ``depth``, or fewer so that no sequence has more pins than the shortest
-    orienting plan of ``found`` (0 or less: none)."""
+    orienting plan of ``found`` (0 or less: none); ``fewer``: so that each
+    has fewer pins than it (with a support family, where a plan of as many
+    pins would only be an alternative and each costs worst-member searches)."""
     fewest = min((len(p.labels) for p in found), default=None)
-    return depth if fewest is None else min(depth, fewest - n_prefix)
+    return depth if fewest is None else min(depth, fewest - n_prefix - int(fewer))
 
 
 def _rank(plan) -> tuple:
