@@ -53,10 +53,13 @@ def rejected_plans(checker: FamilyChecker, n: int = PLANS_TRIED, fixed_only: boo
     """The plans a worst member broke after they passed the sampled
     verification, most trials in one set first: ``(labels, heights, speeds)``
     (``fixed_only``: those without a moving pin)."""
+    def sampled(r):  # the verdict the plan passed before a worst member joined (older records: the last)
+        return r.get("sampled_verdict") or r.get("verdict", {})
+
     broken = [(key, r) for key, r in checker.results.items()
-              if not r["holds"] and r.get("verdict", {}).get("orients")
+              if not r["holds"] and sampled(r).get("orients")
               and not (fixed_only and any(r.get("_speeds", ())))]
-    broken.sort(key=lambda kr: -kr[1]["verdict"]["in_tolerance"])
+    broken.sort(key=lambda kr: -sampled(kr[1])["in_tolerance"])
     return [(key[0], key[1], r.get("_speeds", ())) for key, r in broken[:n]]
 
 

@@ -623,6 +623,7 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
     period = 360.0 / part.symmetry_order()
     what = f"worst member of {family.label} for {name}"
     verdict = verdict or verify_members(part, heights, family, st, speeds, progress, f"{what}: verification")
+    sampled = verdict  # the verdict on the family's sampled members, before any worst member joined
     joined, rounds, worst = family, [], None
     for k in range(MAX_ROUNDS):
         arc = claimed_arc(verdict, st.tolerance)
@@ -644,7 +645,8 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
     arc = claimed_arc(verdict, st.tolerance)
     return {"holds": holds, "space": space.describe(), "budget": st.budget,
             "members": len(joined.members), "trials": verdict["trials"],
-            "verdict": verdict, "set_deg": None if arc is None else [round(arc[0] % period, 3), round(arc[1], 3)],
+            "verdict": verdict, "sampled_verdict": {k: sampled.get(k) for k in ("orients", "in_tolerance", "trials")},
+            "set_deg": None if arc is None else [round(arc[0] % period, 3), round(arc[1], 3)],
             "worst_member": None if worst is None else worst.to_dict(), "rounds": rounds,
             "_family": joined, "_worst": worst}
 
