@@ -60,7 +60,7 @@ def loosest_needed(finals, jammed, n_trials: int, order: int, required: float, c
     return None
 
 
-def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int) -> tuple | None:
+def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, progress=None) -> tuple | None:
     """``(tolerance, plan)``: the smallest tolerance on the ``LADDER`` up to
     ``MAX_TOLERANCE`` at which the complete fixed-pin search over ``pins``
     (label -> height, mm) finds a plan of up to ``depth`` pins, certified on
@@ -76,7 +76,7 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int) 
     def found(t):
         claims = dataclasses.replace(settings.claims, tolerance_deg=float(t))
         search = FixedPinSearch(part, pins, settings.friction, claims, settings.verify, settings.search)
-        plans = search.run(depth, candidates=candidates, keep=1).plans
+        plans = search.run(depth, candidates=candidates, keep=1, progress=_at(progress, t)).plans
         return plans[0] if plans else None
 
     lo = math.floor(settings.claims.tolerance_deg / LADDER) * LADDER  # does not orient (the question)
@@ -94,7 +94,15 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int) 
     return hi, best
 
 
-def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None) -> dict:
+def _at(progress, tolerance):
+    """``progress`` with each line saying which tolerance the search tries."""
+    if progress is None:
+        return None
+    return lambda line: progress(f"nearest yes, tolerance {tolerance:g} deg: {line}")
+
+
+def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None,
+                   progress=None) -> dict:
     """The smallest tolerance at which one of ``plans`` (``(labels, heights,
     speeds)``) orients ``part`` on held-out trials; when none does within
     ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
@@ -114,7 +122,7 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
             best = (tol, labels, heights, speeds, verdict)
     if best is None and pins:
         searched = searched_tolerance(part, settings, pins, depth or settings.search.depth,
-                                      settings.search.candidates)
+                                      settings.search.candidates, progress)
         if searched is not None:
             tol, plan = searched
             best = (tol, plan.labels, plan.heights, plan.speeds, plan.verdict)
@@ -152,7 +160,7 @@ def sensor_axis(entry: dict) -> dict:
     return _axis("sensor", False, "no recommended plan ends in a few sets for a sensor to tell apart")
 
 
-def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = None) -> dict:
+def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = None, progress=None) -> dict:
     """The nearest "yes" on each axis for a part no plan orients (see the
     module docstring); ``entry``: its tight entry; ``plans``: the kept plans
     ``(labels, heights, speeds)``, best first; ``pins``: the fixed pins the
@@ -160,7 +168,8 @@ def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = Non
     tolerances when no kept plan answers."""
     depth = entry.get("depth")
     return {"plans_tried": [list(p[0]) for p in plans],
-            "axes": [tolerance_axis(part, settings, plans, pins, depth), moving_axis(entry), sensor_axis(entry),
+            "axes": [tolerance_axis(part, settings, plans, pins, depth, progress), moving_axis(entry),
+                     sensor_axis(entry),
                      _axis("more pins", False, f"not searched (a deeper complete search costs more than the "
                                                f"rest): run with --depth {depth + 1 if depth else 'N+1'} or "
                                                f"a finer --pins grid")]}

@@ -137,7 +137,7 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     elif not result["orients"] and candidates:
         kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in candidates[:keep]]
         fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
-        result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins)
+        result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins, progress)
     return result
 
 
