@@ -409,7 +409,8 @@ def outside(theta, arc: tuple, period: float = 360.0) -> np.ndarray:
 def score(probe: PlanProbe, support, arc, period: float, coarse: bool = False) -> tuple[float, np.ndarray]:
     """``(objective, finals)`` of one member (see the module docstring), on the
     full probe or (``coarse``) on its :func:`coarse_rows`."""
-    tf, jam = probe.finals(support, probe.coarse if coarse else None)
+    rows = getattr(probe, "coarse", None) if coarse else None  # a probe without a subset: all rows
+    tf, jam = probe.finals(support) if rows is None else probe.finals(support, rows)
     dist = np.where(jam, JAM_SCORE, outside(tf, arc, period))
     return float(dist.max()), tf
 
@@ -492,7 +493,7 @@ def search_worst_member(probe: PlanProbe, space: MemberSpace, arc: tuple, period
             break
     if best["obj"] == -np.inf:
         raise PinfeedError(f"support family {space.label!r} has no member to search")
-    if probe.coarse is not None:  # the member found, on the full probe (it can only score higher)
+    if getattr(probe, "coarse", None) is not None:  # the member found, on the full probe (only higher)
         member = None if getattr(best["support"], "is_uniform", False) else best["support"]
         best["obj"], best["tf"] = score(probe, member, arc, period)
     beat.finish(used[0], "a member breaks the plan" if best["obj"] > 0 else "")
