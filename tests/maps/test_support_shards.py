@@ -210,7 +210,7 @@ def test_config_hash_ignores_the_default_supports():
     cfg = validate_config(base)
     assert cfg["sweep"]["supports"] == ["uniform"]
     # The support keys and the claim's settings, at their defaults, are left out too.
-    planner_neutral = {"support_family", "width_slack_deg", "worst_member_budget"}
+    planner_neutral = {"support_family", "width_slack_deg", "worst_member_budget", "shape_tolerance_mm"}
     verify_neutral = {"confidence", "rule", "holdout_trials"}
     without = dict(cfg, sweep={k: v for k, v in cfg["sweep"].items() if k != "supports"},
                    planner={k: v for k, v in cfg["planner"].items() if k not in planner_neutral},

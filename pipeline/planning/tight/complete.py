@@ -401,13 +401,8 @@ class LevelScreen:
                     cascaded += size - chunk.size
                 if chunk.size == 0:
                     continue
-                verdicts = bench.judge(*self.sequences(chunk), full, stretch=judging.part(
-                    start / alive.size, (start + chunk.size) / alive.size))
-                for idx, verdict in zip(chunk, verdicts):
-                    plan = self.plan(idx, span[idx], verdict)
-                    judged.append(plan)
-                    if verdict["orients"]:
-                        pending.append((idx, plan))
+                self._judge(chunk, full, span, judged, pending,
+                            judging.part(start / alive.size, (start + chunk.size) / alive.size))
                 if not lazy:
                     self._check_family(pending, found, found_idx, record)
                 if enough():
@@ -419,6 +414,17 @@ class LevelScreen:
         if done < order.size:
             beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
         return found, found_idx, judged
+
+    def _judge(self, chunk, rows, span, judged, pending, stretch) -> None:
+        """Judge the level's rows ``chunk`` on all the trials ``rows``: each
+        plan joins ``judged``, and ``(row, plan)`` joins ``pending`` when it
+        orients (its family check still to come)."""
+        verdicts = self.bench.judge(*self.sequences(chunk), rows, stretch=stretch)
+        for idx, verdict in zip(chunk, verdicts):
+            plan = self.plan(idx, span[idx], verdict)
+            judged.append(plan)
+            if verdict["orients"]:
+                pending.append((idx, plan))
 
     def _check_family(self, pending, found, found_idx, record, screen=None, allowed: int = 0) -> None:
         """Move the plans of ``pending`` (``(row, plan)``, orienting on the
