@@ -240,16 +240,17 @@ def nearest_yes(part, family, checker: FamilyChecker, result: dict, make_family,
     if not plans:
         return {"plans_tried": [], "axes": [_not_found(a, "no plan passed the sampled verification: nothing "
                                                          "to loosen") for a in ("inset", "friction", "tolerance")]
-                + [moving_axis(result, moving_yes), _more_pins(result)]}
+                + [moving_axis(result, moving_yes), more_pins_axis(result)]}
     axes = [inset_axis(part, family, plans, st, make_family, progress),
             friction_axis(part, family, plans, st, progress),
             tolerance_axis(part, family, plans, st, progress),
-            moving_axis(result, moving_yes), _more_pins(result)]
+            moving_axis(result, moving_yes), more_pins_axis(result)]
     return {"plans_tried": [list(p[0]) for p in plans], "steps": STEPS,
             "assumes": "holding is monotone along each axis (bisection)", "axes": axes}
 
 
-def _more_pins(result: dict) -> dict:
+def more_pins_axis(result: dict) -> dict:
+    """The more-pins axis: not searched; the line says how to run the deeper search."""
     depth = result.get("depth")
     return _not_found("more pins", f"not searched (a deeper complete search costs more than the rest): "
                                    f"run with --depth {depth + 1 if depth else 'N+1'} or a finer --pins grid")

@@ -32,9 +32,9 @@ import math
 import numpy as np
 
 from pipeline.planning.claims import orient
+from pipeline.planning.family.nearest import MAX_TOLERANCE, more_pins_axis
 from pipeline.planning.tight.judge import TrialBench
 
-MAX_TOLERANCE = 45.0  # deg: the loosest tolerance asked about
 LADDER = 0.5  # deg: tolerances are answered on this ladder
 
 
@@ -169,7 +169,4 @@ def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = Non
     depth = entry.get("depth")
     return {"plans_tried": [list(p[0]) for p in plans],
             "axes": [tolerance_axis(part, settings, plans, pins, depth, progress), moving_axis(entry),
-                     sensor_axis(entry),
-                     _axis("more pins", False, f"not searched (a deeper complete search costs more than the "
-                                               f"rest): run with --depth {depth + 1 if depth else 'N+1'} or "
-                                               f"a finer --pins grid")]}
+                     sensor_axis(entry), more_pins_axis(entry)]}
