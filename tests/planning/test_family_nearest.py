@@ -110,3 +110,25 @@ def test_a_moving_plan_that_holds_is_the_moving_axis_and_the_rest_ask_without_it
     assert axis["found"] and axis["holds"] and axis["value"] == 1 and axis["plan"] == ["P1", "P2v-1"]
     assert "holds" in nearest.nearest_yes_lines({"axes": [axis]})[1]
     assert not nearest.moving_axis({"moving_pin_search": {"levels": []}})["found"]
+
+
+@pytest.mark.parametrize("tolerance", [10.0, 30.0])
+def test_fresh_finals_that_fit_no_arc_leave_a_member_outside_of_every_set(tolerance):
+    """The falsifier before each worst-member search (``certificate.fresh_fit``):
+    when the fresh members' finals fit in no arc of the tolerance, every
+    claimable set (each start on a 0.05-degree sweep, width the tolerance)
+    has a fresh member outside, so the certificate cannot be a "yes"; when
+    they fit, some set on the sweep holds them all."""
+    from pipeline.planning.family.certificate import fresh_finals, fresh_fit
+    from pipeline.planning.family.worst_member import outside
+    family = parse_support_family("tripods:4", RECTANGLE)
+    st = _settings((0.1, 0.2), tolerance, 20, budget=40)
+    pins = _pins(RECTANGLE, 6)
+    fresh = fresh_finals(RECTANGLE, (pins["Q5"], pins["Q1"], pins["Q5"]), family, st)
+    _, tf, jam = fresh
+    period = 360.0 / RECTANGLE.symmetry_order()
+    leaving = [int(np.any(outside(tf, (start, tolerance), period) > 0, axis=1).sum() + jam.any(axis=1).sum())
+               for start in np.arange(0.0, period, 0.05)]
+    assert fresh_fit(fresh, tolerance, RECTANGLE.symmetry_order()) == (min(leaving) == 0)
+    if tolerance == 10.0:
+        assert min(leaving) > 0  # the plan's 10-degree "no" (see the first test): the falsifier has work here

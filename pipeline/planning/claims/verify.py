@@ -208,16 +208,14 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     jam = np.full(n, "", dtype=object)
     missed = np.zeros((n, n_pins), bool)
     alive = np.ones(n, bool)
-    kw = {"ds_max": ds_max, "tol": tol} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
+    kw = _kernel_kw(ds_max, tol, belt_speed, mu_s)
     for k in range(n_pins):
         idx = np.flatnonzero(alive)
         if idx.size == 0:
             break
-        d = contact_parameter(heights[idx, k] + offsets[idx, k], y_c[idx], part.a)
-        res = rollouts_by_speed(part, theta[idx], d, mu[idx], speeds[idx, k], pin_radius,
-                                 model if belt_speed is None else "dynamic", kw,
-                                 None if support is None else support[idx], supports,
-                                 stretch.part(k / n_pins, (k + 1) / n_pins))
+        res = _pin_step(part, heights[idx, k] + offsets[idx, k], speeds[idx, k], theta[idx], y_c[idx], mu[idx],
+                        pin_radius, model, kw, None if support is None else support[idx], supports,
+                        stretch.part(k / n_pins, (k + 1) / n_pins))
         st = res["status"]
         stuck = (st == JAMMED) | (st == TRUNCATED)
         for j in np.flatnonzero(stuck):
@@ -229,6 +227,61 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
         if path is not None:
             path.append((np.where(alive, theta % 360.0, np.nan), np.where(alive, y_c, np.nan)))
     return theta % 360.0, y_c, jam, missed
+
+
+def _kernel_kw(ds_max, tol, belt_speed, mu_s) -> dict:
+    """The rollout keywords of the quasi-static kernel, or of the dynamic model at ``belt_speed``."""
+    return {"ds_max": ds_max, "tol": tol} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
+
+
+def _pin_step(part, pin_y, v_pin, theta, y_c, mu, pin_radius, model, kw, support, supports, stretch) -> dict:
+    """One pin (placed at ``pin_y`` mm, speed ``v_pin``) for every row: the
+    rollouts' results (``rollouts_by_speed``)."""
+    d = contact_parameter(pin_y, y_c, part.a)
+    return rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model if "belt_speed" not in kw else "dynamic",
+                             kw, support, supports, stretch)
+
+
+def replay_shared(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
+                  ds_max=DEFAULT_DS_MAX, tol=DEFAULT_TOL, belt_speed=None, mu_s=0.5, support=None,
+                  supports=None, stretch: Stretch = SILENT):
+    """Every plan (a row of ``pin_heights``, ``pin_speeds``: ``(plans, pins)``)
+    replayed on every trial (``theta``, ``y_c``, ``mu``, ``support``: one
+    value per trial; ``offsets``: ``(trials, pins)``), as :func:`replay` on
+    the plans' rows tiled over the trials would, but each distinct *prefix*
+    (the first ``k`` pins of one or more plans) is rolled out once per trial:
+    the plans of a search level share most of their pins (all of a moving-pin
+    level's fixed prefix), so this saves most rollouts.
+
+    Returns ``(theta_f, jammed)``, each ``(plans, trials)``. The numbers are
+    :func:`replay`'s: a trial's state after a pin (``theta``, ``y_c``, jammed
+    or not) depends only on the pins so far, and every rollout is
+    independent of the others in its batch. ``stretch`` hears each pin as an
+    equal share."""
+    heights, speeds = np.atleast_2d(np.asarray(pin_heights, float)), np.atleast_2d(np.asarray(pin_speeds, float))
+    n_plans, n_pins = heights.shape
+    n = np.size(theta)
+    kw = _kernel_kw(ds_max, tol, belt_speed, mu_s)
+    # The states of each distinct prefix (a node) on every trial; one node, no pin, to start.
+    node = np.zeros(n_plans, int)
+    th, yc = np.asarray(theta, float)[None, :].copy(), np.asarray(y_c, float)[None, :].copy()
+    jam = np.zeros((1, n), bool)
+    sup = None if support is None else np.broadcast_to(np.asarray(support, dtype=int), (n,))
+    for k in range(n_pins):
+        nodes, node = np.unique(np.column_stack([node, heights[:, k], speeds[:, k]]), axis=0, return_inverse=True)
+        node = node.ravel()
+        parent = nodes[:, 0].astype(int)
+        th, yc, jam = th[parent], yc[parent], jam[parent]
+        rows, cols = np.nonzero(~jam)
+        if rows.size:
+            res = _pin_step(part, nodes[rows, 1] + offsets[cols, k], nodes[rows, 2], th[rows, cols], yc[rows, cols],
+                            mu[cols], pin_radius, model, kw, None if sup is None else sup[cols], supports,
+                            stretch.part(k / n_pins, (k + 1) / n_pins))
+            th[rows, cols] = res["theta_f"]
+            yc[rows, cols] = yc[rows, cols] + res["dy"]
+            st = res["status"]
+            jam[rows, cols] = (st == JAMMED) | (st == TRUNCATED)
+    return th[node] % 360.0, jam[node]
 
 
 def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw, support=None,

@@ -30,7 +30,7 @@ from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE, share_upper_
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import nominal_friction
 from pipeline.planning.claims.verify import perturbed_batch, replay
-from pipeline.planning.family.worst_member import JAM_SCORE, member_space, outside
+from pipeline.planning.family.worst_member import JAM_SCORE, arc_holds, member_space, outside
 from pipeline.progress import SILENT, Heartbeat, Stretch
 
 MIN_FRESH_MEMBERS = 300
@@ -73,18 +73,39 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
     return tf[order].reshape(len(members), per), (jam[order] != "").reshape(len(members), per)
 
 
-def family_certificate(part, heights, family, check: dict, st, n_members: int = MIN_FRESH_MEMBERS,
-                       speeds=(), confidence: float = DEFAULT_CONFIDENCE, progress=None) -> dict:
-    """The certificate of a plan (pins at ``heights``) for ``family`` given its
-    worst-member ``check`` (:func:`~pipeline.planning.family.worst_member.check_plan_for_family`);
-    a JSON-ready dict (see the module docstring). ``progress`` hears how far
-    the fresh members' replay has got."""
-    n_members = max(int(n_members), MIN_FRESH_MEMBERS)
-    period = 360.0 / part.symmetry_order()
-    members = fresh_members(part, family, n_members, st.seed)
+def fresh_finals(part, heights, family, st, n_members: int = MIN_FRESH_MEMBERS, speeds=(), progress=None):
+    """``(members, finals, jams)`` of the certificate's fresh sample (at least
+    ``MIN_FRESH_MEMBERS`` of each continuous part of ``family``) replayed
+    through the pins at ``heights`` (:func:`fresh_replay`); ``progress`` hears
+    how far the replay has got."""
+    members = fresh_members(part, family, max(int(n_members), MIN_FRESH_MEMBERS), st.seed)
     with Heartbeat(f"fresh members of {family.label}", len(members), "member", progress) as beat:
         tf, jam = fresh_replay(part, heights, members, st, speeds, seed=st.seed,
                                stretch=beat.stretch(0, len(members)))
+    return members, tf, jam
+
+
+def fresh_fit(fresh, tolerance: float, order: int = 1) -> bool:
+    """Whether every final of the fresh sample ``fresh`` (:func:`fresh_finals`)
+    lies in one arc of ``tolerance`` degrees and none jammed: when not, every
+    set a plan may claim leaves a fresh member outside, whatever the
+    worst-member search then finds, so the certificate cannot count 0
+    violations (a falsifier that costs one replay instead of a search)."""
+    _, tf, jam = fresh
+    return not jam.any() and arc_holds(tf.ravel(), tolerance, order)
+
+
+def family_certificate(part, heights, family, check: dict, st, n_members: int = MIN_FRESH_MEMBERS,
+                       speeds=(), confidence: float = DEFAULT_CONFIDENCE, progress=None, fresh=None) -> dict:
+    """The certificate of a plan (pins at ``heights``) for ``family`` given its
+    worst-member ``check`` (:func:`~pipeline.planning.family.worst_member.check_plan_for_family`);
+    a JSON-ready dict (see the module docstring). ``progress`` hears how far
+    the fresh members' replay has got; ``fresh``: that replay
+    (:func:`fresh_finals`), when it was done before (its members are drawn
+    from ``st.seed`` alone, so it is the same sample)."""
+    period = 360.0 / part.symmetry_order()
+    members, tf, jam = fresh if fresh is not None else fresh_finals(part, heights, family, st, n_members, speeds,
+                                                                    progress)
     arc = check.get("set_deg")
     dist = np.where(jam, JAM_SCORE, outside(tf, tuple(arc), period)) if arc else np.full(tf.shape, JAM_SCORE)
     leaving = int(np.sum(dist.max(axis=1) > 0.0))

@@ -40,7 +40,7 @@ import re
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.support_family import DEFAULT_INSET, parse_support_family
-from pipeline.planning.family.certificate import family_certificate
+from pipeline.planning.family.certificate import family_certificate, fresh_finals, fresh_fit
 from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family, member_space
 
 STEPS = 5  # bisection halvings per axis
@@ -66,12 +66,19 @@ def rejected_plans(checker: FamilyChecker, n: int = PLANS_TRIED, fixed_only: boo
 def _holds(part, plans, family, st, progress) -> tuple | None:
     """The first of ``plans`` that holds for ``family`` under ``st`` and whose
     certificate finds no fresh member outside its set: ``(plan, check,
-    certificate)``, or None."""
+    certificate)``, or None. The certificate's fresh members are replayed
+    first: when their finals do not fit in one arc of the tolerance, no
+    worst-member search can make the certificate count none outside
+    (``fresh_fit``), and the plan is passed over without one."""
     for labels, heights, speeds in plans:
+        fresh = fresh_finals(part, heights, family, st, speeds=speeds, progress=progress)
+        if not fresh_fit(fresh, st.tolerance, part.symmetry_order()):
+            continue
         check = check_plan_for_family(part, heights, family, st, None, speeds, progress, " ".join(labels))
         if not check["holds"]:
             continue
-        cert = family_certificate(part, heights, family, check, st, speeds=speeds, progress=progress)
+        cert = family_certificate(part, heights, family, check, st, speeds=speeds, progress=progress,
+                                  fresh=fresh)
         if cert["holds"] and cert["claim"]["violations"] == 0:
             return (labels, heights, speeds), check, cert
     return None

@@ -63,7 +63,7 @@ from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE
 from pipeline.planning.core.resting import resting_states
 from pipeline.config import schema_default
 from pipeline.planning.core.settings import PlannerSettings, nominal_friction
-from pipeline.planning.claims.verify import corner_inputs, replay, trial_inputs, verify_dict
+from pipeline.planning.claims.verify import corner_inputs, replay, replay_shared, trial_inputs, verify_dict
 from pipeline.progress import Heartbeat
 
 DEFAULT_BUDGET = schema_default("planner", "worst_member_budget")  # member evaluations per search
@@ -780,15 +780,12 @@ class FamilyChecker:
         tfs, jams = [], []
         step = max(1, PRESCREEN_ROWS // per)
         for start in range(0, heights.shape[0], step):
-            h, v = heights[start:start + step], speeds[start:start + step]
-            n = h.shape[0] * members
-            tf, _, jam, _ = replay(self.part, np.repeat(h, per, axis=0), np.repeat(v, per, axis=0),
-                                   np.tile(th, n), np.tile(yc, n), np.tile(mu, n), np.tile(offs, (n, 1)),
-                                   st.pin_radius, st.model, **kw,
-                                   support=np.tile(np.repeat(np.arange(members), th.size), h.shape[0]),
-                                   supports=list(self.breakers))
-            tfs.append(tf.reshape(h.shape[0], per))
-            jams.append((jam != "").reshape(h.shape[0], per))
+            tf, jam = replay_shared(self.part, heights[start:start + step], speeds[start:start + step],
+                                    np.tile(th, members), np.tile(yc, members), np.tile(mu, members),
+                                    np.tile(offs, (members, 1)), st.pin_radius, st.model, **kw,
+                                    support=np.repeat(np.arange(members), th.size), supports=list(self.breakers))
+            tfs.append(tf)
+            jams.append(jam)
         return np.concatenate(tfs), np.concatenate(jams)
 
     @staticmethod

@@ -27,7 +27,7 @@ from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
 
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
-from pipeline.planning.claims.verify import holdout_settings, replay, trial_inputs
+from pipeline.planning.claims.verify import holdout_settings, replay_shared, trial_inputs
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
 from pipeline.progress import SILENT, Heartbeat, Stretch
@@ -108,15 +108,12 @@ class TrialBench:
     def replay(self, heights, speeds, rows, stretch: Stretch = SILENT):
         """Final orientations ``(sequences, trials)`` and jam flags of the
         sequences ``heights``, ``speeds`` on ``rows`` (``stretch`` is told how
-        far the replay has got)."""
+        far the replay has got). Sequences that share their first pins share
+        those rollouts (``verify.replay_shared``)."""
         th, yc, mu, offs, sup = rows
-        n_trials, n_plans = th.size, heights.shape[0]
-        tf, _, jam, _ = replay(self.part, np.repeat(heights, n_trials, axis=0),
-                               np.repeat(speeds, n_trials, axis=0), np.tile(th, n_plans), np.tile(yc, n_plans),
-                               np.tile(mu, n_plans), np.tile(offs, (n_plans, 1)), self.pin_radius,
-                               self.model, self.kernel["ds_max"], self.kernel["tol"], **self.belt,
-                               support=np.tile(sup, n_plans), supports=self.supports, stretch=stretch)
-        return tf.reshape(n_plans, n_trials), (jam != "").reshape(n_plans, n_trials)
+        return replay_shared(self.part, heights, speeds, th, yc, mu, offs, self.pin_radius, self.model,
+                             self.kernel["ds_max"], self.kernel["tol"], **self.belt, support=sup,
+                             supports=self.supports, stretch=stretch)
 
     def failures(self, heights, speeds, rows, stretch: Stretch = SILENT) -> np.ndarray:
         """Trials of ``rows`` that no one arc of the tolerance can hold, per
