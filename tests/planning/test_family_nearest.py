@@ -10,6 +10,8 @@ claimed set at the answer. On the triangle's plan P11 P3 P11 P19 a fresh
 tripod jams: no tolerance is a "yes", and the axis says so. The bisection is checked against a sweep of a monotone predicate;
 the inset text and the largest inset with members against brute force.
 """
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -27,7 +29,6 @@ HEIGHTS = (15.0, -5.0, 15.0, 35.0)
 
 
 def test_the_smallest_tolerance_holds_and_half_a_degree_less_does_not():
-    import dataclasses
     family = parse_support_family("tripods:4", RECTANGLE)
     st = _settings((0.1, 0.2), 10.0, 20, budget=40)
     pins = _pins(RECTANGLE, 6)
@@ -132,3 +133,35 @@ def test_fresh_finals_that_fit_no_arc_leave_a_member_outside_of_every_set(tolera
     assert fresh_fit(fresh, tolerance, RECTANGLE.symmetry_order()) == (min(leaving) == 0)
     if tolerance == 10.0:
         assert min(leaving) > 0  # the plan's 10-degree "no" (see the first test): the falsifier has work here
+
+
+def test_a_kept_member_refutes_only_where_no_arc_holds_its_finals():
+    """The kept members' screen before each axis's checks: on the rectangle's
+    plan Q5 Q1 Q5 the worst member found at 20 deg is kept; the screen says
+    "broken" at a tolerance exactly when no arc of it (a 0.05-degree sweep)
+    holds that member's nominal and corner finals, replayed pin by pin
+    through the public rollout API."""
+    from test_worst_member import _inside
+    family = parse_support_family("tripods:4", RECTANGLE)
+    pins = _pins(RECTANGLE, 6)
+    heights = (pins["Q5"], pins["Q1"], pins["Q5"])
+    st = _settings((0.1, 0.2), 20.0, 20, budget=40)
+    check = check_plan_for_family(RECTANGLE, heights, family, st)
+    member = check["_worst"].support
+    assert check["_worst"].breaks
+    finals = _corner_finals(RECTANGLE, heights, member, (0.1, 0.2))
+    period = 360.0 / RECTANGLE.symmetry_order()
+    starts = np.arange(0.0, period, 0.05)
+    seen = set()
+    for tolerance in (10.0, 20.0, 30.0, 45.0):
+        fits = any(_outside(finals, s, tolerance, period).max() == 0.0 for s in starts)
+        seen.add(fits)
+        broken = nearest._broken_by_kept(RECTANGLE, heights, (), family,
+                                         dataclasses.replace(st, tolerance=tolerance), [member])
+        assert broken == (not fits), tolerance
+    assert seen == {True, False}  # both answers met
+    # a tripod belongs to a narrower family only when every leg is that far inside
+    verts = np.asarray(RECTANGLE.vertices, float)
+    depth = min(_inside(verts, p)[1] for p in member.points)
+    assert nearest.kept_members(RECTANGLE, [member], depth / RECTANGLE.a - 1e-3) == [member]
+    assert nearest.kept_members(RECTANGLE, [member], depth / RECTANGLE.a + 1e-3) == []

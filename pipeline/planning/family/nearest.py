@@ -38,7 +38,10 @@ import dataclasses
 import math
 import re
 
+import numpy as np
+
 from pipeline.errors import PinfeedError
+from pipeline.parts.support import material_distance
 from pipeline.parts.support_family import DEFAULT_INSET, parse_support_family
 from pipeline.planning.family.certificate import family_certificate, fresh_finals, fresh_fit
 from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family, member_space
@@ -63,14 +66,48 @@ def rejected_plans(checker: FamilyChecker, n: int = PLANS_TRIED, fixed_only: boo
     return [(key[0], key[1], r.get("_speeds", ())) for key, r in broken[:n]]
 
 
-def _holds(part, plans, family, st, progress) -> tuple | None:
+def kept_members(part, kept, inset: float | None = None) -> list:
+    """The worst members the search kept (``FamilyChecker.breakers``) that are
+    members of the family an axis asks about: all of them for the same family
+    at another friction or tolerance; with ``inset``, a tripod only when all
+    its legs lie at least ``inset * a`` inside the material (fewer members
+    only make the screen below weaker, never wrong)."""
+    kept = list(kept or ())
+    if inset is None:
+        return kept
+
+    def inside(m):
+        on, dist = material_distance(part, m.points)
+        return bool(on.all() and dist.min() >= inset * part.a - 1e-9)
+    return [m for m in kept if m.n_points == 0 or inside(m)]
+
+
+def _broken_by_kept(part, heights, speeds, family, st, kept) -> bool:
+    """Whether a kept member's probe finals (nominal rollouts and box corners)
+    fit in no arc of the tolerance through these pins: then no set the plan
+    may claim holds that member (``FamilyChecker.prescreen``)."""
+    if not kept:
+        return False
+    screen = FamilyChecker(part, family, st)
+    screen.breakers = list(kept)
+    speeds = list(speeds) or [0.0] * len(heights)
+    return bool(screen.prescreen(np.atleast_2d(np.asarray(heights, float)), np.atleast_2d(np.asarray(speeds, float)),
+                                 st.tolerance)[0])
+
+
+def _holds(part, plans, family, st, progress, kept=()) -> tuple | None:
     """The first of ``plans`` that holds for ``family`` under ``st`` and whose
     certificate finds no fresh member outside its set: ``(plan, check,
-    certificate)``, or None. The certificate's fresh members are replayed
-    first: when their finals do not fit in one arc of the tolerance, no
+    certificate)``, or None. Cheap refutations come first, each exact: a
+    member ``kept`` from the search (:func:`kept_members`) that no set can
+    hold, then the certificate's fresh members, replayed before the search:
+    when their finals do not fit in one arc of the tolerance, no
     worst-member search can make the certificate count none outside
-    (``fresh_fit``), and the plan is passed over without one."""
+    (``fresh_fit``). A plan refuted either way is passed over without a
+    worst-member search."""
     for labels, heights, speeds in plans:
+        if _broken_by_kept(part, heights, speeds, family, st, kept):
+            continue
         fresh = fresh_finals(part, heights, family, st, speeds=speeds, progress=progress)
         if not fresh_fit(fresh, st.tolerance, part.symmetry_order()):
             continue
@@ -157,7 +194,7 @@ def largest_inset(part, label: str, lo: float) -> float:
     return hi
 
 
-def inset_axis(part, family, plans, st, make_family, progress=None) -> dict:
+def inset_axis(part, family, plans, st, make_family, progress=None, kept=()) -> dict:
     """The smallest tripod inset for which one of ``plans`` holds (the
     largest sub-family of legs far enough inside the outline)."""
     inset0 = _tripod_inset(family.label)
@@ -169,7 +206,7 @@ def inset_axis(part, family, plans, st, make_family, progress=None) -> dict:
     def holds_at(f):
         key = round(f, 4)
         families[key] = families.get(key) or make_family(_with_inset(family.label, key))
-        return _holds(part, plans, families[key], st, progress)
+        return _holds(part, plans, families[key], st, progress, kept_members(part, kept, key))
     value, found = _bisect(holds_at, inset0, top)
     if found is None:
         return _not_found("inset", f"no plan tried holds even for tripods at the largest inset with a "
@@ -180,7 +217,7 @@ def inset_axis(part, family, plans, st, make_family, progress=None) -> dict:
                    found, families[value])
 
 
-def friction_axis(part, family, plans, st, progress=None) -> dict:
+def friction_axis(part, family, plans, st, progress=None, kept=()) -> dict:
     """The widest friction range about the middle of ``st.mu_c`` for which one of ``plans`` holds."""
     if not isinstance(st.mu_c, (tuple, list)):
         return _not_found("friction", f"the friction is one value ({st.mu_c:g}): no range to narrow")
@@ -192,7 +229,7 @@ def friction_axis(part, family, plans, st, progress=None) -> dict:
         return (round(mid - w, 4), round(mid + w, 4)) if w > 1e-9 else round(mid, 4)
 
     def holds_at(h):
-        return _holds(part, plans, family, dataclasses.replace(st, mu_c=at(h)), progress)
+        return _holds(part, plans, family, dataclasses.replace(st, mu_c=at(h)), progress, kept)
     value, found = _bisect(holds_at, 0.0, 1.0)
     if found is None:
         return _not_found("friction", f"no plan tried holds even at the middle friction {mid:g}")
@@ -201,12 +238,12 @@ def friction_axis(part, family, plans, st, progress=None) -> dict:
     return _answer("friction", text, "", f"a friction range {text} (the family as given)", found, family)
 
 
-def tolerance_axis(part, family, plans, st, progress=None) -> dict:
+def tolerance_axis(part, family, plans, st, progress=None, kept=()) -> dict:
     """The smallest tolerance (deg, to 0.5 deg) for which one of ``plans`` holds for the whole family."""
     top = min(MAX_TOLERANCE, 180.0 / part.symmetry_order())
 
     def holds_at(t):
-        return _holds(part, plans, family, dataclasses.replace(st, tolerance=math.ceil(2 * t) / 2), progress)
+        return _holds(part, plans, family, dataclasses.replace(st, tolerance=math.ceil(2 * t) / 2), progress, kept)
     value, found = _bisect(holds_at, st.tolerance, top)
     if found is None:
         return _not_found("tolerance", f"no plan tried holds for the family within {top:g} deg")
@@ -248,9 +285,10 @@ def nearest_yes(part, family, checker: FamilyChecker, result: dict, make_family,
         return {"plans_tried": [], "axes": [_not_found(a, "no plan passed the sampled verification: nothing "
                                                          "to loosen") for a in ("inset", "friction", "tolerance")]
                 + [moving_axis(result, moving_yes), more_pins_axis(result)]}
-    axes = [inset_axis(part, family, plans, st, make_family, progress),
-            friction_axis(part, family, plans, st, progress),
-            tolerance_axis(part, family, plans, st, progress),
+    kept = kept_members(part, checker.breakers)
+    axes = [inset_axis(part, family, plans, st, make_family, progress, kept),
+            friction_axis(part, family, plans, st, progress, kept),
+            tolerance_axis(part, family, plans, st, progress, kept),
             moving_axis(result, moving_yes), more_pins_axis(result)]
     return {"plans_tried": [list(p[0]) for p in plans], "steps": STEPS,
             "assumes": "holding is monotone along each axis (bisection)", "axes": axes}
