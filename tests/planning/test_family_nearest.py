@@ -131,6 +131,12 @@ def test_fresh_finals_that_fit_no_arc_leave_a_member_outside_of_every_set(tolera
     leaving = [int(np.any(outside(tf, (start, tolerance), period) > 0, axis=1).sum() + jam.any(axis=1).sum())
                for start in np.arange(0.0, period, 0.05)]
     assert fresh_fit(fresh, tolerance, RECTANGLE.symmetry_order()) == (min(leaving) == 0)
+    # replayed a chunk at a time, stopping once the members so far fit no arc: the same numbers, or none
+    early = fresh_finals(RECTANGLE, (pins["Q5"], pins["Q1"], pins["Q5"]), family, st, must_fit=True)
+    if early is None:
+        assert min(leaving) > 0
+    else:
+        assert np.array_equal(early[1], tf) and np.array_equal(early[2], jam)
     if tolerance == 10.0:
         assert min(leaving) > 0  # the plan's 10-degree "no" (see the first test): the falsifier has work here
 

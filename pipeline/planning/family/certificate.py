@@ -35,6 +35,7 @@ from pipeline.progress import SILENT, Heartbeat, Stretch
 
 MIN_FRESH_MEMBERS = 300
 FRESH_TRIALS = 4  # perturbed trials per member and resting state (besides the nominal one)
+FRESH_CHUNK = 50  # members replayed at once (a refutation may stop after the first chunks)
 
 
 def fresh_members(part, family, n: int, seed: int) -> list:
@@ -49,11 +50,16 @@ def fresh_members(part, family, n: int, seed: int) -> list:
 
 
 def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIALS, seed: int = 0,
-                 stretch: Stretch = SILENT):
+                 stretch: Stretch = SILENT, give_up=None):
     """Final orientations ``(members, states * (1 + trials))`` and jam flags of
     every member, each from every resting state nominally and with ``trials``
     perturbed starts (the verification's perturbation box); ``stretch`` is
-    told how far the replay has got."""
+    told how far the replay has got.
+
+    The members are replayed ``FRESH_CHUNK`` at a time (every start is drawn
+    first, so the numbers do not depend on it); ``give_up(finals, jams)``,
+    asked with the members replayed so far, may end the replay early: then
+    the result is None."""
     rng = np.random.default_rng([int(seed), 35])
     n_pins = len(heights)
     rows = []
@@ -64,25 +70,44 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
                      np.zeros((len(members), n_pins)), np.arange(len(members))))
         rows.append((th, yc, mu, offs, np.repeat(np.arange(len(members)), trials)))
     th, yc, mu, offs, sup = (np.concatenate([r[k] for r in rows]) for k in range(5))
-    kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
-    tf, _, jam, _ = replay(part, list(heights), list(speeds) or [0.0] * n_pins, th, yc, mu, offs,
-                           st.pin_radius, st.model, **kw, support=sup,
-                           supports=[None if m.is_uniform else m for m in members], stretch=stretch)
-    order = np.argsort(sup, kind="stable")
+    order = np.argsort(sup, kind="stable")  # member by member, each in the order above
     per = th.size // len(members)
-    return tf[order].reshape(len(members), per), (jam[order] != "").reshape(len(members), per)
+    kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
+    tf, jam = np.empty((len(members), per)), np.empty((len(members), per), bool)
+    for lo in range(0, len(members), FRESH_CHUNK):
+        hi = min(len(members), lo + FRESH_CHUNK)
+        idx = order[lo * per:hi * per]
+        out, _, jams, _ = replay(part, list(heights), list(speeds) or [0.0] * n_pins, th[idx], yc[idx], mu[idx],
+                                 offs[idx], st.pin_radius, st.model, **kw, support=sup[idx] - lo,
+                                 supports=[None if m.is_uniform else m for m in members[lo:hi]],
+                                 stretch=stretch.part(lo / len(members), hi / len(members)))
+        tf[lo:hi], jam[lo:hi] = out.reshape(hi - lo, per), (jams != "").reshape(hi - lo, per)
+        if give_up is not None and hi < len(members) and give_up(tf[:hi], jam[:hi]):
+            return None
+    return tf, jam
 
 
-def fresh_finals(part, heights, family, st, n_members: int = MIN_FRESH_MEMBERS, speeds=(), progress=None):
+def fresh_finals(part, heights, family, st, n_members: int = MIN_FRESH_MEMBERS, speeds=(), progress=None,
+                 must_fit: bool = False):
     """``(members, finals, jams)`` of the certificate's fresh sample (at least
     ``MIN_FRESH_MEMBERS`` of each continuous part of ``family``) replayed
     through the pins at ``heights`` (:func:`fresh_replay`); ``progress`` hears
-    how far the replay has got."""
+    how far the replay has got. ``must_fit``: None as soon as the members
+    replayed so far fail :func:`fresh_fit` (then the whole sample does)."""
     members = fresh_members(part, family, max(int(n_members), MIN_FRESH_MEMBERS), st.seed)
+    order = part.symmetry_order()
+
+    replayed = [0]
+
+    def give_up(tf, jam):
+        replayed[0] = tf.shape[0]
+        return must_fit and not fresh_fit((None, tf, jam), st.tolerance, order)
     with Heartbeat(f"fresh members of {family.label}", len(members), "member", progress) as beat:
-        tf, jam = fresh_replay(part, heights, members, st, speeds, seed=st.seed,
-                               stretch=beat.stretch(0, len(members)))
-    return members, tf, jam
+        got = fresh_replay(part, heights, members, st, speeds, seed=st.seed, stretch=beat.stretch(0, len(members)),
+                           give_up=give_up)
+        if got is None:
+            beat.finish(replayed[0], "stopped: their finals fit in no arc of the tolerance, so no set holds them all")
+    return None if got is None else (members, *got)
 
 
 def fresh_fit(fresh, tolerance: float, order: int = 1) -> bool:

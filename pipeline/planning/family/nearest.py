@@ -108,8 +108,8 @@ def _holds(part, plans, family, st, progress, kept=()) -> tuple | None:
     for labels, heights, speeds in plans:
         if _broken_by_kept(part, heights, speeds, family, st, kept):
             continue
-        fresh = fresh_finals(part, heights, family, st, speeds=speeds, progress=progress)
-        if not fresh_fit(fresh, st.tolerance, part.symmetry_order()):
+        fresh = fresh_finals(part, heights, family, st, speeds=speeds, progress=progress, must_fit=True)
+        if fresh is None or not fresh_fit(fresh, st.tolerance, part.symmetry_order()):
             continue
         check = check_plan_for_family(part, heights, family, st, None, speeds, progress, " ".join(labels))
         if not check["holds"]:
