@@ -225,3 +225,26 @@ def test_the_search_scores_members_on_a_subset_of_a_many_pin_probe():
         full, _ = score(probe, member, arc, 360.0)
         assert coarse <= full + 1e-12
     assert member_space(part, family).describe()
+
+
+def test_the_quick_weight_test_changes_no_drawn_tripod(monkeypatch):
+    """``TripodSpace.random`` tests each random triple's centroid weights in
+    plain floats before the full feasibility test: it never rejects a triple
+    the statics' weights accept (random triples, some near the weight bound),
+    and the drawn tripods are the same with it and without it."""
+    from pipeline.planning.family import worst_member as wm
+    rng = np.random.default_rng(4)
+    near = 0
+    for _ in range(4000):
+        x = rng.uniform(-30.0, 30.0, 6)
+        lam = wm._weights(x.reshape(3, 2), TRIANGLE.a)
+        accepted = lam is not None and lam.min() >= wm.MIN_LEG_WEIGHT
+        near += bool(lam is not None and abs(lam.min() - wm.MIN_LEG_WEIGHT) < 0.02)
+        assert wm._may_hold_centroid(x, TRIANGLE.a) or not accepted
+    assert near > 10
+    space = wm.member_space(TRIANGLE, "tripods:12:inset=0.25").spaces[0]
+    quick = space.random(np.random.default_rng(9), 60)
+    monkeypatch.setattr(wm, "_may_hold_centroid", lambda x, a: True)
+    slow = space.random(np.random.default_rng(9), 60)
+    assert len(quick) == len(slow) == 60
+    assert all(np.array_equal(p, q) for p, q in zip(quick, slow))

@@ -88,13 +88,16 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
 
 
 def fresh_finals(part, heights, family, st, n_members: int = MIN_FRESH_MEMBERS, speeds=(), progress=None,
-                 must_fit: bool = False):
+                 must_fit: bool = False, members=None):
     """``(members, finals, jams)`` of the certificate's fresh sample (at least
     ``MIN_FRESH_MEMBERS`` of each continuous part of ``family``) replayed
     through the pins at ``heights`` (:func:`fresh_replay`); ``progress`` hears
     how far the replay has got. ``must_fit``: None as soon as the members
-    replayed so far fail :func:`fresh_fit` (then the whole sample does)."""
-    members = fresh_members(part, family, max(int(n_members), MIN_FRESH_MEMBERS), st.seed)
+    replayed so far fail :func:`fresh_fit` (then the whole sample does).
+    ``members``: that sample, when drawn before (:func:`fresh_members` with
+    these ``n_members`` and ``st.seed``), to replay it through other pins."""
+    if members is None:
+        members = fresh_members(part, family, max(int(n_members), MIN_FRESH_MEMBERS), st.seed)
     order = part.symmetry_order()
 
     replayed = [0]

@@ -43,7 +43,8 @@ import numpy as np
 from pipeline.errors import PinfeedError
 from pipeline.parts.support import material_distance
 from pipeline.parts.support_family import DEFAULT_INSET, parse_support_family
-from pipeline.planning.family.certificate import family_certificate, fresh_finals, fresh_fit
+from pipeline.planning.family.certificate import (MIN_FRESH_MEMBERS, family_certificate, fresh_finals, fresh_fit,
+                                                  fresh_members)
 from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family, member_space
 
 STEPS = 5  # bisection halvings per axis
@@ -105,10 +106,13 @@ def _holds(part, plans, family, st, progress, kept=()) -> tuple | None:
     worst-member search can make the certificate count none outside
     (``fresh_fit``). A plan refuted either way is passed over without a
     worst-member search."""
+    members = None  # the fresh sample, drawn once for every plan
     for labels, heights, speeds in plans:
         if _broken_by_kept(part, heights, speeds, family, st, kept):
             continue
-        fresh = fresh_finals(part, heights, family, st, speeds=speeds, progress=progress, must_fit=True)
+        members = members or fresh_members(part, family, MIN_FRESH_MEMBERS, st.seed)
+        fresh = fresh_finals(part, heights, family, st, speeds=speeds, progress=progress, must_fit=True,
+                             members=members)
         if fresh is None or not fresh_fit(fresh, st.tolerance, part.symmetry_order()):
             continue
         check = check_plan_for_family(part, heights, family, st, None, speeds, progress, " ".join(labels))

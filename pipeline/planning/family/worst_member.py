@@ -155,7 +155,7 @@ class TripodSpace:
         out = []
         for _ in range(200 * n if pool.shape[0] >= 3 else 0):
             x = pool[rng.choice(pool.shape[0], 3, replace=False)].ravel()
-            if self.violation(x) == 0.0:
+            if _may_hold_centroid(x, self.part.a) and self.violation(x) == 0.0:
                 out.append(x)
                 if len(out) == n:
                     break
@@ -242,6 +242,20 @@ def _weights(legs: np.ndarray, a: float) -> np.ndarray | None:
     if abs(ux * vy - uy * vx) < 1e-9 * a * a:
         return None
     return barycentric(*legs)
+
+
+def _may_hold_centroid(x, a: float) -> bool:
+    """A quick necessary test of :meth:`TripodSpace.violation`'s weights: legs
+    ``x`` (6 numbers) not in a line whose centroid weights (barycentric, in
+    plain floats) are all at least ``MIN_LEG_WEIGHT`` less a rounding slack.
+    Most random triples fail it, at a fraction of the full test's cost."""
+    x0, y0, x1, y1, x2, y2 = (float(v) for v in x)
+    det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
+    if abs(det) < 1e-9 * a * a:
+        return False
+    l1 = (-x0 * (y2 - y0) + (x2 - x0) * y0) / det
+    l2 = (-(x1 - x0) * y0 + x0 * (y1 - y0)) / det
+    return min(l1, l2, 1.0 - l1 - l2) >= MIN_LEG_WEIGHT - 1e-6
 
 
 def inset_corners(verts: np.ndarray, distance: float, holes=()) -> np.ndarray:
