@@ -133,3 +133,23 @@ def test_the_dxf_reads_back_to_the_changed_outline(trapezoid_design, tmp_path):
     assert paths["figure"].stat().st_size > 0
     for key in ("git_commit", "config_hash", "pinfeed_version", "parameters", "files"):
         assert key in stored
+
+
+def test_the_bracket_chamfer_and_its_four_pin_plan_replay_in_one_set():
+    """The tutorial bracket's design answer (design for feeding, measured with
+    ``pinfeed design --depth 4``): a 6.5 mm chamfer (0.2 a) at corner 2 and
+    the plan P19 P16 P1 P4 at 26, 20, -10, -4 mm. Replayed here by the tests'
+    oracle alone (public rollout API, its own uniform box with every corner,
+    mu_c 0.16 to 0.24), every trial of the chamfered bracket ends in one arc
+    of 10 deg; the bracket as drawn, through the same pins, does not."""
+    from oracle import box_trials, most_in_arc, replay_box
+    from pipeline.planning.design.edits import OutlineChange, apply_change, ccw_outline
+    bracket = ccw_outline(np.array([[0, 0], [50, 0], [50, 12], [18, 12], [18, 30], [0, 30]], float))
+    a = Part.from_vertices(bracket.tolist()).a
+    chamfered = apply_change(bracket, OutlineChange("chamfer", 2, (0.2 * a, 0.2 * a)))
+    heights = [26.0, 20.0, -10.0, -4.0]
+    for vertices, orients in ((chamfered, True), (bracket, False)):
+        part = Part.from_vertices(vertices.tolist())
+        finals = replay_box(part, heights, box_trials(part, 4, 60, 11, (0.16, 0.24)), strict=False)
+        assert (most_in_arc(finals, 10.0) == finals.size) == orients
+    assert len(Part.from_vertices(chamfered.tolist()).stable_states()) == 3  # the end-face state is gone
