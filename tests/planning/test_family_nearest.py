@@ -133,9 +133,8 @@ def test_fresh_finals_that_fit_no_arc_leave_a_member_outside_of_every_set(tolera
     assert fresh_fit(fresh, tolerance, RECTANGLE.symmetry_order()) == (min(leaving) == 0)
     # replayed a chunk at a time, stopping once the members so far fit no arc: the same numbers, or none
     early = fresh_finals(RECTANGLE, (pins["Q5"], pins["Q1"], pins["Q5"]), family, st, must_fit=True)
-    if early is None:
-        assert min(leaving) > 0
-    else:
+    assert (early is None) == (min(leaving) > 0)  # a result is a sample that fits
+    if early is not None:
         assert np.array_equal(early[1], tf) and np.array_equal(early[2], jam)
     if tolerance == 10.0:
         assert min(leaving) > 0  # the plan's 10-degree "no" (see the first test): the falsifier has work here
@@ -162,8 +161,8 @@ def test_a_kept_member_refutes_only_where_no_arc_holds_its_finals():
     for tolerance in (10.0, 20.0, 30.0, 45.0):
         fits = any(_outside(finals, s, tolerance, period).max() == 0.0 for s in starts)
         seen.add(fits)
-        broken = nearest._broken_by_kept(RECTANGLE, heights, (), family,
-                                         dataclasses.replace(st, tolerance=tolerance), [member])
+        broken = nearest._kept_screen(RECTANGLE, family, dataclasses.replace(st, tolerance=tolerance),
+                                      [member])(heights, ())
         assert broken == (not fits), tolerance
     assert seen == {True, False}  # both answers met
     # a tripod belongs to a narrower family only when every leg is that far inside

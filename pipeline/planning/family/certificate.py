@@ -82,7 +82,7 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
                                  supports=[None if m.is_uniform else m for m in members[lo:hi]],
                                  stretch=stretch.part(lo / len(members), hi / len(members)))
         tf[lo:hi], jam[lo:hi] = out.reshape(hi - lo, per), (jams != "").reshape(hi - lo, per)
-        if give_up is not None and hi < len(members) and give_up(tf[:hi], jam[:hi]):
+        if give_up is not None and give_up(tf[:hi], jam[:hi]):
             return None
     return tf, jam
 
@@ -93,13 +93,13 @@ def fresh_finals(part, heights, family, st, n_members: int = MIN_FRESH_MEMBERS, 
     ``MIN_FRESH_MEMBERS`` of each continuous part of ``family``) replayed
     through the pins at ``heights`` (:func:`fresh_replay`); ``progress`` hears
     how far the replay has got. ``must_fit``: None as soon as the members
-    replayed so far fail :func:`fresh_fit` (then the whole sample does).
+    replayed so far fail :func:`fresh_fit` (then the whole sample does), so
+    a result is a sample that fits.
     ``members``: that sample, when drawn before (:func:`fresh_members` with
     these ``n_members`` and ``st.seed``), to replay it through other pins."""
     if members is None:
         members = fresh_members(part, family, max(int(n_members), MIN_FRESH_MEMBERS), st.seed)
     order = part.symmetry_order()
-
     replayed = [0]
 
     def give_up(tf, jam):

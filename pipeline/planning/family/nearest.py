@@ -43,8 +43,7 @@ import numpy as np
 from pipeline.errors import PinfeedError
 from pipeline.parts.support import material_distance
 from pipeline.parts.support_family import DEFAULT_INSET, parse_support_family
-from pipeline.planning.family.certificate import (MIN_FRESH_MEMBERS, family_certificate, fresh_finals, fresh_fit,
-                                                  fresh_members)
+from pipeline.planning.family.certificate import MIN_FRESH_MEMBERS, family_certificate, fresh_finals, fresh_members
 from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family, member_space
 
 STEPS = 5  # bisection halvings per axis
@@ -83,17 +82,22 @@ def kept_members(part, kept, inset: float | None = None) -> list:
     return [m for m in kept if m.n_points == 0 or inside(m)]
 
 
-def _broken_by_kept(part, heights, speeds, family, st, kept) -> bool:
-    """Whether a kept member's probe finals (nominal rollouts and box corners)
-    fit in no arc of the tolerance through these pins: then no set the plan
-    may claim holds that member (``FamilyChecker.prescreen``)."""
+def _kept_screen(part, family, st, kept):
+    """A check that says, for a plan's pins, whether a kept member's probe
+    finals (nominal rollouts and box corners) fit in no arc of the tolerance:
+    then no set the plan may claim holds that member
+    (``FamilyChecker.prescreen`` with ``kept`` as its breakers); None
+    without kept members."""
     if not kept:
-        return False
+        return None
     screen = FamilyChecker(part, family, st)
     screen.breakers = list(kept)
-    speeds = list(speeds) or [0.0] * len(heights)
-    return bool(screen.prescreen(np.atleast_2d(np.asarray(heights, float)), np.atleast_2d(np.asarray(speeds, float)),
-                                 st.tolerance)[0])
+
+    def broken(heights, speeds) -> bool:
+        speeds = list(speeds) or [0.0] * len(heights)
+        return bool(screen.prescreen(np.atleast_2d(np.asarray(heights, float)),
+                                     np.atleast_2d(np.asarray(speeds, float)), st.tolerance)[0])
+    return broken
 
 
 def _holds(part, plans, family, st, progress, kept=()) -> tuple | None:
@@ -104,16 +108,17 @@ def _holds(part, plans, family, st, progress, kept=()) -> tuple | None:
     hold, then the certificate's fresh members, replayed before the search:
     when their finals do not fit in one arc of the tolerance, no
     worst-member search can make the certificate count none outside
-    (``fresh_fit``). A plan refuted either way is passed over without a
+    (``certificate.fresh_fit``). A plan refuted either way is passed over without a
     worst-member search."""
+    broken_by_kept = _kept_screen(part, family, st, kept)
     members = None  # the fresh sample, drawn once for every plan
     for labels, heights, speeds in plans:
-        if _broken_by_kept(part, heights, speeds, family, st, kept):
+        if broken_by_kept is not None and broken_by_kept(heights, speeds):
             continue
         members = members or fresh_members(part, family, MIN_FRESH_MEMBERS, st.seed)
         fresh = fresh_finals(part, heights, family, st, speeds=speeds, progress=progress, must_fit=True,
                              members=members)
-        if fresh is None or not fresh_fit(fresh, st.tolerance, part.symmetry_order()):
+        if fresh is None:  # the fresh finals fit in no arc of the tolerance
             continue
         check = check_plan_for_family(part, heights, family, st, None, speeds, progress, " ".join(labels))
         if not check["holds"]:
