@@ -20,12 +20,12 @@ under ``tests/data``.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
 import subprocess
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -103,25 +103,52 @@ _DOCS_ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="session")
 def built_docs(tmp_path_factory) -> Path:
     """The HTML manual, built with warnings as errors from a copy-free run of
-    Sphinx on ``docs/`` (its doctree cache in a temporary folder)."""
+    Sphinx on ``docs/`` (its doctree cache in a temporary folder).
+
+    Built once per test run: the tests that read it share one pytest-xdist
+    worker (``--dist loadgroup``), and should two workers ask for it anyway,
+    the second waits on a lock and reads the first one's build. Two builds at
+    once would race: each starts by removing the gallery the other writes."""
     pytest.importorskip("sphinx")
-    out = tmp_path_factory.mktemp("docs_html")
-    doctrees = tmp_path_factory.mktemp("doctrees")
+    # All workers of one run share the parent of their base temp folders.
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+    with _exclusive(shared / "docs_build.lock"):
+        out, verdict = shared / "docs_html", shared / "docs_build.txt"
+        if not verdict.exists():
+            verdict.write_text(_build_docs(out, shared / "doctrees"))
+    failure = verdict.read_text()
+    assert not failure, failure
+    return out
+
+
+@contextlib.contextmanager
+def _exclusive(lock: Path):
+    """Hold an exclusive lock on ``lock`` (POSIX ``flock``; no lock where the
+    platform has none)."""
+    try:
+        import fcntl
+    except ImportError:     # pragma: no cover - Windows runs the suite in one process
+        yield
+        return
+    with open(lock, "w") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def _build_docs(out: Path, doctrees: Path) -> str:
+    """Run Sphinx into ``out``; return "" when it succeeded, else why it failed."""
     env = {**os.environ, "PYTHONPATH": f"{_DOCS_ROOT}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
            "MPLBACKEND": "Agg"}
-    def build():
-        return subprocess.run([sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q",
-                               "-d", str(doctrees), str(_DOCS_ROOT / "docs"), str(out)],
-                              cwd=_DOCS_ROOT, env=env, capture_output=True, text=True, timeout=900)
-
-    run = build()
-    if run.returncode != 0 and "image file is truncated" in run.stderr:
-        # Seen once on CI (a gallery figure read back before it was whole) and
-        # never reproduced: say what the disk and the gallery held, build once more.
-        warnings.warn(f"the docs build read a truncated gallery image; {_gallery_state()}; building again")
-        run = build()
-    assert run.returncode == 0, f"the docs build failed ({_gallery_state()}):\n{run.stdout}\n{run.stderr}"
-    return out
+    run = subprocess.run([sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q",
+                          "-d", str(doctrees), str(_DOCS_ROOT / "docs"), str(out)],
+                         cwd=_DOCS_ROOT, env=env, capture_output=True, text=True, timeout=900)
+    if run.returncode == 0:
+        return ""
+    return f"the docs build failed ({_gallery_state()}):\n{run.stdout}\n{run.stderr}"
 
 
 def _gallery_state() -> str:
@@ -132,10 +159,16 @@ def _gallery_state() -> str:
     return f"{free:.1f} GiB free; gallery images: {sizes or 'none'}"
 
 
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """Under pytest-xdist (``make test`` runs two workers), the tests that read the
     built manual share one worker, so the manual is built once; the other tests
-    spread over the workers (``--dist loadgroup``)."""
+    spread over the workers (``--dist loadgroup``).
+
+    ``tryfirst``: pytest-xdist reads the group marks in its own hook of this
+    name, so they must be set before it runs. (pytest 9.2 broke the grouping
+    again, so the test extra keeps pytest below it: the suite's
+    ``test_manual_built_once`` checks the grouping.)"""
     for item in items:
         if "built_docs" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.xdist_group("built_docs"))

@@ -1,0 +1,58 @@
+"""The tests that read the built manual run on one pytest-xdist worker, so
+``make test`` builds the manual once: two builds at once would race (each
+starts by removing the gallery the other is writing).
+
+Checked by running the suite's own grouping hook (tests/conftest.py) in a
+small pytest session with two workers, as ``make test`` runs them."""
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+TESTS = Path(__file__).resolve().parents[1]
+
+CONFTEST = f'''
+import importlib.util, os
+import pytest
+spec = importlib.util.spec_from_file_location("pinfeed_suite_conftest", {str(TESTS / "conftest.py")!r})
+suite = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(suite)
+pytest_collection_modifyitems = suite.pytest_collection_modifyitems
+
+@pytest.fixture(scope="session")
+def built_docs():
+    return os.environ.get("PYTEST_XDIST_WORKER")
+'''
+
+TESTS_PY = '''
+import pytest
+
+@pytest.mark.parametrize("i", range(12))
+def test_reads_the_manual(built_docs, i):
+    pass
+
+@pytest.mark.parametrize("i", range(12))
+def test_other(i):
+    pass
+'''
+
+
+def test_the_tests_reading_the_manual_share_one_worker(tmp_path):
+    pytest.importorskip("xdist")
+    (tmp_path / "conftest.py").write_text(CONFTEST)
+    (tmp_path / "test_grouping.py").write_text(TESTS_PY)
+    run = subprocess.run([sys.executable, "-m", "pytest", "-v", "-p", "no:cacheprovider", "-n", "2",
+                          "--dist", "loadgroup", "test_grouping.py"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    workers = {}
+    for worker, name in re.findall(r"\[(gw\d+)\].*?PASSED test_grouping\.py::(\w+)", run.stdout):
+        workers.setdefault(name, set()).add(worker)
+    assert len(workers.get("test_reads_the_manual", ())) == 1, (
+        f"the tests reading the manual ran on {workers.get('test_reads_the_manual')}: "
+        "pytest-xdist did not keep their group on one worker")
+    assert workers.get("test_other"), run.stdout[-3000:]
