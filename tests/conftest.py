@@ -161,14 +161,29 @@ def _gallery_state() -> str:
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
-    """Under pytest-xdist (``make test`` runs two workers), the tests that read the
-    built manual share one worker, so the manual is built once; the other tests
-    spread over the workers (``--dist loadgroup``).
+    """Under pytest-xdist (``make test`` runs two workers, ``--dist loadgroup``),
+    keep the tests that share a costly fixture on one worker, so it is made
+    once: the tests that read the built manual form one group, and the tests
+    of a module that use one of its module-scoped fixtures (a small workflow
+    run, a design search) another. The other tests spread over the workers.
 
     ``tryfirst``: pytest-xdist reads the group marks in its own hook of this
     name, so they must be set before it runs. (pytest 9.2 broke the grouping
-    again, so the test extra keeps pytest below it: the suite's
-    ``test_manual_built_once`` checks the grouping.)"""
+    again, so the test extra keeps pytest below it; ``test_manual_built_once``
+    checks the grouping.)"""
     for item in items:
-        if "built_docs" in getattr(item, "fixturenames", ()):
-            item.add_marker(pytest.mark.xdist_group("built_docs"))
+        group = _costly_fixture_group(item)
+        if group:
+            item.add_marker(pytest.mark.xdist_group(group))
+
+
+def _costly_fixture_group(item) -> str | None:
+    """The xdist group of ``item``: ``built_docs``, ``module:<path>`` when it
+    uses a module-scoped fixture, else None."""
+    names = getattr(item, "fixturenames", ())
+    if "built_docs" in names:
+        return "built_docs"
+    defined = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
+    if any(defs and defs[-1].scope == "module" for name, defs in defined.items() if name in names):
+        return "module:" + item.nodeid.split("::")[0]
+    return None
