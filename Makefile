@@ -37,8 +37,9 @@ unlock: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/pinfeed demo --out results/demo
 
-# Two pytest-xdist workers (TEST_WORKERS=N for more, 0 for one process); the
-# tests that read the built manual share one worker (tests/conftest.py).
+# Two pytest-xdist workers (TEST_WORKERS=N for more, 0 for one process); tests
+# sharing a costly fixture (the built manual, a module's workflow run) share one
+# worker (tests/conftest.py).
 TEST_WORKERS ?= 2
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadgroup
