@@ -113,7 +113,14 @@ class Outline:
     hole_layers: list = field(default_factory=list)  # each hole's DXF layer (None: SVG, or several)
     layer: str | None = None  # the outline's DXF layer (None: SVG, or joined across layers)
     joined_layers: list = field(default_factory=list)  # the layers an outline joined across, if several
+    index: int = 0  # the part's index in its drawing (read_sheet's order)
+    n_parts: int = 1  # how many parts the drawing holds
     _a: float | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def label(self) -> str:
+        """``"FILE#index"``: the part's name in its drawing (``--id`` takes it)."""
+        return f"{Path(self.source).name}#{self.index}"
 
     @property
     def n_vertices(self) -> int:
@@ -184,6 +191,7 @@ class _Piece:
     pick: str | None = None  # what --id names: DXF handle (the top INSERT's in a block), SVG element id
     construction: str = ""  # why it is construction geometry ("linetype CENTER"), "" when not
     members: tuple = ()  # the drawn pieces a loop or chain was joined from
+    svg: bool = False  # drawn in an SVG (ids are case-sensitive), not a DXF (handles are not)
 
     @property
     def parts(self) -> tuple:
@@ -235,23 +243,21 @@ class _Drawing:
 def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa: A002 (CLI's --id)
                  flatten_tol: float | None = None, units: str | None = None,
                  join_tol: float | None = None) -> Outline:
-    """The part outline in ``path`` (.dxf or .svg), with its holes.
+    """The part in ``path`` (.dxf or .svg): its outline, with its holes.
 
-    Pieces are joined into closed loops layer by layer (across layers only when
-    no layer closes on its own); the largest closed loop, leaving out a drawing
-    frame and construction geometry, is the outline, or the loop that ``id``
-    names; closed loops strictly inside it are its holes (from its own layer or
-    closed on another); loops outside it and open chains are reported in
-    ``left_out``. See the module docstring for the rules.
+    A drawing may hold several parts (:func:`read_sheet` reads them all);
+    this is the largest one, or the one ``id`` picks, and the others are
+    named in one line of ``left_out`` (so in :meth:`Outline.warnings`), each
+    with the ``--id`` that picks it. See the module docstring for the rules.
 
     Parameters
     ----------
-    layer : read only this DXF layer (outline and holes).
-    id : the outline is the loop holding this SVG element id or DXF entity
-        handle (an INSERT's handle for the entities of its block), its holes
-        the loops inside it as above, and loops across it are left out, not
-        refused (the user chose); otherwise the largest closed loop is the
-        outline.
+    layer : read only this layer (DXF layer, or Inkscape layer of an SVG).
+    id : the part holding this SVG element id or DXF entity handle (an
+        INSERT's handle for the entities of its block) in its outline or a
+        hole, or the part's index: ``"FILE#N"``, ``"#N"`` or ``"N"`` (a bare
+        number that is also a piece's id or handle names the piece). Loops
+        across the outline it picks are left out, not refused (the user chose).
     flatten_tol : chordal tolerance for curves, mm (``None``: :data:`DEFAULT_FLATTEN_TOL`
         or :data:`FLATTEN_FRACTION` of the drawing's diagonal, whichever is larger,
         which keeps the vertex count of a large drawing modest).
@@ -262,36 +268,130 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
     Raises
     ------
     OutlineError
-        No closed loop, loops that cross or touch, a loop inside a hole, a
-        self-intersection, too many vertices, or a file that cannot be read:
-        one line naming the problem and the way out.
+        No closed loop, loops that cross or touch, a self-intersection, too
+        many vertices, or a file that cannot be read: one line naming the
+        problem and the way out.
     """
+    drawing, pieces, texts, tol, tol_mm = _read(path, layer, id, flatten_tol, units, join_tol)
+    sheet = _layout(pieces, texts, tol, drawing)
+    if id is None:
+        _check_open(sheet, pieces, tol, drawing)
+        k = 0
+    else:
+        k = _picked(sheet, pieces, tol, drawing)
+    outer, holes = sheet.parts[k]
+    left, across = [], set()
+    for a, b in sheet.conflicts.get(k, []):
+        if id is None:
+            raise OutlineError(
+                f"{drawing.path}: outlines {a.name} and {b.name} cross each other or touch; a hole must lie "
+                f"strictly inside the outline (an opening to the outline is a notch: draw it as part of the "
+                f"outline), else draw the part as one closed outline, or {drawing.pick(a, b)}")
+        left.append(f"closed loop {b.name} (area {_area(b) * drawing.unit.scale ** 2:.4g} mm^2; across the "
+                    f"outline that --id {id} picked)")
+        across.add(_key(b))
+    left = sheet.notes + [_construction_note(lp, outer, drawing) for lp in sheet.construction] + left
+    others = [j for j in range(len(sheet.parts)) if j != k and _key(sheet.parts[j][0]) not in across]
+    if others:
+        left.append(_others_note(sheet, others, drawing, outer))
+    left += _chain_notes(sheet.chains, outer, pieces, tol, drawing)
+    out = _outline(outer, holes, drawing, tol_mm, left, index=k, n_parts=len(sheet.parts))
+    return out
+
+
+@dataclass
+class Sheet:
+    """All parts of a drawing (:func:`read_sheet`), in the order of their index."""
+
+    source: str  # the file
+    units: Units
+    parts: list  # Outline, one per part; ``Outline.label`` is "FILE#index"
+    left_out: list = field(default_factory=list)  # frame, construction loops, open chains: described
+    refused: list = field(default_factory=list)  # (label, one-line reason) of parts that cannot be read
+
+    def warnings(self) -> list[str]:
+        """Lines worth a warning: what was left out, and the parts refused."""
+        out = [f"{self.source}: left out {item}" for item in self.left_out]
+        out += [f"{reason} (part {label} left out)" for label, reason in self.refused]
+        return out
+
+
+def read_sheet(path, layer: str | None = None, flatten_tol: float | None = None, units: str | None = None,
+               join_tol: float | None = None, strict: bool = True) -> Sheet:
+    """Every part in the drawing ``path`` (.dxf or .svg), each an :class:`Outline`
+    with its holes, indexed by the stable rule of the module docstring (largest
+    outline first; equal ones left to right, then bottom to top) and labelled
+    ``"FILE#index"`` (``--id`` takes that label). A loop inside a hole is a part
+    of its own (an island: a washer in a bore). Parameters as :func:`read_outline`;
+    ``strict``: a part that cannot be read (loops that cross, a self-intersection,
+    too many vertices) raises :class:`OutlineError`, else it is listed in
+    ``refused`` with its one-line reason and the others are returned."""
+    drawing, pieces, texts, tol, tol_mm = _read(path, layer, None, flatten_tol, units, join_tol)
+    sheet = _layout(pieces, texts, tol, drawing)
+    _check_open(sheet, pieces, tol, drawing)
+    notes = sheet.notes + [_construction_note(lp, None, drawing) for lp in sheet.construction]
+    notes += _chain_notes(sheet.chains, sheet.parts[0][0], pieces, tol, drawing)
+    out = Sheet(str(drawing.path), drawing.unit, [], notes)
+    for k, (outer, holes) in enumerate(sheet.parts):
+        try:
+            for a, b in sheet.conflicts.get(k, [])[:1]:
+                raise OutlineError(
+                    f"{drawing.path}: outlines {a.name} and {b.name} cross each other or touch; a hole must lie "
+                    f"strictly inside the outline (an opening to the outline is a notch: draw it as part of "
+                    f"the outline), else draw the part as one closed outline")
+            out.parts.append(_outline(outer, holes, drawing, tol_mm, [], index=k, n_parts=len(sheet.parts)))
+        except OutlineError as exc:
+            if strict:
+                raise
+            out.refused.append((f"{drawing.path.name}#{k}", str(exc)))
+    return out
+
+
+def read_parts(path, layer: str | None = None, flatten_tol: float | None = None, units: str | None = None,
+               join_tol: float | None = None) -> list[tuple[str, Outline]]:
+    """``[(label, outline), ...]``: every part of the drawing, by index (:func:`read_sheet`,
+    strict); ``outline.part(name)`` is the :class:`~pipeline.parts.part.Part`."""
+    return [(o.label, o) for o in read_sheet(path, layer, flatten_tol, units, join_tol).parts]
+
+
+def _key(piece) -> int:
+    """Identity of a loop (pieces hold arrays: compare by object)."""
+    return id(piece)
+
+
+def _read(path, layer, id, flatten_tol, units, join_tol):  # noqa: A002
+    """The drawing's pieces, read: ``(drawing, pieces, texts, join tolerance, chordal tolerance in mm)``."""
     path = Path(path)
     _check_options(flatten_tol, units, join_tol)
     if not path.is_file():
         raise OutlineError(f"no outline file at {path}")
     suffix = path.suffix.lower()
-    pieces, unit, tol_mm, texts = _pieces(path, suffix, layer, flatten_tol, units)
-    on = f" on layer {layer!r}" if layer else ""
+    pieces, unit, tol_mm, texts, layers = _pieces(path, suffix, layer, flatten_tol, units)
     if not pieces:
-        raise OutlineError(f"{path}: no lines, arcs, polylines or shapes{on}")
-    if id is not None and not any(_names_id(p, id) for p in pieces):
-        raise OutlineError(f"{path}: no lines, arcs, polylines or shapes with id {id!r}{on}; give the "
-                           f"{'element id' if suffix == '.svg' else 'entity handle'} of a piece of the outline")
+        if layer is not None:
+            known = f"its layers: {', '.join(layers)}" if layers else "it has no layers"
+            raise OutlineError(f"{path}: no lines, arcs, polylines or shapes on layer {layer!r}; "
+                               f"give one of the drawing's layers ({known})")
+        raise OutlineError(f"{path}: no lines, arcs, polylines or shapes; draw the part with lines, arcs, "
+                           f"polylines, circles or splines (text, hatches, points and dimensions are not read)")
     drawing = _Drawing(path, unit, suffix == ".svg", sorted({p.layer for p in pieces if p.layer is not None}), id)
     tol = join_tol if join_tol is not None else JOIN_TOL_FRACTION * _extent(pieces)
-    outer, holes, left_out, joined = _choose(pieces, texts, tol, drawing)
+    return drawing, pieces, texts, tol, tol_mm
+
+
+def _outline(outer, holes, drawing, tol_mm, left, index=0, n_parts=1) -> Outline:
     xy, hole_xy = _checked(outer, holes, drawing, tol_mm)
-    return Outline(vertices=xy, source=str(path), name=outer.name, flatten_tol=float(tol_mm), units=unit,
-                   left_out=left_out, holes=hole_xy, hole_names=[h.name for h in holes],
-                   hole_layers=[h.layer for h in holes], layer=outer.layer, joined_layers=joined)
+    return Outline(vertices=xy, source=str(drawing.path), name=outer.name, flatten_tol=float(tol_mm),
+                   units=drawing.unit, left_out=left, holes=hole_xy, hole_names=[h.name for h in holes],
+                   hole_layers=[h.layer for h in holes], layer=outer.layer,
+                   joined_layers=outer.layers if len(outer.layers) > 1 else [], index=index, n_parts=n_parts)
 
 
 def _names_id(piece: _Piece, want) -> bool:
     """Whether ``--id want`` names this drawn piece (DXF handles in any case)."""
     if piece.pick is None:
         return False
-    return piece.pick == str(want) or (piece.layer is not None and piece.pick.upper() == str(want).upper())
+    return piece.pick == str(want) or (not piece.svg and piece.pick.upper() == str(want).upper())
 
 
 def _checked(outer: _Piece, holes: list, drawing: _Drawing, tol_mm: float):
@@ -333,9 +433,13 @@ def _pieces(path: Path, suffix: str, layer, flatten_tol, units):
     if suffix == ".dxf":
         return _dxf_pieces(path, layer, flatten_tol, units)
     if suffix == ".svg":
+        pieces, unit, tol_mm, layers = _svg_pieces(path, flatten_tol, units)
         if layer is not None:
-            raise OutlineError(f"{path}: --layer picks a DXF layer; pick an SVG element with --id")
-        return (*_svg_pieces(path, flatten_tol, units), [])
+            if not layers:
+                raise OutlineError(f"{path}: --layer picks a layer, and this SVG has none (an Inkscape layer is "
+                                   f"a group with inkscape:groupmode=\"layer\"); pick an element with --id")
+            pieces = [p for p in pieces if p.layer == layer]
+        return pieces, unit, tol_mm, [], layers
     raise OutlineError(f"{path}: unknown outline format {suffix or '(none)'}; give a .dxf or .svg file")
 
 
@@ -392,8 +496,10 @@ def _dxf_pieces(path: Path, layer, flatten_tol, override):
     except (OSError, ezdxf.DXFStructureError, UnicodeDecodeError) as exc:
         raise OutlineError(f"{path} is not a readable DXF file: {exc}".splitlines()[0]) from None
     unit = _dxf_units(doc, override)
-    chosen, texts = [], []
+    chosen, texts, layers = [], [], set()
     for e, where, on_layer, pick, linetype in _dxf_entities(doc):
+        if e.dxftype() in _DXF_CURVES:
+            layers.add(on_layer)
         if layer is not None and on_layer != layer:
             continue
         kind = e.dxftype()
@@ -420,7 +526,7 @@ def _dxf_pieces(path: Path, layer, flatten_tol, override):
         closed = bool(getattr(e, "closed", False) or getattr(e, "is_closed", False)) or kind == "CIRCLE"
         pieces.append(_Piece(pts, f"{kind} {where} on layer {on_layer}", closed, layer=on_layer, pick=pick,
                              construction=_construction(on_layer, linetype)))
-    return pieces, unit, tol * unit.scale, texts
+    return pieces, unit, tol * unit.scale, texts, sorted(layers)
 
 
 def _dxf_entities(doc):
@@ -536,8 +642,32 @@ def _svg_units(svg, override) -> tuple[Units, float]:
                        f"{'; ' + px_said if in_px else ''})", user_mm), 1.0 / px_per_user
 
 
-def _svg_pieces(path: Path, flatten_tol, override) -> tuple[list[_Piece], Units, float]:
-    """The flattened pieces of an SVG's shapes, their units and the chordal tolerance (mm)."""
+_INKSCAPE = "{http://www.inkscape.org/namespaces/inkscape}"
+
+
+def _svg_layers(group, layer=None, out=None) -> dict:
+    """``{id(element): layer label}``: the Inkscape layer (a group with
+    ``inkscape:groupmode="layer"``, named by its ``inkscape:label``, else its id)
+    each element lies in, the innermost one for a sublayer."""
+    import svgelements as se
+    out = {} if out is None else out
+    for child in group:
+        if not isinstance(child, se.SVGElement):
+            continue
+        here = layer
+        if isinstance(child, se.Group):
+            v = child.values
+            if (v.get(_INKSCAPE + "groupmode") or v.get("inkscape:groupmode")) == "layer":
+                here = str(v.get(_INKSCAPE + "label") or v.get("inkscape:label") or child.id or "layer")
+            _svg_layers(child, here, out)
+        if here is not None:
+            out[id(child)] = here
+    return out
+
+
+def _svg_pieces(path: Path, flatten_tol, override) -> tuple[list[_Piece], Units, float, list]:
+    """The flattened pieces of an SVG's shapes, their units, the chordal
+    tolerance (mm) and the Inkscape layers' labels."""
     import svgelements as se
     try:
         svg = se.SVG.parse(str(path), ppi=96.0)  # transforms and viewBox applied
@@ -545,25 +675,32 @@ def _svg_pieces(path: Path, flatten_tol, override) -> tuple[list[_Piece], Units,
         raise OutlineError(f"{path} is not a readable SVG file: {exc}".splitlines()[0]) from None
     unit, user_per_px = _svg_units(svg, override)
     flip = np.array([user_per_px, -user_per_px])
+    layer_of = _svg_layers(svg)
     chosen = []
     for k, el in enumerate(svg.elements()):
         if not isinstance(el, se.Shape) or isinstance(el, se.Group):
             continue
         eid = el.values.get("id") or el.id
         label = f"<{type(el).__name__.lower()} id={eid!r}>" if eid else f"{type(el).__name__.lower()} #{k}"
+        layer = layer_of.get(id(el))
+        dashed = str(el.values.get("stroke-dasharray") or "none").strip().lower() not in ("none", "", "0")
+        why = "dashed stroke" if dashed else (_construction(layer, "") if layer is not None else "")
         shape = se.Path(el)
         shape.reify()  # bake the transform into the coordinates
-        chosen.append((label, eid, shape))
-    tol_px = _chordal_tolerance(flatten_tol, _svg_diagonal(s for _, _, s in chosen) * user_per_px,
+        named = layer is not None and len(set(layer_of.values())) > 1  # name the layer where there are several
+        chosen.append((label + (f" on layer {layer}" if named else ""), eid, shape, layer, why))
+    tol_px = _chordal_tolerance(flatten_tol, _svg_diagonal(c[2] for c in chosen) * user_per_px,
                                 unit.scale) / user_per_px
     pieces = []
-    for label, eid, shape in chosen:
+    for label, eid, shape, layer, why in chosen:
         subs = [(sub, closed) for sub, closed in _subpaths(shape, tol_px) if len(sub) >= 2]
         for i, (sub, closed) in enumerate(subs, start=1):
             pts = np.array(sub, dtype=float) * flip
-            pieces.append(_Piece(pts, label + (f" subpath {i}" if len(subs) > 1 else ""), closed,
-                                 pick=str(eid) if eid else None))
-    return pieces, unit, tol_px * user_per_px * unit.scale
+            name = label if len(subs) == 1 else label.replace(" on layer ", f" subpath {i} on layer ", 1) \
+                if " on layer " in label else label + f" subpath {i}"
+            pieces.append(_Piece(pts, name, closed, layer=layer, pick=str(eid) if eid else None,
+                                 construction=why, svg=True))
+    return pieces, unit, tol_px * user_per_px * unit.scale, sorted(set(layer_of.values()))
 
 
 def _svg_diagonal(shapes) -> float:
@@ -652,7 +789,7 @@ def _joined(points, members: list, closed: bool) -> _Piece:
     layers = {m.layer for m in members}
     return _Piece(points, name, closed, layer=first.layer if len(layers) == 1 else None, pick=first.pick,
                   construction=first.construction if all(m.construction for m in members) else "",
-                  members=tuple(members))
+                  members=tuple(members), svg=first.svg)
 
 
 def _join(pieces: list[_Piece], tol: float) -> tuple[list[_Piece], list[_Piece]]:
@@ -725,8 +862,18 @@ def _inside(pt, poly) -> bool:
 
 
 def _inside_all(points, poly) -> np.ndarray:
-    """Whether each of ``points`` lies inside ``poly`` (even-odd)."""
-    return np.array([_inside(pt, poly) for pt in points])
+    """Whether each of ``points`` lies inside ``poly`` (even-odd; :func:`_inside`, for many points at once)."""
+    points = np.asarray(points, float)
+    xs, ys = poly[:, 0][None, :], poly[:, 1][None, :]
+    xj, yj = np.roll(xs, 1, axis=1), np.roll(ys, 1, axis=1)
+    dy = np.where(yj == ys, 1e-300, yj - ys)
+    out = np.empty(len(points), bool)
+    step = max(1, 2_000_000 // max(1, poly.shape[0]))
+    for k in range(0, len(points), step):
+        x, y = points[k:k + step, :1], points[k:k + step, 1:]
+        crosses = ((ys > y) != (yj > y)) & (x < (xj - xs) * (y - ys) / dy + xs)
+        out[k:k + step] = np.count_nonzero(crosses, axis=1) % 2 == 1
+    return out
 
 
 def _diagonal(xy) -> float:
@@ -752,14 +899,27 @@ def _loops_and_chains(pieces, tol):
     return [lp for lp in loops if len(lp.points) >= 3], chains
 
 
-def _choose(pieces: list[_Piece], texts: list, tol: float, drawing: _Drawing):
-    """The outline, its holes, descriptions of what was left out, and the
-    layers the outline joined across (when several); an error for crossing
-    loops, an island, or an open chain that looks like the outline."""
+@dataclass
+class _Layout:
+    """A drawing's loops sorted out: its parts (outline, holes) by index, the
+    loop pairs across each other by part, construction loops, open chains and
+    notes (a frame left out)."""
+
+    parts: list  # (outline loop, [hole loops]), by index
+    conflicts: dict  # part index -> [(its loop, other loop)] that cross or touch
+    construction: list  # closed construction loops (never parts, never holes)
+    chains: list  # open chains, largest first
+    notes: list  # what was left out, described (a drawing frame)
+
+
+def _layout(pieces: list[_Piece], texts: list, tol: float, drawing: _Drawing) -> _Layout:
+    """The drawing's parts: pieces joined into loops layer by layer (across
+    layers only when no layer closes on its own), a drawing frame left out,
+    and the loops nested into parts: a loop inside no other, or inside a hole,
+    is a part's outline; the loops directly inside an outline are its holes."""
     if all(p.construction for p in pieces):  # all dashed, or on a construction layer: take it as drawn
-        pieces = [_Piece(p.points, p.name, p.closed, p.layer, p.pick) for p in pieces]
+        pieces[:] = [_Piece(p.points, p.name, p.closed, p.layer, p.pick, svg=p.svg) for p in pieces]
     loops, chains = _loops_and_chains(pieces, tol)
-    joined = []
     plain = [p for p in pieces if not p.construction]
     if not any(not lp.construction for lp in loops) and len({p.layer for p in plain}) > 1:
         # No layer closes on its own: join the layers' pieces (never construction geometry).
@@ -770,38 +930,151 @@ def _choose(pieces: list[_Piece], texts: list, tol: float, drawing: _Drawing):
             chains = [c for c in chains if c.construction] + mixed_chains
     loops.sort(key=lambda lp: -_area(lp))
     chains.sort(key=lambda c: -_diagonal(c.points))
-    frame, left = None, []
-    if drawing.id is not None:
-        mine = [lp for lp in loops if any(_names_id(m, drawing.id) for m in lp.parts)]
-        if not mine:
-            chain = next((c for c in chains if any(_names_id(m, drawing.id) for m in c.parts)), None)
-            if chain is None:
-                raise OutlineError(f"{drawing.path}: the piece with id {drawing.id!r} has no length or repeats "
-                                   f"another piece; give the id of another piece of the outline")
-            raise _open_error(chain, pieces, tol, drawing, None)
-        outer = mine[0]
+    notes = []
+    frame = _frame(loops, pieces, texts, tol, drawing)
+    if frame is not None and not _named(drawing, [p for p in pieces if p.layer == frame[0]]):
+        notes.append(frame[1])
+        loops = [lp for lp in loops if lp.layer != frame[0]]
+        chains = [c for c in chains if c.layer != frame[0]]
     else:
-        frame = _frame(loops, pieces, texts, tol, drawing)
-        if frame is not None:
-            left.append(frame[1])
-            loops = [lp for lp in loops if lp.layer != frame[0]]
-            chains = [c for c in chains if c.layer != frame[0]]
-        candidates = [lp for lp in loops if not lp.construction] or loops
-        plain_chains = [c for c in chains if not c.construction]
-        # A lone straight line (a centre line, a dimension) is never an outline left open.
-        could_be = [c for c in plain_chains if len(c.points) > 2]
-        if could_be and (not candidates or _diagonal(could_be[0].points) > _diagonal(candidates[0].points)):
-            raise _open_error(could_be[0], pieces, tol, drawing, candidates[0] if candidates else None)
-        if not candidates:
-            if plain_chains or chains:
-                raise _open_error((plain_chains or chains)[0], pieces, tol, drawing, None)
-            raise OutlineError(f"{drawing.path}: no closed outline with an area")
-        outer = candidates[0]
-    if len(outer.layers) > 1:
-        joined = outer.layers
-    holes, left_loops = _holes(outer, [lp for lp in loops if lp is not outer], drawing)
-    left += left_loops
-    scale = drawing.unit.scale
+        inplace = _frame_in_place(loops, chains, pieces, texts, tol, drawing)
+        if inplace is not None and not _named(drawing, inplace[0]):
+            gone = {_key(m) for m in inplace[0]}
+            notes.append(inplace[1])
+            loops = [lp for lp in loops if not all(_key(m) in gone for m in lp.parts)]
+            chains = [c for c in chains if not all(_key(m) in gone for m in c.parts)]
+    named = [lp for lp in loops if lp.construction and _named(drawing, lp.parts)]
+    solid = [lp for lp in loops if not lp.construction or any(lp is x for x in named)]
+    if not solid:  # only construction loops close: take them as parts
+        solid = loops
+    construction = [lp for lp in loops if not any(lp is s_ for s_ in solid)]
+    parts, conflicts = _nest(solid, tol)
+    return _Layout(parts, conflicts, construction, chains, notes)
+
+
+def _named(drawing: _Drawing, members) -> bool:
+    """Whether ``--id`` names one of these drawn pieces."""
+    return drawing.id is not None and any(_names_id(m, drawing.id) for m in members)
+
+
+def _box(xy) -> tuple:
+    return xy.min(axis=0), xy.max(axis=0)
+
+
+def _nest(loops: list, tol: float):
+    """The parts of ``loops`` (sorted largest first): ``[(outline, [holes])]``
+    in index order, and ``{index: [(its loop, other loop)]}`` for loops of
+    different parts that cross or touch (crossing holes of one part are left to
+    :func:`pipeline.parts.part.check_holes`)."""
+    n = len(loops)
+    boxes = [_box(lp.points) for lp in loops]
+    parent, depth, crossing = [None] * n, [0] * n, []
+    for i in range(n):
+        lo, hi = boxes[i]
+        for j in range(i):  # the larger loops, largest first: the last that holds loop i is the innermost
+            jlo, jhi = boxes[j]
+            if np.any(lo > jhi + tol) or np.any(hi < jlo - tol):
+                continue
+            inside = _inside_all(loops[i].points, loops[j].points)
+            if inside.all():
+                parent[i] = j
+            elif inside.any():
+                crossing.append((j, i))
+        depth[i] = 0 if parent[i] is None else depth[parent[i]] + 1
+    outlines = [i for i in range(n) if depth[i] % 2 == 0]
+    outlines.sort(key=lambda i: (-float(f"{_area(loops[i]):.6g}"), float(boxes[i][0][0]), float(boxes[i][0][1])))
+    index = {i: k for k, i in enumerate(outlines)}
+    owner = [index[i] if depth[i] % 2 == 0 else index[parent[i]] for i in range(n)]
+    parts = [(loops[i], [loops[h] for h in range(n) if parent[h] == i]) for i in outlines]
+    conflicts = {}
+    for j, i in crossing:
+        if owner[i] != owner[j]:
+            conflicts.setdefault(owner[j], []).append((loops[j], loops[i]))
+            conflicts.setdefault(owner[i], []).append((loops[i], loops[j]))
+    return parts, conflicts
+
+
+def _check_open(sheet: _Layout, pieces, tol, drawing: _Drawing) -> None:
+    """An error when an open chain looks like the outline (larger than every
+    closed loop), or when nothing closes."""
+    plain_chains = [c for c in sheet.chains if not c.construction]
+    # A lone straight line (a centre line, a dimension) is never an outline left open.
+    could_be = [c for c in plain_chains if len(c.points) > 2]
+    biggest = sheet.parts[0][0] if sheet.parts else None
+    if could_be and (biggest is None or _diagonal(could_be[0].points) > _diagonal(biggest.points)):
+        raise _open_error(could_be[0], pieces, tol, drawing, biggest)
+    if biggest is None:
+        if plain_chains or sheet.chains:
+            raise _open_error((plain_chains or sheet.chains)[0], pieces, tol, drawing, None)
+        raise OutlineError(f"{drawing.path}: no closed outline with an area; draw the part's outline as a "
+                           f"closed loop (a closed polyline, or pieces whose ends meet)")
+
+
+_INDEX = re.compile(r"\s*(?:(.*)#)?(\d+)\s*")
+
+
+def _picked(sheet: _Layout, pieces, tol, drawing: _Drawing) -> int:
+    """The index of the part that ``--id`` picks: the part holding the named
+    piece (in its outline or a hole), or the part of that index."""
+    want = drawing.id
+    for k, (outer, holes) in enumerate(sheet.parts):
+        if any(_names_id(m, want) for lp in (outer, *holes) for m in lp.parts):
+            return k
+    m = _INDEX.fullmatch(str(want))
+    if m and not any(_names_id(p, want) for p in pieces):
+        k, n = int(m.group(2)), len(sheet.parts)
+        if k < n:
+            return k
+        raise OutlineError(f"{drawing.path}: no part #{k}: the drawing holds {n} part{'s' if n != 1 else ''} "
+                           f"(#0{f' to #{n - 1}' if n > 1 else ''}); give --id {drawing.path.name}#N with N "
+                           f"from 0 to {n - 1}")
+    if not any(_names_id(p, want) for p in pieces):
+        what = "element id" if drawing.svg else "entity handle"
+        raise OutlineError(f"{drawing.path}: no lines, arcs, polylines or shapes with id {want!r}; give the "
+                           f"{what} of a piece of the part, or its index ({drawing.path.name}#N)")
+    loop = next((lp for lp in sheet.construction if _named(drawing, lp.parts)), None)
+    if loop is not None:
+        raise OutlineError(f"{drawing.path}: the piece with id {want!r} is construction geometry ("
+                           f"{loop.construction}); give the id of a piece of the part")
+    chain = next((c for c in sheet.chains if _named(drawing, c.parts)), None)
+    if chain is None:
+        raise OutlineError(f"{drawing.path}: the piece with id {want!r} has no length, repeats another piece or "
+                           f"belongs to a drawing frame; give the id of another piece of the part")
+    raise _open_error(chain, pieces, tol, drawing, None)
+
+
+def _construction_note(lp: _Piece, outer: _Piece | None, drawing: _Drawing) -> str:
+    area = f"area {_area(lp) * drawing.unit.scale ** 2:.4g} mm^2"
+    where = ""
+    if outer is not None:
+        inside = _inside_all(lp.points, outer.points)
+        where = " " + ("inside" if inside.all() else ("outside" if not inside.any() else "across")) + " the outline,"
+    return f"closed loop {lp.name} ({area}; {lp.construction}: construction geometry,{where} never a hole)"
+
+
+MAX_NAMED_PARTS = 6  # the warning about other parts names this many, then counts the rest
+
+
+def _others_note(sheet: _Layout, others: list, drawing: _Drawing, chosen: _Piece) -> str:
+    """One line: the other parts of the drawing, each with the ``--id`` that picks it."""
+    scale2 = drawing.unit.scale ** 2
+    label = drawing.path.name
+    named = []
+    for j in others[:MAX_NAMED_PARTS]:
+        outer, holes = sheet.parts[j]
+        area = (_area(outer) - sum(_area(h) for h in holes)) * scale2
+        with_holes = f", {len(holes)} hole{'s' if len(holes) != 1 else ''}" if holes else ""
+        option = drawing.option(outer, chosen)
+        pick = f"--id {label}#{j}" + (f" or {option}" if option.startswith("--") and outer.pick else "")
+        named.append(f"{label}#{j} ({outer.name}{with_holes}, area {area:.4g} mm^2; to plan it instead: {pick})")
+    more = len(others) - len(named)
+    tail = f", and {more} more (#{others[len(named)]} to #{others[-1]})" if more else ""
+    n = len(others)
+    return f"{n} other part{'s' if n != 1 else ''} of this drawing: " + ", ".join(named) + tail
+
+
+def _chain_notes(chains: list, outer: _Piece, pieces, tol, drawing: _Drawing) -> list[str]:
+    out, scale = [], drawing.unit.scale
     for c in chains:
         gap = np.hypot(*(c.points[-1] - c.points[0])) * scale
         note = f"; construction geometry, {c.construction}" if c.construction else ""
@@ -810,43 +1083,8 @@ def _choose(pieces: list[_Piece], texts: list, tol: float, drawing: _Drawing):
             if bridge:
                 note = (f"; {bridge}: draw it closed on layer {c.layer}, or read layer {c.layer} alone "
                         f"with --layer {c.layer}")
-        left.append(f"open chain {c.name} (ends {gap:.4g} mm apart{note})")
-    return outer, holes, left, joined
-
-
-def _holes(outer: _Piece, others: list, drawing: _Drawing):
-    """The loops strictly inside ``outer`` that are holes, and descriptions of
-    the loops left out; an error for a loop across the outline or inside a hole."""
-    scale, path = drawing.unit.scale, drawing.path
-    holes, left = [], []
-    for lp in others:
-        inside = _inside_all(lp.points, outer.points)
-        area = f"area {_area(lp) * scale ** 2:.4g} mm^2"
-        if lp.construction:
-            where = "inside" if inside.all() else ("outside" if not inside.any() else "across")
-            left.append(f"closed loop {lp.name} ({area}; {lp.construction}: construction geometry, "
-                        f"{where} the outline, never a hole)")
-        elif inside.all():
-            holes.append(lp)
-        elif not inside.any():
-            left.append(f"closed loop {lp.name} ({area}; to plan it instead: {drawing.option(lp, outer)})")
-        elif drawing.id is not None:
-            left.append(f"closed loop {lp.name} ({area}; across the outline that --id {drawing.id} picked)")
-        else:
-            raise OutlineError(
-                f"{path}: outlines {outer.name} and {lp.name} cross each other or touch; a hole must lie "
-                f"strictly inside the outline (an opening to the outline is a notch: draw it as part of the "
-                f"outline), else draw the part as one closed outline, or {drawing.pick(outer, lp)}")
-    for j, hole in enumerate(holes):
-        for k, other in enumerate(holes):
-            if k != j and _inside_all(hole.points, other.points).all():
-                way = (f"pick the outline's layer with --layer {outer.layer} to leave layer {hole.layer} out"
-                       if outer.layer is not None and hole.layer != outer.layer and len(drawing.layers) > 1
-                       else "delete it from this drawing")
-                raise OutlineError(
-                    f"{path}: {hole.name} lies inside the hole {other.name} of outline {outer.name} (an island: "
-                    f"a separate part); plan it as a part of its own (--id {hole.pick}), or {way}")
-    return holes, left
+        out.append(f"open chain {c.name} (ends {gap:.4g} mm apart{note})")
+    return out
 
 
 def _is_box(xy: np.ndarray, tol: float) -> bool:
@@ -863,7 +1101,7 @@ def _frame(loops: list, pieces: list, texts: list, tol: float, drawing: _Drawing
     when it is an axis-aligned rectangle around all other geometry holding
     closed loops of other layers, on a layer named as a frame or holding TEXT
     outside the other layers' geometry (a title block)."""
-    if not loops or drawing.svg or len(drawing.layers) < 2:
+    if not loops or len(drawing.layers) < 2:
         return None
     big = loops[0]
     layer = big.layer
@@ -888,6 +1126,131 @@ def _frame(loops: list, pieces: list, texts: list, tol: float, drawing: _Drawing
     return layer, (f"drawing frame on layer {layer}: {big.name}, a {w:.4g} x {h:.4g} mm rectangle around "
                    f"everything else ({why}), and the other {n - 1} piece(s) of the layer; if it is the part, "
                    f"read layer {layer} alone with --layer {layer}")
+
+
+# Sheet sizes (mm): a rectangle of one of these is a drawing's border, not a part.
+SHEET_SIZES_MM = {"A0": (841, 1189), "A1": (594, 841), "A2": (420, 594), "A3": (297, 420), "A4": (210, 297),
+                  "A5": (148, 210), "ANSI A": (215.9, 279.4), "ANSI B": (279.4, 431.8), "ANSI C": (431.8, 558.8),
+                  "ANSI D": (558.8, 863.6), "ANSI E": (863.6, 1117.6)}
+FRAME_AREA_RATIO = 4.0  # a frame's area is at least this many times the box around what it holds
+INNER_BORDER_AREA = 0.6  # an inner border holds at least this fraction of the sheet's area
+
+
+def _near(points, line, tol: float, closed: bool = False) -> bool:
+    """Whether any of ``points`` lies within ``tol`` of the polyline ``line``."""
+    a = line if closed else line[:-1]
+    b = np.roll(line, -1, axis=0) if closed else line[1:]
+    ab = b - a
+    L2 = np.einsum("ij,ij->i", ab, ab)
+    for k in range(0, len(points), 4096):
+        p = points[k:k + 4096, None, :]
+        t = np.clip(np.einsum("pij,ij->pi", p - a, ab) / np.where(L2 == 0, 1.0, L2), 0.0, 1.0)
+        d = np.hypot(*np.moveaxis(p - a - t[..., None] * ab, -1, 0))
+        if np.any(d <= tol):
+            return True
+    return False
+
+
+def _touching(seeds: list, rest: list, tol: float) -> list:
+    """Groups of the pieces of ``rest`` connected to ``seeds``, each group grown from
+    one seed through pieces whose points lie on one another's lines."""
+    left = [p for p in rest if not any(p is s_ for s_ in seeds)]
+    groups = []
+    for seed in seeds:
+        if any(seed is m for g in groups for m in g):
+            continue
+        group, todo = [seed], [seed]
+        while todo:
+            cur = todo.pop()
+            lo, hi = _box(cur.points)
+            for p in list(left):
+                plo, phi = _box(p.points)
+                if np.any(plo > hi + tol) or np.any(phi < lo - tol):
+                    continue
+                ends = p.points if p.closed else p.points[[0, -1]]
+                cur_ends = cur.points if cur.closed else cur.points[[0, -1]]
+                if _near(ends, cur.points, tol, cur.closed) or _near(cur_ends, p.points, tol, p.closed):
+                    left = [q for q in left if q is not p]
+                    group.append(p)
+                    todo.append(p)
+        groups.append(group)
+    return groups
+
+
+def _sheet_size(w: float, h: float) -> str | None:
+    """The name of the sheet size ``w`` x ``h`` mm is (either way round, to 1 %), or None."""
+    for name, (a, b) in SHEET_SIZES_MM.items():
+        for x, y in ((a, b), (b, a)):
+            if abs(w - x) <= 0.01 * x and abs(h - y) <= 0.01 * y:
+                return name
+    return None
+
+
+def _frame_in_place(loops: list, chains: list, pieces: list, texts: list, tol: float, drawing: _Drawing):
+    """``(drawn pieces, description)`` of a drawing frame drawn among the parts'
+    pieces (same layer, or an SVG), or None. The frame is the largest closed
+    loop, an axis-aligned rectangle around all other geometry, with no closed
+    loop touching it, at least :data:`FRAME_AREA_RATIO` times the area of the
+    box around what it holds, and a sheet's mark: a title block (lines touching
+    it, which close a corner region of at most half its area) or a sheet size
+    (:data:`SHEET_SIZES_MM`). An inner border (a rectangle holding everything
+    else and :data:`INNER_BORDER_AREA` of the sheet's area, nothing touching the
+    outer one) goes with it, and the rules apply to it."""
+    plain = [lp for lp in loops if not lp.construction]
+    if len(plain) < 2 or not _is_box(plain[0].points, tol):
+        return None
+    lo, hi = _box(plain[0].points)
+    allpts = np.vstack([p.points for p in pieces])
+    if not np.all((allpts >= lo - tol) & (allpts <= hi + tol)):
+        return None
+    gone, borders, frame = [], [], plain[0]
+    while True:
+        gone += list(frame.parts)
+        borders.append(frame)
+        rest = [p for p in pieces if not any(p is g for g in gone)]
+        seeds = [p for p in rest if _near(p.points, frame.points, tol, closed=True)]
+        blocks = _touching(seeds, rest, tol)
+        title = [m for g in blocks for m in g]
+        contents = [p for p in rest if not any(p is t for t in title)]
+        if not contents:
+            return None
+        clo, chi = _box(np.vstack([p.points for p in contents]))
+        nxt = next((lp for lp in plain if all(any(m is c for c in contents) for m in lp.parts)), None)
+        inner = (not title and nxt is not None and _is_box(nxt.points, tol) and len(borders) < 3
+                 and _area(nxt) >= INNER_BORDER_AREA * _area(frame)
+                 and np.allclose(_box(nxt.points)[0], clo, atol=tol)
+                 and np.allclose(_box(nxt.points)[1], chi, atol=tol))
+        if not inner:
+            break
+        frame = nxt
+    frame = borders[-1]
+    flo, fhi = _box(frame.points)
+    solid = [lp for lp in plain if all(any(m is c for c in contents) for m in lp.parts)]
+    if not solid or float(np.prod(fhi - flo)) < FRAME_AREA_RATIO * float(np.prod(chi - clo)):
+        return None
+    corners = [np.array(c) for c in ((flo[0], flo[1]), (fhi[0], flo[1]), (fhi[0], fhi[1]), (flo[0], fhi[1]))]
+    area = float(np.prod(fhi - flo))
+    corner_blocks = []
+    for g in blocks:
+        glo, ghi = _box(np.vstack([p.points for p in g]))
+        if float(np.prod(ghi - glo)) <= 0.5 * area and any(np.all((c >= glo - tol) & (c <= ghi + tol))
+                                                            for c in corners):
+            corner_blocks.append(g)
+    scale = drawing.unit.scale
+    w, h = (hi - lo) * scale
+    size = _sheet_size(w, h)
+    if not corner_blocks and size is None:
+        return None
+    why = []
+    if corner_blocks:
+        why.append(f"a title block of {sum(len(g) for g in corner_blocks)} piece(s) touching it")
+    if size is not None:
+        why.append(f"sheet size {size}")
+    border = f" with its inner border {', '.join(b.name for b in borders[1:])}" if len(borders) > 1 else ""
+    out = borders[0]
+    return gone + title, (f"drawing frame {out.name}{border}: a {w:.4g} x {h:.4g} mm rectangle around everything "
+                          f"else ({'; '.join(why)}), and {len(title)} piece(s) touching it; if it is the part, "
+                          f"pick it with --id {out.pick or '(give it an id)'}")
 
 
 def _bridge(chain: _Piece, pieces: list, tol: float) -> str:

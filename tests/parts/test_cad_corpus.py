@@ -269,14 +269,16 @@ def test_bad_outlines_are_one_line_errors(tmp_path, capsys):
     assert len(out.holes) == 1 and out.hole_names[0].startswith("CIRCLE") and "1 on layer HOLES" in out.describe()
     assert not read_outline(path, layer="0").holes  # --layer reads one layer alone
 
-    def island(msp):  # a disc in the hole: a separate part
+    def island(msp):  # a disc in the hole: a separate part, named in a warning
         washer(msp)
         msp.add_circle((SL / 2, 0), 1, dxfattribs={"layer": "HOLES"})
     island_path = dxf_file(tmp_path / "island.dxf", island)
-    _one_line_error(capsys, _rollout_args(island_path), "an island", "CIRCLE", "part of its own",
-                    "--layer 0")
-    code, _, err = run_cli(capsys, _rollout_args(island_path, "--layer", "0"))  # the way out works
-    assert code == 0 and "chain of 4 pieces" in err
+    code, _, err = run_cli(capsys, _rollout_args(island_path))
+    warning = [line for line in err.splitlines() if "other part" in line]
+    assert code == 0 and "chain of 4 pieces" in err and "1 hole" in err and len(warning) == 1
+    assert "island.dxf#1 (CIRCLE" in warning[0] and "--id island.dxf#1" in warning[0]
+    code, _, err = run_cli(capsys, _rollout_args(island_path, "--id", "island.dxf#1"))  # the disc alone
+    assert code == 0 and "outline " + str(island_path) + ": CIRCLE" in err
 
     def gapped(msp):  # the L in two open polylines, 0.05 mm apart at (0, 0)
         msp.add_lwpolyline(L_XY[:4])

@@ -73,17 +73,19 @@ def test_holes_that_cross_each_other_are_named(tmp_path):
     _one_line(exc, f"LWPOLYLINE {build.handles[0]}", f"LWPOLYLINE {build.handles[1]}", "cross or touch")
 
 
-def test_island_is_refused_with_the_way_out(tmp_path):
+def test_island_is_a_part_of_its_own(tmp_path):
     def build(msp):
-        msp.add_circle((0, 0), 20)
+        build.ring = msp.add_circle((0, 0), 20).dxf.handle
         msp.add_circle((0, 0), 10)
         build.island = msp.add_circle((0, 0), 4).dxf.handle
     path = dxf_file(tmp_path / "i.dxf", build)
-    with pytest.raises(OutlineError) as exc:
-        read_outline(path)
-    _one_line(exc, f"CIRCLE {build.island}", "an island", f"part of its own (--id {build.island})")
-    island = read_outline(path, id=build.island)  # the way out: the island as a part of its own
-    assert not island.holes and len(island.left_out) == 2
+    ring = read_outline(path)  # the largest part: the ring; the disc in its hole is named
+    assert ring.name.startswith(f"CIRCLE {build.ring}") and len(ring.holes) == 1 and ring.label == "i.dxf#0"
+    (other,) = ring.left_out
+    assert other.startswith("1 other part of this drawing: i.dxf#1 (CIRCLE") and f"--id {build.island}" in other
+    island = read_outline(path, id=build.island)  # picked by its handle, or by its index
+    assert not island.holes and island.label == "i.dxf#1" and "i.dxf#0" in island.left_out[0]
+    assert read_outline(path, id="i.dxf#1").name == island.name == read_outline(path, id="#1").name
 
 
 def test_loop_outside_is_left_out_and_pickable(tmp_path):
@@ -250,12 +252,12 @@ def test_rectangular_plate_with_holes_on_another_layer_is_no_frame(tmp_path):
     assert out.layer == "PLATE" and len(out.holes) == 2 and not out.left_out
 
 
-def test_frame_on_the_parts_layer_is_not_guessed(tmp_path):
-    # Frame and part on one layer: no rule tells them apart; the part reads as a hole of the
-    # frame and the part's hole as an island, refused with the way out.
-    with pytest.raises(OutlineError) as exc:
-        read_outline(dxf_file(tmp_path / "f.dxf", lambda m: _sheet(m, "0", part_layer="0")))
-    _one_line(exc, "an island", "--id")
+def test_a4_frame_on_the_parts_layer_is_left_out(tmp_path):
+    # Frame and part on one layer: the 297 x 210 rectangle is an A4 sheet, around everything else.
+    out = read_outline(dxf_file(tmp_path / "f.dxf", lambda m: _sheet(m, "0", part_layer="0")))
+    assert _area(out.vertices) == pytest.approx(2400) and len(out.holes) == 1
+    (frame,) = [item for item in out.left_out if item.startswith("drawing frame")]
+    assert "297 x 210 mm" in frame and "sheet size A4" in frame
 
 
 # ---------------------------------------------------------------- blocks
@@ -280,7 +282,7 @@ def test_block_entities_are_named_by_block_and_insert_and_take_its_layer(tmp_pat
     assert out.hole_names == [f"CIRCLE in block HOLE in block BRACKET (INSERT {h}) on layer PART"] * 2
 
 
-def test_block_marks_inside_holes_are_islands(tmp_path):
+def test_block_marks_inside_holes_are_parts_of_their_own(tmp_path):
     doc = ezdxf.new("R2010")
     hole = doc.blocks.new("HOLE")
     hole.add_circle((0, 0), 2)
@@ -288,10 +290,11 @@ def test_block_marks_inside_holes_are_islands(tmp_path):
     doc.modelspace().add_lwpolyline([(0, 0), (30, 0), (30, 20), (0, 20)], close=True)
     insert = doc.modelspace().add_blockref("HOLE", (10, 10), dxfattribs={"layer": "PART"})
     doc.saveas(tmp_path / "m.dxf")
-    with pytest.raises(OutlineError) as exc:
-        read_outline(tmp_path / "m.dxf")
-    _one_line(exc, f"CIRCLE in block HOLE (INSERT {insert.dxf.handle}) on layer MARKS", "an island",
-              "--layer")
+    out = read_outline(tmp_path / "m.dxf")
+    assert len(out.holes) == 1 and out.n_vertices == 4
+    (mark,) = out.left_out
+    assert f"m.dxf#1 (CIRCLE in block HOLE (INSERT {insert.dxf.handle}) on layer MARKS" in mark
+    assert "--layer MARKS" in mark
 
 
 def test_id_of_an_insert_picks_its_block(tmp_path):

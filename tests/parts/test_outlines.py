@@ -113,7 +113,7 @@ def test_disjoint_outlines_largest_by_default_others_reported(tmp_path):
     out = read_outline(path)
     assert _area(out.vertices) == pytest.approx(SLOT_AREA, rel=1e-2) and "layer SLOT" in out.name
     assert len(out.left_out) == 1 and "layer BRACKET" in out.left_out[0] and "900 mm^2" in out.left_out[0]
-    assert any("left out closed loop" in w for w in out.warnings())
+    assert any("left out 1 other part of this drawing: two.dxf#1" in w for w in out.warnings())
     assert read_outline(path, layer="BRACKET").n_vertices == 6
     svg = _svg(tmp_path / "two.svg", f'<path id="slot" d="{SLOT_D}"/>'
                '<rect id="plate" x="80" y="0" width="10" height="10"/>')
