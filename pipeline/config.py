@@ -34,7 +34,12 @@ def _schema_text() -> str:
     return SCHEMA_PATH.read_text()
 
 
+@functools.lru_cache(maxsize=1)
 def _schema():
+    """The parsed schema, read once: ``schema_default`` is called for every
+    settings default (tens of times when the planner's types are defined),
+    and parsing the YAML each time cost seconds. Callers do not change it
+    (``schema_default`` hands out copies)."""
     return yaml.safe_load(_schema_text())
 
 

@@ -107,7 +107,8 @@ def progress_interval() -> float:
     except ValueError:
         seconds = math.nan
     if not (seconds > 0 and math.isfinite(seconds)):
-        raise PinfeedError(f"{INTERVAL_VARIABLE} must be a positive number of seconds, got {text!r}")
+        raise PinfeedError(f"{INTERVAL_VARIABLE} must be a positive number of seconds (e.g. 5), "
+                           f"got {text!r}; fix or unset it")
     return seconds
 
 

@@ -23,6 +23,12 @@ module          verbs
 :func:`build_parser` returns the whole parser (the manual's command reference
 is generated from it; ``pinfeed --version`` prints ``pipeline.__version__``);
 :func:`main` runs it, with shell completion by argcomplete when the shell asks.
+
+Every command starts fast: building the parsers imports nothing heavy (no
+numpy, planner, Numba kernels, xarray or matplotlib); each verb imports what
+it uses inside the function that runs it. The environment (``SOURCE_DATE_EPOCH``,
+``PINFEED_PROGRESS_SECONDS``) is checked before the verb runs, so a bad value
+is one line, never a traceback from a library that read it first.
 """
 from __future__ import annotations
 
@@ -34,9 +40,9 @@ from pipeline import __version__
 from pipeline.cli import catalog, design, feeder, maps, plans, sense, support
 from pipeline.cli.maps import DEFAULT_TRIANGLE, PAPER_D
 from pipeline.cli.options import parse_values, progress_line
-from pipeline.cli.plan_text import print_plan_result as _print_plan_result
 from pipeline.errors import PinfeedError
 from pipeline.progress import progress_interval, reporting
+from pipeline.provenance import source_date_epoch
 
 __all__ = ["DEFAULT_TRIANGLE", "PAPER_D", "PinfeedParser", "build_parser", "main", "parse_values"]
 
@@ -89,10 +95,24 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _print_plan_result(*args, **kwargs):
+    """:func:`pipeline.cli.plan_text.print_plan_result`, imported when a plan is printed."""
+    from pipeline.cli.plan_text import print_plan_result
+    return print_plan_result(*args, **kwargs)
+
+
 def _plan(args):
     """``pinfeed plan``, printing through this package's ``_print_plan_result``
     (looked up when called, so that a test may replace it)."""
     plans.cmd_plan(args, print_result=_print_plan_result)
+
+
+def check_environment() -> None:
+    """Refuse a bad ``SOURCE_DATE_EPOCH`` or ``PINFEED_PROGRESS_SECONDS`` with a
+    :class:`PinfeedError` that says how to fix it; called before any verb
+    imports numpy (whose f2py crashes on a non-numeric ``SOURCE_DATE_EPOCH``)."""
+    source_date_epoch()
+    progress_interval()
 
 
 def _complete(parser) -> None:
@@ -116,9 +136,7 @@ def main(argv=None) -> int:
     _complete(parser)
     args = parser.parse_args(join_signed_values(sys.argv[1:] if argv is None else list(argv)))
     try:
-        from pipeline.provenance import source_date_epoch
-        source_date_epoch()  # before numpy's f2py reads it (and crashes on a bad value)
-        progress_interval()  # a bad PINFEED_PROGRESS_SECONDS is refused before any work
+        check_environment()  # before any heavy import reads it, and before any work
         with reporting(progress_line):  # long stages say how far they have got, on stderr
             args.func(args)
     except PinfeedError as exc:

@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from pipeline.cli.options import (add_json_option, add_physics, bands_option, parse_values, part_from_args,
                                   print_json)
 from pipeline.errors import PinfeedError
@@ -53,6 +51,7 @@ def cmd_rollout(args):
 
 def _print_trajectory(row, n_rows: int = 11):
     """A short table of one rollout's trajectory: about ``n_rows`` evenly spaced samples."""
+    import numpy as np
     traj = np.asarray(row["trajectory"], float).reshape(-1, 4)
     print(f"\ntrajectory of theta_i = {row['theta_i']:g} deg ({len(traj)} samples; "
           f"--json gives them all): belt travel since first contact s, centroid displacement x, y, "
@@ -68,6 +67,8 @@ def _print_trajectory(row, n_rows: int = 11):
 
 def cmd_map(args):
     """``pinfeed map``: compute one map set (dims ``d x theta_i``) and write it to HDF5."""
+    import numpy as np
+
     from pipeline.checks import MAP_SUFFIXES, MAX_MAP, check_grid_size, check_out_path
     from pipeline.maps import simulate
     from pipeline.maps.io import write_atomic
@@ -103,6 +104,8 @@ def cmd_plot_map(args):
 def cmd_demo(args):
     """The main job until the workflow lands: one map set of a default triangle."""
     from pathlib import Path
+
+    import numpy as np
 
     from pipeline.maps import simulate
     from pipeline.maps.io import write_atomic

@@ -19,8 +19,6 @@ import re
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from pipeline.errors import PinfeedError
 
 CONFIG_HELP = "workflow config YAML (default: the embedded one)"
@@ -37,9 +35,11 @@ def print_json(obj, **kw):
     sys.stdout.write("\n")
 
 
-def parse_values(text: str, what: str) -> np.ndarray:
+def parse_values(text: str, what: str) -> numpy.ndarray:
     """``"a,b,c"`` or an inclusive range ``"start:stop:step"``: finite, distinct,
     at most ``checks.MAX_VALUES`` values (refused before anything is allocated)."""
+    import numpy as np
+
     from pipeline.checks import check_grid_size, check_values, range_size
     bad = PinfeedError(f"{what} {text!r} is not a list 'a,b,c' or a range 'start:stop:step' "
                        f"of finite numbers with step > 0")

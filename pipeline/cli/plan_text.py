@@ -6,8 +6,6 @@
 """
 from __future__ import annotations
 
-from pipeline.planning import format_arcs, merge_modulo
-
 
 def _verification_counts(plan) -> dict | None:
     v = plan.get("verification")
@@ -86,8 +84,7 @@ def plan_json(result, mode) -> dict:
 
 def print_plan_result(result, part, config, mode):
     """A plan result (the dict ``plan_command`` returns), for people."""
-    from pipeline.planning import PlannerSettings, mechanics_label, planner_belt
-    from pipeline.planning import as_plan_file
+    from pipeline.planning import PlannerSettings, as_plan_file, format_arcs, mechanics_label, planner_belt
     result = as_plan_file(result)
     pc = config["planner"]
     search = PlannerSettings.from_config(config).search
@@ -148,6 +145,7 @@ def sets_text(arcs, order: int) -> str:
     """Final orientation sets for people, one arc per set: on a part with ``order``-fold
     rotational symmetry (``order`` > 1) the copies ``360 / order`` deg apart are one
     set, shown once in [0, 360 / order) and marked ``(xK by symmetry)``."""
+    from pipeline.planning import format_arcs, merge_modulo
     if order <= 1 or not arcs:
         return format_arcs(arcs)
     pairs = [(s["start"], s["width"]) if isinstance(s, dict) else tuple(s) for s in arcs]

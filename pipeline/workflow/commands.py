@@ -3,6 +3,9 @@
 The CLI (``pipeline.cli``) parses options, calls one of these functions with
 explicit arguments and prints what it returns; the choices and the checks
 live here, where a script or a test can call them without argparse.
+
+Each function imports the planner's names it uses when it runs, so that
+``pinfeed rollout`` (which needs none) does not import the planner.
 """
 from __future__ import annotations
 
@@ -13,7 +16,6 @@ from pipeline.errors import PinfeedError
 from pipeline.maps.catalog import Catalog, entry_part
 from pipeline.parts.families import family_parts
 from pipeline.parts.part import Part
-from pipeline.planning import Friction, PlannerSettings, check_tolerance, plan_tight_all, planner_belt
 from pipeline.provenance import provenance_attrs
 
 
@@ -33,6 +35,7 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
     for (``planner.support_family``; ``"uniform"`` for none); ``shape_tolerance``:
     the outline's tolerance, mm (``planner.shape_tolerance_mm``, > 0). Raises
     :class:`PinfeedError` on a bad value before any work."""
+    from pipeline.planning import Friction, check_tolerance
     config = copy.deepcopy(config)
     if catalog:
         config["catalog_dir"] = catalog
@@ -99,6 +102,7 @@ def named_part(config: dict, name: str | None) -> Part:
 
 def plan_tight_only(part: Part, settings: PlannerSettings, catalog_root, progress=None) -> dict:
     """A plan file with the tight planner's plans only (``pinfeed plan --mode tight``)."""
+    from pipeline.planning import plan_tight_all, planner_belt
     belt_speed, mu_s = planner_belt(settings.search, part)
     belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
     return {"part": part.to_dict(), "model": settings.search.model, **belt,
@@ -112,6 +116,7 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     with their speed limit (``speed_limit.attach_speed_limits``). A belt speed
     plans with the tight planner only (a one-line error otherwise). The
     planner's settings are made here, once, from ``config``."""
+    from pipeline.planning import PlannerSettings, planner_belt
     settings = PlannerSettings.from_config(config)
     belt_speed, _ = planner_belt(settings.search, part)  # a bad belt: a one-line error before any work
     if belt_speed is not None and mode != "tight":
@@ -314,7 +319,7 @@ def animation_inputs(result: dict, config: dict, part_name: str, plan, layout, s
     from pathlib import Path
 
     from pipeline.maps.io import read_json
-    from pipeline.planning import layout_inputs, plan_inputs
+    from pipeline.planning import PlannerSettings, layout_inputs, plan_inputs
     if layout is None:
         return plan_inputs(result, plan, PlannerSettings.from_config(config)), None
     if plan is not None:
@@ -338,7 +343,8 @@ def animate_stored(result, config: dict, out, plan_index=None, frames: int = 120
     plan is animated on one belt instead (:func:`pipeline.planning.station_scene`,
     :func:`pipeline.present.animate.animate_layout`): pins at the stations, parts
     arriving at the layout's pitch; ``plan_index`` is then not used."""
-    from pipeline.planning import as_plan_file, layout_inputs, plan_inputs, roll_plan, station_scene
+    from pipeline.planning import (PlannerSettings, as_plan_file, layout_inputs, plan_inputs, roll_plan,
+                                   station_scene)
     from pipeline.present.animate import animate_layout, animate_plan, check_animation_out
     check_animation_out(out, frames, fps)  # before any rollout
     result = as_plan_file(result)
@@ -375,7 +381,7 @@ def speed_command(result, config: dict, plan: int = 1, mu_text=None, mu_s=None, 
     default to those of the speed limit stored with the plan (else the config's
     ``speed`` section); with the same settings the stored figure is returned
     (``source``: ``stored with the plan``), else it is computed (``computed``)."""
-    from pipeline.planning import pick_tight_plan, stored_plan_speed, stored_speed_limit
+    from pipeline.planning import PlannerSettings, pick_tight_plan, stored_plan_speed, stored_speed_limit
     planner = PlannerSettings.from_config(config)
     chosen, _, _ = pick_tight_plan(result, plan, mu_text)
     stored = stored_speed_limit(chosen)

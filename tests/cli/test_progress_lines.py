@@ -162,7 +162,8 @@ def test_a_bad_interval_is_one_line_before_any_work(monkeypatch, capsys, tmp_pat
     monkeypatch.setenv("PINFEED_PROGRESS_SECONDS", "soon")
     code, out, err = run_cli(capsys, ["atlas", "--results", str(tmp_path)])
     assert code == 2 and out == ""
-    assert err == "pinfeed: error: PINFEED_PROGRESS_SECONDS must be a positive number of seconds, got 'soon'\n"
+    assert err == ("pinfeed: error: PINFEED_PROGRESS_SECONDS must be a positive number of seconds (e.g. 5), "
+                   "got 'soon'; fix or unset it\n")
 
 
 def test_the_interval_comes_from_the_environment(monkeypatch):
