@@ -779,6 +779,10 @@ def _unique(pieces: list[_Piece], tol: float) -> list[_Piece]:
 def _same(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
     if a.shape != b.shape:
         return False
+    ends = (a[0, 0] - b[0, 0]) ** 2 + (a[0, 1] - b[0, 1]) ** 2
+    back = (a[0, 0] - b[-1, 0]) ** 2 + (a[0, 1] - b[-1, 1]) ** 2
+    if min(ends, back) > tol * tol:  # the first points differ: no need to compare the rest
+        return False
     return bool(np.all(np.hypot(*(a - b).T) <= tol) or np.all(np.hypot(*(a - b[::-1]).T) <= tol))
 
 
@@ -1074,12 +1078,14 @@ def _others_note(sheet: _Layout, others: list, drawing: _Drawing, chosen: _Piece
 
 
 def _chain_notes(chains: list, outer: _Piece, pieces, tol, drawing: _Drawing) -> list[str]:
-    out, scale = [], drawing.unit.scale
+    out, scale, joined = [], drawing.unit.scale, None
     for c in chains:
         gap = np.hypot(*(c.points[-1] - c.points[0])) * scale
         note = f"; construction geometry, {c.construction}" if c.construction else ""
         if not c.construction and outer.layer is not None and c.layer == outer.layer and len(drawing.layers) > 1:
-            bridge = _bridge(c, pieces, tol)
+            if joined is None:
+                joined, _ = _join(_unique(pieces, tol), tol)
+            bridge = _bridge(c, pieces, tol, joined)
             if bridge:
                 note = (f"; {bridge}: draw it closed on layer {c.layer}, or read layer {c.layer} alone "
                         f"with --layer {c.layer}")
@@ -1154,11 +1160,12 @@ def _near(points, line, tol: float, closed: bool = False) -> bool:
 def _touching(seeds: list, rest: list, tol: float) -> list:
     """Groups of the pieces of ``rest`` connected to ``seeds``, each group grown from
     one seed through pieces whose points lie on one another's lines."""
-    left = [p for p in rest if not any(p is s_ for s_ in seeds)]
+    left = list(rest)
     groups = []
     for seed in seeds:
         if any(seed is m for g in groups for m in g):
             continue
+        left = [q for q in left if q is not seed]
         group, todo = [seed], [seed]
         while todo:
             cur = todo.pop()
@@ -1243,20 +1250,22 @@ def _frame_in_place(loops: list, chains: list, pieces: list, texts: list, tol: f
         return None
     why = []
     if corner_blocks:
-        why.append(f"a title block of {sum(len(g) for g in corner_blocks)} piece(s) touching it")
+        why.append(f"a title block of {sum(len(g) for g in corner_blocks)} piece(s) in a corner")
     if size is not None:
         why.append(f"sheet size {size}")
     border = f" with its inner border {', '.join(b.name for b in borders[1:])}" if len(borders) > 1 else ""
     out = borders[0]
     return gone + title, (f"drawing frame {out.name}{border}: a {w:.4g} x {h:.4g} mm rectangle around everything "
-                          f"else ({'; '.join(why)}), and {len(title)} piece(s) touching it; if it is the part, "
-                          f"pick it with --id {out.pick or '(give it an id)'}")
+                          f"else ({'; '.join(why)}), with the {len(title)} piece(s) touching it; if it is the "
+                          f"part, pick it with --id {out.pick or '(give it an id)'}")
 
 
-def _bridge(chain: _Piece, pieces: list, tol: float) -> str:
+def _bridge(chain: _Piece, pieces: list, tol: float, loops: list | None = None) -> str:
     """When ``chain`` would close only through pieces of other layers or
-    construction geometry: what closes it and why that is not joined; else ""."""
-    loops, _ = _join(_unique(pieces, tol), tol)
+    construction geometry: what closes it and why that is not joined; else ""
+    (``loops``: all pieces joined, when already known)."""
+    if loops is None:
+        loops, _ = _join(_unique(pieces, tol), tol)
     mine = {id(m) for m in chain.parts}
     for lp in loops:
         if not any(id(m) in mine for m in lp.parts):

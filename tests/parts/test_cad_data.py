@@ -16,7 +16,7 @@ import pytest
 ezdxf = pytest.importorskip("ezdxf")
 pytest.importorskip("svgelements")
 
-from pipeline.parts.outlines import OutlineError, read_outline  # noqa: E402
+from pipeline.parts.outlines import OutlineError, read_outline, read_parts, read_sheet  # noqa: E402
 
 CAD = Path(__file__).resolve().parents[1] / "data" / "cad"
 TUTORIAL = Path(__file__).resolve().parents[2] / "docs" / "tutorials" / "holed_bracket.dxf"
@@ -222,6 +222,150 @@ def test_inkscape048_plate_90_px_per_inch():
     assert over.size_mm[:2] == pytest.approx((180, 90), rel=1e-12) and "from --units" in over.describe()
 
 
+def test_island_r2010_is_a_part_of_its_own():
+    path = CAD / "island_r2010.dxf"
+    island = _handles(path, "CIRCLE[radius<6]")[0]
+    out = read_outline(path)  # the washer (radius 20 with its hole of 10); the disc in the hole is named
+    assert len(out.holes) == 1 and out.label == "island_r2010.dxf#0"
+    (other,) = out.left_out
+    assert "island_r2010.dxf#1 (CIRCLE" in other and f"--id {island}" in other
+    disc = read_outline(path, id=island)  # the way to plan it
+    assert not disc.holes and disc.n_vertices >= 8 and disc.label == "island_r2010.dxf#1"
+
+
+# ---------------------------------------------------------------- several parts on one sheet
+
+
+def _half_disc(c, r, side):
+    """(area, centroid, length of curve) of the half disc of centre c, radius r, on the ``side`` (+1 right, -1 left)."""
+    return math.pi * r * r / 2, np.array(c, float) + [side * 4 * r / (3 * math.pi), 0.0], math.pi * r
+
+
+def _union(*shapes):
+    """(area, centroid, length of curve) of shapes that do not overlap."""
+    area = sum(s[0] for s in shapes)
+    return area, sum(s[0] * s[1] for s in shapes) / area, sum(s[2] for s in shapes)
+
+
+LEVER_TRAPEZOID = [(0, -20), (80, -10), (80, 10), (0, 20)]
+
+
+def _lever_boundary(n=3601):
+    """Points of the lever's true outline: the half circles (radius 20 at (0, 0) on the left,
+    10 at (80, 0) on the right) and the corners between."""
+    t = np.linspace(np.pi / 2, 3 * np.pi / 2, n)
+    left = np.column_stack([20 * np.cos(t), 20 * np.sin(t)])
+    right = np.column_stack([80 - 10 * np.cos(t), 10 * np.sin(t)])
+    return np.vstack([left, right, LEVER_TRAPEZOID])
+
+
+def test_lever_with_a_washer_in_its_bore():
+    path = CAD / "lever_washer_r2010.dxf"
+    out = read_outline(path, flatten_tol=TOL)
+    assert out.name.startswith("chain of 4 pieces") and out.label == "lever_washer_r2010.dxf#0"
+    outer = _union(_polygon(LEVER_TRAPEZOID), _half_disc((0, 0), 20, -1), _half_disc((80, 0), 10, +1))
+    _check_part(out, outer, [_circle((0, 0), 11), _circle((80, 0), 4)], _lever_boundary(), 2)
+    # The washer, its circles in the bore, is named in one warning with the ways to plan it.
+    (washer,) = _handles(path, "CIRCLE[radius==9]")
+    (washer_hole,) = _handles(path, "CIRCLE[radius==5.5]")
+    (bore,) = _handles(path, "CIRCLE[radius==11]")
+    (other,) = out.left_out
+    assert other.startswith("1 other part of this drawing: lever_washer_r2010.dxf#1 (CIRCLE")
+    assert "1 hole" in other and f"--id {washer}" in other and "--id lever_washer_r2010.dxf#1" in other
+    warnings = out.warnings()
+    assert len(warnings) == 1 and "left out 1 other part" in warnings[0]
+    # --id of any piece of the lever (a LINE of its chain, its bore) picks the lever.
+    for piece in _handles(path, "LINE") + [bore]:
+        assert read_outline(path, id=piece, flatten_tol=TOL).name == out.name
+    # --id of the washer's circles, or its index, picks the washer: a ring.
+    for pick in (washer, washer_hole, "lever_washer_r2010.dxf#1", "#1"):
+        ring = read_outline(path, id=pick, flatten_tol=TOL)
+        assert ring.name == f"CIRCLE {washer} on layer STANDARD" and ring.label == "lever_washer_r2010.dxf#1"
+        _check_part(ring, _circle((0, 0), 9), [_circle((0, 0), 5.5)], _stadium_boundary((0, 0), (0, 0), 9), 1)
+        assert "lever_washer_r2010.dxf#0 (chain of 4 pieces" in ring.left_out[0]
+    with pytest.raises(OutlineError, match=r"no part #2: the drawing holds 2 parts \(#0 to #1\)"):
+        read_outline(path, id="lever_washer_r2010.dxf#2")
+    assert [label for label, _ in read_parts(path)] == ["lever_washer_r2010.dxf#0", "lever_washer_r2010.dxf#1"]
+
+
+def test_sheet_of_three_parts_by_index():
+    path = CAD / "sheet_three_parts_r2000.dxf"
+    parts = read_parts(path, flatten_tol=TOL)
+    # Largest first; the two equal squares left to right (the one at x = 100 is drawn first).
+    assert [label for label, _ in parts] == [f"sheet_three_parts_r2000.dxf#{k}" for k in range(3)]
+    assert [tuple(o.vertices.min(axis=0)) for _, o in parts] == [(0, 0), (60, 0), (100, 0)]
+    assert [len(o.holes) for _, o in parts] == [1, 0, 0]
+    _check_part(parts[0][1], _rect(0, 0, 40, 30), [_circle((20, 15), 5)], [(0, 0), (40, 0), (40, 30), (0, 30)], 1)
+    for _, square in parts[1:]:
+        assert square.part().area == pytest.approx(400)
+    out = read_outline(path, flatten_tol=TOL)
+    (other,) = out.left_out
+    assert other.startswith("2 other parts of this drawing: sheet_three_parts_r2000.dxf#1 (LWPOLYLINE")
+    assert "sheet_three_parts_r2000.dxf#2 (LWPOLYLINE" in other
+    assert tuple(read_outline(path, id="2").vertices.min(axis=0)) == (100, 0)  # no entity has handle 2
+    sheet = read_sheet(path)
+    assert not sheet.left_out and not sheet.refused and len(sheet.parts) == 3
+
+
+def test_frame_on_the_parts_layer_with_a_title_block():
+    path = CAD / "frame_same_layer_r2000.dxf"
+    out = read_outline(path, flatten_tol=TOL)
+    assert out.name.startswith("LWPOLYLINE") and out.n_vertices == 6 and out.n_parts == 1
+    (frame,) = out.left_out  # the title block's lines go with the frame: no open chains left over
+    assert frame.startswith("drawing frame chain of 4 pieces from LINE") and "250 x 180 mm" in frame
+    assert "a title block of 3 piece(s) in a corner" in frame and "--id" in frame
+    foot, upright = _rect(50, 60, 110, 70), _rect(50, 70, 60, 100)
+    corners = [(50, 60), (110, 60), (110, 70), (60, 70), (60, 100), (50, 100)]
+    _check_part(out, _union(foot, upright), [_circle((55, 65), 3)], corners, 1)
+    first = _handles(path, "LINE")[0]  # the frame's first LINE: --id keeps the frame, as a part
+    assert read_outline(path, id=first).size_mm[:2] == pytest.approx((250, 180))
+
+
+def test_inkscape_layers_part_and_dimensions():
+    path = CAD / "inkscape_layers.svg"
+    out = read_outline(path, flatten_tol=TOL)
+    # The box on layer Dimensions is larger, but a dimensions layer is construction geometry; the
+    # dimension lines touch the plate's corners but are never joined into it (another layer).
+    assert "on layer Part" in out.name and out.layer == "Part" and out.n_vertices == 4
+    assert out.hole_names == ["<circle id='bore'> on layer Part"]
+    _check_part(out, _rect(10, -50, 70, -10), [_circle((40, -30), 6)], [(10, -50), (70, -50), (70, -10), (10, -10)], 1)
+    assert any("<rect id='box'> on layer Dimensions" in item and "construction" in item for item in out.left_out)
+    part = read_outline(path, layer="Part", flatten_tol=TOL)
+    assert part.name == out.name and not part.left_out
+    assert read_outline(path, layer="Dimensions").size_mm[:2] == pytest.approx((70, 50))
+    with pytest.raises(OutlineError, match="on layer 'Nope'; give one of the drawing's layers .*Dimensions, Part"):
+        read_outline(path, layer="Nope")
+
+
+def test_inkscape_two_parts_on_two_layers():
+    path = CAD / "inkscape_two_parts.svg"
+    out = read_outline(path, flatten_tol=TOL)
+    assert out.name == "<rect id='bracket'> on layer Bracket" and len(out.holes) == 1
+    (other,) = out.left_out
+    assert "inkscape_two_parts.svg#1 (<circle id='washer'> on layer Washer, 1 hole" in other
+    assert "--id washer" in other
+    for kw in ({"layer": "Washer"}, {"id": "washer-hole"}, {"id": "inkscape_two_parts.svg#1"}):
+        ring = read_outline(path, flatten_tol=TOL, **kw)
+        assert ring.name == "<circle id='washer'> on layer Washer"
+        _check_part(ring, _circle((80, -25), 9), [_circle((80, -25), 5.5)],
+                    _stadium_boundary((80, -25), (80, -25), 9), 1)
+    assert [o.layer for _, o in read_parts(path)] == ["Bracket", "Washer"]
+
+
+def test_cli_rollout_of_the_lever_warns_of_the_washer(capsys):
+    from pipeline.cli import main
+    path = CAD / "lever_washer_r2010.dxf"
+    assert main(["rollout", "--outline", str(path), "--theta-i", "0", "--d", "0.3", "--mu-c", "0.2",
+                 "--pin-radius", "3"]) == 0
+    err = capsys.readouterr().err
+    assert "chain of 4 pieces" in err and "2 holes" in err
+    (warning,) = [line for line in err.splitlines() if line.startswith("pinfeed: warning:")]
+    assert "1 other part of this drawing: lever_washer_r2010.dxf#1" in warning
+    assert main(["rollout", "--outline", str(path), "--id", "lever_washer_r2010.dxf#1", "--theta-i", "0",
+                 "--d", "0.3", "--mu-c", "0.2", "--pin-radius", "3"]) == 0
+    assert "CIRCLE" in capsys.readouterr().err
+
+
 # ---------------------------------------------------------------- refused: one line, the problem and the way out
 
 
@@ -229,14 +373,6 @@ def test_arc_bridged_by_construction_lines():
     _one_line(CAD / "arc_bridged_r2010.dxf", "open outline: ARC", "closes only through LINE",
               "on layer construction", "never joined into an outline", "draw it closed on layer vector",
               "--layer NAME (layers construction, vector)")
-
-
-def test_island_r2010():
-    path = CAD / "island_r2010.dxf"
-    island = _handles(path, "CIRCLE[radius<6]")[0]
-    _one_line(path, f"CIRCLE {island}", "an island", f"plan it as a part of its own (--id {island})")
-    out = read_outline(path, id=island)  # the way out
-    assert not out.holes and out.n_vertices >= 8
 
 
 def test_notch_r12():

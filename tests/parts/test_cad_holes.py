@@ -260,6 +260,33 @@ def test_a4_frame_on_the_parts_layer_is_left_out(tmp_path):
     assert "297 x 210 mm" in frame and "sheet size A4" in frame
 
 
+def test_rectangular_part_on_its_own_layer_is_no_frame(tmp_path):
+    # A plate with one small central hole and a bend line from edge to edge, all on one layer: a
+    # rectangle around everything else, much larger than what it holds, lines touching it, but no
+    # title block in a corner and no sheet size: the part, not a frame.
+    def build(msp):
+        _rect(msp, 0, 0, 120, 80)
+        msp.add_circle((60, 40), 5)
+        msp.add_line((90, 0), (90, 80))
+    out = read_outline(dxf_file(tmp_path / "p.dxf", build))
+    assert out.n_vertices == 4 and _area(out.vertices) == pytest.approx(9600) and len(out.holes) == 1
+    assert not any(item.startswith("drawing frame") for item in out.left_out)
+
+
+def test_frame_with_inner_border_and_title_block_on_the_parts_layer(tmp_path):
+    def build(msp):
+        _rect(msp, 0, 0, 300, 200)  # the sheet's edge (no standard size)
+        _rect(msp, 20, 10, 290, 190)  # the inner border, the title block touching it
+        msp.add_line((200, 10), (200, 40))
+        msp.add_line((200, 40), (290, 40))
+        _rect(msp, 60, 60, 120, 100)  # the part, with a hole
+        msp.add_circle((90, 80), 5)
+    out = read_outline(dxf_file(tmp_path / "f.dxf", build))
+    assert _area(out.vertices) == pytest.approx(2400) and len(out.holes) == 1 and out.n_parts == 1
+    (frame,) = out.left_out
+    assert "with its inner border" in frame and "300 x 200 mm" in frame and "title block of 2 piece(s)" in frame
+
+
 # ---------------------------------------------------------------- blocks
 
 

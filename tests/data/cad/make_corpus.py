@@ -223,6 +223,70 @@ def notch_r12():
     return doc
 
 
+def lever_washer_r2010():
+    """A lever with a washer drawn in its bore, all on layer STANDARD, R2010 (as a CAD
+    program exports a drawing of an assembly: the washer's circles in the part's bore).
+
+    The lever's outline, loose LINEs and ARCs (drawn out of order): the ARC centre (0, 0),
+    radius 20, 90..270 deg; the LINE (0, -20)-(80, -10); the ARC centre (80, 0), radius
+    10, -90..90 deg; the LINE (80, 10)-(0, 20). Its holes: the bore, a CIRCLE radius 11 at
+    (0, 0), and a CIRCLE radius 4 at (80, 0). The washer in the bore: CIRCLEs radius 9
+    (its outline) and 5.5 (its hole) at (0, 0).
+    """
+    doc = _new("R2010")
+    msp = doc.modelspace()
+    s = _layer(doc, "STANDARD")
+    msp.add_line((0, -20), (80, -10), dxfattribs=s)
+    msp.add_arc((80, 0), 10, -90, 90, dxfattribs=s)
+    msp.add_arc((0, 0), 20, 90, 270, dxfattribs=s)
+    msp.add_line((80, 10), (0, 20), dxfattribs=s)
+    for r in (11, 9, 5.5):
+        msp.add_circle((0, 0), r, dxfattribs=s)
+    msp.add_circle((80, 0), 4, dxfattribs=s)
+    return doc
+
+
+def sheet_three_parts_r2000():
+    """Three parts side by side on layer 0, R2000 (a sheet of parts to cut).
+
+    A square 20 x 20 from (100, 0) (drawn first), a plate 40 x 30 from (0, 0) with a
+    hole, a CIRCLE radius 5 at (20, 15), and a square 20 x 20 from (60, 0): closed
+    LWPOLYLINEs. By the reader's rule the plate is #0 (largest), then the squares
+    (equal areas) left to right: (60, 0) is #1, (100, 0) is #2.
+    """
+    doc = _new("R2000")
+    msp = doc.modelspace()
+    for x0 in (100, 60):
+        if x0 == 60:
+            msp.add_lwpolyline([(0, 0), (40, 0), (40, 30), (0, 30)], close=True)
+            msp.add_circle((20, 15), 5)
+        msp.add_lwpolyline([(x0, 0), (x0 + 20, 0), (x0 + 20, 20), (x0, 20)], close=True)
+    return doc
+
+
+def frame_same_layer_r2000():
+    """A part in a drawing frame with a title block, all on layer 0, R2000 (as a drawing
+    is often drawn: frame and part on one layer).
+
+    The frame: four LINEs boxing (0, 0)-(250, 180) (no standard sheet size). The title
+    block: LINEs (170, 0)-(170, 30), (170, 30)-(250, 30) and (170, 15)-(250, 15), and a
+    TEXT at (175, 20). The part: the L-bracket (50, 60), (110, 60), (110, 70), (60, 70),
+    (60, 100), (50, 100), a closed LWPOLYLINE, with a hole, a CIRCLE radius 3 at (55, 65).
+    """
+    doc = _new("R2000")
+    msp = doc.modelspace()
+    corners = [(0, 0), (250, 0), (250, 180), (0, 180)]
+    for k in range(4):
+        msp.add_line(corners[k], corners[(k + 1) % 4])
+    msp.add_line((170, 0), (170, 30))
+    msp.add_line((170, 30), (250, 30))
+    msp.add_line((170, 15), (250, 15))
+    msp.add_text("L-BRACKET 60 x 40", dxfattribs={"height": 4, "insert": (175, 20)})
+    msp.add_lwpolyline([(50, 60), (110, 60), (110, 70), (60, 70), (60, 100), (50, 100)], close=True)
+    msp.add_circle((55, 65), 3)
+    return doc
+
+
 DXF = {
     "holed_bracket.dxf": holed_bracket,
     "gusset_bracket.dxf": gusset_bracket,
@@ -234,6 +298,9 @@ DXF = {
     "insert_blocks_r2000.dxf": insert_blocks_r2000,
     "island_r2010.dxf": island_r2010,
     "notch_r12.dxf": notch_r12,
+    "lever_washer_r2010.dxf": lever_washer_r2010,
+    "sheet_three_parts_r2000.dxf": sheet_three_parts_r2000,
+    "frame_same_layer_r2000.dxf": frame_same_layer_r2000,
 }
 
 
@@ -339,10 +406,77 @@ def open_path_svg():
             '</svg>\n')
 
 
+def inkscape_layers_svg():
+    """Inkscape 1.3 (mm page over a viewBox, y down), two layers. Layer "Part": a plate
+    60 x 40 mm, (10, 10)-(70, 50) on the page, as a path of two open subpaths
+    meeting at the corners (10, 10) and (70, 50), and a hole, a <circle> radius 6 at
+    (40, 30). Layer "Dimensions": a box around the plate, (5, 5)-(75, 55) (larger than
+    the plate: without layers it would be the outline), and two dimension lines whose
+    ends touch the plate's corners (they would join its outline on one layer)."""
+    return """<?xml version="1.0" encoding="UTF-8" standalone="no"?>
+<!-- Created with Inkscape (http://www.inkscape.org/) -->
+<svg
+   width="80mm"
+   height="60mm"
+   viewBox="0 0 80 60"
+   version="1.1"
+   id="svg1"
+   inkscape:version="1.3.2 (091e20e, 2023-11-25)"
+   xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"
+   xmlns:sodipodi="http://sodipodi.sourceforge.net/DTD/sodipodi-0.dtd"
+   xmlns="http://www.w3.org/2000/svg"
+   xmlns:svg="http://www.w3.org/2000/svg">
+  <sodipodi:namedview id="namedview1" inkscape:document-units="mm" />
+  <g inkscape:label="Part" inkscape:groupmode="layer" id="layer1">
+    <path style="fill:none;stroke:#000000;stroke-width:0.26" d="M 10,10 H 70 V 50 M 10,10 V 50 H 70" id="plate" />
+    <circle style="fill:none;stroke:#000000;stroke-width:0.26" id="bore" cx="40" cy="30" r="6" />
+  </g>
+  <g inkscape:label="Dimensions" inkscape:groupmode="layer" id="layer2">
+    <rect style="fill:none;stroke:#0000ff;stroke-width:0.1" id="box" x="5" y="5" width="70" height="50" />
+    <path style="fill:none;stroke:#0000ff;stroke-width:0.1" d="M 10,50 V 57 H 70 V 50" id="dim-width" />
+    <path style="fill:none;stroke:#0000ff;stroke-width:0.1" d="M 70,10 H 77 V 50 H 70" id="dim-height" />
+  </g>
+</svg>
+"""
+
+
+def inkscape_two_parts_svg():
+    """Inkscape 1.3 (mm page, y down), a part on each of two layers. Layer "Bracket": a
+    50 x 40 mm plate, (5, 5)-(55, 45) on the page (a <rect>), with a hole, a <circle>
+    radius 4 at (15, 15). Layer "Washer": a washer, <circle>s radius 9 (id washer) and
+    5.5 (id washer-hole) at (80, 25)."""
+    return """<?xml version="1.0" encoding="UTF-8" standalone="no"?>
+<!-- Created with Inkscape (http://www.inkscape.org/) -->
+<svg
+   width="100mm"
+   height="50mm"
+   viewBox="0 0 100 50"
+   version="1.1"
+   id="svg1"
+   inkscape:version="1.3.2 (091e20e, 2023-11-25)"
+   xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"
+   xmlns:sodipodi="http://sodipodi.sourceforge.net/DTD/sodipodi-0.dtd"
+   xmlns="http://www.w3.org/2000/svg"
+   xmlns:svg="http://www.w3.org/2000/svg">
+  <sodipodi:namedview id="namedview1" inkscape:document-units="mm" />
+  <g inkscape:label="Bracket" inkscape:groupmode="layer" id="layer1">
+    <rect style="fill:none;stroke:#000000;stroke-width:0.26" id="bracket" x="5" y="5" width="50" height="40" />
+    <circle style="fill:none;stroke:#000000;stroke-width:0.26" id="bracket-hole" cx="15" cy="15" r="4" />
+  </g>
+  <g inkscape:label="Washer" inkscape:groupmode="layer" id="layer2">
+    <circle style="fill:none;stroke:#000000;stroke-width:0.26" id="washer" cx="80" cy="25" r="9" />
+    <circle style="fill:none;stroke:#000000;stroke-width:0.26" id="washer-hole" cx="80" cy="25" r="5.5" />
+  </g>
+</svg>
+"""
+
+
 SVG = {
     "inkscape048_plate.svg": inkscape048_svg,
     "inkscape1_bracket.svg": inkscape1_svg,
     "open_path.svg": open_path_svg,
+    "inkscape_layers.svg": inkscape_layers_svg,
+    "inkscape_two_parts.svg": inkscape_two_parts_svg,
 }
 
 
