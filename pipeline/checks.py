@@ -154,3 +154,19 @@ def schema_problem(data, schema: dict, limit: int = 120) -> str | None:
         return None
     where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
     return f"at {where}: {' '.join(err.message.split())[:limit]}"
+
+
+def check_time_limit(value, what: str = "planner.time_limit_s") -> float | None:
+    """A planning time limit in seconds (``None``: no limit), or a one-line
+    :class:`PinfeedError` naming ``what`` for a value that is not a number of
+    seconds above 0."""
+    if value is None:
+        return None
+    try:
+        seconds = float(value)
+    except (TypeError, ValueError):
+        seconds = math.nan
+    if isinstance(value, bool) or not (math.isfinite(seconds) and seconds > 0):
+        raise PinfeedError(f"{what} must be a number of seconds above 0, got {value!r}; "
+                           "leave it out (or null in a config) to search without a time limit")
+    return seconds

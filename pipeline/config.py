@@ -20,7 +20,7 @@ from pathlib import Path
 import jsonschema
 import yaml
 
-from pipeline.checks import MAX_MAP, check_finite_tree, check_grid_size, check_pin_ratio
+from pipeline.checks import MAX_MAP, check_finite_tree, check_grid_size, check_pin_ratio, check_time_limit
 from pipeline.errors import PinfeedError
 from pipeline.parts.families import family_parts
 from pipeline.provenance import source_date_epoch
@@ -118,6 +118,7 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
             raise PinfeedError(f"config error at {key}: it is empty, which would write into the "
                                f"current folder; name a folder (default {key.split('_')[0]})")
     check_finite_tree(cfg)
+    _check_time_limit(cfg)
     resolve_outlines(cfg, base_dir or Path.cwd())
     schema = _schema()
     validator = _fill_defaults(jsonschema.Draft202012Validator)(schema)
@@ -207,6 +208,17 @@ def _check_support_study(cfg: dict) -> None:
         raise PinfeedError(f"config error at {where}: support families need planner/model minpower "
                            f"without planner/belt_speed (the other models assume uniform pressure); "
                            f"set the family to null or plan with minpower")
+
+
+def _check_time_limit(cfg: dict) -> None:
+    """planner/time_limit_s: seconds above 0 or null, said with the way out
+    (before the schema, whose message would not say it)."""
+    planner = cfg.get("planner")
+    if isinstance(planner, dict) and planner.get("time_limit_s") is not None:
+        try:
+            check_time_limit(planner["time_limit_s"], "it")
+        except PinfeedError as exc:
+            raise PinfeedError(f"config error at planner/time_limit_s: {exc}") from None
 
 
 def _check_planner_belt(cfg: dict) -> None:

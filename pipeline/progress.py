@@ -31,6 +31,11 @@ silent and does not split its batches.
 The interval is ``PINFEED_PROGRESS_SECONDS`` from the environment (seconds,
 default :data:`DEFAULT_SECONDS`): with the default a long stage prints a line
 at least every 5 to 6 seconds.
+
+Long work may also have an end: a :class:`Deadline` (``pinfeed plan
+--time-limit``) that the work reads between its steps, stopping there and
+saying what it left undone; :func:`duration_text` writes the estimate of
+how long a stage will take.
 """
 from __future__ import annotations
 
@@ -251,6 +256,66 @@ def row_batches(n: int, stretch: Stretch | None = None, seconds: float = BATCH_S
         stretch.tick(hi / n)
         size = max(1, int(size * min(8.0, max(0.125, seconds / took))))
         lo = hi
+
+
+RESERVE_SHARE = 0.2  # of a time limit kept for verifying what the search found ...
+RESERVE_MAX = 60.0  # ... but at most this many seconds
+
+
+class Deadline:
+    """The end of time-limited work, on a monotonic clock: ``seconds`` from
+    when it is made (``None``: no end; every check then says there is time).
+
+    The work checks it between its steps (a block of sequences screened, a
+    batch of rollouts), so it ends within the limit plus the step that was
+    running. Of the limit, ``reserve`` seconds (:data:`RESERVE_SHARE` of it,
+    at most :data:`RESERVE_MAX`) are kept for verifying what a search found:
+    :meth:`search_over` is true that much before :meth:`over`.
+    """
+
+    def __init__(self, seconds: float | None = None, clock=time.monotonic):
+        self.seconds = None if seconds is None else float(seconds)
+        self.clock = clock
+        self.started = clock()
+        self.reserve = 0.0 if self.seconds is None else min(RESERVE_SHARE * self.seconds, RESERVE_MAX)
+
+    @property
+    def limited(self) -> bool:
+        """True when there is a time limit."""
+        return self.seconds is not None
+
+    def elapsed(self) -> float:
+        """Seconds since the deadline was made."""
+        return self.clock() - self.started
+
+    def left(self) -> float:
+        """Seconds left before the limit (``inf`` without one; negative once past it)."""
+        return math.inf if self.seconds is None else self.seconds - self.elapsed()
+
+    def search_over(self) -> bool:
+        """True when a search should stop: less than the reserve for verification is left."""
+        return self.seconds is not None and self.left() <= self.reserve
+
+    def over(self) -> bool:
+        """True once the limit has passed (nothing more should start, verification included)."""
+        return self.seconds is not None and self.left() <= 0.0
+
+
+NO_DEADLINE = Deadline()  # work without a time limit
+
+
+def duration_text(seconds: float) -> str:
+    """A duration for people, rounded: ``12 s``, ``4 min``, ``1 h 58 min``."""
+    if not math.isfinite(seconds):
+        return "an unknown time"
+    seconds = max(0.0, float(seconds))
+    if seconds < 90:
+        return f"{max(1, round(seconds))} s"
+    minutes = round(seconds / 60)
+    if minutes < 60:
+        return f"{minutes} min"
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours} h" + (f" {minutes} min" if minutes else "")
 
 
 def _plural(unit: str, n: float) -> str:

@@ -45,7 +45,8 @@ def cmd_plan(args, print_result=print_plan_result):
                               depth=args.depth, model=args.model, coverage=args.coverage, speeds=speeds,
                               dynamic_depth=args.dynamic_depth, pins=pins, belt_speed=args.belt_speed,
                               mu_s=args.mu_s, tolerance=args.tolerance,
-                              support_family=args.support_family, shape_tolerance=args.shape_tolerance)
+                              support_family=args.support_family, shape_tolerance=args.shape_tolerance,
+                              time_limit=args.time_limit)
     part = plan_part_arg(args, config)
     out = plan_store_path(config, part.name, args.out)  # checked before any work
     result = plan_command(part, config, args.mode, progress=progress_line)
@@ -53,10 +54,42 @@ def cmd_plan(args, print_result=print_plan_result):
         from pipeline.maps.io import write_json
         write_json(result, out)
     if args.json:
-        print_json(plan_json(result, args.mode), default=float)
+        print_json({**plan_json(result, args.mode), **time_limit_summary(result)}, default=float)
     else:
         print_result(result, part, config, args.mode)
+        print_time_limit(result)
     print_next_steps(result, out, config, args, plan_options(), sys.stderr if args.json else sys.stdout)
+
+
+def time_limit_summary(result: dict) -> dict:
+    """The time limit's keys of ``plan --json``: ``time_limit_s`` (``None``: no
+    limit), ``complete`` (False when the limit left something out) and
+    ``unsearched`` (what, for people; labelled with the friction when several
+    were planned)."""
+    tight = result.get("tight") or []
+    several = len(tight) > 1
+    unsearched = [f"mu_c {t['friction']}: {u}" if several else u
+                  for t in tight for u in t.get("unsearched") or ()]
+    return {"time_limit_s": next((t["time_limit_s"] for t in tight if t.get("time_limit_s")), None),
+            "complete": all(t.get("complete", True) for t in tight), "unsearched": unsearched}
+
+
+def print_time_limit(result: dict, stream=None) -> None:
+    """Under a time limit, what the plan is worth: complete within the limit,
+    or not complete and what was left unsearched (one item a line)."""
+    summary = time_limit_summary(result)
+    if summary["time_limit_s"] is None:
+        return
+    stream = stream or sys.stdout
+    seconds = max((t.get("stats", {}).get("wall_seconds", 0.0) for t in result.get("tight") or ()), default=0.0)
+    if summary["complete"]:
+        print(f"time limit {summary['time_limit_s']:g} s: the search was complete ({seconds:.0f} s)", file=stream)
+        return
+    print(f"time limit {summary['time_limit_s']:g} s: the search is NOT complete (stopped after {seconds:.0f} s); "
+          "a \"no\" covers only the sequences searched. Not searched:", file=stream)
+    for item in summary["unsearched"]:
+        print(f"  - {item}", file=stream)
+    print("  (run without --time-limit, or with a longer one, for the complete search)", file=stream)
 
 
 def plan_options() -> list:
@@ -156,6 +189,10 @@ def add_plan_commands(sub) -> None:
                         "(default: the config's planner.belt_speed; none = quasi-static)")
     p.add_argument("--mu-s", dest="mu_s", type=float, default=None,
                    help="belt friction with --belt-speed (default: planner.mu_s, 0.5)")
+    p.add_argument("--time-limit", dest="time_limit", type=float, default=None, metavar="S",
+                   help="return within about S seconds (plus the step running then) with the best verified "
+                        "answer so far, marked not complete, with what was left unsearched (default: the "
+                        "config's planner.time_limit_s; none = the complete search)")
     p.add_argument("--out", default=None, help="store the plan JSON here (default: RESULTS/plans/NAME.json, "
                    "where speed, layout and animate look; a part the workflow plans is stored only "
                    "with --out)")

@@ -21,7 +21,7 @@ from pipeline.provenance import provenance_attrs
 
 def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model=None, coverage=None,
                      speeds=None, dynamic_depth=None, pins=None, belt_speed=None, mu_s=None,
-                     tolerance=None, support_family=None, shape_tolerance=None) -> dict:
+                     tolerance=None, support_family=None, shape_tolerance=None, time_limit=None) -> dict:
     """A copy of ``config`` with ``pinfeed plan``'s overrides applied, each checked.
 
     ``None`` leaves the config's value. ``catalog``: the catalog folder;
@@ -33,8 +33,9 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
     (only with a belt speed); ``tolerance``: the full width (deg) a final set
     may have, in (0, 360); ``support_family``: the supports plans must hold
     for (``planner.support_family``; ``"uniform"`` for none); ``shape_tolerance``:
-    the outline's tolerance, mm (``planner.shape_tolerance_mm``, > 0). Raises
-    :class:`PinfeedError` on a bad value before any work."""
+    the outline's tolerance, mm (``planner.shape_tolerance_mm``, > 0);
+    ``time_limit``: seconds the planning may take (``planner.time_limit_s``,
+    > 0). Raises :class:`PinfeedError` on a bad value before any work."""
     from pipeline.planning import Friction, check_tolerance
     config = copy.deepcopy(config)
     if catalog:
@@ -63,6 +64,9 @@ def planner_settings(config: dict, *, catalog=None, mu_c=None, depth=None, model
             raise PinfeedError("--support-family is empty; give a family such as 'tripods:12' or "
                                "'warp:0.3', or 'uniform' for none")
         pc["support_family"] = None if support_family.strip() == "uniform" else support_family
+    if time_limit is not None:
+        from pipeline.checks import check_time_limit
+        pc["time_limit_s"] = check_time_limit(time_limit, "--time-limit")
     if belt_speed is not None:
         pc["belt_speed"] = belt_speed
     if mu_s is not None:
@@ -100,13 +104,14 @@ def named_part(config: dict, name: str | None) -> Part:
     return entry_part(e)
 
 
-def plan_tight_only(part: Part, settings: PlannerSettings, catalog_root, progress=None) -> dict:
-    """A plan file with the tight planner's plans only (``pinfeed plan --mode tight``)."""
+def plan_tight_only(part: Part, settings: PlannerSettings, catalog_root, progress=None, deadline=None) -> dict:
+    """A plan file with the tight planner's plans only (``pinfeed plan --mode tight``);
+    ``deadline``: its time limit (default: ``planner.time_limit_s`` from now)."""
     from pipeline.planning import plan_tight_all, planner_belt
     belt_speed, mu_s = planner_belt(settings.search, part)
     belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
     return {"part": part.to_dict(), "model": settings.search.model, **belt,
-            "tight": plan_tight_all(part, settings, catalog_root, progress=progress),
+            "tight": plan_tight_all(part, settings, catalog_root, progress=progress, deadline=deadline),
             **provenance_attrs()}
 
 
@@ -115,7 +120,13 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     ``mode`` (``tight``, ``paper`` or ``both``), each verified, the tight ones
     with their speed limit (``speed_limit.attach_speed_limits``). A belt speed
     plans with the tight planner only (a one-line error otherwise). The
-    planner's settings are made here, once, from ``config``."""
+    planner's settings are made here, once, from ``config``.
+
+    With ``planner.time_limit_s`` (``--time-limit``, tight mode only) the
+    time runs from here: the planner stops its searches in time
+    (:func:`pipeline.planning.plan_tight_all`), the speed limits are found
+    only while time is left and the shape tolerance's search is skipped; each
+    entry's ``unsearched`` says what was left out."""
     from pipeline.planning import PlannerSettings, planner_belt
     settings = PlannerSettings.from_config(config)
     belt_speed, _ = planner_belt(settings.search, part)  # a bad belt: a one-line error before any work
@@ -133,17 +144,42 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
         check_family_mechanics(settings.search)
         parse_support_family(family, part)  # a bad family: a one-line error before any work
     from pipeline.planning import attach_speed_limits
+    from pipeline.progress import Deadline
+    deadline = Deadline(settings.search.time_limit_s)
+    if deadline.limited and mode != "tight":
+        raise PinfeedError("--time-limit (planner.time_limit_s) bounds the tight planner's search; "
+                           "use --mode tight, or leave the time limit out")
     if mode == "tight":
-        result = attach_speed_limits(plan_tight_only(part, settings, config["catalog_dir"], progress=progress),
-                                     settings)
-        from pipeline.workflow.plan import with_shape_tolerance
-        return with_shape_tolerance(result, part, settings, progress)
+        result = plan_tight_only(part, settings, config["catalog_dir"], progress=progress, deadline=deadline)
+        if not deadline.limited:
+            from pipeline.workflow.plan import with_shape_tolerance
+            return with_shape_tolerance(attach_speed_limits(result, settings), part, settings, progress)
+        return _time_limited_stages(result, settings, deadline)
     from pipeline.workflow.plan import ensure_maps, plan_part
     cat = ensure_maps(config, part)
     result = plan_part(cat, part.id, settings, progress=progress, tight=mode == "both")
     if mode == "paper":
         result.pop("tight")
     return attach_speed_limits(result, settings)
+
+
+def _time_limited_stages(result: dict, settings, deadline) -> dict:
+    """The stages after the tight planner under a time limit: the speed limits
+    while time is left; the shape tolerance's search (a search of its own) not
+    at all. What is skipped joins the first entry's ``unsearched``."""
+    from pipeline.planning import attach_speed_limits
+    skipped = []
+    if deadline.over():
+        skipped.append("the speed limits of the plans: skipped")
+    else:
+        attach_speed_limits(result, settings)
+    if settings.search.shape_tolerance_mm is not None:
+        skipped.append("the shape tolerance's worst-member search: skipped under a time limit")
+    entry = (result.get("tight") or [None])[0]
+    if skipped and entry is not None:
+        entry["unsearched"] = list(entry.get("unsearched") or []) + skipped
+        entry["complete"] = False
+    return result
 
 
 def layout_settings(margin=None, trials=None) -> dict:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pipeline.checks import check_time_limit
 from pipeline.config import schema_default
 from pipeline.errors import PinfeedError
 
@@ -276,8 +277,10 @@ class SearchSettings:
     mechanics (``model``, ``pin_radius``, kernel step ``ds_max`` and ``tol``),
     the belt (``belt_speed`` mm/s, ``None`` quasi-static; ``mu_s``), moving
     pins (``dynamic_speeds``, ``dynamic_depth``, ``beam``), the search's
-    sizes and ranking slack, the support family and the outline's shape
-    tolerance (mm; ``None``: no shape check)."""
+    sizes and ranking slack, the support family, the outline's shape
+    tolerance (mm; ``None``: no shape check) and the time limit of one
+    part's planning (``time_limit_s``, seconds; ``None``: none, the complete
+    search; checked when made)."""
 
     pin_radius: float  # sweep.pin_radius (mm), which the config must give
     pins: object = _default("planner", "pins")
@@ -300,6 +303,10 @@ class SearchSettings:
     coverage: str = _default("planner", "coverage")
     support_family: object = _default("planner", "support_family")
     shape_tolerance_mm: float | None = _default("planner", "shape_tolerance_mm")
+    time_limit_s: float | None = _default("planner", "time_limit_s")
+
+    def __post_init__(self):
+        object.__setattr__(self, "time_limit_s", check_time_limit(self.time_limit_s))
 
     @property
     def kernel_settings(self) -> dict:
@@ -385,7 +392,7 @@ class PlannerSettings:
             beam=int(dyn["beam"]), candidates=int(pc["candidates"]), max_branches=int(pc["max_branches"]),
             width_slack_deg=float(pc["width_slack_deg"]), worst_member_budget=int(pc["worst_member_budget"]),
             paper_depth=int(pc["paper_depth"]), coverage=pc["coverage"], support_family=pc.get("support_family"),
-            shape_tolerance_mm=pc.get("shape_tolerance_mm"))
+            shape_tolerance_mm=pc.get("shape_tolerance_mm"), time_limit_s=pc.get("time_limit_s"))
         claims = ClaimSettings(pc["tolerance_deg"], vc["required"], vc["confidence"], vc["rule"])
         verify = VerifySettings(int(vc["trials"]), bool(vc["corners"]), int(vc["seed"]), vc["holdout_trials"],
                                 Perturbation(float(vc["theta_sigma"]), float(vc["y_halfwidth"]), sigma,

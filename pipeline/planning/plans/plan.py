@@ -15,6 +15,15 @@ Outcomes computed for the propagation are kept in the catalog under
 ``refine/PART_ID/MODEL/v_pin=V.h5`` (see :mod:`pipeline.planning.tight.store`) and
 reused by later runs.
 
+With ``planner.time_limit_s`` (``pinfeed plan --time-limit``) a
+:class:`~pipeline.progress.Deadline` runs through the stages: the complete
+searches stop between their steps once their time is over, the chosen plans
+are carried and verified one by one while the limit lasts, and the moving
+pins and the untruncated replay are skipped when there is no time left for
+them; the family certificate and the nearest "yes" (searches of their own)
+are skipped under a limit. The entry then says so (``time_limit_s``,
+``complete``, ``unsearched``).
+
 With ``planner.belt_speed`` (mm/s) set, the planner plans with the dynamic
 model (``kernels.dynamic``) at that belt speed and belt friction
 ``planner.mu_s``, stores its outcomes apart
@@ -47,7 +56,7 @@ from pipeline.planning.core.settings import (TRUNCATE_SIGMA, Friction, PlannerSe
 from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.claims.verify import holdout_settings, verify_plan
 from pipeline.planning.claims.tails import describe_untruncated, untruncated_check
-from pipeline.progress import SILENT, Heartbeat
+from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat
 
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
@@ -90,7 +99,7 @@ def planner_for(part: Part, settings: PlannerSettings, lattices=None, moving: bo
 
 
 def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int | None = None,
-               keep: int = 5, progress=None, family=None) -> dict:
+               keep: int = 5, progress=None, family=None, deadline: Deadline = NO_DEADLINE) -> dict:
     """Search, verify and rank plans for ``part`` at ``settings.friction`` (a
     value or a range); returns a JSON-ready dict (``plans`` best first, each
     with its ``verification`` and orientation verdict; ``recommended``;
@@ -106,22 +115,31 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     :func:`pipeline.planning.family.members.planning_family`): the plans must
     orient the part for every member; the search, the carried sets and the
     verification sample its members (``support_family`` in the result).
-    ``None``: uniform pressure."""
+    ``None``: uniform pressure.
+
+    ``deadline``: a time limit (see the module's docstring); the result then
+    has ``time_limit_s``, ``complete`` and ``unsearched``."""
     depth = int(depth if depth is not None else settings.search.depth)
     family = None if family is None or family.is_uniform else family
     planner = planner_for(part, settings, lattices)
     checker = family_checker(part, settings, family, progress)
-    fixed = _fixed_search(part, settings, planner, depth, keep, progress, family, checker)
+    fixed = _fixed_search(part, settings, planner, depth, keep, progress, family, checker, deadline)
+    unsearched = list(fixed.unsearched)
     # No pin is the plan with the fewest pins: then nothing is certified or recommended.
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
-    candidates = _carried(planner, chosen, settings.verify, family, progress)
-    selections = [p.selection or p.verdict for p in chosen]
+    candidates = _carried(planner, chosen, settings.verify, family, progress, deadline, unsearched)
+    selections = [p.selection or p.verdict for p in chosen[:len(candidates)]]
     moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, settings, planner)
     moving_search = None
-    if moving is not None:
-        moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker)
-        candidates += _carried(moving, moving_search.plans, settings.verify, family, progress)
-        selections += [p.selection or p.verdict for p in moving_search.plans]
+    if moving is not None and deadline.search_over():
+        unsearched.append(f"moving pins: not reached (up to {settings.search.dynamic_depth} moving pin(s) after "
+                          f"no fixed pin and after the {MOVING_PREFIXES} best fixed-pin results)")
+    elif moving is not None:
+        moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker, deadline)
+        unsearched += moving_search.unsearched
+        carried = _carried(moving, moving_search.plans, settings.verify, family, progress, deadline, unsearched)
+        candidates += carried
+        selections += [p.selection or p.verdict for p in moving_search.plans[:len(carried)]]
         planner = moving
     states = resting_states(part)
     _verify_candidates(part, settings, planner, candidates, states, progress, family, selections)
@@ -129,26 +147,49 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     candidates = robust_order(candidates, _rank, lambda p: p.verification["orientation"].get("width_deg"),
                               lambda p: p.margin, settings.search.width_slack_deg)
     good = [p for p in candidates if _acceptable(p)]
-    _check_tails(part, settings, planner, good[0] if good else None, states, progress, family)
+    if good and deadline.over():
+        unsearched.append("the recommended plan's replay on untruncated normals: skipped")
+    else:
+        _check_tails(part, settings, planner, good[0] if good else None, states, progress, family)
     result = _tight_result(settings, depth, keep, planner, candidates, good, states, fixed, moving_search)
     if family is not None:
         result["support_family"] = family.to_dict()
-        certify_for_family(result, part, settings, family, checker, good)
+        if deadline.limited:  # the certificate and the nearest "yes" are searches of their own
+            unsearched.append("the support family's certificate of the recommended plan and its nearest "
+                              '"yes": skipped under a time limit')
+        else:
+            certify_for_family(result, part, settings, family, checker, good)
     elif not result["orients"] and candidates:
-        kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in candidates[:keep]]
-        fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
-        result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins, progress)
+        if deadline.limited:  # the nearest "yes" runs complete searches of its own
+            unsearched.append('the nearest "yes" (complete searches at looser tolerances): skipped under a '
+                              'time limit')
+        else:
+            kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in candidates[:keep]]
+            fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
+            result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins, progress)
+    if deadline.limited:
+        result.update(time_limit_s=deadline.seconds, complete=not unsearched, unsearched=unsearched)
     return result
 
 
-def _carried(planner, chosen, verify, family, progress) -> list:
+def _carried(planner, chosen, verify, family, progress, deadline: Deadline = NO_DEADLINE,
+             unsearched: list | None = None) -> list:
     """The carried sets of each chosen plan (``certify.carried_plan``), telling
     ``progress`` how many are done (and, between the propagation's rollout
-    batches, that it is still at it)."""
+    batches, that it is still at it). Once ``deadline`` has passed no further
+    plan is started (each one started is then verified): the plans left are
+    named in ``unsearched``."""
     out = []
     with Heartbeat("carried sets of the chosen plans", len(chosen), "plan", progress) as beat:
         try:
             for p in chosen:
+                if deadline.over():
+                    left = chosen[len(out):]
+                    beat.finish(len(out), "the time limit has passed")
+                    if unsearched is not None:
+                        unsearched.append(f"carried sets and held-out verification of {len(left)} chosen "
+                                          f"plan(s): skipped ({', '.join(' '.join(q.labels) for q in left)})")
+                    break
                 for lattice in planner.lattices.values():
                     lattice.stretch = beat.stretch(len(out), len(out))
                 out.append(carried_plan(planner, p.labels, p.margin, verify, family))
@@ -172,10 +213,11 @@ def _pin_search(part, settings: PlannerSettings, planner, moving: bool, family=N
 
 
 def _fixed_search(part, settings: PlannerSettings, planner, depth, keep, progress, family=None,
-                  checker=None) -> FixedSearch:
+                  checker=None, deadline: Deadline = NO_DEADLINE) -> FixedSearch:
     """The complete fixed-pin search with the planner's pins and the settings."""
     search = _pin_search(part, settings, planner, moving=False, family=family, checker=checker)
-    return search.run(depth, candidates=settings.search.candidates, keep=keep, progress=progress)
+    return search.run(depth, candidates=settings.search.candidates, keep=keep, progress=progress,
+                      deadline=deadline)
 
 
 def _moving_planner(part, settings: PlannerSettings, planner):
@@ -186,7 +228,7 @@ def _moving_planner(part, settings: PlannerSettings, planner):
 
 
 def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progress, family=None,
-                   checker=None) -> FixedSearch:
+                   checker=None, deadline: Deadline = NO_DEADLINE) -> FixedSearch:
     """Up to ``search.dynamic_depth`` moving pins after no fixed pin and after
     each of the ``MOVING_PREFIXES`` best fixed-pin results, by the same
     enumeration, screen and judgement as the fixed pins; the orienting plans,
@@ -197,14 +239,19 @@ def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progre
     sequence orients with ``k`` pins a prefix of ``L`` fixed pins is searched
     only up to ``k - L`` moving pins, and not at all when ``L >= k``
     (``skipped`` in the search's record): the plans left out could only rank
-    after the one found."""
+    after the one found. Under a time limit (``deadline``) the prefixes
+    not reached and what each search left out are in ``unsearched``."""
     if progress:
         progress(f"mu_c {settings.friction.label}: fixed pins do not orient the part: adding moving pins")
     search = _pin_search(part, settings, moving, moving=True, family=family, checker=checker)
     depth = settings.search.dynamic_depth
-    total = FixedSearch([], [], depth, settings.claims.tolerance_deg, settings.claims.required)
+    total = FixedSearch([], [], depth, settings.claims.tolerance_deg, settings.claims.required,
+                        time_limit=deadline.seconds)
     for prefix in [None, *chosen[:MOVING_PREFIXES]]:
         after = list(prefix.labels) if prefix else []
+        if deadline.search_over():
+            total.unsearched.append(f"moving pins after {' '.join(after) or 'no fixed pin'}: not reached")
+            continue
         room = moving_room(total.plans, len(after), depth, fewer=family is not None)
         if room < 1:  # then room = (pins of the shortest plan found) - len(after), less one with a family
             total.skipped.append({"after": after,
@@ -212,8 +259,9 @@ def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progre
                                          f"orients the part" + (" for the family" if family is not None else "")})
             continue
         res = search.run(room, candidates=settings.search.candidates, keep=keep, progress=progress,
-                         prefix=prefix)
+                         prefix=prefix, deadline=deadline)
         total.plans += res.plans
+        total.unsearched += res.unsearched
         total.levels += [dict(lv, after=after) for lv in res.levels]
         total.rollouts += res.rollouts
         total.seconds += res.seconds
@@ -313,9 +361,15 @@ def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance
     if fixed.needs_no_pin:
         return fixed.evidence()
     why = fixed.evidence()
-    if moving is not None:
+    if moving is not None and not moving.complete:
+        why += (f"; nor do the moving-pin sequences searched before the time limit (up to {moving.depth} moving "
+                f"pins after no fixed pin or after the {MOVING_PREFIXES} best fixed-pin results; not searched: "
+                f"{'; '.join(moving.unsearched)})")
+    elif moving is not None:
         why += (f"; nor do up to {moving.depth} moving pins after no fixed pin or after the "
                 f"{MOVING_PREFIXES} best fixed-pin results")
+    if not candidates and not fixed.complete:
+        return f"{why}; no plan was verified within the time limit"
     if not candidates:
         return f"{why}; no allowed pin sequence within depth {depth}"
     if not good:
@@ -357,7 +411,9 @@ def _tight_result(settings: PlannerSettings, depth: int, keep: int, planner, can
             "orients": moving.orients, "depth": moving.depth, "levels": moving.levels,
             "found": [list(p.labels) for p in moving.plans], "skipped": moving.skipped,
             "nominal_rollouts": moving.rollouts,
-            "seconds": round(moving.seconds, 2)},
+            "seconds": round(moving.seconds, 2),
+            **({} if moving.time_limit is None else {"complete": moving.complete,
+                                                      "unsearched": list(moving.unsearched)})},
         "pins_used": {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0},
         "stats": {"transitions": planner.stats.transitions,
                   "rollouts": planner.stats.rollouts + fixed.rollouts + (moving.rollouts if moving else 0),
@@ -428,12 +484,16 @@ def plan_hint(planned_parts, name: str, root) -> str:
 # ---------------------------------------------------------------------- every configured friction
 
 
-def plan_tight_all(part: Part, settings: PlannerSettings, catalog_root, keep: int = 5, progress=None) -> list:
+def plan_tight_all(part: Part, settings: PlannerSettings, catalog_root, keep: int = 5, progress=None,
+                   deadline: Deadline | None = None) -> list:
     """Tight plans at every friction of ``settings.frictions`` (the first is the
     recommended one), at the search's belt speed when it is set, for every
     member of its support family when it is set (its extremes found at each
     friction); the planner's rollouts are stored in the catalog (keyed by
-    model, pin speed and belt)."""
+    model, pin speed and belt). ``deadline``: the time limit of them all
+    (default: one of ``settings.search.time_limit_s`` from now, if set)."""
+    if deadline is None:
+        deadline = Deadline(settings.search.time_limit_s)
     search = settings.search
     belt_speed, mu_s = planner_belt(search, part)
     speeds = [0.0, *search.dynamic_speeds]
@@ -447,7 +507,8 @@ def plan_tight_all(part: Part, settings: PlannerSettings, catalog_root, keep: in
             at = settings.at(friction)
             family = planning_family(part, search.support_family or "uniform", at)
             res = plan_tight(part, at, lattices=lattices, keep=keep,
-                             progress=_labelled(progress, f"mu_c {friction.label}"), family=family)
+                             progress=_labelled(progress, f"mu_c {friction.label}"), family=family,
+                             deadline=deadline)
             res["stats"]["wall_seconds"] = round(time.perf_counter() - t0, 2)  # search, verification and all
             res.pop("lattices")
             out.append(res)

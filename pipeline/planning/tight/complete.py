@@ -59,6 +59,17 @@ and the fewest sets within ``T``) among the judged sequences and the
 ``EVIDENCE_PER_LEVEL`` sequences of each level whose nominal finals fall
 into the fewest clusters.
 
+Under a time limit (a :class:`~pipeline.progress.Deadline`, ``planner.time_limit_s``)
+the search reads the clock between its steps (a batch of nominal rollouts,
+a chunk of the first screen, a block of ``SCREEN_BLOCK`` sequences) and
+stops at the first step after its search time is over, keeping what it
+judged. It is then complete only up to the last level it finished: the
+result says so (``complete``, ``unsearched``: the level cut short and how
+far it got, the levels not reached, the evidence not judged), and its "no"
+covers the sequences searched only. Orienting sequences found before the
+stop are still certified on held-out trials while the limit lasts; those it
+leaves no time for are ``unverified`` candidates, never plans.
+
 Who does what. :class:`FixedPinSearch` drives the levels (steps 1 and 6, the
 ranking and the evidence); a :class:`LevelScreen` takes one level through
 steps 2 to 5; :class:`~pipeline.planning.tight.judge.TrialBench` replays and
@@ -81,7 +92,7 @@ from pipeline.config import schema_default
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
 from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE
 from pipeline.planning.claims.verify import replay
-from pipeline.progress import Heartbeat
+from pipeline.progress import NO_DEADLINE, Deadline, Heartbeat, duration_text
 
 SLACK_DEG = 1.0  # nominal finals may spread this much beyond the tolerance and still be tried
 PROBE = (6, 2)  # random trials and corners per resting state that order the candidates
@@ -93,6 +104,7 @@ SCREEN = (12, 8)  # random trials and corners per resting state in the screen
 # what the full judgement would, at a fraction of its cost.
 CASCADE = ((48, 64), (150, 384))
 SCREEN_BLOCK = 96  # candidates screened at once
+PROBE_CHUNK = 1024  # candidates probed at once under a time limit (the clock is read between chunks)
 EVIDENCE_PER_LEVEL = 4  # several-set sequences judged per level when nothing orients
 WIDTH_SLACK_DEG = schema_default("planner", "width_slack_deg")  # a safe margin outranks this much width
 
@@ -208,6 +220,24 @@ class FixedSearch:
     seconds: float = 0.0
     resting: dict | None = None  # the verdict on the resting states themselves (no pin)
     skipped: list = field(default_factory=list)  # moving pins: prefixes a shorter plan made moot
+    time_limit: float | None = None  # seconds (None: no limit, the complete search)
+    unsearched: list = field(default_factory=list)  # what a time limit left out, for people
+    unverified: list = field(default_factory=list)  # orienting on the selection trials; no time for held-out
+
+    @property
+    def complete(self) -> bool:
+        """True unless a time limit left part of the search out (``unsearched``)."""
+        return not self.unsearched
+
+    @property
+    def complete_to(self) -> int:
+        """Pins of the deepest level searched in full before any level a time limit cut short."""
+        deepest = 0
+        for lv in self.levels:
+            if lv.get("complete") is False:
+                break
+            deepest = lv["pins"]
+        return deepest
 
     @property
     def orients(self) -> bool:
@@ -231,8 +261,22 @@ class FixedSearch:
         if self.plans:
             best = self.plans[0]
             return (f"{len(best.labels)} fixed pins orient this part within {self.tolerance:g} deg "
-                    f"(held-out width {best.verdict['width_deg']:.1f} deg); no sequence of fewer does")
-        text = f"no fixed-pin sequence of up to {self.depth} pins orients this part within {self.tolerance:g} deg"
+                    f"(held-out width {best.verdict['width_deg']:.1f} deg); no sequence of fewer does"
+                    + self._time_limit_text())
+        if not self.complete:
+            deepest = max((lv["pins"] for lv in self.levels), default=0)
+            text = (f"no fixed-pin sequence of up to {deepest} pins among the sequences searched orients this "
+                    f"part within {self.tolerance:g} deg" if deepest else
+                    f"no fixed-pin sequence was searched")
+        else:
+            text = (f"no fixed-pin sequence of up to {self.depth} pins orients this part within "
+                    f"{self.tolerance:g} deg")
+        text += self._time_limit_text()
+        if self.unverified:
+            u = self.unverified[0]
+            text += (f"; unverified candidate: {' '.join(u.labels)} orients on the selection trials "
+                     f"(width {u.verdict['width_deg']:.1f} deg) but the time limit left no time to "
+                     f"replay it on held-out trials")
         if self.best_effort:
             b = self.best_effort[0]
             v = b.verdict
@@ -242,6 +286,13 @@ class FixedSearch:
                      + (", but a member of the support family ends outside that set"
                         if v.get("broken_by_worst_member") else ""))
         return text + self._too_few_trials()
+
+    def _time_limit_text(self) -> str:
+        """What a time limit left out, in words (empty when nothing was)."""
+        if self.complete:
+            return ""
+        return (f" (time limit {self.time_limit:g} s: complete up to {self.complete_to} pin(s) only; "
+                f"not searched: {'; '.join(self.unsearched)})")
 
     def _too_few_trials(self) -> str:
         """Where some level's verification had too few trials for the claim at all."""
@@ -261,7 +312,17 @@ class FixedSearch:
                 "evidence": self.evidence(), "levels": self.levels,
                 "nominal_rollouts": self.rollouts, "seconds": round(self.seconds, 2),
                 "best_effort": [{"pins": list(b.labels), "pin_heights_mm": list(b.heights),
-                                 **b.verdict} for b in self.best_effort]}
+                                 **b.verdict} for b in self.best_effort],
+                **({} if self.time_limit is None else self.time_limit_record())}
+
+    def time_limit_record(self) -> dict:
+        """The time limit's part of the record: the limit, whether the search
+        was complete, the deepest level searched in full, what was left out and
+        the unverified candidates."""
+        return {"time_limit_s": self.time_limit, "complete": self.complete, "complete_to_pins": self.complete_to,
+                "unsearched": list(self.unsearched),
+                "unverified": [{"pins": list(u.labels), "pin_heights_mm": list(u.heights), **(u.verdict or {})}
+                               for u in self.unverified]}
 
 
 @dataclass(eq=False)
@@ -310,6 +371,7 @@ class LevelScreen:
                  certifier: Certifier, name: str):
         self.level, self.n_pins, self.prefix, self.pins = level, n_pins, prefix, pins
         self.bench, self.certifier, self.name = bench, certifier, name
+        self.unverified = []  # orienting on the selection trials, left uncertified by a time limit
 
     def sequences(self, idx) -> tuple:
         """``(heights, speeds)`` of the level's rows ``idx`` (:meth:`CandidatePins.rows`)."""
@@ -319,9 +381,14 @@ class LevelScreen:
         """The plan of the level's row ``idx``, with its nominal span and verdict."""
         return self.pins.plan(self.prefix, self.level.seq[idx], span, self.level.margin[idx], verdict)
 
-    def search(self, candidates: int, progress=None):
+    def search(self, candidates: int, progress=None, deadline: Deadline = NO_DEADLINE):
         """``(orienting plans, every judged plan, the level's counts)``; each
-        stage tells ``progress`` how far it has got."""
+        stage tells ``progress`` how far it has got. Once ``deadline``'s
+        search is over the level stops between chunks of the first screen or
+        between blocks of the screen (``complete`` False and ``unsearched`` in
+        its counts say how far it got); orienting sequences are certified
+        unless the limit itself has passed (then they are kept in
+        ``unverified``)."""
         level, bench = self.level, self.bench
         record = {"sequences": level.size, "nominal_within": 0, "screened_out": 0, "judged": 0,
                   "orienting": 0, "not_screened": 0, "held_out": 0, "certified": 0}
@@ -341,21 +408,49 @@ class LevelScreen:
         # A probe of a few trials per state orders the candidates (most promising
         # first) and already rejects the hopeless ones.
         with Heartbeat(f"{self.name}: first screen", within.size, "sequence", progress) as beat:
-            probe_fails = bench.failures(*self.sequences(within), bench.screen_rows(inputs, *PROBE),
-                                         beat.stretch(0, within.size))
+            probe_fails = self._probe(within, bench.screen_rows(inputs, *PROBE), beat, deadline)
+        if probe_fails.size < within.size:  # the time limit ended the first screen
+            record["complete"] = False
+            record["unsearched"] = (f"{self.name}: the first screen reached {probe_fails.size:,} of the "
+                                    f"{within.size:,} sequences within the tolerance nominally; none judged")
+            return [], [], record
         order = within[probe_fails <= allowed][np.argsort(probe_fails[probe_fails <= allowed], kind="stable")]
         record["screened_out"] = int(within.size - order.size)
         with Heartbeat(f"{self.name}: screening and judging", order.size, "sequence", progress) as beat:
             found, found_idx, judged = self._screen_and_judge(order, inputs, allowed, span, candidates,
-                                                              record, beat)
+                                                              record, beat, deadline)
         record["judged"], record["orienting"] = len(judged), len(found)
+        if found and deadline.over():  # no time left to certify them: candidates, not plans
+            self.unverified = found
+            record["complete"] = False
+            record["unverified"] = len(found)
+            record["unsearched"] = "; ".join(filter(None, [
+                record.get("unsearched"), f"{self.name}: the {len(found)} sequence(s) orienting on the selection "
+                                          f"trials not replayed on held-out trials (unverified)"]))
+            return [], judged, record
         certified = self.certifier.certify(
             found, *self.sequences(np.asarray(found_idx, dtype=int)), self.n_pins,
             Heartbeat(f"{self.name}: held-out trials", len(found), "sequence", progress))
         record["held_out"], record["certified"] = len(found), len(certified)
         return certified, judged, record
 
-    def _screen_and_judge(self, order, inputs, allowed, span, candidates, record, beat):
+    def _probe(self, within, rows, beat, deadline: Deadline) -> np.ndarray:
+        """Failures of the level's rows ``within`` on the probe's ``rows``, all at
+        once; under a time limit in chunks of ``PROBE_CHUNK``, stopping between
+        them once the search is over (fewer failures than ``within`` then)."""
+        if not deadline.limited:
+            return self.bench.failures(*self.sequences(within), rows, beat.stretch(0, within.size))
+        out = []
+        for start in range(0, within.size, PROBE_CHUNK):
+            if start and deadline.search_over():
+                beat.finish(start, "the time limit ended the first screen here")
+                break
+            chunk = within[start:start + PROBE_CHUNK]
+            out.append(self.bench.failures(*self.sequences(chunk), rows, beat.stretch(start, start + chunk.size)))
+        return np.concatenate(out) if out else np.zeros(0, dtype=int)
+
+    def _screen_and_judge(self, order, inputs, allowed, span, candidates, record, beat,
+                          deadline: Deadline = NO_DEADLINE):
         """Screen the sequences ``order`` (level rows, most promising first) in
         blocks of ``SCREEN_BLOCK`` and judge the survivors on all the trials
         ``inputs``, until ``candidates`` are judged and one orients;
@@ -371,7 +466,11 @@ class LevelScreen:
         With a support family, the orienting plans of a block are checked
         against it at the end of the block, best first, and the level ends
         with the first block where one holds (``_check_family``): each check
-        is a worst-member search, dearer than a wider ranking is worth."""
+        is a worst-member search, dearer than a wider ranking is worth.
+
+        Once ``deadline``'s search is over no further block starts: the
+        blocks left are counted as not screened, ``complete`` is False and
+        ``unsearched`` says how many were left."""
         bench = self.bench
         screen, full = bench.screen_rows(inputs, *SCREEN), stack(inputs)
         cascade = [rows for rows in (bench.screen_rows(inputs, *c) for c in CASCADE)
@@ -385,7 +484,11 @@ class LevelScreen:
         def enough() -> bool:
             return bool(found) and (lazy or len(judged) + cascaded >= candidates)
 
+        timed_out = False
         while done < order.size and not enough():
+            if deadline.search_over():
+                timed_out = True
+                break
             block = order[done:done + SCREEN_BLOCK]
             fails = bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
             alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
@@ -411,7 +514,15 @@ class LevelScreen:
                 self._check_family(pending, found, found_idx, record, screen, allowed)
             beat.tick(done)
         record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
-        if done < order.size:
+        if timed_out:
+            beat.finish(done, f"the time limit ended the screen here: the other {order.size - done} are not "
+                              "screened")
+            record["complete"] = False
+            record["unsearched"] = (f"{self.name}: {order.size - done:,} of the {order.size:,} sequences that "
+                                    f"passed the first screen not screened or judged"
+                                    + (f" (the plans found are ranked among the {len(judged)} judged)"
+                                       if found else ""))
+        elif done < order.size:
             beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
         return found, found_idx, judged
 
@@ -512,6 +623,26 @@ class LevelScreen:
             return [self.plan(i, spread[i], v) for i, v in zip(best, verdicts)]
 
 
+def _empty_record(sequences: int) -> dict:
+    """A level's counts before any of its sequences is screened."""
+    return {"sequences": int(sequences), "nominal_within": 0, "screened_out": 0, "judged": 0, "orienting": 0,
+            "not_screened": 0, "held_out": 0, "certified": 0}
+
+
+def level_estimate(name: str, n: int, rate: float | None, deadline: Deadline = NO_DEADLINE) -> str:
+    """A level's first progress line: its ``n`` candidate sequences and, from
+    ``rate`` (candidate sequences per second over the level before; ``None``:
+    none yet), about how long the level will take; under a time limit, the
+    seconds of it left."""
+    line = f"{name}: {n:,} candidate sequences"
+    if rate:
+        line += f", about {duration_text(n / rate)} at {rate:,.0f}/s (the pace of the level before)"
+    if deadline.limited:
+        left = max(0.0, deadline.left())
+        line += f"; {left:.1f} s of the time limit left" if left < 10 else f"; {left:.0f} s of the time limit left"
+    return line
+
+
 class FixedPinSearch:
     """The complete search over ``pins`` (label -> height, mm) for one part and friction.
 
@@ -572,16 +703,20 @@ class FixedPinSearch:
         self.certifier.member_check = check
 
     def run(self, depth: int, candidates: int = 12, keep: int = 5, progress=None,
-            prefix: FixedPlan | None = None) -> FixedSearch:
+            prefix: FixedPlan | None = None, deadline: Deadline = NO_DEADLINE) -> FixedSearch:
         """Search levels 1 to ``depth`` (after the pins of ``prefix``, if given:
         every sequence then starts with them); stop at the first level with an
         orienting plan. ``progress`` (a function of one line of text) hears
-        about each level and, at most every few seconds, how far each stage
-        of a level has got (:class:`pipeline.progress.Heartbeat`)."""
+        about each level (its first line: its candidate sequences and, from
+        the pace of the level before, about how long it will take) and, at
+        most every few seconds, how far each stage of a level has got
+        (:class:`pipeline.progress.Heartbeat`). ``deadline``: a time limit
+        (see the module's docstring); the result then says what it left
+        unsearched."""
         t0 = time.perf_counter()
         bench = self.bench
         result = FixedSearch([], [], int(depth), bench.tolerance, bench.required,
-                             confidence=bench.confidence, rule=bench.rule)
+                             confidence=bench.confidence, rule=bench.rule, time_limit=deadline.seconds)
         runners_up, levels = [], []
         self.prefix, root = prefix or FixedPlan((), (), 0.0, np.inf), None
         if prefix is not None:
@@ -592,31 +727,75 @@ class FixedPinSearch:
             empty = self.tree.root()
             result.resting = next(bench.judge(*self.pins.rows(self.prefix, empty.seq[np.array([0])]),
                                               stack(bench.trials(0))))
-        def enumeration(length, n):
-            return Heartbeat(f"{self._name(len(self.prefix.labels) + length)}: nominal paths", n,
-                             "candidate sequence", progress)
+        pace = {}  # the level before: its candidate sequences and when it started
 
-        for level in self.tree.levels(int(depth), root, enumeration):
+        def enumeration(length, n):
+            name = self._name(len(self.prefix.labels) + length)
+            now = time.perf_counter()
+            if progress:
+                rate = pace["n"] / max(now - pace["t"], 1e-9) if pace.get("n") else None
+                progress(level_estimate(name, n, rate, deadline))
+            pace.update(n=n, t=now)
+            return Heartbeat(f"{name}: nominal paths", n, "candidate sequence", progress)
+
+        last = root if root is not None else self.tree.root()
+        for level in self.tree.levels(int(depth), root, enumeration, deadline):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
+            if level.cut:  # the time limit ended the enumeration: nothing of the level is judged
+                record = {"pins": n_pins, **_empty_record(level.size), "complete": False,
+                          "candidates": level.cut[1], "candidates_enumerated": level.cut[0],
+                          "unsearched": f"{self._name(n_pins)}: nominal paths of {level.cut[0]:,} of "
+                                        f"{level.cut[1]:,} candidate sequences rolled out, none judged"}
+                result.levels.append(record)
+                result.unsearched.append(record["unsearched"])
+                break
             screen = LevelScreen(level, n_pins, self.prefix, self.pins, bench, self.certifier, self._name(n_pins))
-            found, judged, record = screen.search(candidates, progress)
+            found, judged, record = screen.search(candidates, progress, deadline)
             result.levels.append({"pins": n_pins, **record})
             if progress:
                 progress(f"{self._name(n_pins)}: {record['sequences']} sequences, "
                          f"{record['nominal_within']} within {bench.tolerance:g} deg nominally, "
                          f"{record['judged']} replayed in full, {record['orienting']} orient the part")
             runners_up.extend(judged)
+            result.unverified += screen.unverified
+            if record.get("unsearched"):
+                result.unsearched.append(record["unsearched"])
+            last = level
             if found:
                 result.plans = self.ranked(found)[:keep]
                 break
             levels.append(screen)
+            if record.get("complete") is False:
+                break
+        if deadline.limited and not result.plans:
+            self._not_reached(result, last, int(depth))
+        result.unverified = self.ranked(result.unverified)[:keep]
         if not result.plans:  # the evidence: the best several-set results of every level
-            for screen in levels:
+            for k, screen in enumerate(levels):
+                if deadline.search_over():
+                    result.unsearched.append(f"the fewest-set sequences of {len(levels) - k} level(s) "
+                                             "(the evidence when nothing orients): not judged")
+                    break
                 runners_up.extend(screen.several_sets(min(candidates, EVIDENCE_PER_LEVEL), progress))
             result.best_effort = self.ranked(_distinct(runners_up))[:keep]
         result.rollouts = self.tree.rollouts
         result.seconds = time.perf_counter() - t0
         return result
+
+    def _not_reached(self, result: FixedSearch, last: Level, depth: int) -> None:
+        """Add the levels up to ``depth`` that a time limit left unstarted to
+        ``result.unsearched`` (``last``: the deepest level enumerated in full;
+        after a level of no sequence no deeper level exists)."""
+        reached = len(result.levels)
+        cut_enumeration = bool(result.levels) and "candidates_enumerated" in result.levels[-1]
+        if reached >= depth or (result.levels and not cut_enumeration and last.size == 0):
+            return
+        for length in range(reached + 1, depth + 1):
+            name = self._name(len(self.prefix.labels) + length)
+            known = length == reached + 1 and not cut_enumeration
+            result.unsearched.append(f"{name}: not reached"
+                                     + (f" ({last.size * self.pins.heights.size:,} candidate sequences)"
+                                        if known else ""))
 
     def _name(self, n_pins: int) -> str:
         """A level of the search for people: ``3 fixed pin(s)``, or its moving pins after the prefix."""

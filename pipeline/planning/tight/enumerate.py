@@ -23,7 +23,10 @@ A sequence is dropped (with all its extensions) when, on its nominal path:
   so the part may turn either way (metastable).
 
 Nothing else is pruned: every other sequence of up to ``depth`` pins is
-enumerated (``NominalTree.levels``).
+enumerated (``NominalTree.levels``). Only a time limit (a
+:class:`~pipeline.progress.Deadline`) ends the enumeration early: it is
+checked between batches of parents, and a level it cuts says how many of its
+candidate sequences were rolled out (``Level.cut``).
 
 With several supports (a support family's representatives), every
 resting state is rolled out under each of them: the level's columns are
@@ -32,6 +35,7 @@ of the nominal finals take the union over the supports.
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,10 +44,11 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from pipeline.parts.part import Part
 from pipeline.planning.claims.verify import rollouts_by_speed
-from pipeline.progress import SILENT, Heartbeat, Stretch
+from pipeline.progress import BATCH_SECONDS, NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
 
 QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout
 MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
+FIRST_PARENTS = 64  # parents of the first batch of a level under a time limit (it sets the pace)
 
 
 @dataclass
@@ -54,11 +59,19 @@ class Level:
     state's nominal orientation (deg) and centroid height (mm) after the
     sequence ``(n, states)``; ``margin``: the smallest distance of any
     touching nominal ``|d|`` from ``[d_min, d_max]`` (negative outside;
-    ``inf`` if nothing was touched)."""
+    ``inf`` if nothing was touched); ``cut``: ``None`` for a whole level,
+    else ``(candidate sequences rolled out, candidate sequences of the
+    level)`` when a time limit ended its enumeration early (its sequences are
+    then those of the parents done)."""
     seq: np.ndarray
     theta: np.ndarray
     y: np.ndarray
     margin: np.ndarray
+    cut: tuple | None = None
+
+    def rows(self, lo: int, hi: int) -> "Level":
+        """The sequences ``lo`` to ``hi`` of the level."""
+        return Level(self.seq[lo:hi], self.theta[lo:hi], self.y[lo:hi], self.margin[lo:hi])
 
     @property
     def size(self) -> int:
@@ -111,37 +124,66 @@ class NominalTree:
         return Level(np.zeros((1, 0), dtype=np.int16), states[None, :, 0].copy(),
                      states[None, :, 1].copy(), np.full(1, np.inf))
 
-    def levels(self, depth: int, root: Level | None = None, heartbeat=None):
+    def levels(self, depth: int, root: Level | None = None, heartbeat=None, deadline: Deadline = NO_DEADLINE):
         """Yield the levels of lengths 1 to ``depth`` after ``root`` (default
         :meth:`root`) in turn (lazily, so a search may stop early).
 
         ``heartbeat(length, n)``, if given, returns the
         :class:`~pipeline.progress.Heartbeat` that the enumeration of the
-        ``n`` sequences of ``length`` pins after ``root`` reports to."""
+        ``n`` sequences of ``length`` pins after ``root`` reports to.
+        ``deadline``: no level starts once its search is over
+        (:meth:`~pipeline.progress.Deadline.search_over`), and a level it
+        cuts short is the last (``Level.cut``)."""
         heartbeat = heartbeat or (lambda length, n: Heartbeat("", n))
         level = self.root() if root is None else root
         for _ in range(depth):
+            if deadline.search_over():
+                return
             n = level.size * self.heights.size
             with heartbeat(level.seq.shape[1] + 1, n) as beat:
-                level = self.extend(level, beat.stretch(0, n))
+                level = self.extend(level, beat.stretch(0, n), deadline)
+                if level.cut:
+                    beat.finish(level.cut[0], "the time limit ended the enumeration here")
             yield level
-            if level.size == 0:
+            if level.size == 0 or level.cut:
                 return
 
-    def extend(self, level: Level, stretch: Stretch = SILENT) -> Level:
+    def extend(self, level: Level, stretch: Stretch = SILENT, deadline: Deadline = NO_DEADLINE) -> Level:
         """Every surviving sequence of ``level`` followed by every candidate pin
         (in chunks of parents, so memory stays bounded on long levels);
-        ``stretch`` is told the share of parents done."""
+        ``stretch`` is told the share of parents done. Under a time limit
+        (``deadline``) the chunks are about ``BATCH_SECONDS`` of work each and
+        the enumeration stops between them once the search is over: the
+        level returned is then ``cut``. (An outcome depends on its rounded
+        pose only, so the sequences enumerated are the same in any chunks.)"""
         per_parent = max(1, self.heights.size * level.theta.shape[1])
         step = max(1, MAX_PAIRS // per_parent)
+        if deadline.limited:
+            return self._extend_timed(level, step, stretch, deadline)
         if level.size <= step:
             return self._extend(level, stretch)
-        parts = [self._extend(Level(level.seq[i:i + step], level.theta[i:i + step], level.y[i:i + step],
-                                    level.margin[i:i + step]),
+        parts = [self._extend(level.rows(i, i + step),
                               stretch.part(i / level.size, min(i + step, level.size) / level.size))
                  for i in range(0, level.size, step)]
-        return Level(*(np.concatenate([getattr(p, k) for p in parts])
-                       for k in ("seq", "theta", "y", "margin")))
+        return _joined(parts)
+
+    def _extend_timed(self, level: Level, step: int, stretch: Stretch, deadline: Deadline) -> Level:
+        """:meth:`extend` under a time limit: chunks of parents sized by the pace
+        of the ones before (up to ``step``), the deadline read between them."""
+        if level.size == 0:
+            return self._extend(level, stretch)
+        parts, done, size = [], 0, min(step, FIRST_PARENTS)
+        while done < level.size and not (parts and deadline.search_over()):
+            hi = min(level.size, done + size)
+            t0 = time.monotonic()
+            parts.append(self._extend(level.rows(done, hi), stretch.part(done / level.size, hi / level.size)))
+            took = max(time.monotonic() - t0, 1e-6)
+            size = max(1, min(step, int((hi - done) * min(8.0, max(0.125, BATCH_SECONDS / took)))))
+            done = hi
+        out = _joined(parts)
+        if done < level.size:
+            out.cut = (done * self.heights.size, level.size * self.heights.size)
+        return out
 
     def _extend(self, level: Level, stretch: Stretch = SILENT) -> Level:
         n_pins, n = self.heights.size, level.size
@@ -184,3 +226,10 @@ class NominalTree:
         shape = theta.shape
         return (res["status"][inverse].reshape(shape), res["theta_f"][inverse].reshape(shape),
                 res["dy"][inverse].reshape(shape))
+
+
+def _joined(parts) -> Level:
+    """The levels ``parts`` (sequences of one length) as one level, in order."""
+    if len(parts) == 1:
+        return parts[0]
+    return Level(*(np.concatenate([getattr(p, k) for p in parts]) for k in ("seq", "theta", "y", "margin")))
