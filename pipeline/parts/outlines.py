@@ -113,6 +113,7 @@ class Outline:
     hole_layers: list = field(default_factory=list)  # each hole's DXF layer (None: SVG, or several)
     layer: str | None = None  # the outline's DXF layer (None: SVG, or joined across layers)
     joined_layers: list = field(default_factory=list)  # the layers an outline joined across, if several
+    hints: list = field(default_factory=list)  # further warnings (a frame taken for the part?)
     index: int = 0  # the part's index in its drawing (read_sheet's order)
     n_parts: int = 1  # how many parts the drawing holds
     _a: float | None = field(default=None, repr=False, compare=False)
@@ -167,7 +168,7 @@ class Outline:
     def warnings(self) -> list[str]:
         """Lines worth a warning: loops left out, an outline joined across layers,
         and a size that suggests wrong units."""
-        out = [f"{self.source}: left out {item}" for item in self.left_out]
+        out = [f"{self.source}: left out {item}" for item in self.left_out] + list(self.hints)
         if self.joined_layers:
             out.append(f"{self.source}: the outline joins pieces of layers {', '.join(self.joined_layers)} "
                        f"(no layer closes on its own); if some are construction lines, draw the outline "
@@ -279,6 +280,11 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
         k = 0
     else:
         k = _picked(sheet, pieces, tol, drawing)
+        frame = sheet.parts[k][0]
+        if not _named(drawing, frame.parts) and _is_box(frame.points, tol) and _around_all(frame, pieces, tol):
+            # --id names a loop inside a rectangle around everything else: a frame not recognised.
+            sheet = _layout(pieces, texts, tol, drawing, drop=frame)
+            k = _picked(sheet, pieces, tol, drawing)
     outer, holes = sheet.parts[k]
     left, across = [], set()
     for a, b in sheet.conflicts.get(k, []):
@@ -296,6 +302,10 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
         left.append(_others_note(sheet, others, drawing, outer))
     left += _chain_notes(sheet.chains, outer, pieces, tol, drawing)
     out = _outline(outer, holes, drawing, tol_mm, left, index=k, n_parts=len(sheet.parts))
+    if id is None and holes and _is_box(outer.points, tol) and _around_all(outer, pieces, tol):
+        out.hints.append(f"{drawing.path}: the part {outer.name} is a rectangle around everything else; if it is "
+                         f"a drawing frame, pick the part inside it with --id (the id of a piece of it), and the "
+                         f"frame is left out")
     return out
 
 
@@ -916,7 +926,15 @@ class _Layout:
     notes: list  # what was left out, described (a drawing frame)
 
 
-def _layout(pieces: list[_Piece], texts: list, tol: float, drawing: _Drawing) -> _Layout:
+def _around_all(loop: _Piece, pieces: list, tol: float) -> bool:
+    """Whether every piece lies within the box of ``loop``."""
+    lo, hi = _box(loop.points)
+    allpts = np.vstack([p.points for p in pieces])
+    return bool(np.all((allpts >= lo - tol) & (allpts <= hi + tol)))
+
+
+def _layout(pieces: list[_Piece], texts: list, tol: float, drawing: _Drawing,
+            drop: _Piece | None = None) -> _Layout:
     """The drawing's parts: pieces joined into loops layer by layer (across
     layers only when no layer closes on its own), a drawing frame left out,
     and the loops nested into parts: a loop inside no other, or inside a hole,
@@ -947,6 +965,12 @@ def _layout(pieces: list[_Piece], texts: list, tol: float, drawing: _Drawing) ->
             notes.append(inplace[1])
             loops = [lp for lp in loops if not all(_key(m) in gone for m in lp.parts)]
             chains = [c for c in chains if not all(_key(m) in gone for m in c.parts)]
+    if drop is not None:
+        w, h = np.ptp(drop.points, axis=0) * drawing.unit.scale
+        notes.append(f"drawing frame {drop.name}: a {w:.4g} x {h:.4g} mm rectangle around everything else, "
+                     f"taken for a frame since --id {drawing.id} picked a loop inside it; to plan it instead: "
+                     f"--id {drop.pick or '(give it an id)'}")
+        loops = [lp for lp in loops if not all(any(m is d for d in drop.parts) for m in lp.parts)]
     named = [lp for lp in loops if lp.construction and _named(drawing, lp.parts)]
     solid = [lp for lp in loops if not lp.construction or any(lp is x for x in named)]
     if not solid:  # only construction loops close: take them as parts

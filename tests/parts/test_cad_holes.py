@@ -287,6 +287,21 @@ def test_frame_with_inner_border_and_title_block_on_the_parts_layer(tmp_path):
     assert "with its inner border" in frame and "300 x 200 mm" in frame and "title block of 2 piece(s)" in frame
 
 
+def test_id_inside_a_frame_not_recognised_leaves_the_frame_out(tmp_path):
+    # An SVG frame (no title block, no sheet size) around a plate: the frame reads as the part, with
+    # a warning; --id of the plate leaves the frame out and picks the plate with its hole.
+    svg = tmp_path / "plate.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">'
+                   '<rect id="frame" x="2" y="2" width="98" height="68"/>'
+                   '<path id="plate" d="M 10,10 H 90 V 60 H 10 Z"/><circle id="hole" cx="30" cy="30" r="5"/></svg>')
+    out = read_outline(svg)
+    assert out.name == "<rect id='frame'>" and any("if it is a drawing frame" in w for w in out.warnings())
+    plate = read_outline(svg, id="plate")
+    assert plate.name == "<path id='plate'>" and len(plate.holes) == 1
+    (frame,) = plate.left_out
+    assert frame.startswith("drawing frame <rect id='frame'>") and "--id frame" in frame
+
+
 # ---------------------------------------------------------------- blocks
 
 
