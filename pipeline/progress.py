@@ -304,6 +304,12 @@ class Deadline:
 NO_DEADLINE = Deadline()  # work without a time limit
 
 
+class OutOfTime(Exception):
+    """Raised by work that a :class:`Deadline` ended before it could answer
+    whole (a bisection over searches, say, whose part answer would mislead):
+    its caller says the stage was not finished."""
+
+
 def duration_text(seconds: float) -> str:
     """A duration for people, rounded: ``12 s``, ``4 min``, ``1 h 58 min``."""
     if not math.isfinite(seconds):

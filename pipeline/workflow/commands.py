@@ -169,7 +169,9 @@ def _time_limited_stages(result: dict, settings, deadline) -> dict:
     at all. What is skipped joins the first entry's ``unsearched``."""
     from pipeline.planning import attach_speed_limits
     skipped = []
-    if deadline.over():
+    if not any(t["plans"] for t in result.get("tight") or ()):
+        pass  # no plan: no speed limit to find
+    elif deadline.over():
         skipped.append("the speed limits of the plans: skipped")
     else:
         attach_speed_limits(result, settings)

@@ -34,6 +34,7 @@ import numpy as np
 from pipeline.planning.claims import orient
 from pipeline.planning.family.nearest import MAX_TOLERANCE, more_pins_axis
 from pipeline.planning.tight.judge import TrialBench
+from pipeline.progress import NO_DEADLINE, Deadline, OutOfTime
 
 LADDER = 0.5  # deg: tolerances are answered on this ladder
 
@@ -60,7 +61,8 @@ def loosest_needed(finals, jammed, n_trials: int, order: int, required: float, c
     return None
 
 
-def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, progress=None) -> tuple | None:
+def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, progress=None,
+                       deadline: Deadline = NO_DEADLINE) -> tuple | None:
     """``(tolerance, plan)``: the smallest tolerance on the ``LADDER`` up to
     ``MAX_TOLERANCE`` at which the complete fixed-pin search over ``pins``
     (label -> height, mm) finds a plan of up to ``depth`` pins, certified on
@@ -68,7 +70,11 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
 
     Exact bisection: on the same trials, a sequence that orients within ``t``
     orients within any looser tolerance, and its nominal finals pass the
-    looser filter too, so "some plan orients" is monotone in ``t``."""
+    looser filter too, so "some plan orients" is monotone in ``t``.
+
+    Under a time limit (``deadline``) a search it cuts short raises
+    :class:`~pipeline.progress.OutOfTime`: a bisection over part searches
+    would give a wrong tolerance."""
     import dataclasses
 
     from pipeline.planning.tight.complete import FixedPinSearch
@@ -76,8 +82,10 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
     def found(t):
         claims = dataclasses.replace(settings.claims, tolerance_deg=float(t))
         search = FixedPinSearch(part, pins, settings.friction, claims, settings.verify, settings.search)
-        plans = search.run(depth, candidates=candidates, keep=1, progress=_at(progress, t)).plans
-        return plans[0] if plans else None
+        result = search.run(depth, candidates=candidates, keep=1, progress=_at(progress, t), deadline=deadline)
+        if not result.complete:
+            raise OutOfTime(f"the search at {t:g} deg was not finished")
+        return result.plans[0] if result.plans else None
 
     lo = math.floor(settings.claims.tolerance_deg / LADDER) * LADDER  # does not orient (the question)
     hi = MAX_TOLERANCE
@@ -102,15 +110,19 @@ def _at(progress, tolerance):
 
 
 def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None,
-                   progress=None) -> dict:
+                   progress=None, deadline: Deadline = NO_DEADLINE) -> dict:
     """The smallest tolerance at which one of ``plans`` (``(labels, heights,
     speeds)``) orients ``part`` on held-out trials; when none does within
     ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
-    complete search over them finds a plan (:func:`searched_tolerance`)."""
+    complete search over them finds a plan (:func:`searched_tolerance`).
+    Raises :class:`~pipeline.progress.OutOfTime` when ``deadline`` passes
+    before the answer is whole."""
     bench = TrialBench(part, settings.friction, settings.claims, settings.verify, settings.search)
     claims = settings.claims
     best = None
     for labels, heights, speeds in plans:
+        if deadline.over():
+            raise OutOfTime("the held-out replays of the kept plans were not finished")
         rows = bench.held_out(len(heights))
         tf, jam = bench.replay(np.atleast_2d(np.asarray(heights, float)),
                                np.atleast_2d(np.asarray(speeds or [0.0] * len(heights), float)), rows)
@@ -122,7 +134,7 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
             best = (tol, labels, heights, speeds, verdict)
     if best is None and pins:
         searched = searched_tolerance(part, settings, pins, depth or settings.search.depth,
-                                      settings.search.candidates, progress)
+                                      settings.search.candidates, progress, deadline)
         if searched is not None:
             tol, plan = searched
             best = (tol, plan.labels, plan.heights, plan.speeds, plan.verdict)
@@ -160,13 +172,16 @@ def sensor_axis(entry: dict) -> dict:
     return _axis("sensor", False, "no recommended plan ends in a few sets for a sensor to tell apart")
 
 
-def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = None, progress=None) -> dict:
+def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = None, progress=None,
+                     deadline: Deadline = NO_DEADLINE) -> dict:
     """The nearest "yes" on each axis for a part no plan orients (see the
     module docstring); ``entry``: its tight entry; ``plans``: the kept plans
     ``(labels, heights, speeds)``, best first; ``pins``: the fixed pins the
     search chose from (label -> height, mm), searched again at looser
-    tolerances when no kept plan answers."""
+    tolerances when no kept plan answers. ``deadline``: a time limit; raises
+    :class:`~pipeline.progress.OutOfTime` when it passes before the answer
+    is whole (the answer is then never a part one)."""
     depth = entry.get("depth")
     return {"plans_tried": [list(p[0]) for p in plans],
-            "axes": [tolerance_axis(part, settings, plans, pins, depth, progress), moving_axis(entry),
+            "axes": [tolerance_axis(part, settings, plans, pins, depth, progress, deadline), moving_axis(entry),
                      sensor_axis(entry), more_pins_axis(entry)]}

@@ -20,8 +20,9 @@ With ``planner.time_limit_s`` (``pinfeed plan --time-limit``) a
 searches stop between their steps once their time is over, the chosen plans
 are carried and verified one by one while the limit lasts, and the moving
 pins and the untruncated replay are skipped when there is no time left for
-them; the family certificate and the nearest "yes" (searches of their own)
-are skipped under a limit. The entry then says so (``time_limit_s``,
+them; the nearest "yes" runs its searches under the same limit and is left
+out whole if one is cut; the family certificate (a search of its own) is
+skipped under a limit. The entry then says so (``time_limit_s``,
 ``complete``, ``unsearched``).
 
 With ``planner.belt_speed`` (mm/s) set, the planner plans with the dynamic
@@ -56,7 +57,7 @@ from pipeline.planning.core.settings import (TRUNCATE_SIGMA, Friction, PlannerSe
 from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.claims.verify import holdout_settings, verify_plan
 from pipeline.planning.claims.tails import describe_untruncated, untruncated_check
-from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat
+from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat, OutOfTime
 
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
@@ -160,13 +161,17 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
         else:
             certify_for_family(result, part, settings, family, checker, good)
     elif not result["orients"] and candidates:
-        if deadline.limited:  # the nearest "yes" runs complete searches of its own
-            unsearched.append('the nearest "yes" (complete searches at looser tolerances): skipped under a '
-                              'time limit')
+        kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in candidates[:keep]]
+        fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
+        if deadline.search_over() or not fixed.complete:  # its searches would be cut (or mislead)
+            unsearched.append('the nearest "yes" (complete searches at looser tolerances): skipped')
         else:
-            kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in candidates[:keep]]
-            fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
-            result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins, progress)
+            try:
+                result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins, progress,
+                                                         deadline)
+            except OutOfTime:  # a part answer would mislead: none
+                unsearched.append('the nearest "yes" (complete searches at looser tolerances): not finished '
+                                  'within the time limit')
     if deadline.limited:
         result.update(time_limit_s=deadline.seconds, complete=not unsearched, unsearched=unsearched)
     return result

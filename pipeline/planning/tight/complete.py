@@ -291,8 +291,9 @@ class FixedSearch:
         """What a time limit left out, in words (empty when nothing was)."""
         if self.complete:
             return ""
-        return (f" (time limit {self.time_limit:g} s: complete up to {self.complete_to} pin(s) only; "
-                f"not searched: {'; '.join(self.unsearched)})")
+        done = (f"complete up to {self.complete_to} pin(s) only" if self.complete_to
+                else "no level searched in full")
+        return f" (time limit {self.time_limit:g} s: {done}; not searched: {'; '.join(self.unsearched)})"
 
     def _too_few_trials(self) -> str:
         """Where some level's verification had too few trials for the claim at all."""

@@ -1,0 +1,169 @@
+"""A time limit on the complete search: it returns in time, says it is not
+complete and what it left unsearched; without one (or with one it never
+reaches) the answer is the one the complete search gave before."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from pipeline.errors import PinfeedError
+from pipeline.parts.part import Part
+from pipeline.planning.core.settings import ClaimSettings, SearchSettings, VerifySettings
+from pipeline.planning.tight.complete import FixedPinSearch, level_estimate
+from pipeline.planning.tight import enumerate as enumerate_module
+from pipeline.planning.tight.enumerate import NominalTree
+from pipeline.progress import NO_DEADLINE, Deadline, duration_text
+
+TRIANGLE = [[0, 0], [60, 0], [15, 35]]
+PINS = {f"P{k}": float(y) for k, y in enumerate(np.arange(3, 44, 4), start=1)}  # 11 pins, 3 to 43 mm
+HANG = 60.0  # seconds beyond the limit that would mean a hang (not a performance bound)
+
+
+class SteppingClock:
+    """A clock that moves ``step`` seconds at every read."""
+
+    def __init__(self, step: float):
+        self.now, self.step = 0.0, step
+
+    def __call__(self):
+        self.now += self.step
+        return self.now
+
+
+def _search(tolerance: float):
+    part = Part.from_vertices(TRIANGLE, name="tri")
+    return FixedPinSearch(part, PINS, 0.0, ClaimSettings(tolerance, 0.995, rule="point"), VerifySettings(trials=20),
+                          SearchSettings(3.0))
+
+
+def _answer(result) -> dict:
+    return {"plans": [[list(p.labels), p.verdict["in_tolerance"], p.verdict["trials"],
+                       round(p.verdict["width_deg"], 4)] for p in result.plans],
+            "best": [[list(p.labels), p.verdict["in_tolerance"], p.verdict["trials"]] for p in result.best_effort],
+            "levels": [(lv["pins"], lv["sequences"], lv["nominal_within"], lv["judged"], lv["certified"])
+                       for lv in result.levels]}
+
+
+# What the complete search answered before the time limit existed (recorded
+# with the code of the commit before it, same part, pins, trials and claim).
+BEFORE = {
+    10.0: {"plans": [[["P2", "P7"], 156, 156, 4.8935], [["P2", "P6"], 156, 156, 7.9402]], "best": [],
+           "levels": [(1, 11, 0, 0, 0), (2, 96, 2, 2, 2)]},
+    1.0: {"plans": [], "best": [[["P2", "P4", "P8"], 172, 252], [["P11", "P2", "P7"], 152, 252],
+                                [["P2", "P7"], 64, 156], [["P3"], 58, 108], [["P4"], 35, 108]],
+          "levels": [(1, 11, 0, 0, 0), (2, 96, 0, 0, 0), (3, 760, 16, 0, 0)]},
+}
+
+
+def test_the_deadline_keeps_a_reserve_for_verification_and_no_limit_never_ends():
+    clock = SteppingClock(1.0)
+    deadline = Deadline(10.0, clock=clock)  # made at t = 1
+    assert deadline.limited and deadline.reserve == pytest.approx(2.0)
+    assert not deadline.search_over()  # t = 2: 9 s left
+    clock.now = 8.5  # the next read is t = 9.5: 1.5 s left, inside the reserve
+    assert deadline.search_over() and not deadline.over()
+    clock.now = 11.0
+    assert deadline.over()
+    assert not NO_DEADLINE.limited and not NO_DEADLINE.search_over() and not NO_DEADLINE.over()
+    assert Deadline(3600.0).reserve == 60.0  # at most a minute is kept back
+
+
+def test_durations_and_the_level_estimate_read_as_one_line():
+    assert duration_text(12.2) == "12 s"
+    assert duration_text(240) == "4 min"
+    assert duration_text(7080) == "1 h 58 min"
+    line = level_estimate("4 fixed pin(s)", 593_810, 84.0)
+    assert line == "4 fixed pin(s): 593,810 candidate sequences, about 1 h 58 min at 84/s (the pace of the level before)"
+    assert "\n" not in line
+    assert level_estimate("1 fixed pin(s)", 11, None) == "1 fixed pin(s): 11 candidate sequences"
+
+
+@pytest.mark.parametrize("tolerance", [10.0, 1.0])
+def test_without_a_limit_the_answer_is_the_one_before(tolerance):
+    """No limit, and a limit the search never reaches, give the complete
+    search's answer of before: same plans, verdicts and level counts."""
+    unlimited = _search(tolerance).run(3, candidates=3)
+    assert _answer(unlimited) == BEFORE[tolerance]
+    assert unlimited.complete and "time_limit_s" not in unlimited.to_dict()
+    roomy = _search(tolerance).run(3, candidates=3, deadline=Deadline(3600.0))
+    assert _answer(roomy) == BEFORE[tolerance]
+    assert roomy.evidence() == unlimited.evidence()
+    record = roomy.to_dict()
+    assert record["time_limit_s"] == 3600.0 and record["complete"] is True and record["unsearched"] == []
+
+
+def test_a_tiny_limit_returns_in_time_and_lists_every_level_it_left():
+    lines = []
+    t0 = time.monotonic()
+    # a clock that runs 1 s a read: the limit has passed before the first level
+    result = _search(1.0).run(4, candidates=3, progress=lines.append,
+                              deadline=Deadline(0.01, clock=SteppingClock(1.0)))
+    assert time.monotonic() - t0 < 0.01 + HANG
+    assert not result.complete and result.plans == [] and result.levels == []
+    assert result.unsearched == ["1 fixed pin(s): not reached (11 candidate sequences)",
+                                 "2 fixed pin(s): not reached", "3 fixed pin(s): not reached",
+                                 "4 fixed pin(s): not reached"]
+    text = result.evidence()
+    assert text.startswith("no fixed-pin sequence was searched")
+    assert "not searched: 1 fixed pin(s): not reached" in text
+    assert "no level searched in full" in text
+    record = result.to_dict()
+    assert record["complete"] is False and record["complete_to_pins"] == 0
+
+
+def test_a_limit_reached_mid_search_keeps_the_levels_done_and_says_what_is_left():
+    """The limit ends the search part way (a second on a search that takes
+    longer): the levels finished are the complete search's, and the rest is
+    listed, level by level, never as the complete search's "no"."""
+    t0 = time.monotonic()
+    result = _search(1.0).run(4, candidates=3, deadline=Deadline(1.0))
+    took = time.monotonic() - t0
+    assert took < 1.0 + HANG
+    if result.complete:  # a machine so fast that the whole search fits in a second
+        pytest.skip(f"the whole search took {took:.2f} s, within the limit")
+    finished = [lv for lv in result.levels if lv.get("complete") is not False]
+    assert [(lv["pins"], lv["sequences"]) for lv in finished] == [(k, n) for k, n, *_ in
+                                                                  BEFORE[1.0]["levels"]][:len(finished)]
+    assert result.unsearched and any("4 fixed pin(s)" in u for u in result.unsearched)
+    text = result.evidence()
+    assert "among the sequences searched" in text and "not searched:" in text
+    assert (f"complete up to {result.complete_to} pin(s) only" if result.complete_to
+            else "no level searched in full") in text
+
+
+def test_a_cut_enumeration_keeps_exactly_the_sequences_of_the_parents_done(monkeypatch):
+    part = Part.from_vertices(TRIANGLE, name="tri")
+    tree = NominalTree(part, np.array(list(PINS.values())), 0.0, 3.0)
+    two = tree.extend(tree.extend(tree.root()))
+    whole = tree.extend(two)
+    monkeypatch.setattr(enumerate_module, "FIRST_PARENTS", 8)  # batches of 8 parents, then at most 64
+    # a clock that runs 1 s a read: the search time is over at the second read, after two batches
+    cut = tree.extend(two, deadline=Deadline(1.5, clock=SteppingClock(1.0)))
+    assert cut.cut is not None and 0 < cut.cut[0] < cut.cut[1] == two.size * len(PINS)
+    assert cut.size < whole.size
+    np.testing.assert_array_equal(cut.seq, whole.seq[:cut.size])
+    np.testing.assert_array_equal(cut.theta, whole.theta[:cut.size])
+
+
+@pytest.mark.parametrize("value", [0, -1, float("nan"), "soon", True])
+def test_a_bad_time_limit_is_one_line_with_the_way_out(value):
+    with pytest.raises(PinfeedError) as err:
+        SearchSettings(3.0, time_limit_s=value)
+    text = str(err.value)
+    assert "\n" not in text and "time_limit_s" in text and "without a time limit" in text
+
+
+def test_the_config_key_is_checked_and_read_into_the_settings():
+    from pipeline.config import load_config, validate_config
+    from pipeline.planning.core.settings import PlannerSettings
+    config = load_config(None)
+    assert config["planner"]["time_limit_s"] is None
+    assert PlannerSettings.from_config(config).search.time_limit_s is None
+    config["planner"]["time_limit_s"] = 90
+    assert PlannerSettings.from_config(validate_config(config)).search.time_limit_s == 90.0
+    config["planner"]["time_limit_s"] = -5
+    with pytest.raises(PinfeedError, match=r"^config error at planner/time_limit_s: it must be a number of "
+                                           r"seconds above 0, got -5; leave it out"):
+        validate_config(config)
