@@ -11,35 +11,56 @@ modest vertex count; duplicate pieces are dropped; pieces whose ends lie
 within ``join_tol`` (drawing units; default 1e-4 of the drawing's size) are
 joined end to end into closed loops.
 
-Layers (DXF). Pieces are joined layer by layer: construction lines on another
-layer never become part of the outline. The largest closed loop is the part's
-outline (the layer whose largest loop is largest is the part's layer), or the
-loop picked by ``id``: a DXF entity handle (an INSERT's handle for what its
-block holds) or an SVG element id, naming any piece of the loop. ``layer``
-restricts everything to one layer. Only when no layer closes on its own are
-the pieces of several layers joined, and the outline says which layers it
-joined. An entity of a block on layer 0 takes the layer of its INSERT (CAD's
-rule). Pieces in a dashed linetype (CENTER, DASHED, HIDDEN, ...) or on a layer
-named for construction, centre lines or dimensions are construction geometry:
-joined only among themselves, never a hole, and the outline only when nothing
-else closes.
+Layers (DXF layers; Inkscape layers of an SVG: groups with
+``inkscape:groupmode="layer"``, named by their ``inkscape:label``). Pieces are
+joined layer by layer: construction lines on another layer never become part
+of an outline. ``layer`` restricts everything to one layer. Only when no layer
+closes on its own are the pieces of several layers joined, and the outline
+says which layers it joined. An entity of a block on layer 0 takes the layer
+of its INSERT (CAD's rule). Pieces in a dashed linetype (CENTER, DASHED, ...;
+an SVG's stroke-dasharray) or on a layer named for construction, centre lines
+or dimensions are construction geometry: joined only among themselves, never
+a hole or a part, and taken as drawn only when nothing else closes.
 
-Holes. A closed loop strictly inside the outline is a hole: a loop of the
-outline's layer, or one closed on its own on another layer (a "HOLES" layer).
-The belt presses on the material only, so the area, centroid and ``a`` are
-those of the outline minus its holes (:class:`pipeline.parts.part.Part`); pins
-touch the outline only. Holes are checked by
+Parts. The closed loops nest: a loop inside no other is a part's outline; the
+loops directly inside an outline are its holes (from any layer); a loop inside
+a hole (a washer drawn in a bore, an island) is the outline of a part of its
+own, and so on down. Parts are indexed by the area their outlines enclose,
+largest first; outlines of equal area (to 6 significant digits) left to right,
+then bottom to top (the lower left corner of their bounding box). A part is
+labelled ``FILE#index`` (``lever.dxf#0``). :func:`read_sheet` (and
+:func:`read_parts`) read them all; :func:`read_outline` reads the largest, or
+the one ``id`` picks, and names the others in one line of ``left_out``, each
+with the ``--id`` that picks it. ``id`` is a DXF entity handle (an INSERT's
+handle for what its block holds) or an SVG element id of any piece of a part,
+outline or hole, or the part's index (``FILE#N``, ``#N``, or ``N`` where no
+piece has that id).
+
+Holes. The belt presses on the material only, so the area, centroid and ``a``
+are those of the outline minus its holes (:class:`pipeline.parts.part.Part`);
+pins touch the outline only. Holes are checked by
 :func:`pipeline.parts.part.check_holes`. Refused, in one line naming the loops
-and the way out: loops that cross each other, a hole touching the outline (an
-opening to the outline is a notch: draw it as part of the outline), and a loop
-inside a hole (an island: a part of its own). Loops outside the outline and
-open chains are left out and reported.
+and the way out: loops that cross each other, and a hole touching the outline
+(an opening to the outline is a notch: draw it as part of the outline); with
+``id``, loops across the outline it picked are left out instead. Open chains
+are left out and reported; one larger than every closed loop is refused as an
+open outline.
 
-Drawing frames. A sheet border is usually a drawing's largest loop. It is left
-out (with everything on its layer, and said so) when it is an axis-aligned
-rectangle around all other geometry, holds closed loops of other layers, and
-its layer is named as a frame (TITLE, BORDER, FRAME, SHEET, RAHMEN, ...) or
-holds TEXT outside the other layers' geometry (a title block).
+Drawing frames. A sheet border is usually a drawing's largest loop, and is
+left out (and said so) when it is an axis-aligned rectangle around all other
+geometry and
+- on a layer of its own, holds closed loops of other layers, and its layer is
+  named as a frame (TITLE, BORDER, FRAME, SHEET, RAHMEN, ...) or holds TEXT
+  outside the other layers' geometry (a title block): left out with its layer;
+- or, drawn among the parts' pieces (same layer, or an SVG), touches no closed
+  loop, is at least :data:`FRAME_AREA_RATIO` times the area of the box around
+  what it holds, and has a title block (lines touching it that close a corner
+  region of at most half its area) or a sheet's size (ISO A0-A5, ANSI A-E, to
+  1 %): left out with the pieces touching it, and with an inner border (a
+  rectangle around everything else, nothing touching the outer one).
+A rectangular part with holes has no title block in a corner and is not a
+sheet size, so it stays a part. ``id`` naming a loop inside a rectangle around
+everything else that was not taken for a frame leaves that rectangle out.
 
 Units are said out loud (:meth:`Outline.describe`): a DXF's ``$INSUNITS``
 (unitless, as every R12 file: mm), an SVG's width/height over its viewBox (no
