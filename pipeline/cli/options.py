@@ -96,16 +96,18 @@ def add_outline_args(p, required=True):
     g.add_argument("--vertices", help='part outline "x0,y0 x1,y1 ..." (mm)')
     g.add_argument("--outline", metavar="FILE",
                    help="or a CAD outline: a .dxf or .svg file; its pieces are joined into closed loops "
-                   "layer by layer; the largest closed loop is the part's outline and the closed loops "
-                   "inside it are its holes (a drawing frame, construction lines and loops outside are "
-                   "reported and left out)")
+                   "layer by layer; a loop inside no other (or inside a hole) is a part's outline, the loops "
+                   "directly inside it its holes; the largest part is read, the others are named in a "
+                   "warning (a drawing frame and construction lines are reported and left out)")
     p.add_argument("--hole", action="append", default=None, metavar="VERTICES",
                    help='a hole of a --vertices part, "x0,y0 x1,y1 ..." (mm, the outline\'s frame), '
                    "strictly inside the outline and apart from other holes; repeat for each hole")
     p.add_argument("--layer", default=None, metavar="NAME",
-                   help="DXF layer to read alone (the outline and its holes), when the file holds several")
-    p.add_argument("--id", default=None, help="SVG element id, or DXF entity handle (an INSERT's for its block), of a "
-                   "piece of the outline")
+                   help="layer to read alone (a DXF layer, or an Inkscape layer's label in an SVG), when "
+                   "the file holds several")
+    p.add_argument("--id", default=None, help="the part to read: the SVG element id or DXF entity handle (an "
+                   "INSERT's for its block) of a piece of it (outline or hole), or its label FILE#N as the "
+                   "warning names it")
     p.add_argument("--units", default=None, choices=["mm", "cm", "m", "in"],
                    help="units of the outline file's coordinates, overriding the file's own "
                    "(DXF $INSUNITS, unitless: mm; SVG width/height over viewBox)")
