@@ -303,7 +303,8 @@ def test_zero_length_line_is_ignored(tmp_path):
 def test_help_says_join_tol_units_and_holes(capsys):
     code, out, _ = run_cli(capsys, ["rollout", "--help"])
     text = " ".join(out.split())
-    assert code == 0 and "in the drawing's units" in text and "closed loops inside it are its holes" in text
+    assert code == 0 and "in the drawing's units" in text and "the loops directly inside it its holes" in text
+    assert "the largest part is read, the others are named in a warning" in text and "FILE#N" in text
     assert "--units {mm,cm,m,in}" in text
 
 
