@@ -147,3 +147,56 @@ def test_rig_agrees_with_the_kernel_for_a_holed_part():
     assert str(rig.status.item()) == str(kernel.status.item()) == "ok"
     assert _circ(float(rig.theta_f), float(kernel.theta_f)) <= AGREE_DEG
     assert _circ(float(kernel.theta_f), float(solid.theta_f)) > 3 * AGREE_DEG
+
+
+# ------------------------------------------------- the off-centre-hole plate
+# tests/data/cad/plate_offcentre_r12.dxf: an 80 x 50 plate with a hole r 15
+# at (55, 25): the hole moves the material's centroid 3.2 mm off the plate's
+# centre and takes out 18 % of its area.
+
+def _shoelace(loop):
+    """Signed area, centroid and polar second moment about the origin of a
+    closed polygon (the textbook edge sums, written out here)."""
+    x, y = np.asarray(loop, dtype=float).T
+    xn, yn = np.roll(x, -1), np.roll(y, -1)
+    cr = x * yn - xn * y
+    area = cr.sum() / 2.0
+    centroid = np.array([((x + xn) * cr).sum(), ((y + yn) * cr).sum()]) / (6.0 * area)
+    j_origin = (cr * (x * x + x * xn + xn * xn + y * y + y * yn + yn * yn)).sum() / 12.0
+    return area, centroid, j_origin
+
+
+def _offcentre_plate():
+    from pathlib import Path
+    from pipeline.parts.outlines import read_outline
+    pytest.importorskip("ezdxf")
+    return read_outline(Path(__file__).resolve().parents[1] / "data" / "cad" / "plate_offcentre_r12.dxf",
+                        flatten_tol=0.05)
+
+
+def test_rig_body_of_the_offcentre_plate_is_the_material():
+    """The compiled MuJoCo body: its origin (the joints' axis) at the
+    material's centroid, its mass and polar inertia the material's, worked
+    out here from the drawing (outline sums less the hole's), not the
+    outline's; a rig that filled the hole puts the origin 3.2 mm away and
+    the inertia 9 % off."""
+    out = _offcentre_plate()
+    (a_o, c_o, j_o), (a_h, c_h, j_h) = _shoelace(out.vertices), _shoelace(out.holes[0])
+    a_o, a_h, j_o, j_h = abs(a_o), abs(a_h), abs(j_o), abs(j_h)  # either winding
+    area = a_o - a_h
+    centroid = (a_o * c_o - a_h * c_h) / area
+    j_material = j_o - j_h - area * float(centroid @ centroid)
+    assert np.hypot(*(centroid - (40.0, 25.0))) == pytest.approx(15.0 ** 3 * math.pi / (4000.0 - 225.0 * math.pi),
+                                                                 rel=2e-3)  # the true circle's shift, 3.2 mm
+    xy, a, izz, pts, _ = _support(out.part(), MASS, 0.5)
+    model, data = _build(mujoco, xy, 3e-3, 0.2, MASS, izz, np.array([1.0, 0.0]), np.array([-1.0, 0.0]), 0.0)
+    mujoco.mj_forward(model, data)
+    body = model.body("part").id
+    assert model.body_mass[body] == pytest.approx(MASS, rel=1e-12)
+    assert np.allclose(model.body_ipos[body], 0.0)
+    assert model.body_inertia[body][2] == pytest.approx(MASS * j_material / area / 1e6, rel=1e-9)
+    # The outline about the body origin is the drawing's outline less the material's centroid.
+    assert np.allclose(np.sort(xy * 1000.0 + centroid, axis=0), np.sort(out.vertices, axis=0), atol=1e-9)
+    # Filled, the answers would differ by far more than the tolerances above.
+    izz_filled = MASS * (j_o - a_o * float(c_o @ c_o)) / a_o / 1e6
+    assert abs(izz_filled / izz - 1.0) > 0.05 and np.hypot(*(centroid - c_o)) > 3.0
