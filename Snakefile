@@ -58,6 +58,8 @@ include: "rules/report.smk"
 include: "rules/support.smk"
 # design for feeding: its own target (rule design), for the parts pins do not orient
 include: "rules/design.smk"
+# a parts library (config key library): its own target (rule library), and in 'all' when configured
+include: "rules/library.smk"
 
 
 rule all:
@@ -66,4 +68,5 @@ rule all:
         BAND_FILES,
         rules.atlas.output.json,
         rules.report.output.report,
+        LIBRARY_TARGETS,
     default_target: True

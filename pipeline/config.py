@@ -94,6 +94,15 @@ def resolve_outlines(cfg: dict, base_dir) -> None:
                 p["outline"] = str((Path(base_dir) / p["outline"]).resolve())
 
 
+def resolve_library_paths(cfg: dict, base_dir) -> None:
+    """Make the ``library.paths`` entries (drawings, folders, glob patterns)
+    absolute, relative to ``base_dir`` (the config file's folder)."""
+    lib = cfg.get("library")
+    if isinstance(lib, dict) and isinstance(lib.get("paths"), list):
+        lib["paths"] = [str(Path(base_dir) / p) if isinstance(p, str) and p.strip() and not Path(p).is_absolute()
+                        else p for p in lib["paths"]]
+
+
 def config_name(path) -> str:
     """The default config name of a config file: its stem, in file-name-safe characters."""
     stem = re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem).lstrip(".-")
@@ -120,6 +129,7 @@ def validate_config(config: dict, base_dir=None, name: str | None = None) -> dic
     check_finite_tree(cfg)
     _check_time_limit(cfg)
     resolve_outlines(cfg, base_dir or Path.cwd())
+    resolve_library_paths(cfg, base_dir or Path.cwd())
     schema = _schema()
     validator = _fill_defaults(jsonschema.Draft202012Validator)(schema)
     errors = sorted(validator.iter_errors(cfg), key=lambda e: list(e.absolute_path))
