@@ -1,24 +1,16 @@
 # A parts library (config key library): one job reads each drawing, one job
 # plans each part (its only input: its own drawing), then the library's page,
 # JSON and CSV (pipeline/workflow/library.py says how and why).
-from pipeline.workflow.library import library_plan
+from pipeline.workflow.library import drawing_lookup, library_plan, part_runtime
 
 LIBRARY = library_plan(config)
 LIB = f"{RESULTS}/library"
 LIBRARY_TARGETS = [f"{RESULTS}/library.html"] if LIBRARY["drawings"] else []
 
 
-def library_drawing(wildcards):
-    """The drawing file a library job reads: the drawing itself, or a part's drawing."""
-    if "key" in wildcards.keys():
-        return LIBRARY["drawings"][LIBRARY["parts"][wildcards.key]["drawing"]]
-    return LIBRARY["drawings"][wildcards.drawing]
-
-
-def library_runtime(wildcards, attempt):
-    """Minutes a part's job may run: its time limit, the steps after it, and Python's start."""
-    limit = config.get("library", {}).get("time_limit_s")
-    return 120 if limit is None else int(3 + 3 * float(limit) / 60) * attempt
+# input functions and runtimes (pipeline/workflow/library.py)
+library_drawing = drawing_lookup(LIBRARY)
+library_runtime = part_runtime(config)
 
 
 rule library_read:

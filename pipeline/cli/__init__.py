@@ -17,6 +17,7 @@ module          verbs
 ``support``     ``support fit``
 ``feeder``      ``speed``, ``layout``, ``animate``
 ``design``      ``design`` (the smallest outline change fixed pins orient)
+``library``     ``library`` (every part of a folder of drawings, by the workflow)
 ``options``     the option groups they share
 ==============  =======================================================
 
@@ -37,7 +38,7 @@ import re
 import sys
 
 from pipeline import __version__
-from pipeline.cli import catalog, design, feeder, maps, plans, sense, support
+from pipeline.cli import catalog, design, feeder, library, maps, plans, sense, support
 from pipeline.cli.maps import DEFAULT_TRIANGLE, PAPER_D
 from pipeline.cli.options import parse_values, progress_line
 from pipeline.errors import PinfeedError
@@ -90,6 +91,7 @@ def build_parser() -> argparse.ArgumentParser:
     feeder.add_stored_plan_commands(sub)
     feeder.add_layout_commands(sub)
     design.add_design_command(sub)
+    library.add_library_command(sub)
     maps.add_demo_command(sub)
     sub.choices["plan"].set_defaults(func=_plan)
     return parser

@@ -159,6 +159,27 @@ def library_plan(config: dict, cache: Path = CACHE) -> dict:
     return {"drawings": {k: str(v) for k, v in drawings.items()}, "parts": parts}
 
 
+def drawing_lookup(plan: dict):
+    """The input function of the library's jobs: the drawing a job reads (by
+    its ``drawing`` wildcard, or its part's ``key``)."""
+    def drawing(wildcards):
+        if "key" in wildcards.keys():
+            return plan["drawings"][plan["parts"][wildcards.key]["drawing"]]
+        return plan["drawings"][wildcards.drawing]
+    return drawing
+
+
+def part_runtime(config: dict):
+    """The ``runtime`` resource of a part's job (minutes, for a cluster): its
+    time limit, the steps after it (speed limits, layout) and Python's start;
+    doubled on each retry."""
+    limit = (config.get("library") or {}).get("time_limit_s")
+
+    def runtime(wildcards, attempt):
+        return (120 if limit is None else int(3 + 3 * float(limit) / 60)) * attempt
+    return runtime
+
+
 # ---------------------------------------------------------------- the jobs
 
 
@@ -297,6 +318,8 @@ def answer(plan_result: dict | None) -> dict:
     else:
         cls = "no"
         text = "no: " + ("; ".join(nearest) if nearest else "no nearest \"yes\" found")
+    if cls not in ("fixed pins", "moving pins"):
+        verdict = {}  # no claim: no set, no width
     s = verdict.get("set") or {}
     return {"class": cls, "text": text, "fixed_pins": row["fixed_pins"], "moving_pins": row["moving_pins"],
             "plan": row["plan"], "set_start_deg": s.get("start"), "width_deg": verdict.get("width_deg"),

@@ -20,7 +20,8 @@ jobs are planned, and recovery after a run was killed (``kill -9``).
    ``--summary``, ...) print Snakemake's own output instead.
 5. When the run made the config's report, it prints its path
    (``report: .../results/NAME/report.html``; for the ``support_study``
-   target, ``report_support.html`` and one line per studied part).
+   target, ``report_support.html`` and one line per studied part; for the
+   ``library`` target, ``library.html`` after the count of parts per answer).
 
 The Snakefile calls :func:`reconcile_catalog` while it loads, before
 Snakemake plans any job: Snakemake treats a missing intermediate file (a
@@ -230,7 +231,12 @@ def _print_report_path(args: list[str]) -> None:
     and the study's answer per part."""
     from pipeline.config import load_config, results_folder
     results = results_folder(load_config(_config_path(args)))
-    if "support_study" in args:
+    if "library" in args:
+        from pipeline.maps.io import read_json
+        if (results / "library.json").is_file():
+            print(f"library: {read_json(results / 'library.json')['summary']}", flush=True)
+        report = results / "library.html"
+    elif "support_study" in args:
         from pipeline.maps.io import read_json
         from pipeline.workflow.supports import support_summary_text
         for path in sorted((results / "support").glob("*.json")):
