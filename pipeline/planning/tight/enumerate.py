@@ -49,6 +49,7 @@ from pipeline.progress import BATCH_SECONDS, NO_DEADLINE, SILENT, Deadline, Hear
 QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout
 MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
 FIRST_PARENTS = 64  # parents of the first batch of a level under a time limit (it sets the pace)
+MAX_OUTCOMES = 8_000_000  # nominal outcomes kept for reuse (about 200 MB)
 
 
 @dataclass
@@ -112,6 +113,9 @@ class NominalTree:
         n_states = self.part.stable_states().shape[0]
         self.column_support = np.repeat(np.arange(len(self.supports)), n_states)
         self.rollouts = 0
+        self._outcomes = _Outcomes()
+        self._column_tries = np.zeros(self.column_support.size, dtype=np.int64)
+        self._column_drops = np.zeros(self.column_support.size, dtype=np.int64)
 
     def start_poses(self) -> np.ndarray:
         """``(columns, 2)``: each column's resting state ``(theta, y_c)``
@@ -191,7 +195,7 @@ class NominalTree:
         y_c = np.repeat(level.y, n_pins, axis=0)
         y_pin = np.tile(self.heights, n)[:, None]
         v_pin = np.broadcast_to(np.tile(self.speeds, n)[:, None], theta.shape)
-        status, theta_f, dy = self._rollouts(theta, y_pin - y_c, v_pin, stretch)
+        status, theta_f, dy = self._columns(theta, y_pin - y_c, v_pin, stretch)
         touched = status != MISS
         d_abs = np.abs(y_pin - y_c) / self.part.a
         bad = ((status == JAMMED) | (status == TRUNCATED)).any(axis=1)
@@ -204,13 +208,45 @@ class NominalTree:
         margin = np.minimum(np.repeat(level.margin, n_pins), step_margin)
         return Level(seq[keep], theta_f[keep], (y_c + dy)[keep], margin[keep])
 
-    def _rollouts(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT):
+    def _columns(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT):
+        """:meth:`_rollouts` of every (candidate sequence, column) pair, one
+        column at a time: a candidate whose rollout in one column jams (or runs
+        out of steps) or passes a centroid it touches within ``pin_halfwidth``
+        is dropped whatever its other columns do, so its other columns are not
+        rolled out. Those entries keep the pose they started from and read
+        ``JAMMED``: the candidate is dropped all the same, and every surviving
+        candidate has all its columns rolled out, exactly as at once. The
+        columns go in the order of the share of candidates each dropped so far
+        (any order gives the same survivors)."""
+        n, cols = theta.shape
+        status = np.full(theta.shape, JAMMED, dtype=np.int8)
+        theta_f, dy = theta.astype(float, copy=True), np.zeros(theta.shape)
+        alive = np.arange(n)
+        for k, c in enumerate(np.argsort(-self._column_drops / np.maximum(self._column_tries, 1), kind="stable")):
+            if alive.size == 0:
+                break
+            st, tf, d = self._rollouts(theta[alive, c:c + 1], dy_pin[alive, c:c + 1], v_pin[alive, c:c + 1],
+                                       stretch.part(k / cols, (k + 1) / cols), columns=np.array([c]))
+            status[alive, c], theta_f[alive, c], dy[alive, c] = st[:, 0], tf[:, 0], d[:, 0]
+            st = st[:, 0]
+            drop = (st == JAMMED) | (st == TRUNCATED) | ((st != MISS) & (np.abs(dy_pin[alive, c]) < self.pin_halfwidth))
+            self._column_tries[c] += alive.size
+            self._column_drops[c] += int(drop.sum())
+            alive = alive[~drop]
+        return status, theta_f, dy
+
+    def _rollouts(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT, columns=None):
         """``(status, theta_f, dy)`` arrays shaped like ``theta`` for the pin offsets
         ``dy_pin`` (mm) and pin speeds ``v_pin``, one rollout per distinct
-        quantised pose and speed (``stretch`` is told the share done)."""
+        quantised pose and speed (``stretch`` is told the share done); the
+        columns of ``theta`` are the tree's columns ``columns`` (default all).
+        An outcome is a function of its key alone, so the outcomes of keys
+        rolled out before (by any level, chunk or column of this tree) are
+        reused (``_Outcomes``)."""
         a = self.part.a
         speed_index = np.searchsorted(np.unique(self.speeds), v_pin)
-        support = np.broadcast_to(self.column_support[None, :], theta.shape)
+        col_support = self.column_support if columns is None else self.column_support[columns]
+        support = np.broadcast_to(col_support[None, :], theta.shape)
         keys = np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM), speed_index,
                          support], axis=-1).reshape(-1, 4).astype(np.int64)
         if keys.shape[0] == 0:
@@ -218,14 +254,64 @@ class NominalTree:
             return empty.astype(np.int8), empty, empty
         uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
         inverse = inverse.ravel()
-        # Roll out from the rounded pose itself, so an outcome depends on its key only.
-        res = rollouts_by_speed(self.part, uniq[:, 0] * QUANTUM, uniq[:, 1] * QUANTUM / a,
-                                np.full(uniq.shape[0], self.mu_c), np.unique(self.speeds)[uniq[:, 2]],
-                                self.pin_radius, self.model, self.kernel, uniq[:, 3], self.supports, stretch)
-        self.rollouts += uniq.shape[0]
+        status, theta_f, dy, known = self._outcomes.lookup(uniq)
+        new = np.flatnonzero(~known)
+        if new.size:
+            # Roll out from the rounded pose itself, so an outcome depends on its key only.
+            todo = uniq[new]
+            res = rollouts_by_speed(self.part, todo[:, 0] * QUANTUM, todo[:, 1] * QUANTUM / a,
+                                    np.full(todo.shape[0], self.mu_c), np.unique(self.speeds)[todo[:, 2]],
+                                    self.pin_radius, self.model, self.kernel, todo[:, 3], self.supports, stretch)
+            status[new], theta_f[new], dy[new] = res["status"], res["theta_f"], res["dy"]
+            self._outcomes.add(todo, status[new], theta_f[new], dy[new])
+        self.rollouts += new.size
         shape = theta.shape
-        return (res["status"][inverse].reshape(shape), res["theta_f"][inverse].reshape(shape),
-                res["dy"][inverse].reshape(shape))
+        return status[inverse].reshape(shape), theta_f[inverse].reshape(shape), dy[inverse].reshape(shape)
+
+
+class _Outcomes:
+    """The nominal rollouts' outcomes ``(status, theta_f, dy)`` by key (a
+    rounded pose, pin offset, speed and support: a rollout starts from the
+    rounded pose itself, so its outcome is a function of the key alone), up
+    to ``MAX_OUTCOMES`` keys; later keys are rolled out without being kept."""
+
+    def __init__(self):
+        self.codes = np.zeros(0, dtype=np.int64)
+        self.status = np.zeros(0, dtype=np.int8)
+        self.theta_f, self.dy = np.zeros(0), np.zeros(0)
+
+    @staticmethod
+    def _codes(keys):
+        """One int64 per key row, or ``None`` where a key is out of range."""
+        t, d, v, s = keys.T
+        if keys.size and (t.min() < 0 or t.max() >= 1 << 14 or np.abs(d).max() >= 1 << 30 or v.max() >= 1 << 8
+                          or s.max() >= 1 << 8 or v.min() < 0 or s.min() < 0):
+            return None
+        return (((t << 31) + (d + (1 << 30))) << 16) + (v << 8) + s
+
+    def lookup(self, keys):
+        """``(status, theta_f, dy, known)`` arrays over the key rows ``keys``."""
+        n = keys.shape[0]
+        status, theta_f, dy = np.zeros(n, dtype=np.int8), np.zeros(n), np.zeros(n)
+        known = np.zeros(n, bool)
+        codes = self._codes(keys)
+        if codes is None or self.codes.size == 0:
+            return status, theta_f, dy, known
+        at = np.minimum(np.searchsorted(self.codes, codes), self.codes.size - 1)
+        known = self.codes[at] == codes
+        status[known], theta_f[known], dy[known] = self.status[at[known]], self.theta_f[at[known]], self.dy[at[known]]
+        return status, theta_f, dy, known
+
+    def add(self, keys, status, theta_f, dy) -> None:
+        """Keep the outcomes of the (new) key rows ``keys``, while there is room."""
+        codes = self._codes(keys)
+        if codes is None or self.codes.size + codes.size > MAX_OUTCOMES:
+            return
+        order = np.argsort(np.concatenate([self.codes, codes]), kind="stable")
+        self.codes = np.concatenate([self.codes, codes])[order]
+        self.status = np.concatenate([self.status, np.asarray(status, dtype=np.int8)])[order]
+        self.theta_f = np.concatenate([self.theta_f, theta_f])[order]
+        self.dy = np.concatenate([self.dy, dy])[order]
 
 
 def _joined(parts) -> Level:

@@ -23,16 +23,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL
+from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAMMED, TRUNCATED
 
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
-from pipeline.planning.claims.verify import holdout_settings, replay_shared, trial_inputs
+from pipeline.planning.claims.verify import _kernel_kw, _pin_step, holdout_settings, trial_inputs
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
 from pipeline.progress import SILENT, Heartbeat, Stretch
 
 MAX_ROWS = 150_000  # trials replayed in one batch
+MAX_KEPT = 3_000_000  # trial states after a prefix kept for reuse (a few hundred MB at most)
 
 
 def stack(rows) -> tuple:
@@ -76,6 +77,7 @@ class TrialBench:
         self.states = resting_states(part)
         self.family = None if family is None or family.is_uniform else family
         self.supports = None if self.family is None else self.family.kernel_supports
+        self.kept = PrefixStates()
 
     def trials(self, n_pins: int) -> list:
         """The verification's trials for plans of ``n_pins`` pins (``verify.trial_inputs``), per state."""
@@ -108,12 +110,49 @@ class TrialBench:
     def replay(self, heights, speeds, rows, stretch: Stretch = SILENT):
         """Final orientations ``(sequences, trials)`` and jam flags of the
         sequences ``heights``, ``speeds`` on ``rows`` (``stretch`` is told how
-        far the replay has got). Sequences that share their first pins share
-        those rollouts (``verify.replay_shared``)."""
-        th, yc, mu, offs, sup = rows
-        return replay_shared(self.part, heights, speeds, th, yc, mu, offs, self.pin_radius, self.model,
-                             self.kernel["ds_max"], self.kernel["tol"], **self.belt, support=sup,
-                             supports=self.supports, stretch=stretch)
+        far the replay has got), as ``verify.replay_shared`` gives them:
+        sequences that share their first pins share those rollouts, and so do
+        the calls of this bench (:class:`PrefixStates`: the probe, the screen,
+        the cascade and the full judgement replay subsets of one level's
+        trials, in blocks whose sequences share prefixes with earlier blocks).
+        A trial's state after a prefix depends on the trial and the prefix
+        only, and each rollout is independent of its batch, so the numbers are
+        those of one ``replay_shared`` call."""
+        th0, yc0, mu, offsets, sup = rows
+        heights, speeds = np.atleast_2d(np.asarray(heights, float)), np.atleast_2d(np.asarray(speeds, float))
+        n_plans, n_pins = heights.shape
+        n = np.size(th0)
+        kept = self.kept
+        trial = kept.trial_ids(rows)
+        kw = _kernel_kw(self.kernel["ds_max"], self.kernel["tol"], self.belt.get("belt_speed"),
+                        self.belt.get("mu_s", 0.5))
+        node, key = np.zeros(n_plans, int), np.zeros(1, dtype=np.int64)  # distinct prefixes; their keys
+        th, yc = np.asarray(th0, float)[None, :].copy(), np.asarray(yc0, float)[None, :].copy()
+        jam = np.zeros((1, n), bool)
+        for k in range(n_pins):
+            nodes, node = np.unique(np.column_stack([node, heights[:, k], speeds[:, k]]), axis=0,
+                                    return_inverse=True)
+            node = node.ravel()
+            parent = nodes[:, 0].astype(int)
+            th, yc, jam = th[parent], yc[parent], jam[parent]
+            key = np.array([kept.node(key[p], h, v) for p, h, v in zip(parent.tolist(), nodes[:, 1].tolist(),
+                                                                           nodes[:, 2].tolist())], dtype=np.int64)
+            rows_, cols = np.nonzero(~jam)
+            at = kept.lookup(key[rows_], trial[cols])
+            old = at >= 0
+            th[rows_[old], cols[old]], yc[rows_[old], cols[old]], jam[rows_[old], cols[old]] = kept.get(at[old])
+            rows_, cols = rows_[~old], cols[~old]
+            if rows_.size:
+                res = _pin_step(self.part, nodes[rows_, 1] + offsets[cols, k], nodes[rows_, 2], th[rows_, cols],
+                                yc[rows_, cols], mu[cols], self.pin_radius, self.model, kw,
+                                None if sup is None else np.asarray(sup)[cols], self.supports,
+                                stretch.part(k / n_pins, (k + 1) / n_pins))
+                th[rows_, cols] = res["theta_f"]
+                yc[rows_, cols] = yc[rows_, cols] + res["dy"]
+                st = res["status"]
+                jam[rows_, cols] = (st == JAMMED) | (st == TRUNCATED)
+                kept.add(key[rows_], trial[cols], th[rows_, cols], yc[rows_, cols], jam[rows_, cols])
+        return th[node] % 360.0, jam[node]
 
     def failures(self, heights, speeds, rows, stretch: Stretch = SILENT) -> np.ndarray:
         """Trials of ``rows`` that no one arc of the tolerance can hold, per
@@ -138,6 +177,56 @@ class TrialBench:
         for k in range(heights.shape[0]):
             yield orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order, self.required,
                                self.confidence, interval, self.rule)
+
+
+class PrefixStates:
+    """Each trial's state ``(theta, y_c, jammed)`` after a prefix of pins, kept
+    for later replays on the same bench (up to ``MAX_KEPT`` states; later ones
+    are rolled out without being kept).
+
+    A prefix is a node: the empty prefix is 0 and each (node, pin height,
+    pin speed) gets the next number; a trial is numbered by its values (its
+    start, friction, pin offsets and support), so the same trial in two sets
+    of rows (the probe's rows are among the screen's, the screen's among the
+    full trials) is one trial."""
+
+    def __init__(self):
+        self.nodes, self.trials, self.at = {}, {}, {}
+        self.theta, self.y_c, self.jammed = np.zeros(1024), np.zeros(1024), np.zeros(1024, bool)
+
+    def node(self, parent: int, height: float, speed: float) -> int:
+        """The number of the prefix ``parent`` followed by a pin at ``height``, ``speed``."""
+        return self.nodes.setdefault((int(parent), float(height), float(speed)), len(self.nodes) + 1)
+
+    def trial_ids(self, rows) -> np.ndarray:
+        """The number of each trial of ``rows``."""
+        th, yc, mu, offsets, sup = rows
+        n = np.size(th)
+        values = np.column_stack([np.asarray(th, float), np.asarray(yc, float), np.asarray(mu, float),
+                                  np.asarray(offsets, float).reshape(n, -1),
+                                  np.zeros(n) if sup is None else np.asarray(sup, float)])
+        return np.array([self.trials.setdefault(v.tobytes(), len(self.trials)) for v in values], dtype=np.int64)
+
+    def lookup(self, nodes, trials) -> np.ndarray:
+        """Where the state of each (node, trial) pair is kept (-1: not kept)."""
+        get = self.at.get
+        return np.array([get((a, b), -1) for a, b in zip(nodes.tolist(), trials.tolist())], dtype=np.int64)
+
+    def get(self, at) -> tuple:
+        """``(theta, y_c, jammed)`` kept at ``at``."""
+        return self.theta[at], self.y_c[at], self.jammed[at]
+
+    def add(self, nodes, trials, theta, y_c, jammed) -> None:
+        """Keep the states of the (node, trial) pairs, while there is room."""
+        start = len(self.at)
+        if start + nodes.size > MAX_KEPT:
+            return
+        while self.theta.size < start + nodes.size:
+            self.theta, self.y_c = np.concatenate([self.theta, self.theta]), np.concatenate([self.y_c, self.y_c])
+            self.jammed = np.concatenate([self.jammed, self.jammed])
+        self.theta[start:start + nodes.size], self.y_c[start:start + nodes.size] = theta, y_c
+        self.jammed[start:start + nodes.size] = jammed
+        self.at.update(zip(zip(nodes.tolist(), trials.tolist()), range(start, start + nodes.size)))
 
 
 class Certifier:
