@@ -15,13 +15,17 @@ import csv
 import html
 import io
 import json
-import os
 from pathlib import Path
 
 COLUMNS = ("label", "drawing", "key", "class", "answer", "width_mm", "height_mm", "vertices", "holes",
            "resting_states", "fixed_pins", "moving_pins", "plan", "set_start_deg", "width_deg",
            "share_lower_bound", "sets", "complete", "nearest_yes", "reason", "planning_seconds",
            "thumbnail", "plan_file", "layout", "animation", "log")
+# Answer classes, in the order the report sorts them.
+CLASSES = ("fixed pins", "moving pins", "sensor", "no", "not decided", "not readable")
+CLASS_TEXT = {"fixed pins": "orients with fixed pins", "moving pins": "needs moving pins",
+              "sensor": "needs the sensor", "no": "no (see its nearest \"yes\")",
+              "not decided": "not decided within the time limit", "not readable": "not readable"}
 COLOURS = {"fixed pins": "#2a7d2a", "moving pins": "#c77c00", "sensor": "#b05000", "no": "#b00",
            "not decided": "#666", "not readable": "#555"}
 
@@ -51,73 +55,8 @@ def draw_thumbnail(part, out) -> Path:
     return out
 
 
-# ---------------------------------------------------------------- rows
-
-
-def _row(**values) -> dict:
-    return {k: values.get(k) for k in COLUMNS}
-
-
-def library_rows(records, part_dirs, base, logs: dict | None = None) -> list[dict]:
-    """One row per part (and per unreadable drawing or part) from the drawings'
-    read records and the parts' folders (``{key: folder}``); paths in the rows
-    are relative to ``base`` (the page's folder). ``logs``: key -> a part job's log."""
-    from pipeline.workflow.library import CLASS_TEXT, answer
-    rows = []
-    for rec in sorted(records, key=lambda r: r["drawing"]):
-        name = Path(rec["file"]).name
-        if rec.get("error"):
-            rows.append(_row(label=name, drawing=rec["drawing"], key=rec["drawing"], **{"class": "not readable"},
-                             answer=f"not readable: {rec['error']}", reason=rec["error"]))
-            continue
-        for part in rec["parts"]:
-            folder = Path(part_dirs.get(part["key"], ""))
-            rows.append(_part_row(rec, part, folder, base, (logs or {}).get(part["key"]), answer, CLASS_TEXT))
-        for ref in rec["refused"]:
-            rows.append(_row(label=ref["label"], drawing=rec["drawing"], key=part_key_of(rec, ref["label"]),
-                             **{"class": "not readable"}, answer=f"not readable: {ref['reason']}",
-                             reason=ref["reason"]))
-    rows.sort(key=lambda r: (r["drawing"], int(r["label"].rsplit("#", 1)[1]) if "#" in r["label"] else -1))
-    return rows
-
-
-def part_key_of(rec: dict, label: str) -> str:
-    from pipeline.workflow.library import part_key
-    return part_key(rec["drawing"], label) if "#" in label else rec["drawing"]
-
-
-def _part_row(rec, part, folder: Path, base, log, answer, class_text) -> dict:
-    def rel(name):
-        return os.path.relpath(folder / name, base) if name else None
-    info = {}
-    if (folder / "part.json").is_file():
-        info = json.loads((folder / "part.json").read_text())
-    files = info.get("files") or {}
-    common = dict(label=part["label"], drawing=rec["drawing"], key=part["key"],
-                  width_mm=part["width_mm"], height_mm=part["height_mm"], vertices=part["vertices"],
-                  holes=part["holes"], resting_states=info.get("resting_states"),
-                  thumbnail=rel(files.get("thumbnail")), plan_file=rel(files.get("plan")),
-                  layout=rel(files.get("layout")), animation=rel(files.get("animation")),
-                  log=os.path.relpath(log, base) if log and Path(log).is_file() else None,
-                  planning_seconds=info.get("seconds"))
-    if not info:
-        return _row(**common, **{"class": "not readable"}, answer="not planned: its job left no record",
-                    reason="its job left no record (see its log)")
-    if info["status"] != "planned":
-        what = "refused by the planner" if info["status"] == "refused" else "planning failed"
-        return _row(**common, **{"class": "not readable"}, answer=f"not readable ({what}): {info['reason']}",
-                    reason=info["reason"])
-    plan = json.loads((folder / "plan.json").read_text())
-    ans = answer(plan)
-    text = ans["text"] + ("" if ans["complete"] else " [search not complete: time limit]")
-    return _row(**common, **{"class": ans["class"]}, answer=text,
-                **{k: ans[k] for k in ("fixed_pins", "moving_pins", "plan", "set_start_deg", "width_deg",
-                                       "share_lower_bound", "sets", "complete", "nearest_yes")})
-
-
 def class_counts(rows) -> dict:
     """Parts per answer class, in the classes' order (classes with none left out)."""
-    from pipeline.workflow.library import CLASSES
     counts = {c: 0 for c in CLASSES}
     for r in rows:
         counts[r["class"]] += 1
@@ -126,7 +65,6 @@ def class_counts(rows) -> dict:
 
 def summary_line(rows) -> str:
     """``N parts: a orient with fixed pins, b need moving pins, ...``."""
-    from pipeline.workflow.library import CLASS_TEXT
     counts = class_counts(rows)
     return f"{len(rows)} parts: " + ", ".join(f"{n} {CLASS_TEXT[c]}" for c, n in counts.items())
 
@@ -236,7 +174,6 @@ def _html_row(r: dict) -> str:
 
 def library_page(rows, title: str, note: str = "") -> str:
     """The library's HTML page (one table; sort by a header's click, filter by answer)."""
-    from pipeline.workflow.library import CLASS_TEXT, CLASSES
     counts = class_counts(rows)
     options = "".join(f'<option value="{html.escape(c)}">{html.escape(CLASS_TEXT[c])} ({n})</option>'
                       for c, n in counts.items())

@@ -13,7 +13,8 @@ The config key ``library`` lists drawings (files, folders, glob patterns;
   planning step that fails writes its one-line reason there instead, so the
   other parts and the report go on;
 - ``library`` (the target): ``RESULTS/library.html``, ``library.json`` and
-  ``library.csv``, one row per part (:mod:`pipeline.present.library`).
+  ``library.csv``, one row per part (:func:`library_rows`, drawn by
+  :mod:`pipeline.present.library`).
 
 Which parts a drawing holds is read when the workflow loads (a few hundredths
 of a second a drawing), cached by the drawing's content in
@@ -26,21 +27,16 @@ from __future__ import annotations
 import glob
 import hashlib
 import json
+import os
 import re
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
+from pipeline.present.library import CLASS_TEXT, CLASSES  # noqa: F401  (the classes, named here too)
 
 SUFFIXES = (".dxf", ".svg")
 READER_KEYS = ("layer", "flatten_tol", "units", "join_tol")
 CACHE = Path(".snakemake") / "pinfeed-library"
-# Answer classes, in the order the report sorts them.
-CLASSES = ("fixed pins", "moving pins", "sensor", "no", "not decided", "not readable")
-CLASS_TEXT = {"fixed pins": "orients with fixed pins", "moving pins": "needs moving pins",
-              "sensor": "needs the sensor", "no": "no (see its nearest \"yes\")",
-              "not decided": "not decided within the time limit", "not readable": "not readable"}
-
-
 # ---------------------------------------------------------------- which drawings, which parts
 
 
@@ -181,6 +177,14 @@ def part_runtime(config: dict):
 
 
 # ---------------------------------------------------------------- the jobs
+
+
+def write_read_record(drawing_id: str, path, lib: dict, out) -> dict:
+    """Rule ``library_read``: :func:`read_record`, written to ``out``."""
+    from pipeline.maps.io import write_json
+    rec = read_record(drawing_id, path, lib)
+    write_json(rec, out)
+    return rec
 
 
 def read_record(drawing_id: str, path, lib: dict) -> dict:
@@ -329,10 +333,73 @@ def answer(plan_result: dict | None) -> dict:
             "planning_seconds": row.get("planning_seconds")}
 
 
+# ---------------------------------------------------------------- the library's rows
+
+
+def _row(**values) -> dict:
+    from pipeline.present.library import COLUMNS
+    return {k: values.get(k) for k in COLUMNS}
+
+
+def library_rows(records, part_dirs, base, logs: dict | None = None) -> list[dict]:
+    """One row per part (and per unreadable drawing or part) from the drawings'
+    read records and the parts' folders (``{key: folder}``); paths in the rows
+    are relative to ``base`` (the page's folder). ``logs``: key -> a part job's log."""
+    rows = []
+    for rec in sorted(records, key=lambda r: r["drawing"]):
+        name = Path(rec["file"]).name
+        if rec.get("error"):
+            rows.append(_row(label=name, drawing=rec["drawing"], key=rec["drawing"], **{"class": "not readable"},
+                             answer=f"not readable: {rec['error']}", reason=rec["error"]))
+            continue
+        for part in rec["parts"]:
+            folder = Path(part_dirs.get(part["key"], ""))
+            rows.append(_part_row(rec, part, folder, base, (logs or {}).get(part["key"]), answer))
+        for ref in rec["refused"]:
+            rows.append(_row(label=ref["label"], drawing=rec["drawing"], key=part_key_of(rec, ref["label"]),
+                             **{"class": "not readable"}, answer=f"not readable: {ref['reason']}",
+                             reason=ref["reason"]))
+    rows.sort(key=lambda r: (r["drawing"], int(r["label"].rsplit("#", 1)[1]) if "#" in r["label"] else -1))
+    return rows
+
+
+def part_key_of(rec: dict, label: str) -> str:
+    return part_key(rec["drawing"], label) if "#" in label else rec["drawing"]
+
+
+def _part_row(rec, part, folder: Path, base, log, answer) -> dict:
+    def rel(name):
+        return os.path.relpath(folder / name, base) if name else None
+    info = {}
+    if (folder / "part.json").is_file():
+        info = json.loads((folder / "part.json").read_text())
+    files = info.get("files") or {}
+    common = dict(label=part["label"], drawing=rec["drawing"], key=part["key"],
+                  width_mm=part["width_mm"], height_mm=part["height_mm"], vertices=part["vertices"],
+                  holes=part["holes"], resting_states=info.get("resting_states"),
+                  thumbnail=rel(files.get("thumbnail")), plan_file=rel(files.get("plan")),
+                  layout=rel(files.get("layout")), animation=rel(files.get("animation")),
+                  log=os.path.relpath(log, base) if log and Path(log).is_file() else None,
+                  planning_seconds=info.get("seconds"))
+    if not info:
+        return _row(**common, **{"class": "not readable"}, answer="not planned: its job left no record",
+                    reason="its job left no record (see its log)")
+    if info["status"] != "planned":
+        what = "refused by the planner" if info["status"] == "refused" else "planning failed"
+        return _row(**common, **{"class": "not readable"}, answer=f"not readable ({what}): {info['reason']}",
+                    reason=info["reason"])
+    plan = json.loads((folder / "plan.json").read_text())
+    ans = answer(plan)
+    text = ans["text"] + ("" if ans["complete"] else " [search not complete: time limit]")
+    return _row(**common, **{"class": ans["class"]}, answer=text,
+                **{k: ans[k] for k in ("fixed_pins", "moving_pins", "plan", "set_start_deg", "width_deg",
+                                       "share_lower_bound", "sets", "complete", "nearest_yes")})
+
+
 def library_report(config: dict, record_paths, part_dirs: dict, outputs: dict, logs: dict | None = None) -> dict:
     """Rule ``library``: the rows of every part (:func:`pipeline.present.library.library_rows`)
     written as ``outputs["html"]``, ``["json"]`` and ``["csv"]``."""
-    from pipeline.present.library import library_rows, write_library
+    from pipeline.present.library import write_library
     from pipeline.provenance import provenance_attrs
     records = [json.loads(Path(p).read_text()) for p in record_paths]
     base = Path(outputs["html"]).parent

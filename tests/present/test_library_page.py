@@ -15,8 +15,7 @@ from pathlib import Path
 import pytest
 
 from pipeline.parts.part import Part
-from pipeline.present.library import COLUMNS, draw_thumbnail, summary_line, write_library
-from pipeline.workflow.library import CLASSES
+from pipeline.present.library import CLASSES, COLUMNS, draw_thumbnail, summary_line, write_library
 
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync",

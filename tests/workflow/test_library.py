@@ -169,9 +169,8 @@ def test_the_library_rules_pass_snakemake_lint(library_run):
 
 def test_a_part_whose_planning_fails_is_recorded_and_reported(tmp_path, monkeypatch):
     from pipeline.config import load_config
-    from pipeline.present.library import library_rows
     from pipeline.workflow import commands
-    from pipeline.workflow.library import plan_library_part, read_record
+    from pipeline.workflow.library import library_rows, plan_library_part, read_record
     config = load_config()
     config["library"] = {"paths": [str(DRAWINGS)], "time_limit_s": 5}
 
