@@ -401,6 +401,9 @@ def library_report(config: dict, record_paths, part_dirs: dict, outputs: dict, l
     written as ``outputs["html"]``, ``["json"]`` and ``["csv"]``."""
     from pipeline.present.library import write_library
     from pipeline.provenance import provenance_attrs
+    if not config.get("library"):
+        raise PinfeedError("this config has no parts library: add the key library (paths: the drawings), "
+                           "or run 'pinfeed library DRAWINGS'")
     records = [json.loads(Path(p).read_text()) for p in record_paths]
     base = Path(outputs["html"]).parent
     rows = library_rows(records, part_dirs, base, logs)
