@@ -35,7 +35,8 @@ from pipeline.planning import PlannerSettings, plan_tight_all  # noqa: E402
 
 REPLAY_STAGES = {"_probe": "probe", "_cascade": "cascade", "_drop_known_broken": "known members",
                  "_judge": "judge", "certify": "held-out", "several_sets": "evidence", "failures": "screen",
-                 "judge": "judge"}
+                 "judge": "judge", "verify_plan": "verification", "untruncated_check": "tails",
+                 "sampled_plan": "sampled carried sets"}
 COUNTS = collections.Counter()
 SECONDS = collections.Counter()
 _original = simulate.rollout_points
@@ -46,7 +47,8 @@ def _stage() -> str:
     if "_rollouts" in names:
         return "moving nominal" if "_moving_search" in names else "nominal"
     if "_pin_step" in names:
-        where = next((n for n in reversed(names) if n in REPLAY_STAGES and n not in ("failures", "judge")),
+        where = next((n for n in reversed(names) if n in REPLAY_STAGES and n not in ("failures", "judge")
+                      and not (n == "verify_plan" and "untruncated_check" in names)),
                      "failures" if "failures" in names else "replay")
         return ("moving " if "_moving_search" in names else "") + REPLAY_STAGES.get(where, where)
     return "other"

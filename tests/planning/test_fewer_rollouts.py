@@ -110,3 +110,29 @@ def test_replays_reuse_the_states_of_earlier_calls_and_give_the_same_numbers():
         np.testing.assert_array_equal(tf, ref_tf)
         np.testing.assert_array_equal(jam, ref_jam)
         assert len(bench.kept.at) > before or rows is full
+
+
+def test_verifying_plans_with_a_memo_gives_the_same_records():
+    from pipeline.planning.claims import verify as verify_module
+    from pipeline.planning.claims.verify import ReplayMemo, verify_plan
+    from pipeline.planning.core.resting import resting_states
+
+    part = PARTS["l_bracket"]()
+    heights = _pins(part, 6)
+    pins = {f"P{k}": float(y) for k, y in enumerate(heights)}
+    states = resting_states(part)
+    cfg = {"trials": 12, "seed": 5}
+    plans = [["P1", "P3", "P2"], ["P1", "P3", "P4"], ["P1", "P3", "P2"], ["P2", "P3", "P4"], ["P1", "P3"]]
+    memo, counted = ReplayMemo(), []
+    original = verify_module._pin_step
+    try:
+        verify_module._pin_step = lambda *a, **k: counted.append(np.size(a[1])) or original(*a, **k)
+        with_memo = [verify_plan(part, {"pins": p, "initial_states": {k: [] for k in states}}, pins, states, (0.1, 0.3), 3.0, settings=cfg, memo=memo)
+                     for p in plans]
+        used = sum(counted)
+        counted.clear()
+        without = [verify_plan(part, {"pins": p, "initial_states": {k: [] for k in states}}, pins, states, (0.1, 0.3), 3.0, settings=cfg) for p in plans]
+    finally:
+        verify_module._pin_step = original
+    assert with_memo == without
+    assert used < sum(counted)

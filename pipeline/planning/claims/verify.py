@@ -183,7 +183,7 @@ def _start(state):
 
 def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
            ds_max=DEFAULT_DS_MAX, tol=DEFAULT_TOL, path=None, belt_speed=None, mu_s=0.5,
-           support=None, supports=None, stretch: Stretch = SILENT):
+           support=None, supports=None, stretch: Stretch = SILENT, memo: "ReplayMemo | None" = None):
     """Roll every trial past every pin in turn (batched per pin).
 
     ``belt_speed`` (mm/s) replays with the dynamic model at that speed and
@@ -198,7 +198,9 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     ``missed`` a boolean array ``(n_trials, n_pins)``. If ``path`` is a list,
     ``(theta, y_c)`` arrays after each pin are appended to it. ``stretch``
     (:class:`pipeline.progress.Stretch`) is told how far the replay has got,
-    each pin an equal share."""
+    each pin an equal share. ``memo`` (a :class:`ReplayMemo`, for replays
+    with the same part and rollout settings) keeps each trial's state after
+    each prefix of pins and reuses it: the numbers are the same."""
     theta, y_c = np.array(theta, float), np.array(y_c, float)
     n = theta.size
     n_pins = np.shape(pin_speeds)[-1] if np.ndim(pin_speeds) else 0
@@ -209,24 +211,91 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     missed = np.zeros((n, n_pins), bool)
     alive = np.ones(n, bool)
     kw = _kernel_kw(ds_max, tol, belt_speed, mu_s)
+    if memo is not None:
+        trial, node = memo.trial_ids(theta, y_c, mu, offsets, support), np.zeros(n, dtype=np.int64)
     for k in range(n_pins):
         idx = np.flatnonzero(alive)
         if idx.size == 0:
             break
-        res = _pin_step(part, heights[idx, k] + offsets[idx, k], speeds[idx, k], theta[idx], y_c[idx], mu[idx],
-                        pin_radius, model, kw, None if support is None else support[idx], supports,
-                        stretch.part(k / n_pins, (k + 1) / n_pins))
-        st = res["status"]
-        stuck = (st == JAMMED) | (st == TRUNCATED)
-        for j in np.flatnonzero(stuck):
-            jam[idx[j]] = f"jammed ({JAM_REASONS[res['jam_reason'][j]] or 'truncated'})"
-        alive[idx[stuck]] = False
-        missed[idx, k] = st == MISS
-        theta[idx] = res["theta_f"]
-        y_c[idx] = y_c[idx] + res["dy"]
+        if memo is not None:
+            node = memo.nodes(node, heights[:, k], speeds[:, k])
+            at = memo.lookup(node[idx], trial[idx])
+            old, idx = idx[at >= 0], idx[at < 0]
+            theta[old], y_c[old], reason, missed[old, k] = memo.get(at[at >= 0])
+            jam[old] = reason
+            alive[old[reason != ""]] = False
+        if idx.size:
+            res = _pin_step(part, heights[idx, k] + offsets[idx, k], speeds[idx, k], theta[idx], y_c[idx], mu[idx],
+                            pin_radius, model, kw, None if support is None else support[idx], supports,
+                            stretch.part(k / n_pins, (k + 1) / n_pins))
+            st = res["status"]
+            stuck = (st == JAMMED) | (st == TRUNCATED)
+            for j in np.flatnonzero(stuck):
+                jam[idx[j]] = f"jammed ({JAM_REASONS[res['jam_reason'][j]] or 'truncated'})"
+            alive[idx[stuck]] = False
+            missed[idx, k] = st == MISS
+            theta[idx] = res["theta_f"]
+            y_c[idx] = y_c[idx] + res["dy"]
+            if memo is not None:
+                memo.add(node[idx], trial[idx], theta[idx], y_c[idx], jam[idx], missed[idx, k])
         if path is not None:
             path.append((np.where(alive, theta % 360.0, np.nan), np.where(alive, y_c, np.nan)))
     return theta % 360.0, y_c, jam, missed
+
+
+class ReplayMemo:
+    """Each trial's state after a prefix of pins, for :func:`replay` calls with
+    one part and one set of rollout settings (the chosen plans verified on
+    the same held-out trials share their first pins): ``(theta, y_c, jam
+    reason, missed the last pin)`` by (prefix, trial), up to ``max_kept``
+    states. A prefix is numbered from the empty one (0) by (prefix, pin
+    height, pin speed); a trial by its values (start, friction, pin offsets,
+    support). A state depends on the prefix and the trial only, and each
+    rollout on its own inputs only, so a replay with a memo gives the
+    numbers it gives without."""
+
+    def __init__(self, max_kept: int = 1_000_000):
+        self.max_kept = int(max_kept)
+        self.prefixes, self.trials, self.at, self.reasons = {}, {}, {}, {"": 0}
+        self.theta, self.y_c = np.zeros(256), np.zeros(256)
+        self.reason, self.missed = np.zeros(256, dtype=np.int32), np.zeros(256, bool)
+
+    def trial_ids(self, theta, y_c, mu, offsets, support) -> np.ndarray:
+        """The number of each trial (by its values)."""
+        n = np.size(theta)
+        values = np.column_stack([np.asarray(theta, float), np.asarray(y_c, float), np.asarray(mu, float),
+                                  np.asarray(offsets, float).reshape(n, -1),
+                                  np.zeros(n) if support is None else np.asarray(support, float)])
+        return np.array([self.trials.setdefault(v.tobytes(), len(self.trials)) for v in values], dtype=np.int64)
+
+    def nodes(self, parent, heights, speeds) -> np.ndarray:
+        """The number of each prefix ``parent`` followed by a pin at ``heights``, ``speeds``."""
+        uniq, inverse = np.unique(np.column_stack([parent, heights, speeds]), axis=0, return_inverse=True)
+        ids = [self.prefixes.setdefault((int(p), float(h), float(v)), len(self.prefixes) + 1) for p, h, v in uniq]
+        return np.asarray(ids, dtype=np.int64)[inverse.ravel()]
+
+    def lookup(self, nodes, trials) -> np.ndarray:
+        """Where each (prefix, trial) state is kept (-1: not kept)."""
+        get = self.at.get
+        return np.array([get(c, -1) for c in ((nodes << 32) | trials).tolist()], dtype=np.int64)
+
+    def get(self, at) -> tuple:
+        """``(theta, y_c, jam reason, missed)`` kept at ``at``."""
+        names = np.array(list(self.reasons), dtype=object)
+        return self.theta[at], self.y_c[at], names[self.reason[at]], self.missed[at]
+
+    def add(self, nodes, trials, theta, y_c, reasons, missed) -> None:
+        """Keep these states, while there is room."""
+        start, n = len(self.at), np.size(nodes)
+        if start + n > self.max_kept:
+            return
+        while self.theta.size < start + n:
+            self.theta, self.y_c = np.concatenate([self.theta, self.theta]), np.concatenate([self.y_c, self.y_c])
+            self.reason, self.missed = np.concatenate([self.reason, self.reason]), np.concatenate([self.missed,
+                                                                                                  self.missed])
+        self.theta[start:start + n], self.y_c[start:start + n], self.missed[start:start + n] = theta, y_c, missed
+        self.reason[start:start + n] = [self.reasons.setdefault(r, len(self.reasons)) for r in reasons]
+        self.at.update(zip(((nodes << 32) | trials).tolist(), range(start, start + n)))
 
 
 def _kernel_kw(ds_max, tol, belt_speed, mu_s) -> dict:
@@ -331,8 +400,12 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
                 model: str = "minpower", settings: dict | None = None,
                 speeds: dict | None = None, kernel: dict | None = None,
                 belt_speed: float | None = None, mu_s: float = 0.5, family=None,
-                stretch: Stretch = SILENT) -> dict:
+                stretch: Stretch = SILENT, memo: ReplayMemo | None = None) -> dict:
     """Run the trials for a stored plan (``to_dict()`` of a plan).
+
+    ``memo`` (a :class:`ReplayMemo`): replays of plans with the same part and
+    rollout settings share the states after their common first pins (the
+    result is the same).
 
     ``family`` (a :class:`~pipeline.parts.support_family.SupportFamily`)
     samples each trial's support from it (see :func:`trial_inputs`); each
@@ -363,7 +436,7 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
         tf, yf, jam, missed = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
                                      kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL),
                                      belt_speed=belt_speed, mu_s=mu_s, support=sup, supports=supports,
-                                     stretch=stretch.part(i / len(inputs), (i + 1) / len(inputs)))
+                                     stretch=stretch.part(i / len(inputs), (i + 1) / len(inputs)), memo=memo)
         finals = predicted_sets(plan, label)
         first = plan.get("initial_sets", {}).get(label)
         start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)

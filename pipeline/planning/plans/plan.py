@@ -55,7 +55,7 @@ from pipeline.planning.tight.search import TightPlanner
 from pipeline.planning.core.settings import (TRUNCATE_SIGMA, Friction, PlannerSettings, SearchSettings,
                                              candidate_pins)
 from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
-from pipeline.planning.claims.verify import holdout_settings, verify_plan
+from pipeline.planning.claims.verify import ReplayMemo, holdout_settings, verify_plan
 from pipeline.planning.claims.tails import describe_untruncated, untruncated_check
 from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat, OutOfTime
 
@@ -307,8 +307,10 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
     ``plan.verification``, with the orientation verdict (``orient.judge``: one
     set within the tolerance, with confidence?) as ``orientation`` and the
     verdict on the trials that chose it (``selections``, in order) as
-    ``selection``."""
+    ``selection``. The candidates' replays share the states after their
+    common first pins (``verify.ReplayMemo``: same numbers, fewer rollouts)."""
     verify_cfg = holdout_settings(settings.verify)
+    memo = ReplayMemo()
     claims, search = settings.claims, settings.search
     selections = list(selections or []) + [None] * len(candidates)
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
@@ -317,7 +319,7 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, settings.friction.value,
                           search.pin_radius, search.model, verify_cfg, speeds=speeds,
                           kernel=search.kernel_settings, belt_speed=planner.belt_speed,
-                          mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1))
+                          mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1), memo=memo)
         verdict = judge_verification(res, claims.tolerance_deg, planner.order, claims.required,
                                      claims.confidence, claims.rule)
         plan.verification = {"held_out": True, "seed": verify_cfg["seed"],

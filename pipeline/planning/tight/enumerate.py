@@ -4,14 +4,29 @@ The nominal path of a sequence starts each resting state exactly as it lies
 on the fence (no perturbation) and rolls it past each pin in turn at one
 friction. All sequences of one length are one level: the level's states are
 arrays ``(sequences, resting states)``, and going one pin deeper repeats
-each sequence once per candidate pin and rolls out every (state, pin) pair
-in one parallel batch. Each (state, pin) pair starts from its pose rounded
+each sequence once per candidate pin and rolls out the (state, pin) pairs of
+all of them, one column (resting state) at a time, each column in one
+parallel batch. Each (state, pin) pair starts from its pose rounded
 to a multiple of ``QUANTUM`` (the orientation in degrees, the pin's offset
 from the centroid in millimetres), and pairs that round alike share one
 rollout (so an outcome depends on the rounded pose only): different
 sequences often bring a state to the same pose (a pin that misses leaves it
 as it was; a vertex pushed to rest ends where the vertex sits behind the
-centroid whatever the offset was).
+centroid whatever the offset was). Because an outcome is a function of its
+rounded key (pose, offset, speed, support) alone, the tree keeps the
+outcomes it has rolled out and reuses them in later columns, chunks and
+levels (up to ``MAX_OUTCOMES``).
+
+Fewer rollouts, the same levels. A candidate whose rollout in one column
+jams (or runs out of steps) or passes a touched centroid within
+``pin_halfwidth`` is dropped by the rules below whatever its other columns
+do, so its remaining columns are not rolled out; a candidate that survives
+has had every column rolled out, from the same rounded keys, so its finals,
+heights and margin are exactly those of one batch of every column. (The
+nominal span is *not* used to stop early: a level's sequences, counted in
+the search's record, are all those the rules below keep, and the evidence
+ranks all of them by their clusters of finals, so every surviving candidate
+needs all its columns.)
 
 A sequence is dropped (with all its extensions) when, on its nominal path:
 

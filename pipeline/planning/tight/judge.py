@@ -33,7 +33,7 @@ from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSetti
 from pipeline.progress import SILENT, Heartbeat, Stretch
 
 MAX_ROWS = 150_000  # trials replayed in one batch
-MAX_KEPT = 3_000_000  # trial states after a prefix kept for reuse (a few hundred MB at most)
+MAX_KEPT = 2_000_000  # trial states after a prefix kept for reuse (about 250 MB at most)
 
 
 def stack(rows) -> tuple:
@@ -210,7 +210,7 @@ class PrefixStates:
     def lookup(self, nodes, trials) -> np.ndarray:
         """Where the state of each (node, trial) pair is kept (-1: not kept)."""
         get = self.at.get
-        return np.array([get((a, b), -1) for a, b in zip(nodes.tolist(), trials.tolist())], dtype=np.int64)
+        return np.array([get(c, -1) for c in ((nodes << 32) | trials).tolist()], dtype=np.int64)
 
     def get(self, at) -> tuple:
         """``(theta, y_c, jammed)`` kept at ``at``."""
@@ -226,7 +226,7 @@ class PrefixStates:
             self.jammed = np.concatenate([self.jammed, self.jammed])
         self.theta[start:start + nodes.size], self.y_c[start:start + nodes.size] = theta, y_c
         self.jammed[start:start + nodes.size] = jammed
-        self.at.update(zip(zip(nodes.tolist(), trials.tolist()), range(start, start + nodes.size)))
+        self.at.update(zip(((nodes << 32) | trials).tolist(), range(start, start + nodes.size)))
 
 
 class Certifier:
