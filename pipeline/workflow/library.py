@@ -211,10 +211,13 @@ def read_record(drawing_id: str, path, lib: dict) -> dict:
 
 def library_settings(config: dict) -> dict:
     """The config the library's parts are planned with: the planner's own,
-    under ``library.time_limit_s`` (tight planner only)."""
+    under ``library.time_limit_s`` (tight planner only), at ``planner.mu_c``
+    alone: the answer is the plan for that friction range, so the extra
+    frictions of ``planner.frictions`` (``pinfeed plan --mu-c`` drops them
+    too) would only share its time limit."""
     from pipeline.workflow.commands import planner_settings
     lib = config["library"]
-    return planner_settings(config, time_limit=lib.get("time_limit_s"))
+    return planner_settings(config, time_limit=lib.get("time_limit_s"), mu_c=str(config["planner"]["mu_c"]))
 
 
 def plan_library_part(config: dict, drawing_path, label: str, name: str, out_dir) -> dict:
