@@ -154,7 +154,7 @@ def _html_row(r: dict) -> str:
              if r.get("thumbnail") else "")
     size = "" if r.get("width_mm") is None else f"{r['width_mm']:.0f} x {r['height_mm']:.0f}"
     area = "" if r.get("width_mm") is None else r["width_mm"] * r["height_mm"]
-    cset = "" if r.get("set_start_deg") is None else f"{r['set_start_deg']:g} + {r['width_deg']:g}"
+    cset = "" if r.get("set_start_deg") is None else f"{r['set_start_deg']:.1f} + {r['width_deg']:.1f}"
     width = "" if r.get("width_deg") is None else f"{r['width_deg']:.1f}"
     bound = ("" if r.get("share_lower_bound") is None else
              f" (>= {100 * r['share_lower_bound']:.1f} % in one set)")

@@ -393,7 +393,8 @@ def _part_row(rec, part, folder: Path, base, log, answer) -> dict:
                     reason=info["reason"])
     plan = json.loads((folder / "plan.json").read_text())
     ans = answer(plan)
-    text = ans["text"] + ("" if ans["complete"] else " [search not complete: time limit]")
+    cut = not ans["complete"] and ans["class"] != "not decided"  # "not decided" says so itself
+    text = ans["text"] + (" [search not complete: time limit]" if cut else "")
     return _row(**common, **{"class": ans["class"]}, answer=text,
                 **{k: ans[k] for k in ("fixed_pins", "moving_pins", "plan", "set_start_deg", "width_deg",
                                        "share_lower_bound", "sets", "complete", "nearest_yes")})
