@@ -1238,23 +1238,12 @@ def _sheet_size(w: float, h: float) -> str | None:
     return None
 
 
-def _frame_in_place(loops: list, chains: list, pieces: list, texts: list, tol: float, drawing: _Drawing):
-    """``(drawn pieces, description)`` of a drawing frame drawn among the parts'
-    pieces (same layer, or an SVG), or None. The frame is the largest closed
-    loop, an axis-aligned rectangle around all other geometry, with no closed
-    loop touching it, at least :data:`FRAME_AREA_RATIO` times the area of the
-    box around what it holds, and a sheet's mark: a title block (lines touching
-    it, which close a corner region of at most half its area) or a sheet size
-    (:data:`SHEET_SIZES_MM`). An inner border (a rectangle holding everything
-    else and :data:`INNER_BORDER_AREA` of the sheet's area, nothing touching the
-    outer one) goes with it, and the rules apply to it."""
-    plain = [lp for lp in loops if not lp.construction]
-    if len(plain) < 2 or not _is_box(plain[0].points, tol):
-        return None
-    lo, hi = _box(plain[0].points)
-    allpts = np.vstack([p.points for p in pieces])
-    if not np.all((allpts >= lo - tol) & (allpts <= hi + tol)):
-        return None
+def _peel_borders(plain: list, pieces: list, tol: float):
+    """The frame ``plain[0]`` and the inner borders inside it (at most two),
+    with what touches the innermost one: ``(gone, borders, title, blocks,
+    contents)``, the frames' pieces, the borders outermost first, the pieces
+    touching the innermost border (a title block), those pieces grouped by
+    contact, and everything else; None when nothing is left inside."""
     gone, borders, frame = [], [], plain[0]
     while True:
         gone += list(frame.parts)
@@ -1273,21 +1262,52 @@ def _frame_in_place(loops: list, chains: list, pieces: list, texts: list, tol: f
                  and np.allclose(_box(nxt.points)[0], clo, atol=tol)
                  and np.allclose(_box(nxt.points)[1], chi, atol=tol))
         if not inner:
-            break
+            return gone, borders, title, blocks, contents
         frame = nxt
+
+
+def _corner_blocks(blocks: list, flo, fhi, tol: float) -> list:
+    """The groups of pieces touching the frame ``[flo, fhi]`` that hold one of
+    its corners and cover at most half its area: title blocks."""
+    corners = [np.array(c) for c in ((flo[0], flo[1]), (fhi[0], flo[1]), (fhi[0], fhi[1]), (flo[0], fhi[1]))]
+    area = float(np.prod(fhi - flo))
+    out = []
+    for g in blocks:
+        glo, ghi = _box(np.vstack([p.points for p in g]))
+        if float(np.prod(ghi - glo)) <= 0.5 * area and any(np.all((c >= glo - tol) & (c <= ghi + tol))
+                                                            for c in corners):
+            out.append(g)
+    return out
+
+
+def _frame_in_place(loops: list, chains: list, pieces: list, texts: list, tol: float, drawing: _Drawing):
+    """``(drawn pieces, description)`` of a drawing frame drawn among the parts'
+    pieces (same layer, or an SVG), or None. The frame is the largest closed
+    loop, an axis-aligned rectangle around all other geometry, with no closed
+    loop touching it, at least :data:`FRAME_AREA_RATIO` times the area of the
+    box around what it holds, and a sheet's mark: a title block (lines touching
+    it, which close a corner region of at most half its area) or a sheet size
+    (:data:`SHEET_SIZES_MM`). An inner border (a rectangle holding everything
+    else and :data:`INNER_BORDER_AREA` of the sheet's area, nothing touching the
+    outer one) goes with it, and the rules apply to it."""
+    plain = [lp for lp in loops if not lp.construction]
+    if len(plain) < 2 or not _is_box(plain[0].points, tol):
+        return None
+    lo, hi = _box(plain[0].points)
+    allpts = np.vstack([p.points for p in pieces])
+    if not np.all((allpts >= lo - tol) & (allpts <= hi + tol)):
+        return None
+    peeled = _peel_borders(plain, pieces, tol)
+    if peeled is None:
+        return None
+    gone, borders, title, blocks, contents = peeled
+    clo, chi = _box(np.vstack([p.points for p in contents]))
     frame = borders[-1]
     flo, fhi = _box(frame.points)
     solid = [lp for lp in plain if all(any(m is c for c in contents) for m in lp.parts)]
     if not solid or float(np.prod(fhi - flo)) < FRAME_AREA_RATIO * float(np.prod(chi - clo)):
         return None
-    corners = [np.array(c) for c in ((flo[0], flo[1]), (fhi[0], flo[1]), (fhi[0], fhi[1]), (flo[0], fhi[1]))]
-    area = float(np.prod(fhi - flo))
-    corner_blocks = []
-    for g in blocks:
-        glo, ghi = _box(np.vstack([p.points for p in g]))
-        if float(np.prod(ghi - glo)) <= 0.5 * area and any(np.all((c >= glo - tol) & (c <= ghi + tol))
-                                                            for c in corners):
-            corner_blocks.append(g)
+    corner_blocks = _corner_blocks(blocks, flo, fhi, tol)
     scale = drawing.unit.scale
     w, h = (hi - lo) * scale
     size = _sheet_size(w, h)
