@@ -262,6 +262,22 @@ class _Drawing:
         return f"pick the outline with {option}"
 
 
+def _the_part(pieces: list, texts: list, tol: float, drawing: _Drawing, id):  # noqa: A002
+    """The drawing's parts and the index of the one :func:`read_outline`
+    reads: the largest, or the one ``id`` picks (a loop inside a rectangle
+    around everything else, a frame not recognised, is picked without it)."""
+    sheet = _layout(pieces, texts, tol, drawing)
+    if id is None:
+        _check_open(sheet, pieces, tol, drawing)
+        return sheet, 0
+    k = _picked(sheet, pieces, tol, drawing)
+    frame = sheet.parts[k][0]
+    if not _named(drawing, frame.parts) and _is_box(frame.points, tol) and _around_all(frame, pieces, tol):
+        sheet = _layout(pieces, texts, tol, drawing, drop=frame)
+        k = _picked(sheet, pieces, tol, drawing)
+    return sheet, k
+
+
 def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa: A002 (CLI's --id)
                  flatten_tol: float | None = None, units: str | None = None,
                  join_tol: float | None = None) -> Outline:
@@ -295,17 +311,7 @@ def read_outline(path, layer: str | None = None, id: str | None = None,  # noqa:
         problem and the way out.
     """
     drawing, pieces, texts, tol, tol_mm = _read(path, layer, id, flatten_tol, units, join_tol)
-    sheet = _layout(pieces, texts, tol, drawing)
-    if id is None:
-        _check_open(sheet, pieces, tol, drawing)
-        k = 0
-    else:
-        k = _picked(sheet, pieces, tol, drawing)
-        frame = sheet.parts[k][0]
-        if not _named(drawing, frame.parts) and _is_box(frame.points, tol) and _around_all(frame, pieces, tol):
-            # --id names a loop inside a rectangle around everything else: a frame not recognised.
-            sheet = _layout(pieces, texts, tol, drawing, drop=frame)
-            k = _picked(sheet, pieces, tol, drawing)
+    sheet, k = _the_part(pieces, texts, tol, drawing, id)
     outer, holes = sheet.parts[k]
     left, across = [], set()
     for a, b in sheet.conflicts.get(k, []):
