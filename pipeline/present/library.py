@@ -70,6 +70,7 @@ def summary_line(rows) -> str:
 
 
 def library_csv(rows) -> str:
+    """The rows as CSV text (header: :data:`COLUMNS`)."""
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n")
     writer.writeheader()

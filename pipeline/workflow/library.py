@@ -367,6 +367,7 @@ def library_rows(records, part_dirs, base, logs: dict | None = None) -> list[dic
 
 
 def part_key_of(rec: dict, label: str) -> str:
+    """The row key of a refused part (``ID-N``), or of a drawing not read at all (its id)."""
     return part_key(rec["drawing"], label) if "#" in label else rec["drawing"]
 
 
