@@ -318,8 +318,16 @@ def answer(plan_result: dict | None) -> dict:
         cls, text = "moving pins", f"needs moving pins ({row['fixed_pins']} fixed + {row['moving_pins']} moving)"
     elif not complete:
         cls = "not decided"
-        text = "not decided: no verified plan within the time limit" + (
-            f" (best so far: {row['plan']}, {row.get('sets')} sets)" if row["plan"] else "")
+        fixed = entry.get("fixed_pin_search") or {}
+        if fixed.get("complete"):
+            text = (f"not decided: no plan of up to {fixed.get('depth')} fixed pins orients it (searched in "
+                    "full); the time limit cut the moving pins' search")
+        else:
+            upto = fixed.get("complete_to_pins") or 0
+            text = ("not decided: the time limit cut the fixed-pin search"
+                    + (f" (complete up to {upto} pin{'s' if upto != 1 else ''})" if upto else ""))
+        if row["plan"]:
+            text += f"; best so far: {row['plan']}, {row.get('sets')} sets"
     elif row["outcome"] == "sensor":
         cls, text = "sensor", f"needs the sensor: {row['plan']} ends in {row.get('sets')} sets"
     else:
