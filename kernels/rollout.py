@@ -55,6 +55,7 @@ from .models import (_DEC_TAKE, MINPOWER, MINPOWER_POINTS, NO_MODEL, SEPARATE, S
                      SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide, _minpower_twist,
                      _minpower_twist_points)
 from .support import _fan_quadrature, _max_moment, _table_sizes
+from .support_table import TABLE_MIN_EDGES, _with_table
 
 OK = 0
 MISS = 1
@@ -169,7 +170,9 @@ def _prepare_loops(xy, starts):
     centroid and scaled to ``a = 1``; ``area`` the material's area and
     ``m_max`` its largest support moment in those units; ``quad`` the support
     table (``support._fan_quadrature``) of the material, holes left out
-    (``geometry._keyhole``).
+    (``geometry._keyhole``), with the tabulated integrals of
+    ``support_table`` when the material has ``TABLE_MIN_EDGES`` edges or
+    more.
     """
     loops, area, a = _normalise_loops(xy, starts)
     n = starts[1] - starts[0]
@@ -177,6 +180,8 @@ def _prepare_loops(xy, starts):
     material = _keyhole(loops, starts) / a
     area = area / (a * a)
     quad = _fan_quadrature(material)
+    if material.shape[0] >= TABLE_MIN_EDGES:
+        quad = _with_table(quad)
     return verts, area, a, quad, _max_moment(material, area), _is_convex(verts)
 
 

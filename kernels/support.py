@@ -41,6 +41,8 @@ import math
 import numpy as np
 
 from ._numba import jit, jit_inline
+from .edge_integrals import _edge_support, _support_sum, _table_sizes  # noqa: F401 (re-exported)
+from .support_table import _has_table, _moment_power, _table_support
 
 # Centre-of-rotation distance (in units of a) beyond which the power uses the
 # smooth quadrature instead of the closed forms (see module notes).
@@ -49,107 +51,6 @@ _GL_N = 6
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(_GL_N)
 _GL_X = 0.5 * (_GL_X + 1.0)
 _GL_W = 0.5 * _GL_W
-
-
-@jit
-def _edge_support(px, py, r1, i1, qx, qy, r2, i2, ex, ey):
-    """Scaled signed E, G, N of the triangle (0, p, q); coordinates relative
-    to r, ``r1 = |p|``, ``i1 = 1 / r1`` (likewise ``r2``, ``i2`` for q; both
-    shared with the neighbouring edges) and ``(ex, ey)`` the unit direction
-    from p to q.
-
-    Returns ``(6 E, 2 Gx, 2 Gy, Nxx, Nxy, Nyy)``; ``_support_sum`` applies
-    the factors 1/6 and 1/2 once for the whole polygon.
-
-    Notes
-    -----
-    With ``m = (e_y, -e_x)``, ``h = cross(p, e)``, ``t = (p . e, q . e)`` and
-    ``[S] = log((t_2 + r_2) / (t_1 + r_1))`` (module notes)::
-
-        6 E = h [t R] + h^3 [S]
-        2 G = h [R] e + h^2 [S] m
-        N   = c_ee e e^T + c_em (e m^T + m e^T) + c_mm m m^T
-        c_ee = h ([S] - [t/R]),  c_em = -h^2 [1/R],  c_mm = h [t/R]
-
-    Written out with ``m`` in terms of ``e``, the off-diagonal and diagonal
-    entries need no further products of unit vectors. Only multiplications
-    by the reciprocal distances remain: no division by a distance per edge.
-    """
-    h = px * ey - py * ex
-    if abs(h) <= 1e-15 * (r1 + r2):
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    t1 = px * ex + py * ey
-    t2 = qx * ex + qy * ey
-    # [asinh(t/|h|)] = log of (t2 + R2)/(t1 + R1), each written without
-    # cancellation: t + R = h^2 / (R - t) when t < 0.
-    hh = h * h
-    p1 = t1 + r1 if t1 >= 0.0 else hh / (r1 - t1)
-    p2 = t2 + r2 if t2 >= 0.0 else hh / (r2 - t2)
-    hds = h * math.log(p2 / p1)
-    dtor = t2 * i2 - t1 * i1
-    e6 = h * (t2 * r2 - t1 * r1) + hh * hds
-    a = h * (r2 - r1)
-    gx2 = a * ex + h * hds * ey
-    gy2 = a * ey - h * hds * ex
-    cee = hds - h * dtor
-    cem = -hh * (i2 - i1)
-    cmm = h * dtor
-    exx, eyy, exy = ex * ex, ey * ey, ex * ey
-    nxx = cee * exx + 2.0 * cem * exy + cmm * eyy
-    nxy = (cee - cmm) * exy + cem * (eyy - exx)
-    nyy = cee * eyy - 2.0 * cem * exy + cmm * exx
-    return e6, gx2, gy2, nxx, nxy, nyy
-
-
-@jit
-def _table_sizes(quad):
-    """``(F, S)``: the number of quadrature (or support point) rows of a
-    support table and the number of vertices of its support polygon (its
-    last row; see ``_fan_quadrature``)."""
-    return int(quad[quad.shape[0] - 1, 0]), int(quad[quad.shape[0] - 1, 1])
-
-
-@jit
-def _support_sum(quad, rx, ry):
-    """E(r), G(r), N(r) of the support polygon of the table ``quad`` (see
-    ``_fan_quadrature``: its vertex positions and edges' unit directions).
-
-    Returns ``(E, Gx, Gy, Nxx, Nxy, Nyy)``.
-
-    Notes
-    -----
-    Per vertex one square root and one reciprocal; per edge one logarithm
-    and, only for an edge end behind the foot of the perpendicular, one
-    division (see ``_edge_support``). The unit directions do not depend on
-    r, so the prepared table saves a square root and a division per edge.
-    The edges are signed: the outline counter-clockwise, holes clockwise,
-    so the sum is the integral over the material (module notes).
-    """
-    f, n = _table_sizes(quad)
-    pos = f
-    base = f + n
-    e_val = gx = gy = nxx = nxy = nyy = 0.0
-    x0, y0 = quad[pos, 0] - rx, quad[pos, 1] - ry
-    r0 = math.sqrt(x0 * x0 + y0 * y0)
-    i0 = 1.0 / r0
-    px, py, r1, i1 = x0, y0, r0, i0
-    for j in range(n):
-        if j + 1 < n:
-            qx, qy = quad[pos + j + 1, 0] - rx, quad[pos + j + 1, 1] - ry
-            r2 = math.sqrt(qx * qx + qy * qy)
-            i2 = 1.0 / r2
-        else:
-            qx, qy, r2, i2 = x0, y0, r0, i0
-        ex, ey = quad[base + j, 0], quad[base + j, 1]
-        a0, a1, a2, a3, a4, a5 = _edge_support(px, py, r1, i1, qx, qy, r2, i2, ex, ey)
-        e_val += a0
-        gx += a1
-        gy += a2
-        nxx += a3
-        nxy += a4
-        nyy += a5
-        px, py, r1, i1 = qx, qy, r2, i2
-    return e_val / 6.0, 0.5 * gx, 0.5 * gy, nxx, nxy, nyy
 
 
 @jit
@@ -223,12 +124,12 @@ def _point_table(quad, pts):
     """The support table ``quad`` with its quadrature rows replaced by the
     point support ``pts`` (``(K, 3)`` rows ``(x, y, w)``, units of a,
     weights summing to 1): what ``MINPOWER_POINTS`` rolls on."""
-    f, n = _table_sizes(quad)
+    f = _table_sizes(quad)[0]
     k = pts.shape[0]
-    out = np.empty((k + 2 * n + 1, 3))
+    out = np.empty((k + quad.shape[0] - f, 3))
     out[:k] = pts
     out[k:] = quad[f:]
-    out[k + 2 * n, 0] = k
+    out[out.shape[0] - 1, 0] = k
     return out
 
 
@@ -245,7 +146,10 @@ def _power(quad, area, vx, vy, om):
         # Rotation about r = z x v / omega within _R_FAR: closed forms.
         inv_om = 1.0 / om
         rx, ry = -vy * inv_om, vx * inv_om
-        e_val, gx, gy, nxx, nxy, nyy = _support_sum(quad, rx, ry)
+        if _has_table(quad):
+            e_val, gx, gy, nxx, nxy, nyy = _table_support(quad, rx, ry)
+        else:
+            e_val, gx, gy, nxx, nxy, nyy = _support_sum(quad, rx, ry)
         s = 1.0 if om > 0.0 else -1.0
         p_val = abs(om) * e_val / area
         f = s / area
@@ -258,6 +162,8 @@ def _power(quad, area, vx, vy, om):
         npy = nxy * px + nyy * py
         return (p_val, g0, g1, g2, k * nxx, k * nxy, k * npx, k * nyy, k * npy,
                 k * (px * npx + py * npy))
+    if _has_table(quad) and (vx != 0.0 or vy != 0.0):
+        return _moment_power(quad, area, vx, vy, om)
     # The quadrature rows as weighted points (no point skipped: a tiny of -1).
     r = _point_sums(quad, _table_sizes(quad)[0], vx, vy, om, -1, -1.0)
     f = 1.0 / area

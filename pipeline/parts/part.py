@@ -271,10 +271,22 @@ class Part:
         return bool(_geo._is_convex(self.vertices))
 
     def prepared(self):
-        """Arrays the rollout kernels take (see ``kernels.rollout._prepare``)."""
-        if not self.holes:
-            return _prepare(np.ascontiguousarray(self.vertices))
-        return _prepare_loops(*self.loops())
+        """Arrays the rollout kernels take (see ``kernels.rollout._prepare``),
+        made once per part and kept: a part with many edges carries a support
+        table (``kernels.support_table``) that takes about a second to build.
+        The kernels only read them."""
+        kept = self.__dict__.get("_prepared")
+        if kept is None:
+            if not self.holes:
+                kept = _prepare(np.ascontiguousarray(self.vertices))
+            else:
+                kept = _prepare_loops(*self.loops())
+            object.__setattr__(self, "_prepared", kept)  # a cache, not a field
+        return kept
+
+    def __getstate__(self):
+        """Pickle the fields only: the kept kernel arrays are made again where needed."""
+        return {k: v for k, v in self.__dict__.items() if k != "_prepared"}
 
     def mirrored(self) -> "Part":
         """Mirror image: ``y -> -y`` in the body frame."""
