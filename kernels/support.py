@@ -22,14 +22,17 @@ and ``[.]`` the difference between the two ends::
 An edge whose line passes through r (h = 0) contributes nothing, so the forms
 hold for r inside, outside, on an edge and on a vertex. The derivation is in
 the README's "Mechanics notes"; ``tests/reference.py`` checks them against
-brute-force quadrature.
+brute-force quadrature. The sums themselves are in ``edge_integrals``.
 
 The belt's power for a twist ``xi = (v_x, v_y, omega)`` (spec section 3) is
 ``P = (1/A) integral |v + omega z x w| dA``. For a centre of rotation within
 ``_R_FAR`` of the centroid it is evaluated from E, G, N; farther out (nearly a
 translation) the closed forms lose digits to cancellation, and a collapsed
 Gauss rule on the centroid fan is exact to rounding because the integrand is
-smooth there.
+smooth there. A part with many edges carries a support table
+(``support_table``, built by ``rollout._prepare_loops``): ``_power`` then
+takes E, G, N from the table and, far out, the power from the material's
+moment series, at a cost that does not grow with the number of edges.
 
 A point support replaces the area integral by a weighted sum over
 K points, ``P = sum_k w_k |u(p_k)|``: ``_point_power`` at the end of this

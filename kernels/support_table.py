@@ -274,59 +274,93 @@ def _near_edge_terms(quad, f, n, edge, rx, ry):
 
 
 @jit
-def _fit_cell(quad, f, n, x0, y0, h, near, n_near, out, row):
-    """Interpolate the far part of E over the cell ``[x0, x0 + h] x [y0, y0 + h]``
-    at its Chebyshev points; write the monomial coefficients in the cell's
-    local coordinates at ``out[row:]`` (three to a row)."""
+def _poly_value(block, xl, yl):
+    """The cell polynomial ``block`` (coefficient rows) at local ``(xl, yl)``."""
     d1 = _DEGREE + 1
-    half = 0.5 * h
-    xc, yc = x0 + half, y0 + half
-    vals = np.empty((d1, d1))
-    for a in range(d1):
-        rx = xc + half * _NODES[a]
-        for b in range(d1):
-            ry = yc + half * _NODES[b]
-            e = _support_sum(quad, rx, ry)[0]
-            for m in range(n_near):
-                e -= _near_edge_terms(quad, f, n, near[m], rx, ry)[0]
-            vals[a, b] = e
-    # Chebyshev coefficients a_pq, then the monomials c_ij.
-    cheb = np.zeros((d1, d1))
-    for p in range(d1):
-        for q in range(d1):
-            s = 0.0
-            for a in range(d1):
-                ta = _CHEB_AT_NODES[p, a]
-                for b in range(d1):
-                    s += vals[a, b] * ta * _CHEB_AT_NODES[q, b]
-            wp = 1.0 if p == 0 else 2.0
-            wq = 1.0 if q == 0 else 2.0
-            cheb[p, q] = s * wp * wq / (d1 * d1)
-    tmp = np.zeros((d1, d1))
-    for i in range(d1):
-        for q in range(d1):
-            s = 0.0
-            for p in range(i, d1):
-                s += _CHEB_TO_MONO[p, i] * cheb[p, q]
-            tmp[i, q] = s
-    for i in range(d1):
-        for j in range(d1):
-            s = 0.0
-            for q in range(j, d1):
-                s += tmp[i, q] * _CHEB_TO_MONO[q, j]
-            idx = i * d1 + j
-            out[row + idx // 3, idx % 3] = s
+    val = 0.0
+    for ii in range(_DEGREE, -1, -1):
+        row = 0.0
+        for jj in range(_DEGREE, -1, -1):
+            idx = ii * d1 + jj
+            row = row * yl + block[idx // 3, idx % 3]
+        val = val * xl + row
+    return val
 
 
 @jit
-def _near_edges(quad, f, n, twin, x0, y0, h, near):
-    """Write into ``near`` the edges within ``_NEAR`` cell widths of the cell
-    ``[x0, x0 + h] x [y0, y0 + h]`` (bridges left out); return their number."""
+def _fit(vals, out):
+    """Tensor Chebyshev interpolation of ``vals`` (at the cell's Chebyshev
+    points) written as monomial coefficients into ``out`` (three to a row)."""
+    d1 = _DEGREE + 1
+    cheb = np.zeros((d1, d1))
+    for p in range(d1):
+        for q in range(d1):
+            acc = 0.0
+            for a in range(d1):
+                ta = _CHEB_AT_NODES[p, a]
+                for b in range(d1):
+                    acc += vals[a, b] * ta * _CHEB_AT_NODES[q, b]
+            wp = 1.0 if p == 0 else 2.0
+            wq = 1.0 if q == 0 else 2.0
+            cheb[p, q] = acc * wp * wq / (d1 * d1)
+    tmp = np.zeros((d1, d1))
+    for i in range(d1):
+        for q in range(d1):
+            acc = 0.0
+            for p in range(i, d1):
+                acc += _CHEB_TO_MONO[p, i] * cheb[p, q]
+            tmp[i, q] = acc
+    for i in range(d1):
+        for j in range(d1):
+            acc = 0.0
+            for q in range(j, d1):
+                acc += tmp[i, q] * _CHEB_TO_MONO[q, j]
+            idx = i * d1 + j
+            out[idx // 3, idx % 3] = acc
+
+
+@jit
+def _far_values(quad, f, n, cell, near, n_near, parent, parent_cell, parent_near, n_parent):
+    """E of the edges far from ``cell`` (``(x0, y0, width)``) at its
+    Chebyshev points: the exact sum less the near edges for a cell of the
+    grid (``n_parent`` < 0), else the parent's polynomial ``parent`` (valid
+    over the parent cell, whose far edges these are too) plus the edges near
+    the parent but not near this cell."""
+    d1 = _DEGREE + 1
+    x0, y0, w = cell
+    half = 0.5 * w
+    vals = np.empty((d1, d1))
+    px0, py0, pw = parent_cell
+    for a in range(d1):
+        rx = x0 + half + half * _NODES[a]
+        for b in range(d1):
+            ry = y0 + half + half * _NODES[b]
+            if n_parent < 0:
+                e = _support_sum(quad, rx, ry)[0]
+                for m in range(n_near):
+                    e -= _near_edge_terms(quad, f, n, near[m], rx, ry)[0]
+            else:
+                e = _poly_value(parent, (rx - px0 - 0.5 * pw) * 2.0 / pw, (ry - py0 - 0.5 * pw) * 2.0 / pw)
+                k = 0
+                for m in range(n_parent):
+                    edge = parent_near[m]
+                    if k < n_near and near[k] == edge:
+                        k += 1
+                    else:
+                        e += _near_edge_terms(quad, f, n, edge, rx, ry)[0]
+            vals[a, b] = e
+    return vals
+
+
+@jit
+def _near_edges(quad, f, n, candidates, n_cand, x0, y0, h, near):
+    """Write into ``near`` (in order) the edges among the first ``n_cand`` of
+    ``candidates`` within ``_NEAR`` cell widths of the cell ``[x0, x0 + h] x
+    [y0, y0 + h]``; return their number."""
     m = 0
     reach = _NEAR * h
-    for e in range(n):
-        if twin[e]:
-            continue
+    for c in range(n_cand):
+        e = candidates[c]
         e2 = e + 1 if e + 1 < n else 0
         if _segment_box_distance(quad[f + e, 0], quad[f + e, 1], quad[f + e2, 0],
                                  quad[f + e2, 1], x0, y0, x0 + h, y0 + h) < reach:
@@ -341,13 +375,29 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nea
     ``_SPLIT_NEAR`` near edges into four (down to ``_MAX_SPLIT`` times);
     append to the lists ``cells`` (index rows: a leaf's block, near count and
     list, ``(-2, first child, 0)`` for a split cell, ``(-1, 0, 0)`` unused),
-    ``coefs`` (coefficient blocks) and ``nears`` (near-edge lists)."""
+    ``coefs`` (coefficient blocks) and ``nears`` (near-edge lists).
+
+    A child's far part is its parent's polynomial plus the few edges near
+    the parent but not near it (``_far_values``), so splitting costs the
+    parent's near edges per point, not all of them."""
     h = 2.0 * r_grid / n_grid
-    near = np.empty(n, dtype=np.int64)
     rows_per_cell = (_DEGREE + 1) * (_DEGREE + 1) // 3
+    every = np.empty(n, dtype=np.int64)
+    n_every = 0
+    for e in range(n):
+        if not twin[e]:
+            every[n_every] = e
+            n_every += 1
     first = len(cells)
-    # Pending cells: (row in cells, x0, y0, width, times split).
-    stack = [(0, 0.0, 0.0, 0.0, 0)]
+    # Split cells kept while their children are fitted: block, geometry, near list.
+    parents = [np.empty((1, 3))]
+    parents.pop()
+    parent_geom = [(0.0, 0.0, 0.0)]
+    parent_geom.pop()
+    parent_near = [np.empty(1, dtype=np.int64)]
+    parent_near.pop()
+    # Pending cells: (row in cells, x0, y0, width, times split, parent or -1).
+    stack = [(0, 0.0, 0.0, 0.0, 0, 0)]
     stack.pop()
     for i in range(n_grid):
         for j in range(n_grid):
@@ -355,21 +405,33 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nea
             x0, y0 = -r_grid + i * h, -r_grid + j * h
             if not (skip_inside > 0.0 and x0 >= -skip_inside and x0 + h <= skip_inside
                     and y0 >= -skip_inside and y0 + h <= skip_inside):
-                stack.append((first + i * n_grid + j, x0, y0, h, 0))
+                stack.append((first + i * n_grid + j, x0, y0, h, 0, -1))
+    near = np.empty(n, dtype=np.int64)
     while len(stack) > 0:
-        row, x0, y0, w, depth = stack.pop()
-        m = _near_edges(quad, f, n, twin, x0, y0, w, near)
+        row, x0, y0, w, depth, par = stack.pop()
+        if par < 0:
+            m = _near_edges(quad, f, n, every, n_every, x0, y0, w, near)
+            vals = _far_values(quad, f, n, (x0, y0, w), near, m, parents[0] if len(parents) else
+                               np.empty((1, 3)), (0.0, 0.0, 1.0), near, -1)
+        else:
+            pn = parent_near[par]
+            m = _near_edges(quad, f, n, pn, pn.shape[0], x0, y0, w, near)
+            vals = _far_values(quad, f, n, (x0, y0, w), near, m, parents[par], parent_geom[par], pn,
+                               pn.shape[0])
+        block = np.empty((rows_per_cell, 3))
+        _fit(vals, block)
         if m > _SPLIT_NEAR and depth < _MAX_SPLIT:
+            parents.append(block)
+            parent_geom.append((x0, y0, w))
+            parent_near.append(near[:m].copy())
+            me = len(parents) - 1
             child = len(cells)
             cells[row] = (-2.0, float(child), 0.0)
             half = 0.5 * w
             for c in range(4):
                 cells.append((-1.0, 0.0, 0.0))
-                stack.append((child + c, x0 + half * (c // 2), y0 + half * (c % 2), half,
-                              depth + 1))
+                stack.append((child + c, x0 + half * (c // 2), y0 + half * (c % 2), half, depth + 1, me))
             continue
-        block = np.empty((rows_per_cell, 3))
-        _fit_cell(quad, f, n, x0, y0, w, near, m, block, 0)
         coefs.append(block)
         nears.append(near[:m].copy())
         cells[row] = (float(len(coefs) - 1), float(m), float(len(nears) - 1))

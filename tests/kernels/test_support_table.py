@@ -83,7 +83,7 @@ def test_parts_with_many_edges_carry_a_table_and_small_ones_do_not():
 
 @pytest.mark.parametrize("half_width", [1.2, 3.0, 7.9])
 def test_table_matches_the_exact_sums(half_width):
-    """E to 1e-10, G to 1e-8 and N to 1e-5 of their size, inside the part,
+    """E to 1e-9, G to 5e-8 and N to 1e-5 of their size, inside the part,
     around it and out to the far-field switch."""
     _, _, quad, raw = _plate_quads()
     rng = np.random.default_rng(7)
@@ -92,8 +92,8 @@ def test_table_matches_the_exact_sums(half_width):
         exact = np.array(_support_sum(raw, rx, ry))
         table = np.array(_table_support(quad, rx, ry))
         worst = np.maximum(worst, np.abs(table - exact) / _scales(exact))
-    assert worst[0] < 1e-10, worst
-    assert max(worst[1:3]) < 1e-8, worst
+    assert worst[0] < 1e-9, worst
+    assert max(worst[1:3]) < 5e-8, worst
     assert max(worst[3:]) < 1e-5, worst
 
 
@@ -119,7 +119,7 @@ def test_table_matches_the_exact_sums_on_random_stars(n, wobble, seed):
         exact = np.array(_support_sum(raw, rx, ry))
         table = np.array(_table_support(quad, rx, ry))
         err = np.abs(table - exact) / _scales(exact)
-        assert err[0] < 1e-10 and max(err[1:3]) < 1e-8 and max(err[3:]) < 1e-5, (rx, ry, err)
+        assert err[0] < 1e-9 and max(err[1:3]) < 5e-8 and max(err[3:]) < 1e-5, (rx, ry, err)
 
 
 def test_spoke_terms_make_each_edge_share_a_derivative_of_its_e():
