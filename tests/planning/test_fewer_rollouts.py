@@ -136,3 +136,23 @@ def test_verifying_plans_with_a_memo_gives_the_same_records():
         verify_module._pin_step = original
     assert with_memo == without
     assert used < sum(counted)
+
+
+def test_sampled_carried_sets_with_a_memo_are_the_same():
+    from pipeline.config import load_config
+    from pipeline.planning.claims.verify import ReplayMemo
+    from pipeline.planning.core.settings import PlannerSettings
+    from pipeline.planning.plans.plan import planner_for
+    from pipeline.planning.tight.certify import sampled_plan
+
+    part = PARTS["triangle"]()
+    planner = planner_for(part, PlannerSettings.from_config(load_config()).at(0.3))
+    by_height = {p.y: k for k, p in planner.pins.items()}
+    first = [by_height[10.0], by_height[27.5]]
+    sequences = [first + [by_height[47.5]], first + [by_height[10.0]], first + [by_height[47.5]]]
+    memo = ReplayMemo()
+    for labels in sequences:
+        kept, plain = sampled_plan(planner, labels, 0.0, {"trials": 30}, memo=memo), \
+            sampled_plan(planner, labels, 0.0, {"trials": 30})
+        assert kept.to_dict() == plain.to_dict()
+    assert len(memo.at) < 3 * 3 * len(memo.trials)  # the shared first pins were kept once

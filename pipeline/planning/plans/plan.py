@@ -183,8 +183,9 @@ def _carried(planner, chosen, verify, family, progress, deadline: Deadline = NO_
     ``progress`` how many are done (and, between the propagation's rollout
     batches, that it is still at it). Once ``deadline`` has passed no further
     plan is started (each one started is then verified): the plans left are
-    named in ``unsearched``."""
-    out = []
+    named in ``unsearched``. Sampled carried sets of plans that share their
+    first pins share those rollouts (``verify.ReplayMemo``)."""
+    out, memo = [], ReplayMemo()
     with Heartbeat("carried sets of the chosen plans", len(chosen), "plan", progress) as beat:
         try:
             for p in chosen:
@@ -197,7 +198,7 @@ def _carried(planner, chosen, verify, family, progress, deadline: Deadline = NO_
                     break
                 for lattice in planner.lattices.values():
                     lattice.stretch = beat.stretch(len(out), len(out))
-                out.append(carried_plan(planner, p.labels, p.margin, verify, family))
+                out.append(carried_plan(planner, p.labels, p.margin, verify, family, memo))
                 beat.tick(len(out))
         finally:
             for lattice in planner.lattices.values():

@@ -27,27 +27,30 @@ from pipeline.planning.core.settings import VerifySettings
 CLUSTER_GAP_DEG = 3.0  # sampled final orientations further apart than this are separate sets
 
 
-def carried_plan(planner: TightPlanner, labels, margin: float, verify: VerifySettings, family=None) -> TightPlan:
+def carried_plan(planner: TightPlanner, labels, margin: float, verify: VerifySettings, family=None,
+                 memo=None) -> TightPlan:
     """The :class:`TightPlan` of the sequence ``labels``: propagated if the
     tight propagation allows every pin, else sampled (see the module notes).
     With a support ``family`` other than uniform alone the sets are always
     sampled, over the family's members (the propagation assumes uniform
-    pressure)."""
+    pressure). ``memo``: as for :func:`sampled_plan`."""
     plan = planner.follow(labels) if family is None or family.is_uniform else None
     if plan is not None:
         plan.claim = "propagated"
         return plan
-    return sampled_plan(planner, labels, margin, verify, family)
+    return sampled_plan(planner, labels, margin, verify, family, memo)
 
 
 def sampled_plan(planner: TightPlanner, labels, margin: float, verify: VerifySettings,
-                 family=None) -> TightPlan:
+                 family=None, memo=None) -> TightPlan:
     """A :class:`TightPlan` whose carried sets are sampled: a replay of the
     perturbation box (seed ``verify.seed + 1``; supports sampled from
     ``family`` as the verification does); per initial state, the trials
     whose final orientations form one cluster (gaps of more than
     ``CLUSTER_GAP_DEG`` split clusters) are one branch, and each step of a
-    branch carries the hull of its trials after that pin."""
+    branch carries the hull of its trials after that pin. ``memo`` (a
+    ``verify.ReplayMemo`` shared by the plans of one planner): plans that
+    share their first pins share those rollouts (the same numbers)."""
     cfg = verify_dict(verify)
     cfg["seed"] = int(cfg["seed"]) + 1
     part, unc = planner.part, planner.unc
@@ -61,7 +64,7 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: VerifySet
         path = []
         replay(part, [p.y for p in pins], [p.v_pin for p in pins], th, yc, mu, offs,
                planner.pin_radius, planner.model, path=path, belt_speed=planner.belt_speed,
-               mu_s=planner.mu_s, support=sup, supports=supports)
+               mu_s=planner.mu_s, support=sup, supports=supports, memo=memo)
         before = [yc] + [y for _, y in path[:-1]]
         alive = np.isfinite(path[-1][0])  # jammed trials end nowhere
         branches[label] = []
