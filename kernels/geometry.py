@@ -471,6 +471,19 @@ def _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature):
     n = verts.shape[0]
     gap = np.inf
     for j in range(n):
+        if gap < np.inf:
+            # An edge whose bounding box lies farther from q than the pin
+            # plus the best gap so far cannot lower it: skip its exact
+            # distance (the margin covers rounding, so the minimum is the
+            # same, bit for bit; a rollout of a CAD outline calls this
+            # hundreds of times).
+            k = j + 1 if j + 1 < n else 0
+            ax, ay, bx, by = verts[j, 0], verts[j, 1], verts[k, 0], verts[k, 1]
+            dx = max(min(ax, bx) - qx, 0.0, qx - max(ax, bx))
+            dy = max(min(ay, by) - qy, 0.0, qy - max(ay, by))
+            reach = gap + r_pin
+            if dx * dx + dy * dy > reach * reach * (1.0 + 1e-9):
+                continue
         px, py, t, length = _closest_on_segment(verts, j, qx, qy)
         if math.hypot(px - cx, py - cy) > same_feature:
             gap = min(gap, math.hypot(qx - px, qy - py) - r_pin)
