@@ -242,7 +242,8 @@ def table(rows, tri_rate, planned: bool) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None):
+def arguments(argv=None) -> tuple:
+    """The command line: ``(parser, parsed arguments)``."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("files", nargs="*", help="drawings to run (default: the corpus, or --parts)")
@@ -256,61 +257,59 @@ def main(argv=None):
     ap.add_argument("--record", type=Path, help="JSON record to write (default: "
                     "benchmarks/records/real_parts_DATE.json; '-' for none)")
     ap.add_argument("--label", default="", help="a word for the record (e.g. baseline)")
-    args = ap.parse_args(argv)
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # so a killed run stops its planners too
-    files = files_from(args)
-    if not files:
-        ap.error("no .dxf or .svg files to run")
-    started = machine()
-    today = datetime.date.today().isoformat()
-    print(f"{today} | {started['platform']} | {started['processor']} | {started['nproc']} CPUs | "
-          f"load {started['load_average']}", flush=True)
+    return ap, ap.parse_args(argv)
 
+
+def rate_rows(files, repeat: int) -> tuple:
+    """The triangle's rollout rate and one row per drawing (its outline and
+    its rollout rate, also as a share of the triangle's), printing each:
+    ``(triangle rate, rows)``."""
     tri = Part.from_vertices(TRIANGLE, name="triangle")
-    tri_rate = rollout_rate(tri, args.repeat)
+    tri_rate = rollout_rate(tri, repeat)
     rows = []
     for path in files:
         info = describe(path)
         part = info.pop("part")
-        info["rollouts_per_s"] = round(rollout_rate(part, args.repeat), 1)
+        info["rollouts_per_s"] = round(rollout_rate(part, repeat), 1)
         info["vs_triangle"] = round(info["rollouts_per_s"] / tri_rate, 3)
         rows.append(info)
         print(f"  {path.name}: {info['outline_vertices']} + {sum(info['hole_vertices'])} vertices, "
               f"{info['rollouts_per_s']:,.0f} rollouts/s ({info['vs_triangle']:.2f} x triangle)", flush=True)
+    return tri_rate, rows
 
-    planned = not args.only_speed
-    has_limit = None
-    if planned:
-        has_limit = planner_has_time_limit()
-        print(f"pinfeed plan --time-limit: {'passed' if has_limit else 'not available: wall budget, then kill'}",
-              flush=True)
 
-        def one(k):
-            r = plan(files[k], args.time_limit, has_limit)
-            print(f"  {files[k].name}: {r['answer']} ({r['wall_s']} s wall, {r['cpu_s']} s CPU)", flush=True)
-            return r
-        with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-            for row, result in zip(rows, pool.map(one, range(len(files)))):
-                row["plan"] = result
+def plan_rows(files, rows, time_limit, jobs: int) -> bool:
+    """Plan every drawing (``jobs`` at a time), printing each answer, into
+    its row's ``plan``; returns whether ``pinfeed plan`` has ``--time-limit``."""
+    has_limit = planner_has_time_limit()
+    print(f"pinfeed plan --time-limit: {'passed' if has_limit else 'not available: wall budget, then kill'}",
+          flush=True)
 
-    print()
-    print(table(rows, tri_rate, planned))
-    summary = None
-    if planned:
-        walls = [r["plan"]["wall_s"] for r in rows]
-        worst = max(rows, key=lambda r: r["plan"]["wall_s"])
-        n_timeout = sum(r["plan"]["status"] == "timeout" for r in rows)
-        n_cut = sum(r["plan"]["status"] == "not complete" for r in rows)
-        summary = (f"{len(rows)} parts planned: median wall {statistics.median(walls):.1f} s, worst "
-                   f"{worst['plan']['wall_s']:.1f} s ({Path(worst['file']).name}); {n_timeout} killed at the "
-                   f"wall budget, {n_cut} stopped incomplete by --time-limit")
-        print("\n" + summary)
-    rates = [r["vs_triangle"] for r in rows]
-    print(f"\nrollout rate vs the triangle: median {statistics.median(rates):.2f}, lowest {min(rates):.2f}; "
-          f"load average at the end {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
+    def one(k):
+        r = plan(files[k], time_limit, has_limit)
+        print(f"  {files[k].name}: {r['answer']} ({r['wall_s']} s wall, {r['cpu_s']} s CPU)", flush=True)
+        return r
+    with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        for row, result in zip(rows, pool.map(one, range(len(files)))):
+            row["plan"] = result
+    return has_limit
 
-    if args.record is not None and str(args.record) == "-":
-        return 0
+
+def plan_summary(rows) -> str:
+    """The planning runs in one line: median and worst wall time, parts
+    killed at the wall budget and stopped incomplete by the time limit."""
+    walls = [r["plan"]["wall_s"] for r in rows]
+    worst = max(rows, key=lambda r: r["plan"]["wall_s"])
+    n_timeout = sum(r["plan"]["status"] == "timeout" for r in rows)
+    n_cut = sum(r["plan"]["status"] == "not complete" for r in rows)
+    return (f"{len(rows)} parts planned: median wall {statistics.median(walls):.1f} s, worst "
+            f"{worst['plan']['wall_s']:.1f} s ({Path(worst['file']).name}); {n_timeout} killed at the "
+            f"wall budget, {n_cut} stopped incomplete by --time-limit")
+
+
+def write_record(args, started: dict, today: str, tri_rate: float, rows, planned: bool, has_limit,
+                 summary) -> None:
+    """Write the JSON record (``--record``, default by label and date) and say where."""
     record = args.record or RECORDS / f"real_parts_{(args.label + '_') if args.label else ''}{today}.json"
     doc = {"what": "benchmarks/real_parts.py: vertex counts, rollout rates and planner answers of CAD parts",
            "label": args.label or None, "date": today,
@@ -327,6 +326,38 @@ def main(argv=None):
     record.parent.mkdir(parents=True, exist_ok=True)
     record.write_text(json.dumps(doc, indent=1) + "\n")
     print(f"record: {_rel(record)}")
+
+
+def main(argv=None):
+    """Measure the drawings' rollout rates, plan them (unless ``--only-speed``),
+    print the table and write the record."""
+    ap, args = arguments(argv)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # so a killed run stops its planners too
+    files = files_from(args)
+    if not files:
+        ap.error("no .dxf or .svg files to run")
+    started = machine()
+    today = datetime.date.today().isoformat()
+    print(f"{today} | {started['platform']} | {started['processor']} | {started['nproc']} CPUs | "
+          f"load {started['load_average']}", flush=True)
+
+    tri_rate, rows = rate_rows(files, args.repeat)
+    planned = not args.only_speed
+    has_limit = plan_rows(files, rows, args.time_limit, args.jobs) if planned else None
+
+    print()
+    print(table(rows, tri_rate, planned))
+    summary = None
+    if planned:
+        summary = plan_summary(rows)
+        print("\n" + summary)
+    rates = [r["vs_triangle"] for r in rows]
+    print(f"\nrollout rate vs the triangle: median {statistics.median(rates):.2f}, lowest {min(rates):.2f}; "
+          f"load average at the end {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
+
+    if args.record is not None and str(args.record) == "-":
+        return 0
+    write_record(args, started, today, tri_rate, rows, planned, has_limit, summary)
     return 0
 
 

@@ -46,7 +46,7 @@ def _stage() -> str:
     names = [f.name for f in traceback.extract_stack()]
     if "_rollouts" in names:
         return "moving nominal" if "_moving_search" in names else "nominal"
-    if "_pin_step" in names:
+    if "pin_step" in names:
         where = next((n for n in reversed(names) if n in REPLAY_STAGES and n not in ("failures", "judge")
                       and not (n == "verify_plan" and "untruncated_check" in names)),
                      "failures" if "failures" in names else "replay")

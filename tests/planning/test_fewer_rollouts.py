@@ -124,16 +124,16 @@ def test_verifying_plans_with_a_memo_gives_the_same_records():
     cfg = {"trials": 12, "seed": 5}
     plans = [["P1", "P3", "P2"], ["P1", "P3", "P4"], ["P1", "P3", "P2"], ["P2", "P3", "P4"], ["P1", "P3"]]
     memo, counted = ReplayMemo(), []
-    original = verify_module._pin_step
+    original = verify_module.pin_step
     try:
-        verify_module._pin_step = lambda *a, **k: counted.append(np.size(a[1])) or original(*a, **k)
+        verify_module.pin_step = lambda *a, **k: counted.append(np.size(a[1])) or original(*a, **k)
         with_memo = [verify_plan(part, {"pins": p, "initial_states": {k: [] for k in states}}, pins, states, (0.1, 0.3), 3.0, settings=cfg, memo=memo)
                      for p in plans]
         used = sum(counted)
         counted.clear()
         without = [verify_plan(part, {"pins": p, "initial_states": {k: [] for k in states}}, pins, states, (0.1, 0.3), 3.0, settings=cfg) for p in plans]
     finally:
-        verify_module._pin_step = original
+        verify_module.pin_step = original
     assert with_memo == without
     assert used < sum(counted)
 

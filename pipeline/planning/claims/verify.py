@@ -210,7 +210,7 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     jam = np.full(n, "", dtype=object)
     missed = np.zeros((n, n_pins), bool)
     alive = np.ones(n, bool)
-    kw = _kernel_kw(ds_max, tol, belt_speed, mu_s)
+    kw = kernel_kw(ds_max, tol, belt_speed, mu_s)
     if memo is not None:
         trial, node = memo.trial_ids(theta, y_c, mu, offsets, support), np.zeros(n, dtype=np.int64)
     for k in range(n_pins):
@@ -225,7 +225,7 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
             jam[old] = reason
             alive[old[reason != ""]] = False
         if idx.size:
-            res = _pin_step(part, heights[idx, k] + offsets[idx, k], speeds[idx, k], theta[idx], y_c[idx], mu[idx],
+            res = pin_step(part, heights[idx, k] + offsets[idx, k], speeds[idx, k], theta[idx], y_c[idx], mu[idx],
                             pin_radius, model, kw, None if support is None else support[idx], supports,
                             stretch.part(k / n_pins, (k + 1) / n_pins))
             st = res["status"]
@@ -298,14 +298,43 @@ class ReplayMemo:
         self.at.update(zip(((nodes << 32) | trials).tolist(), range(start, start + n)))
 
 
-def _kernel_kw(ds_max, tol, belt_speed, mu_s) -> dict:
-    """The rollout keywords of the quasi-static kernel, or of the dynamic model at ``belt_speed``."""
+def kernel_kw(ds_max, tol, belt_speed, mu_s) -> dict:
+    """The rollout keywords of the quasi-static kernel, or of the dynamic model at ``belt_speed``.
+
+    Parameters
+    ----------
+    ds_max, tol : the quasi-static kernel's step and tolerance.
+    belt_speed : belt speed (mm/s) of the dynamic model; ``None``: quasi-static.
+    mu_s : belt friction of the dynamic model.
+
+    Returns
+    -------
+    dict
+        The keywords :func:`pin_step` (and ``simulate.rollout_points``) take.
+    """
     return {"ds_max": ds_max, "tol": tol} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
 
 
-def _pin_step(part, pin_y, v_pin, theta, y_c, mu, pin_radius, model, kw, support, supports, stretch) -> dict:
+def pin_step(part, pin_y, v_pin, theta, y_c, mu, pin_radius, model, kw, support, supports, stretch) -> dict:
     """One pin (placed at ``pin_y`` mm, speed ``v_pin``) for every row: the
-    rollouts' results (``rollouts_by_speed``)."""
+    rollouts' results (``rollouts_by_speed``).
+
+    Parameters
+    ----------
+    part : the part.
+    pin_y, v_pin : the pin's height (mm) and speed ratio ``v_pin / v_b``, per row or one for all.
+    theta, y_c, mu : each row's orientation (deg), centroid height (mm) and friction.
+    pin_radius, model : the pin's radius (mm) and the quasi-static model (unused with a belt speed).
+    kw : the rollout keywords (:func:`kernel_kw`).
+    support, supports : each row's index into ``supports``; ``None``: uniform pressure.
+    stretch : told the share of rows done (:class:`pipeline.progress.Stretch`).
+
+    Returns
+    -------
+    dict
+        Arrays over the rows: ``theta_f``, ``dy``, ``status``, ``jam_reason`` and the rest
+        of ``simulate.rollout_points``'s results.
+    """
     d = contact_parameter(pin_y, y_c, part.a)
     return rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model if "belt_speed" not in kw else "dynamic",
                              kw, support, supports, stretch)
@@ -330,7 +359,7 @@ def replay_shared(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, 
     heights, speeds = np.atleast_2d(np.asarray(pin_heights, float)), np.atleast_2d(np.asarray(pin_speeds, float))
     n_plans, n_pins = heights.shape
     n = np.size(theta)
-    kw = _kernel_kw(ds_max, tol, belt_speed, mu_s)
+    kw = kernel_kw(ds_max, tol, belt_speed, mu_s)
     # The states of each distinct prefix (a node) on every trial; one node, no pin, to start.
     node = np.zeros(n_plans, int)
     th, yc = np.asarray(theta, float)[None, :].copy(), np.asarray(y_c, float)[None, :].copy()
@@ -343,7 +372,7 @@ def replay_shared(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, 
         th, yc, jam = th[parent], yc[parent], jam[parent]
         rows, cols = np.nonzero(~jam)
         if rows.size:
-            res = _pin_step(part, nodes[rows, 1] + offsets[cols, k], nodes[rows, 2], th[rows, cols], yc[rows, cols],
+            res = pin_step(part, nodes[rows, 1] + offsets[cols, k], nodes[rows, 2], th[rows, cols], yc[rows, cols],
                             mu[cols], pin_radius, model, kw, None if sup is None else sup[cols], supports,
                             stretch.part(k / n_pins, (k + 1) / n_pins))
             th[rows, cols] = res["theta_f"]
@@ -432,27 +461,60 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     inputs = trial_inputs(initial_states, mu_c, len(labels), cfg, family)
     supports = None if family is None else family.kernel_supports
     for i, ((label, state), (th, yc, mu, offs, sup)) in enumerate(zip(initial_states.items(), inputs)):
-        theta0, yc0 = _start(state)
-        tf, yf, jam, missed = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
-                                     kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL),
-                                     belt_speed=belt_speed, mu_s=mu_s, support=sup, supports=supports,
-                                     stretch=stretch.part(i / len(inputs), (i + 1) / len(inputs)), memo=memo)
-        finals = predicted_sets(plan, label)
-        first = plan.get("initial_sets", {}).get(label)
-        start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)
-        expected = [_expects_contact(plan, label, k, start_arc) for k in range(len(labels))]
-        counts = {"state": label, "trials": 0, "successes": 0, "failures": 0, "reasons": {}}
-        for j in range(tf.size):
-            reason = _failure(jam[j], tf[j], finals, missed[j], expected)
-            counts["trials"] += 1
-            counts["successes" if reason is None else "failures"] += 1
-            if reason:
-                counts["reasons"][reason] = counts["reasons"].get(reason, 0) + 1
-            trials.append({"state": label, "final_theta": float(tf[j]), "final_y_c": float(yf[j]),
-                           "ok": reason is None, "reason": reason or "",
-                           "start": [float(th[j]) % 360.0, float(yc[j])], "mu_c": float(mu[j]),
-                           **({} if family is None else {"support": family.members[sup[j]].label})})
+        outcome = replay(part, heights, vs, th, yc, mu, offs, pin_radius, model,
+                         kernel.get("ds_max", DEFAULT_DS_MAX), kernel.get("tol", DEFAULT_TOL),
+                         belt_speed=belt_speed, mu_s=mu_s, support=sup, supports=supports,
+                         stretch=stretch.part(i / len(inputs), (i + 1) / len(inputs)), memo=memo)
+        counts, detail = _judge_state(plan, label, state, len(labels), (th, yc, mu, sup), outcome, family)
+        trials += detail
         rows.append(counts)
+    return _verification_record(labels, cfg, mu_c, model, belt_speed, mu_s, family, rows, trials)
+
+
+def _judge_state(plan: dict, label: str, state, n_pins: int, start, outcome, family) -> tuple:
+    """Judge the replayed trials of one initial state against the sets the plan predicts.
+
+    Parameters
+    ----------
+    plan : the stored plan.
+    label, state : the initial state's label and its ``(theta, y_c)`` (or planner state).
+    n_pins : the plan's pins.
+    start : the trials' inputs ``(theta, y_c, mu, support)``.
+    outcome : what :func:`replay` returned for them, ``(theta_f, y_c, jam, missed)``.
+    family : the support family the trials sampled (``None``: uniform pressure).
+
+    Returns
+    -------
+    tuple
+        ``(counts, trials)``: the state's counts (``trials``, ``successes``,
+        ``failures``, ``reasons``) and each trial's outcome, in order.
+    """
+    th, yc, mu, sup = start
+    tf, yf, jam, missed = outcome
+    theta0, _ = _start(state)
+    finals = predicted_sets(plan, label)
+    first = plan.get("initial_sets", {}).get(label)
+    start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)
+    expected = [_expects_contact(plan, label, k, start_arc) for k in range(n_pins)]
+    counts = {"state": label, "trials": 0, "successes": 0, "failures": 0, "reasons": {}}
+    trials = []
+    for j in range(tf.size):
+        reason = _failure(jam[j], tf[j], finals, missed[j], expected)
+        counts["trials"] += 1
+        counts["successes" if reason is None else "failures"] += 1
+        if reason:
+            counts["reasons"][reason] = counts["reasons"].get(reason, 0) + 1
+        trials.append({"state": label, "final_theta": float(tf[j]), "final_y_c": float(yf[j]),
+                       "ok": reason is None, "reason": reason or "",
+                       "start": [float(th[j]) % 360.0, float(yc[j])], "mu_c": float(mu[j]),
+                       **({} if family is None else {"support": family.members[sup[j]].label})})
+    return counts, trials
+
+
+def _verification_record(labels, cfg, mu_c, model, belt_speed, mu_s, family, rows, trials) -> dict:
+    """The verification's record: the plan's pins, the settings, the
+    mechanics, the per-state ``rows``, their totals and every trial's
+    outcome (``trials_detail``)."""
     total = {k: sum(r[k] for r in rows) for k in ("trials", "successes", "failures")}
     mu_out = list(mu_c) if isinstance(mu_c, (tuple, list)) else mu_c
     belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}

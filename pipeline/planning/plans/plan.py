@@ -130,18 +130,8 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
     candidates = _carried(planner, chosen, settings.verify, family, progress, deadline, unsearched)
     selections = [p.selection or p.verdict for p in chosen[:len(candidates)]]
-    moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, settings, planner)
-    moving_search = None
-    if moving is not None and deadline.search_over():
-        unsearched.append(f"moving pins: not reached (up to {settings.search.dynamic_depth} moving pin(s) after "
-                          f"no fixed pin and after the {MOVING_PREFIXES} best fixed-pin results)")
-    elif moving is not None:
-        moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker, deadline)
-        unsearched += moving_search.unsearched
-        carried = _carried(moving, moving_search.plans, settings.verify, family, progress, deadline, unsearched)
-        candidates += carried
-        selections += [p.selection or p.verdict for p in moving_search.plans[:len(carried)]]
-        planner = moving
+    planner, moving_search = _add_moving_pins(part, settings, planner, fixed, chosen, keep, progress, family,
+                                              checker, deadline, candidates, selections, unsearched)
     states = resting_states(part)
     _verify_candidates(part, settings, planner, candidates, states, progress, family, selections)
     judge_for_family(candidates, checker)
@@ -153,6 +143,52 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     else:
         _check_tails(part, settings, planner, good[0] if good else None, states, progress, family)
     result = _tight_result(settings, depth, keep, planner, candidates, good, states, fixed, moving_search)
+    _add_certificate_or_nearest_yes(result, part, settings, planner, fixed, candidates, good, keep, progress,
+                                    family, checker, deadline, unsearched)
+    if deadline.limited:
+        result.update(time_limit_s=deadline.seconds, complete=not unsearched, unsearched=unsearched)
+    return result
+
+
+def _add_moving_pins(part: Part, settings: PlannerSettings, planner, fixed: FixedSearch, chosen, keep, progress,
+                     family, checker, deadline: Deadline, candidates: list, selections: list,
+                     unsearched: list) -> tuple:
+    """When fixed pins neither orient the part nor are unneeded: the moving
+    pins' search after the ``chosen`` fixed-pin results (if the settings
+    allow moving pins and the search time lasts; else ``unsearched`` says
+    so). Its plans' carried sets join ``candidates`` and their selection
+    verdicts ``selections``; what it left out joins ``unsearched``.
+
+    Returns
+    -------
+    tuple
+        ``(planner, moving_search)``: the planner whose pins the candidates
+        use (the moving one once moving pins were searched) and the moving
+        pins' :class:`FixedSearch` (``None`` when not searched).
+    """
+    moving = None if fixed.orients or fixed.needs_no_pin else _moving_planner(part, settings, planner)
+    if moving is None:
+        return planner, None
+    if deadline.search_over():
+        unsearched.append(f"moving pins: not reached (up to {settings.search.dynamic_depth} moving pin(s) after "
+                          f"no fixed pin and after the {MOVING_PREFIXES} best fixed-pin results)")
+        return planner, None
+    moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker, deadline)
+    unsearched += moving_search.unsearched
+    carried = _carried(moving, moving_search.plans, settings.verify, family, progress, deadline, unsearched)
+    candidates += carried
+    selections += [p.selection or p.verdict for p in moving_search.plans[:len(carried)]]
+    return moving, moving_search
+
+
+def _add_certificate_or_nearest_yes(result: dict, part: Part, settings: PlannerSettings, planner,
+                                    fixed: FixedSearch, candidates, good, keep, progress, family, checker,
+                                    deadline: Deadline, unsearched: list) -> None:
+    """Add to ``result`` what follows the answer: with a support family, the
+    family and (without a time limit) the recommended plan's certificate and
+    nearest "yes"; without one, when nothing orients, the nearest "yes" of
+    the best ``keep`` candidates (unless a time limit or an incomplete fixed
+    search rules it out). What is skipped or cut short joins ``unsearched``."""
     if family is not None:
         result["support_family"] = family.to_dict()
         if deadline.limited:  # the certificate and the nearest "yes" are searches of their own
@@ -172,9 +208,6 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
             except OutOfTime:  # a part answer would mislead: none
                 unsearched.append('the nearest "yes" (complete searches at looser tolerances): not finished '
                                   'within the time limit')
-    if deadline.limited:
-        result.update(time_limit_s=deadline.seconds, complete=not unsearched, unsearched=unsearched)
-    return result
 
 
 def _carried(planner, chosen, verify, family, progress, deadline: Deadline = NO_DEADLINE,

@@ -352,6 +352,25 @@ class CandidatePins:
                          (prefix.speeds or (0.0,) * len(prefix.labels)) + tuple(float(self.speeds[i]) for i in seq))
 
 
+@dataclass(eq=False)
+class _Screened:
+    """What the screen of a level has gathered so far: the plans that orient
+    and hold for the family (``found``, their level rows ``found_idx``),
+    every plan judged in full (``judged``), the orienting ones whose family
+    check is still to come (``pending``, ``(row, plan)``) and how many
+    sequences the cascade rejected (``cascaded``, counted as judged)."""
+    found: list = field(default_factory=list)
+    found_idx: list = field(default_factory=list)
+    judged: list = field(default_factory=list)
+    pending: list = field(default_factory=list)
+    cascaded: int = 0
+
+    def enough(self, candidates: int, lazy: bool) -> bool:
+        """True once a plan orients and (without ``lazy`` family checks) at
+        least ``candidates`` sequences are judged or cascaded out."""
+        return bool(self.found) and (lazy or len(self.judged) + self.cascaded >= candidates)
+
+
 class LevelScreen:
     """One level of the complete search: its sequences (the rows of
     ``level.seq``, after the pins of ``prefix``) kept by their nominal span,
@@ -472,60 +491,82 @@ class LevelScreen:
         Once ``deadline``'s search is over no further block starts: the
         blocks left are counted as not screened, ``complete`` is False and
         ``unsearched`` says how many were left."""
+        stages = self._screen_stages(inputs)
+        lazy = self.certifier.member_check is not None  # family checks: once per block, best first
+        got = _Screened()
+        done = 0
+        timed_out = False
+        while done < order.size and not got.enough(candidates, lazy):
+            if deadline.search_over():
+                timed_out = True
+                break
+            block = order[done:done + SCREEN_BLOCK]
+            self._screen_block(block, done, stages, allowed, span, candidates, record, beat, got, lazy)
+            done += block.size
+            beat.tick(done)
+        self._close_screen(order.size, done, timed_out, got, record, beat)
+        return got.found, got.found_idx, got.judged
+
+    def _screen_stages(self, inputs) -> tuple:
+        """The trials of each stage of the screen, drawn from ``inputs``:
+        ``(screen rows, all the rows, the cascade's rows, the screen's share
+        of a block's work)``. The ``CASCADE`` keeps only the subsets larger
+        than the screen and under half of all the trials."""
         bench = self.bench
         screen, full = bench.screen_rows(inputs, *SCREEN), stack(inputs)
         cascade = [rows for rows in (bench.screen_rows(inputs, *c) for c in CASCADE)
                    if screen[0].size < rows[0].size < full[0].size // 2]
         share = screen[0].size / (screen[0].size + full[0].size)  # the screen's share of a block's work
-        found, found_idx, judged, pending = [], [], [], []
-        lazy = self.certifier.member_check is not None  # family checks: once per block, best first
+        return screen, full, cascade, share
+
+    def _screen_block(self, block, done: int, stages: tuple, allowed: int, span, candidates: int, record, beat,
+                      got: "_Screened", lazy: bool) -> None:
+        """Screen one ``block`` of level rows (the ``done`` rows before it
+        already screened) on the screen rows of ``stages``
+        (:meth:`_screen_stages`) and judge its survivors in full, in chunks,
+        into ``got``; stop once ``got`` has enough (see
+        :meth:`_screen_and_judge`). With ``lazy`` family checks the block's
+        orienting plans are checked at its end."""
+        screen, full, cascade, share = stages
+        fails = self.bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
+        alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
+        record["screened_out"] += int(block.size - alive.size)
+        judging = beat.stretch(done + share * block.size, done + block.size)
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
-        done = cascaded = 0
-
-        def enough() -> bool:
-            return bool(found) and (lazy or len(judged) + cascaded >= candidates)
-
-        timed_out = False
-        while done < order.size and not enough():
-            if deadline.search_over():
-                timed_out = True
+        for start in range(0, alive.size, step):
+            # members kept from this block's earlier plans already count
+            chunk = self._drop_known_broken(alive[start:start + step], screen, allowed, record)
+            if len(got.judged) >= candidates:  # the first ones are judged in full, for the evidence
+                size = chunk.size
+                chunk = self._cascade(chunk, cascade, allowed, record)
+                got.cascaded += size - chunk.size
+            if chunk.size == 0:
+                continue
+            self._judge(chunk, full, span, got.judged, got.pending,
+                        judging.part(start / alive.size, (start + chunk.size) / alive.size))
+            if not lazy:
+                self._check_family(got.pending, got.found, got.found_idx, record)
+            if got.enough(candidates, lazy):
                 break
-            block = order[done:done + SCREEN_BLOCK]
-            fails = bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
-            alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
-            record["screened_out"] += int(block.size - alive.size)
-            judging = beat.stretch(done + share * block.size, done + block.size)
-            done += block.size
-            for start in range(0, alive.size, step):
-                # members kept from this block's earlier plans already count
-                chunk = self._drop_known_broken(alive[start:start + step], screen, allowed, record)
-                if len(judged) >= candidates:  # the first ones are judged in full, for the evidence
-                    size = chunk.size
-                    chunk = self._cascade(chunk, cascade, allowed, record)
-                    cascaded += size - chunk.size
-                if chunk.size == 0:
-                    continue
-                self._judge(chunk, full, span, judged, pending,
-                            judging.part(start / alive.size, (start + chunk.size) / alive.size))
-                if not lazy:
-                    self._check_family(pending, found, found_idx, record)
-                if enough():
-                    break
-            if lazy:
-                self._check_family(pending, found, found_idx, record, screen, allowed)
-            beat.tick(done)
-        record["not_screened"] = int(order.size - done)  # left once enough orienting plans were found
+        if lazy:
+            self._check_family(got.pending, got.found, got.found_idx, record, screen, allowed)
+
+    def _close_screen(self, n_order: int, done: int, timed_out: bool, got: "_Screened", record, beat) -> None:
+        """Record how the screen of ``n_order`` sequences ended after ``done``
+        of them: the ones not screened, and, when the time limit ended it
+        (``timed_out``), that the level is not complete and what it left
+        unsearched; ``beat`` says why it stopped early."""
+        record["not_screened"] = int(n_order - done)  # left once enough orienting plans were found
         if timed_out:
-            beat.finish(done, f"the time limit ended the screen here: the other {order.size - done} are not "
+            beat.finish(done, f"the time limit ended the screen here: the other {n_order - done} are not "
                               "screened")
             record["complete"] = False
-            record["unsearched"] = (f"{self.name}: {order.size - done:,} of the {order.size:,} sequences that "
+            record["unsearched"] = (f"{self.name}: {n_order - done:,} of the {n_order:,} sequences that "
                                     f"passed the first screen not screened or judged"
-                                    + (f" (the plans found are ranked among the {len(judged)} judged)"
-                                       if found else ""))
-        elif done < order.size:
-            beat.finish(done, f"the other {order.size - done} are not screened: enough orienting plans found")
-        return found, found_idx, judged
+                                    + (f" (the plans found are ranked among the {len(got.judged)} judged)"
+                                       if got.found else ""))
+        elif done < n_order:
+            beat.finish(done, f"the other {n_order - done} are not screened: enough orienting plans found")
 
     def _judge(self, chunk, rows, span, judged, pending, stretch) -> None:
         """Judge the level's rows ``chunk`` on all the trials ``rows``: each
@@ -718,7 +759,6 @@ class FixedPinSearch:
         bench = self.bench
         result = FixedSearch([], [], int(depth), bench.tolerance, bench.required,
                              confidence=bench.confidence, rule=bench.rule, time_limit=deadline.seconds)
-        runners_up, levels = [], []
         self.prefix, root = prefix or FixedPlan((), (), 0.0, np.inf), None
         if prefix is not None:
             root = self._after(prefix)
@@ -728,35 +768,41 @@ class FixedPinSearch:
             empty = self.tree.root()
             result.resting = next(bench.judge(*self.pins.rows(self.prefix, empty.seq[np.array([0])]),
                                               stack(bench.trials(0))))
-        pace = {}  # the level before: its candidate sequences and when it started
+        runners_up, levels = [], []
+        last = self._search_levels(result, root, int(depth), candidates, keep, progress, deadline,
+                                   runners_up, levels)
+        if deadline.limited and not result.plans:
+            self._not_reached(result, last, int(depth))
+        result.unverified = self.ranked(result.unverified)[:keep]
+        if not result.plans:  # the evidence: the best several-set results of every level
+            self._gather_evidence(result, levels, runners_up, candidates, keep, progress, deadline)
+        result.rollouts = self.tree.rollouts
+        result.seconds = time.perf_counter() - t0
+        return result
 
-        def enumeration(length, n):
-            name = self._name(len(self.prefix.labels) + length)
-            now = time.perf_counter()
-            if progress:
-                rate = pace["n"] / max(now - pace["t"], 1e-9) if pace.get("n") else None
-                progress(level_estimate(name, n, rate, deadline))
-            pace.update(n=n, t=now)
-            return Heartbeat(f"{name}: nominal paths", n, "candidate sequence", progress)
-
+    def _search_levels(self, result: FixedSearch, root, depth: int, candidates: int, keep: int, progress,
+                       deadline: Deadline, runners_up: list, levels: list):
+        """Enumerate and screen the levels after ``root`` (``None``: no pin)
+        up to ``depth``, into ``result`` (its levels, plans, unverified
+        candidates and what was left unsearched), until a level has a
+        certified plan, a level is cut short or the levels run out. Every
+        judged plan joins ``runners_up``, the :class:`LevelScreen` of each
+        level without a plan joins ``levels``. Returns the deepest level
+        enumerated in full (the root when none was)."""
         last = root if root is not None else self.tree.root()
-        for level in self.tree.levels(int(depth), root, enumeration, deadline):
+        for level in self.tree.levels(depth, root, self._level_heralds(progress, deadline), deadline):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
             if level.cut:  # the time limit ended the enumeration: nothing of the level is judged
-                record = {"pins": n_pins, **_empty_record(level.size), "complete": False,
-                          "candidates": level.cut[1], "candidates_enumerated": level.cut[0],
-                          "unsearched": f"{self._name(n_pins)}: nominal paths of {level.cut[0]:,} of "
-                                        f"{level.cut[1]:,} candidate sequences rolled out, none judged"}
+                record = self._cut_record(level, n_pins)
                 result.levels.append(record)
                 result.unsearched.append(record["unsearched"])
                 break
-            screen = LevelScreen(level, n_pins, self.prefix, self.pins, bench, self.certifier, self._name(n_pins))
+            screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier,
+                                 self._name(n_pins))
             found, judged, record = screen.search(candidates, progress, deadline)
             result.levels.append({"pins": n_pins, **record})
             if progress:
-                progress(f"{self._name(n_pins)}: {record['sequences']} sequences, "
-                         f"{record['nominal_within']} within {bench.tolerance:g} deg nominally, "
-                         f"{record['judged']} replayed in full, {record['orienting']} orient the part")
+                progress(self._level_summary(n_pins, record))
             runners_up.extend(judged)
             result.unverified += screen.unverified
             if record.get("unsearched"):
@@ -768,20 +814,55 @@ class FixedPinSearch:
             levels.append(screen)
             if record.get("complete") is False:
                 break
-        if deadline.limited and not result.plans:
-            self._not_reached(result, last, int(depth))
-        result.unverified = self.ranked(result.unverified)[:keep]
-        if not result.plans:  # the evidence: the best several-set results of every level
-            for k, screen in enumerate(levels):
-                if deadline.search_over():
-                    result.unsearched.append(f"the fewest-set sequences of {len(levels) - k} level(s) "
-                                             "(the evidence when nothing orients): not judged")
-                    break
-                runners_up.extend(screen.several_sets(min(candidates, EVIDENCE_PER_LEVEL), progress))
-            result.best_effort = self.ranked(_distinct(runners_up))[:keep]
-        result.rollouts = self.tree.rollouts
-        result.seconds = time.perf_counter() - t0
-        return result
+        return last
+
+    def _level_heralds(self, progress, deadline: Deadline):
+        """The function ``NominalTree.levels`` calls as each level's
+        enumeration starts (``(length, n)``: the level's length after the
+        prefix and its candidate sequences): it tells ``progress`` the
+        level's first line (:func:`level_estimate`, from the pace of the level
+        before) and returns the enumeration's :class:`Heartbeat`."""
+        pace = {}  # the level before: its candidate sequences and when it started
+
+        def enumeration(length, n):
+            name = self._name(len(self.prefix.labels) + length)
+            now = time.perf_counter()
+            if progress:
+                rate = pace["n"] / max(now - pace["t"], 1e-9) if pace.get("n") else None
+                progress(level_estimate(name, n, rate, deadline))
+            pace.update(n=n, t=now)
+            return Heartbeat(f"{name}: nominal paths", n, "candidate sequence", progress)
+
+        return enumeration
+
+    def _cut_record(self, level: Level, n_pins: int) -> dict:
+        """The counts of a level of ``n_pins`` pins whose enumeration the time
+        limit cut short (``level.cut``: rolled out, of how many): none judged."""
+        return {"pins": n_pins, **_empty_record(level.size), "complete": False,
+                "candidates": level.cut[1], "candidates_enumerated": level.cut[0],
+                "unsearched": f"{self._name(n_pins)}: nominal paths of {level.cut[0]:,} of "
+                              f"{level.cut[1]:,} candidate sequences rolled out, none judged"}
+
+    def _level_summary(self, n_pins: int, record: dict) -> str:
+        """A searched level's last progress line: its sequences, how many were
+        within the tolerance nominally, replayed in full and orienting."""
+        return (f"{self._name(n_pins)}: {record['sequences']} sequences, "
+                f"{record['nominal_within']} within {self.bench.tolerance:g} deg nominally, "
+                f"{record['judged']} replayed in full, {record['orienting']} orient the part")
+
+    def _gather_evidence(self, result: FixedSearch, levels: list, runners_up: list, candidates: int, keep: int,
+                         progress, deadline: Deadline) -> None:
+        """When nothing orients: judge the fewest-set sequences of each of
+        ``levels`` (while the search time lasts; the levels left are named in
+        ``result.unsearched``) and keep the best of them and ``runners_up``
+        as ``result.best_effort``."""
+        for k, screen in enumerate(levels):
+            if deadline.search_over():
+                result.unsearched.append(f"the fewest-set sequences of {len(levels) - k} level(s) "
+                                         "(the evidence when nothing orients): not judged")
+                break
+            runners_up.extend(screen.several_sets(min(candidates, EVIDENCE_PER_LEVEL), progress))
+        result.best_effort = self.ranked(_distinct(runners_up))[:keep]
 
     def _not_reached(self, result: FixedSearch, last: Level, depth: int) -> None:
         """Add the levels up to ``depth`` that a time limit left unstarted to

@@ -27,7 +27,7 @@ from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAMMED, TRUNCATED
 
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
-from pipeline.planning.claims.verify import _kernel_kw, _pin_step, holdout_settings, trial_inputs
+from pipeline.planning.claims.verify import holdout_settings, kernel_kw, pin_step, trial_inputs
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
 from pipeline.progress import SILENT, Heartbeat, Stretch
@@ -124,8 +124,8 @@ class TrialBench:
         n = np.size(th0)
         kept = self.kept
         trial = kept.trial_ids(rows)
-        kw = _kernel_kw(self.kernel["ds_max"], self.kernel["tol"], self.belt.get("belt_speed"),
-                        self.belt.get("mu_s", 0.5))
+        kw = kernel_kw(self.kernel["ds_max"], self.kernel["tol"], self.belt.get("belt_speed"),
+                       self.belt.get("mu_s", 0.5))
         node, key = np.zeros(n_plans, int), np.zeros(1, dtype=np.int64)  # distinct prefixes; their keys
         th, yc = np.asarray(th0, float)[None, :].copy(), np.asarray(yc0, float)[None, :].copy()
         jam = np.zeros((1, n), bool)
@@ -143,7 +143,7 @@ class TrialBench:
             th[rows_[old], cols[old]], yc[rows_[old], cols[old]], jam[rows_[old], cols[old]] = kept.get(at[old])
             rows_, cols = rows_[~old], cols[~old]
             if rows_.size:
-                res = _pin_step(self.part, nodes[rows_, 1] + offsets[cols, k], nodes[rows_, 2], th[rows_, cols],
+                res = pin_step(self.part, nodes[rows_, 1] + offsets[cols, k], nodes[rows_, 2], th[rows_, cols],
                                 yc[rows_, cols], mu[cols], self.pin_radius, self.model, kw,
                                 None if sup is None else np.asarray(sup)[cols], self.supports,
                                 stretch.part(k / n_pins, (k + 1) / n_pins))
