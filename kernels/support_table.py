@@ -16,8 +16,11 @@ cut into ``_N_INNER``^2 cells and the square ``|x|, |y| < _R_OUTER`` into
 widths of it are its *near* edges; the sum over all other edges is analytic
 on the cell (an edge's term is singular on the edge only), so a tensor
 polynomial of degree ``_DEGREE`` interpolates it at the cell's Chebyshev
-points with an error that falls geometrically with the degree. At a point
-``r`` of the cell::
+points with an error that falls geometrically with the degree. A cell with
+more than ``_SPLIT_NEAR`` near edges is split in four, down to ``_MAX_SPLIT``
+times, so the cells along the outline stay cheap; a child's far part is its
+parent's polynomial plus the few edges near the parent but not near it. At
+a point ``r`` of a cell::
 
     E(r) = poly(r) + sum over near edges of E_edge(r)      (exact near terms)
     G = -grad E,    N = tr(H) I - H,  H = grad grad E
@@ -53,10 +56,12 @@ Offsets below are rows from the table's first row::
     row 1: (_R_OUTER, _N_OUTER, _ORDER)
     row 2: (offset of the cell index, offset of the moments, first outer cell)
     moments: (M + 1)^2 rows (Re, Im, 0) of M_jk, M = _ORDER + 2, j major
-    cell index: one row per cell (inner cells, then outer, x major, then the
-        children of split cells, four at a time, x major):
-        (offset of its coefficients or -1, number of near edges, offset of
-        their indices)
+    cell index: one row per cell: the inner grid's cells (x major), the
+        children of its split cells (four at a time, x major), then the
+        outer grid's cells and their children; a leaf's row is (offset of
+        its coefficients, number of near edges, offset of their indices), a
+        split cell's (-2, row of its first child, 0), an unused outer cell
+        inside the inner square's (-1, 0, 0)
     coefficients: (D + 1)^2 / 3 rows per cell, c_ij of X^i Y^j at index
         i (D + 1) + j, X and Y the cell's local coordinates in [-1, 1]
     near edges: edge indices, three to a row
@@ -129,14 +134,6 @@ _MOM_W = 0.5 * _MOM_W
 def _has_table(quad):
     """True if ``quad`` carries a table (``_with_table``)."""
     return quad[quad.shape[0] - 1, 2] > 0.0
-
-
-@jit
-def _table_start(quad):
-    """Row of the table's header: after the quadrature rows, vertices and
-    edge directions (``support._fan_quadrature``)."""
-    f, n = _table_sizes(quad)
-    return f + 2 * n
 
 
 @jit
