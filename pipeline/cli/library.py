@@ -95,7 +95,7 @@ def add_library_command(sub) -> None:
                        "it again after adding drawings plans only the new ones.")
     p.add_argument("drawings", nargs="+", metavar="DRAWINGS",
                    help="DXF or SVG files, folders (their .dxf and .svg files) or quoted glob patterns "
-                   "('drawings/**/*.dxf')")
+                   "(the shell's wildcards, matched below the folder too with a double star)")
     p.add_argument("--name", default="library", help="the library's name: results go to RESULTS_DIR/NAME/ "
                    "(default: library)")
     p.add_argument("--results-dir", dest="results_dir", default=None,
