@@ -317,34 +317,47 @@ def _fit(vals, out):
 
 
 @jit
-def _far_values(quad, f, n, cell, near, n_near, parent, parent_cell, parent_near, n_parent):
-    """E of the edges far from ``cell`` (``(x0, y0, width)``) at its
-    Chebyshev points: the exact sum less the near edges for a cell of the
-    grid (``n_parent`` < 0), else the parent's polynomial ``parent`` (valid
-    over the parent cell, whose far edges these are too) plus the edges near
-    the parent but not near this cell."""
+def _far_values(quad, f, n, cell, near, n_near):
+    """E of the edges far from a grid cell ``cell`` (``(x0, y0, width)``) at
+    its Chebyshev points: the exact sum less its ``n_near`` near edges."""
     d1 = _DEGREE + 1
     x0, y0, w = cell
     half = 0.5 * w
     vals = np.empty((d1, d1))
-    px0, py0, pw = parent_cell
     for a in range(d1):
         rx = x0 + half + half * _NODES[a]
         for b in range(d1):
             ry = y0 + half + half * _NODES[b]
-            if n_parent < 0:
-                e = _support_sum(quad, rx, ry)[0]
-                for m in range(n_near):
-                    e -= _near_edge_terms(quad, f, n, near[m], rx, ry)[0]
-            else:
-                e = _poly_value(parent, (rx - px0 - 0.5 * pw) * 2.0 / pw, (ry - py0 - 0.5 * pw) * 2.0 / pw)
-                k = 0
-                for m in range(n_parent):
-                    edge = parent_near[m]
-                    if k < n_near and near[k] == edge:
-                        k += 1
-                    else:
-                        e += _near_edge_terms(quad, f, n, edge, rx, ry)[0]
+            e = _support_sum(quad, rx, ry)[0]
+            for m in range(n_near):
+                e -= _near_edge_terms(quad, f, n, near[m], rx, ry)[0]
+            vals[a, b] = e
+    return vals
+
+
+@jit
+def _child_far_values(quad, f, n, cell, near, n_near, parent, parent_cell, parent_near):
+    """``_far_values`` of a split cell's child: its parent's polynomial
+    ``parent`` (valid over the parent cell ``parent_cell``, whose far edges
+    are the child's too) plus the edges near the parent (``parent_near``)
+    but not near the child (``near``, a sublist in the same order)."""
+    d1 = _DEGREE + 1
+    x0, y0, w = cell
+    half = 0.5 * w
+    px0, py0, pw = parent_cell
+    vals = np.empty((d1, d1))
+    for a in range(d1):
+        rx = x0 + half + half * _NODES[a]
+        for b in range(d1):
+            ry = y0 + half + half * _NODES[b]
+            e = _poly_value(parent, (rx - px0 - 0.5 * pw) * 2.0 / pw, (ry - py0 - 0.5 * pw) * 2.0 / pw)
+            k = 0
+            for m in range(parent_near.shape[0]):
+                edge = parent_near[m]
+                if k < n_near and near[k] == edge:
+                    k += 1
+                else:
+                    e += _near_edge_terms(quad, f, n, edge, rx, ry)[0]
             vals[a, b] = e
     return vals
 
@@ -375,7 +388,7 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nea
     ``coefs`` (coefficient blocks) and ``nears`` (near-edge lists).
 
     A child's far part is its parent's polynomial plus the few edges near
-    the parent but not near it (``_far_values``), so splitting costs the
+    the parent but not near it (``_child_far_values``), so splitting costs the
     parent's near edges per point, not all of them."""
     h = 2.0 * r_grid / n_grid
     rows_per_cell = (_DEGREE + 1) * (_DEGREE + 1) // 3
@@ -408,13 +421,11 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nea
         row, x0, y0, w, depth, par = stack.pop()
         if par < 0:
             m = _near_edges(quad, f, n, every, n_every, x0, y0, w, near)
-            vals = _far_values(quad, f, n, (x0, y0, w), near, m, parents[0] if len(parents) else
-                               np.empty((1, 3)), (0.0, 0.0, 1.0), near, -1)
+            vals = _far_values(quad, f, n, (x0, y0, w), near, m)
         else:
             pn = parent_near[par]
             m = _near_edges(quad, f, n, pn, pn.shape[0], x0, y0, w, near)
-            vals = _far_values(quad, f, n, (x0, y0, w), near, m, parents[par], parent_geom[par], pn,
-                               pn.shape[0])
+            vals = _child_far_values(quad, f, n, (x0, y0, w), near, m, parents[par], parent_geom[par], pn)
         block = np.empty((rows_per_cell, 3))
         _fit(vals, block)
         if m > _SPLIT_NEAR and depth < _MAX_SPLIT:
