@@ -10,9 +10,9 @@ import time
 from cli_runs import TRI_PLAN_ARGS, run_cli, small_config_file
 from pipeline.planning.core.types import validate_plan_file
 
-# The triangle at a 1 deg tolerance, 11 pins, depth 4: the whole search
-# (with its nearest "yes") takes tens of seconds, more than the limit.
-DEEP_ARGS = ["--vertices", "0,0 60,0 15,35", "--name", "tri", "--depth", "4", "--pins=3:43:4", "--mu-c", "0",
+# The triangle at a 1 deg tolerance, 11 pins, depth 6: the whole search
+# (over a million sequences at 6 pins) takes minutes, far more than the limit.
+DEEP_ARGS = ["--vertices", "0,0 60,0 15,35", "--name", "tri", "--depth", "6", "--pins=3:43:4", "--mu-c", "0",
              "--dynamic-depth", "0", "--tolerance", "1"]
 HANG = 60.0  # seconds beyond the limit that would mean a hang (not a performance bound)
 
@@ -31,13 +31,13 @@ def test_a_one_second_limit_returns_in_time_and_says_what_it_left(capsys, tmp_pa
     assert code in (0, None), err
     assert took < 1 + HANG
     assert "time limit 1 s: the search is NOT complete" in out
-    assert "Not searched:" in out and "4 fixed pin(s)" in out, out
+    assert "Not searched:" in out and "6 fixed pin(s)" in out, out
     assert "among the sequences searched" in out  # never the complete search's "no"
-    assert "no fixed-pin sequence of up to 4 pins orients this part" not in out
+    assert "no fixed-pin sequence of up to 6 pins orients this part" not in out
     assert "fixed pin(s): " in err and "of the time limit left" in err  # the levels' first lines
     stored = validate_plan_file(path)["tight"][0]  # the plan file still meets its schema
     assert stored["time_limit_s"] == 1.0 and stored["complete"] is False
-    assert any("4 fixed pin(s)" in u for u in stored["unsearched"])
+    assert any("6 fixed pin(s)" in u for u in stored["unsearched"])
     assert stored["fixed_pin_search"]["complete"] is False
 
 

@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from pipeline.errors import PinfeedError
 from pipeline.planning.claims import orient
@@ -229,3 +231,23 @@ def test_too_few_trials_for_the_claim_is_said_with_the_way_out():
     assert all(lv.get("too_few_trials") for lv in result.levels)
     assert "cannot show 99.5 % at 95 % confidence" in evidence and "at least 598 are needed" in evidence
     assert "verify.trials" in evidence
+
+
+def _fewest_arcs_by_enumeration(theta, width, order):
+    """Fewest arcs of ``width`` covering ``theta`` (mod 360/order), by trying
+    every set of start points (an optimal cover's arcs may start at points)."""
+    import itertools
+    period = 360.0 / order
+    x = np.mod(np.asarray(theta, float), period)
+    for k in range(1, x.size + 1):
+        for starts in itertools.combinations(x, k):
+            if all(any(np.mod(t - s, period) <= width + 1e-9 for s in starts) for t in x):
+                return k
+    return 0
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.sampled_from(np.arange(0.0, 360.0, 2.5).tolist()), min_size=1, max_size=7),
+       st.sampled_from([2.5, 5.0, 10.0, 45.0, 200.0]), st.sampled_from([1, 2, 3]))
+def test_the_fewest_sets_are_those_of_exhaustive_enumeration(theta, width, order):
+    assert orient.arcs_to_cover(theta, width, order) == _fewest_arcs_by_enumeration(theta, width, order)

@@ -18,8 +18,9 @@ from pipeline.config import load_config
 from pipeline.parts.part import Part
 from pipeline.planning import PlannerSettings, nearest_yes_lines
 from pipeline.planning.claims import orient
-from pipeline.planning.plans.nearest_part import LADDER, MAX_TOLERANCE, loosest_needed
+from pipeline.planning.plans.nearest_part import LADDER, MAX_TOLERANCE, loosest_needed, moving_axis, part_nearest_yes
 from pipeline.planning.plans.plan import plan_tight
+from pipeline.progress import Deadline
 
 TRAPEZOID = Part.from_vertices([[0.0, 0.0], [70.0, 0.0], [50.0, 25.0], [10.0, 25.0]], "trapezoid")
 
@@ -85,3 +86,66 @@ def test_the_answer_holds_in_an_independent_replay(no_plan):
     assert most_in_arc(finals, tol["value"] + 1.0, order) >= 0.95 * finals.size
     # and the asked tolerance is not enough for it (the reason there was no plan)
     assert most_in_arc(finals, 6.0, order) < 0.95 * finals.size
+
+
+class _SearchCut(Deadline):
+    """A time limit whose search time ends after ``reads`` reads of it, with
+    time left for verification ever after (a search cut part way)."""
+
+    def __init__(self, reads: int):
+        super().__init__(600.0)
+        self.reads = reads
+
+    def search_over(self) -> bool:
+        self.reads -= 1
+        return self.reads < 0
+
+    def over(self) -> bool:
+        return False
+
+
+def test_a_search_cut_by_its_time_limit_still_answers_from_the_kept_plans(no_plan):
+    """A cut search gets the kept plans' tolerance answer (the same held-out
+    replays as the complete search's), marked as kept plans only, with no
+    search at looser tolerances and the cut named in ``unsearched``."""
+    full, settings_ = no_plan
+    cut = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=3))
+    assert cut["complete"] is False and not cut["orients"]
+    assert any("kept plans only" in u for u in cut["unsearched"])
+    axis = next(a for a in cut["nearest_yes"]["axes"] if a["axis"] == "tolerance")
+    assert axis["kept_plans_only"] is True
+    if axis["found"]:  # the kept plan's answer: its held-out finals at that tolerance
+        assert axis["verdict"]["orients"] and axis["verdict"]["tolerance_deg"] == axis["value"]
+        assert "no search at looser tolerances" in axis["statement"]
+        finals = replay_box(TRAPEZOID, axis["pin_heights_mm"],
+                            box_trials(TRAPEZOID, len(axis["pin_heights_mm"]), 60, 29, (0.18, 0.22)), strict=False)
+        assert most_in_arc(finals, axis["value"] + 1.0, TRAPEZOID.symmetry_order()) >= 0.95 * finals.size
+    else:
+        assert "was not run" in axis["statement"]
+
+
+def test_the_kept_plans_answer_needs_no_search(no_plan):
+    """Kept plans only: none of the search's kept plans answers here (the
+    complete answer came from the searches at looser tolerances), and it says
+    so; given the complete answer's plan as a kept plan, it answers with that
+    plan at no looser a tolerance (the same held-out trials)."""
+    full, settings_ = no_plan
+    kept = [(p["pins"], p["pin_heights_mm"], p.get("pin_speeds") or ()) for p in full["plans"]]
+    complete = next(a for a in full["nearest_yes"]["axes"] if a["axis"] == "tolerance")
+    assert complete["kept_plans_only"] is False and complete["plan"] not in [k[0] for k in kept]
+
+    def tolerance(plans):
+        return next(a for a in part_nearest_yes(TRAPEZOID, settings_.at(0.2), full, plans)["axes"]
+                    if a["axis"] == "tolerance")
+
+    none = tolerance(kept)
+    assert not none["found"] and none["kept_plans_only"] and "was not run" in none["statement"]
+    given = tolerance(kept + [(complete["plan"], complete["pin_heights_mm"], ())])
+    assert given["found"] and given["kept_plans_only"] and given["plan"] == complete["plan"]
+    assert 6.0 < given["value"] <= complete["value"] and given["verdict"]["orients"]
+
+
+def test_moving_pins_cut_by_the_limit_are_not_called_unconfigured():
+    axis = moving_axis({}, cut=True)
+    assert not axis["found"] and "time limit" in axis["statement"]
+    assert "no pin speeds given" in moving_axis({})["statement"]

@@ -108,7 +108,8 @@ def narrowest_arc(theta, k: int, order: int = 1) -> tuple[float, float] | None:
 def arcs_to_cover(theta, width: float, order: int = 1) -> int:
     """Fewest arcs of ``width`` degrees that hold every orientation (modulo
     ``360 / order``): greedy from every possible first point, which is exact on
-    the circle."""
+    the circle. All the greedy walks step together: each point's next
+    uncovered point is looked up once."""
     period = 360.0 / order
     x, x2 = _doubled(theta, period)
     n = x.size
@@ -116,16 +117,15 @@ def arcs_to_cover(theta, width: float, order: int = 1) -> int:
         return 0
     if width >= period:
         return 1
-    best = n
-    for i in range(n):
-        count, j = 0, i
-        while j < i + n:
-            count += 1
-            j = int(np.searchsorted(x2, x2[j] + width + 1e-9, side="right"))
-            if count >= best:
-                break
-        best = min(best, count)
-    return best
+    after = np.searchsorted(x2, x2 + width + 1e-9, side="right")  # the first point past an arc from each
+    start = np.arange(n)
+    at, count = start.copy(), np.zeros(n, dtype=np.int64)
+    walking = np.ones(n, dtype=bool)
+    while walking.any():
+        count[walking] += 1
+        at[walking] = after[at[walking]]
+        walking &= at < start + n
+    return int(count.min())
 
 
 def row_spans(theta: np.ndarray, order: int = 1) -> np.ndarray:

@@ -116,13 +116,19 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
     ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
     complete search over them finds a plan (:func:`searched_tolerance`).
     Raises :class:`~pipeline.progress.OutOfTime` when ``deadline`` passes
-    before the answer is whole."""
+    before the answer is whole. Without ``pins`` (a search cut by its time
+    limit: a bisection over searches would be cut too) only the kept plans
+    are replayed, those the limit leaves time for, and the axis says so
+    (``kept_plans_only``)."""
     bench = TrialBench(part, settings.friction, settings.claims, settings.verify, settings.search)
     claims = settings.claims
-    best = None
+    best, tried = None, 0
     for labels, heights, speeds in plans:
         if deadline.over():
-            raise OutOfTime("the held-out replays of the kept plans were not finished")
+            if pins:  # the bisection would follow: a part answer would mislead
+                raise OutOfTime("the held-out replays of the kept plans were not finished")
+            break  # kept plans only: the answer names the plans it replayed
+        tried += 1
         rows = bench.held_out(len(heights))
         tf, jam = bench.replay(np.atleast_2d(np.asarray(heights, float)),
                                np.atleast_2d(np.asarray(speeds or [0.0] * len(heights), float)), rows)
@@ -138,18 +144,26 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
         if searched is not None:
             tol, plan = searched
             best = (tol, plan.labels, plan.heights, plan.speeds, plan.verdict)
+    kept_only = "" if pins else f" (among the {tried} kept plan(s) replayed; no search at looser tolerances)"
     if best is None:
+        if not pins:
+            return _axis("tolerance", False, f"none of the {tried} kept plan(s) replayed orients the part within "
+                                             f"{MAX_TOLERANCE:g} deg on held-out trials; the search at looser "
+                                             "tolerances was not run", kept_plans_only=True)
         return _axis("tolerance", False, f"no plan of up to {depth or settings.search.depth} fixed pins orients "
                                          f"the part within {MAX_TOLERANCE:g} deg on held-out trials")
     tol, labels, heights, speeds, verdict = best
-    return _axis("tolerance", True, f"a tolerance of {tol:g} deg (asked: {claims.tolerance_deg:g} deg)",
+    return _axis("tolerance", True, f"a tolerance of {tol:g} deg (asked: {claims.tolerance_deg:g} deg){kept_only}",
                  value=tol, unit="deg", plan=list(labels), pin_heights_mm=[float(h) for h in heights],
-                 pin_speeds=[float(v) for v in (speeds or ())], verdict=verdict)
+                 pin_speeds=[float(v) for v in (speeds or ())], verdict=verdict, kept_plans_only=not pins)
 
 
-def moving_axis(entry: dict) -> dict:
-    """What the moving-pin stage found for the part."""
+def moving_axis(entry: dict, cut: bool = False) -> dict:
+    """What the moving-pin stage found for the part (``cut``: a time limit
+    ended the search before that stage)."""
     stage = entry.get("moving_pin_search")
+    if not stage and cut:
+        return _axis("moving pins", False, "not searched: the time limit ended the search before the moving pins")
     if not stage:
         return _axis("moving pins", False, "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
     rec = entry.get("recommended") or {}
@@ -173,15 +187,17 @@ def sensor_axis(entry: dict) -> dict:
 
 
 def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = None, progress=None,
-                     deadline: Deadline = NO_DEADLINE) -> dict:
+                     deadline: Deadline = NO_DEADLINE, moving_cut: bool = False) -> dict:
     """The nearest "yes" on each axis for a part no plan orients (see the
     module docstring); ``entry``: its tight entry; ``plans``: the kept plans
     ``(labels, heights, speeds)``, best first; ``pins``: the fixed pins the
     search chose from (label -> height, mm), searched again at looser
     tolerances when no kept plan answers. ``deadline``: a time limit; raises
     :class:`~pipeline.progress.OutOfTime` when it passes before the answer
-    is whole (the answer is then never a part one)."""
+    is whole (the answer is then never a part one). Without ``pins`` only the
+    kept plans are replayed (see :func:`tolerance_axis`); ``moving_cut``: a
+    time limit ended the search before its moving pins."""
     depth = entry.get("depth")
     return {"plans_tried": [list(p[0]) for p in plans],
-            "axes": [tolerance_axis(part, settings, plans, pins, depth, progress, deadline), moving_axis(entry),
+            "axes": [tolerance_axis(part, settings, plans, pins, depth, progress, deadline), moving_axis(entry, moving_cut),
                      sensor_axis(entry), more_pins_axis(entry)]}

@@ -21,7 +21,8 @@ searches stop between their steps once their time is over, the chosen plans
 are carried and verified one by one while the limit lasts, and the moving
 pins and the untruncated replay are skipped when there is no time left for
 them; the nearest "yes" runs its searches under the same limit and is left
-out whole if one is cut; the family certificate (a search of its own) is
+out whole if one is cut (after a cut search it replays the kept plans only,
+and says so); the family certificate (a search of its own) is
 skipped under a limit. The entry then says so (``time_limit_s``,
 ``complete``, ``unsearched``).
 
@@ -188,7 +189,9 @@ def _add_certificate_or_nearest_yes(result: dict, part: Part, settings: PlannerS
     family and (without a time limit) the recommended plan's certificate and
     nearest "yes"; without one, when nothing orients, the nearest "yes" of
     the best ``keep`` candidates (unless a time limit or an incomplete fixed
-    search rules it out). What is skipped or cut short joins ``unsearched``."""
+    search rules it out: then only the kept plans are replayed, without
+    searches at looser tolerances). What is skipped or cut short joins
+    ``unsearched``."""
     if family is not None:
         result["support_family"] = family.to_dict()
         if deadline.limited:  # the certificate and the nearest "yes" are searches of their own
@@ -199,8 +202,15 @@ def _add_certificate_or_nearest_yes(result: dict, part: Part, settings: PlannerS
     elif not result["orients"] and candidates:
         kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in candidates[:keep]]
         fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
-        if deadline.search_over() or not fixed.complete:  # its searches would be cut (or mislead)
-            unsearched.append('the nearest "yes" (complete searches at looser tolerances): skipped')
+        if deadline.over():
+            unsearched.append('the nearest "yes": skipped (no time left)')
+        elif deadline.search_over() or not fixed.complete:  # its searches would be cut (or mislead)
+            # The kept plans' held-out replays still answer "which tolerance would do"; only the
+            # searches at looser tolerances (the answer when no kept plan does) are left out.
+            moving_cut = any(u.startswith("moving pins: not reached") for u in unsearched)
+            result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, None, progress, deadline,
+                                                     moving_cut)
+            unsearched.append('the nearest "yes": kept plans only (no complete searches at looser tolerances)')
         else:
             try:
                 result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins, progress,
