@@ -167,3 +167,22 @@ def test_the_config_key_is_checked_and_read_into_the_settings():
     with pytest.raises(PinfeedError, match=r"^config error at planner/time_limit_s: it must be a number of "
                                            r"seconds above 0, got -5; leave it out"):
         validate_config(config)
+
+
+def test_a_cut_enumeration_with_time_left_screens_what_it_enumerated(monkeypatch):
+    """A level whose enumeration the limit cuts (here after the first 4 of its
+    11 parents) is screened and judged on the sequences it has: the plan of
+    the complete search (first pin P2, among those parents) is found with the
+    complete search's verdict, the levels before are complete, and the
+    result says the level was only partly enumerated."""
+    monkeypatch.setattr(enumerate_module, "FIRST_PARENTS", 4)
+    monkeypatch.setattr(enumerate_module, "ENUMERATION_SHARE", 1e-9)  # stop after the first chunk
+    result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
+    assert not result.complete and result.complete_to == 1
+    cut = result.levels[-1]
+    assert cut["pins"] == 2 and 0 < cut["candidates_enumerated"] < cut["candidates"] == 11 * len(PINS)
+    assert cut["judged"] > 0 and "only those screened" in cut["unsearched"]
+    best = result.plans[0]
+    assert [list(best.labels), best.verdict["in_tolerance"], best.verdict["trials"],
+            round(best.verdict["width_deg"], 4)] == BEFORE[10.0]["plans"][0]
+    assert result.evidence().startswith("2 fixed pins orient this part")

@@ -63,7 +63,11 @@ Under a time limit (a :class:`~pipeline.progress.Deadline`, ``planner.time_limit
 the search reads the clock between its steps (a batch of nominal rollouts,
 a chunk of the first screen, a block of ``SCREEN_BLOCK`` sequences) and
 stops at the first step after its search time is over, keeping what it
-judged. It is then complete only up to the last level it finished: the
+judged. A level's enumeration stops earlier, once it has used
+``enumerate.ENUMERATION_SHARE`` of the search time left when it began: the
+sequences it enumerated are then screened and judged like a whole level's,
+so a plan of that many pins may still be found (it has the fewest pins: the
+levels before are complete). It is then complete only up to the last level it finished: the
 result says so (``complete``, ``unsearched``: the level cut short and how
 far it got, the levels not reached, the evidence not judged), and its "no"
 covers the sequences searched only. Orienting sequences found before the
@@ -792,8 +796,9 @@ class FixedPinSearch:
         last = root if root is not None else self.tree.root()
         for level in self.tree.levels(depth, root, self._level_heralds(progress, deadline), deadline):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
-            if level.cut:  # the time limit ended the enumeration: nothing of the level is judged
-                record = self._cut_record(level, n_pins)
+            if level.cut:  # the time limit ended the enumeration: screen what it enumerated, if time is left
+                record = self._cut_level(result, level, n_pins, candidates, keep, progress, deadline,
+                                         runners_up, levels)
                 result.levels.append(record)
                 result.unsearched.append(record["unsearched"])
                 break
@@ -834,6 +839,30 @@ class FixedPinSearch:
             return Heartbeat(f"{name}: nominal paths", n, "candidate sequence", progress)
 
         return enumeration
+
+    def _cut_level(self, result: FixedSearch, level: Level, n_pins: int, candidates: int, keep: int, progress,
+                   deadline: Deadline, runners_up: list, levels: list) -> dict:
+        """The record of a level of ``n_pins`` pins whose enumeration the time
+        limit cut short: when search time is left, its enumerated sequences
+        are screened and judged as a level's are (an orienting plan found
+        there has the fewest pins, the levels before being complete, and is
+        ranked among the sequences judged), else none is judged."""
+        record = self._cut_record(level, n_pins)
+        if level.size == 0 or deadline.search_over():
+            return record
+        screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier, self._name(n_pins))
+        found, judged, screened = screen.search(candidates, progress, deadline)
+        runners_up.extend(judged)
+        result.unverified += screen.unverified
+        if found:
+            result.plans = self.ranked(found)[:keep]
+        else:
+            levels.append(screen)
+        done, total = level.cut
+        return {**record, **screened, "complete": False,
+                "unsearched": "; ".join(filter(None, [
+                    f"{self._name(n_pins)}: nominal paths of {done:,} of {total:,} candidate sequences rolled "
+                    f"out, only those screened", screened.get("unsearched")]))}
 
     def _cut_record(self, level: Level, n_pins: int) -> dict:
         """The counts of a level of ``n_pins`` pins whose enumeration the time

@@ -65,6 +65,9 @@ QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one no
 MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
 FIRST_PARENTS = 64  # parents of the first batch of a level under a time limit (it sets the pace)
 MAX_OUTCOMES = 8_000_000  # nominal outcomes kept for reuse (about 200 MB)
+# Under a time limit a level's enumeration may use this share of the search
+# time left when it starts; the rest screens the sequences it enumerated.
+ENUMERATION_SHARE = 0.7
 
 
 @dataclass
@@ -151,34 +154,41 @@ class NominalTree:
         :class:`~pipeline.progress.Heartbeat` that the enumeration of the
         ``n`` sequences of ``length`` pins after ``root`` reports to.
         ``deadline``: no level starts once its search is over
-        (:meth:`~pipeline.progress.Deadline.search_over`), and a level it
-        cuts short is the last (``Level.cut``)."""
+        (:meth:`~pipeline.progress.Deadline.search_over`); a level's
+        enumeration stops once it has used ``ENUMERATION_SHARE`` of the search
+        time left when it started (the rest is for screening what it
+        enumerated), and a level it cuts short is the last (``Level.cut``)."""
         heartbeat = heartbeat or (lambda length, n: Heartbeat("", n))
         level = self.root() if root is None else root
         for _ in range(depth):
             if deadline.search_over():
                 return
             n = level.size * self.heights.size
+            stop_at = None
+            if deadline.limited:
+                stop_at = deadline.elapsed() + ENUMERATION_SHARE * max(0.0, deadline.left() - deadline.reserve)
             with heartbeat(level.seq.shape[1] + 1, n) as beat:
-                level = self.extend(level, beat.stretch(0, n), deadline)
+                level = self.extend(level, beat.stretch(0, n), deadline, stop_at)
                 if level.cut:
                     beat.finish(level.cut[0], "the time limit ended the enumeration here")
             yield level
             if level.size == 0 or level.cut:
                 return
 
-    def extend(self, level: Level, stretch: Stretch = SILENT, deadline: Deadline = NO_DEADLINE) -> Level:
+    def extend(self, level: Level, stretch: Stretch = SILENT, deadline: Deadline = NO_DEADLINE,
+               stop_at: float | None = None) -> Level:
         """Every surviving sequence of ``level`` followed by every candidate pin
         (in chunks of parents, so memory stays bounded on long levels);
         ``stretch`` is told the share of parents done. Under a time limit
         (``deadline``) the chunks are about ``BATCH_SECONDS`` of work each and
-        the enumeration stops between them once the search is over: the
-        level returned is then ``cut``. (An outcome depends on its rounded
-        pose only, so the sequences enumerated are the same in any chunks.)"""
+        the enumeration stops between them once the search is over, or once
+        ``stop_at`` seconds of the deadline have passed: the level returned
+        is then ``cut``. (An outcome depends on its rounded pose only, so the
+        sequences enumerated are the same in any chunks.)"""
         per_parent = max(1, self.heights.size * level.theta.shape[1])
         step = max(1, MAX_PAIRS // per_parent)
         if deadline.limited:
-            return self._extend_timed(level, step, stretch, deadline)
+            return self._extend_timed(level, step, stretch, deadline, stop_at)
         if level.size <= step:
             return self._extend(level, stretch)
         parts = [self._extend(level.rows(i, i + step),
@@ -186,13 +196,19 @@ class NominalTree:
                  for i in range(0, level.size, step)]
         return _joined(parts)
 
-    def _extend_timed(self, level: Level, step: int, stretch: Stretch, deadline: Deadline) -> Level:
+    def _extend_timed(self, level: Level, step: int, stretch: Stretch, deadline: Deadline,
+                      stop_at: float | None = None) -> Level:
         """:meth:`extend` under a time limit: chunks of parents sized by the pace
-        of the ones before (up to ``step``), the deadline read between them."""
+        of the ones before (up to ``step``), the deadline (and ``stop_at``)
+        read between them."""
         if level.size == 0:
             return self._extend(level, stretch)
         parts, done, size = [], 0, min(step, FIRST_PARENTS)
-        while done < level.size and not (parts and deadline.search_over()):
+
+        def stop() -> bool:
+            return deadline.search_over() or (stop_at is not None and deadline.elapsed() >= stop_at)
+
+        while done < level.size and not (parts and stop()):
             hi = min(level.size, done + size)
             t0 = time.monotonic()
             parts.append(self._extend(level.rows(done, hi), stretch.part(done / level.size, hi / level.size)))
