@@ -90,10 +90,13 @@ def atlas_row(plan_result: dict, speed: dict | None = None, layout: dict | None 
 def _nearest(entry: dict, axis: str):
     """The nearest "yes" on ``axis`` of a family no plan holds for: its value,
     ``"none"`` when the axis found none, ``None`` when the question was not
-    asked (a plan holds, or no support family)."""
+    asked (a plan holds, or no support family) or not answered in full (a
+    time limit: the kept plans only and none of them, or an axis it cut)."""
     for answer in (entry.get("nearest_yes") or {}).get("axes", []):
         if answer["axis"] == axis:
-            return answer["value"] if answer["found"] else "none"
+            if answer["found"]:
+                return answer["value"]
+            return None if answer.get("kept_plans_only") or answer.get("partial") else "none"
     return None
 
 

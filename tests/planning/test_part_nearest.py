@@ -7,6 +7,8 @@ answer's plan replayed through the public rollout API on the oracle's own
 trials (tests/oracle.py) ends in one set of the answered tolerance (+1 deg:
 the two sample the box differently).
 """
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -105,23 +107,43 @@ class _SearchCut(Deadline):
 
 
 def test_a_search_cut_by_its_time_limit_still_answers_from_the_kept_plans(no_plan):
-    """A cut search gets the kept plans' tolerance answer (the same held-out
-    replays as the complete search's), marked as kept plans only, with no
-    search at looser tolerances and the cut named in ``unsearched``."""
+    """A cut search (here after its first level) gets the kept plans'
+    tolerance answer, marked as kept plans only, with no search at looser
+    tolerances, the cut named in ``unsearched``, only the plans replayed
+    listed, and no advice to search deeper before the depth asked for was
+    searched in full."""
     full, settings_ = no_plan
     cut = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=3))
     assert cut["complete"] is False and not cut["orients"]
+    assert cut["fixed_pin_search"]["complete"] is False
     assert any("kept plans only" in u for u in cut["unsearched"])
-    axis = next(a for a in cut["nearest_yes"]["axes"] if a["axis"] == "tolerance")
-    assert axis["kept_plans_only"] is True
-    if axis["found"]:  # the kept plan's answer: its held-out finals at that tolerance
-        assert axis["verdict"]["orients"] and axis["verdict"]["tolerance_deg"] == axis["value"]
-        assert "no search at looser tolerances" in axis["statement"]
-        finals = replay_box(TRAPEZOID, axis["pin_heights_mm"],
-                            box_trials(TRAPEZOID, len(axis["pin_heights_mm"]), 60, 29, (0.18, 0.22)), strict=False)
-        assert most_in_arc(finals, axis["value"] + 1.0, TRAPEZOID.symmetry_order()) >= 0.95 * finals.size
-    else:
-        assert "was not run" in axis["statement"]
+    nearest = cut["nearest_yes"]
+    axis = next(a for a in nearest["axes"] if a["axis"] == "tolerance")
+    assert axis["kept_plans_only"] is True and axis["replayed"] == len(nearest["plans_tried"]) > 0
+    kept = [p["pins"] for p in cut["plans"] + cut["rejected"]]
+    assert all(p in kept for p in nearest["plans_tried"])
+    more = next(a for a in nearest["axes"] if a["axis"] == "more pins")
+    assert "--time-limit" in more["statement"] and "--depth" not in more["statement"]
+    # the plans kept here end far apart: none orients within the widest tolerance (checked by the
+    # oracle's replays), so there is no answer, and the statement says the search was not run
+    heights = {tuple(p["pins"]): p["pin_heights_mm"] for p in cut["plans"] + cut["rejected"]}
+    for pins in nearest["plans_tried"]:
+        h = heights[tuple(pins)]
+        finals = replay_box(TRAPEZOID, h, box_trials(TRAPEZOID, len(h), 60, 29, (0.18, 0.22)), strict=False)
+        assert most_in_arc(finals, MAX_TOLERANCE - 1.0, TRAPEZOID.symmetry_order()) < 0.99 * finals.size
+    assert not axis["found"] and "was not run" in axis["statement"]
+
+
+def test_moving_pins_the_limit_came_before_are_named_so(no_plan):
+    """With moving pins configured, a limit that ends the search before them
+    says so on the moving-pin axis (never "no pin speeds given")."""
+    _, settings_ = no_plan
+    s = dataclasses.replace(settings_.at(0.2), search=dataclasses.replace(
+        settings_.at(0.2).search, dynamic_speeds=(-1.0, 1.0), dynamic_depth=1))
+    cut = plan_tight(TRAPEZOID, s, deadline=_SearchCut(reads=3))
+    assert any(u.startswith("moving pins: not reached") for u in cut["unsearched"])
+    axis = next(a for a in cut["nearest_yes"]["axes"] if a["axis"] == "moving pins")
+    assert not axis["found"] and "time limit ended the search before the moving pins" in axis["statement"]
 
 
 def test_the_kept_plans_answer_needs_no_search(no_plan):
@@ -149,3 +171,32 @@ def test_moving_pins_cut_by_the_limit_are_not_called_unconfigured():
     axis = moving_axis({}, cut=True)
     assert not axis["found"] and "time limit" in axis["statement"]
     assert "no pin speeds given" in moving_axis({})["statement"]
+    part_way = moving_axis({"moving_pin_search": {"orients": False, "complete": False,
+                                                  "unsearched": ["2 moving pin(s) after P1: not reached"]}})
+    assert not part_way["found"] and part_way["statement"].startswith("searched in part")
+    assert "2 moving pin(s) after P1: not reached" in part_way["statement"]
+
+
+def test_searches_that_reuse_rollouts_find_what_they_find_alone(no_plan):
+    """The bisection's searches share one search's nominal outcomes and trial
+    states: a search at another tolerance that reuses them finds the same
+    plans, verdicts and level counts as alone, with fewer nominal rollouts."""
+    from pipeline.planning.tight.complete import FixedPinSearch
+    full, settings_ = no_plan
+    s = settings_.at(0.2)
+    pins = dict(full["pins_used"])
+
+    def search(tolerance, reuse=None):
+        claims = dataclasses.replace(s.claims, tolerance_deg=tolerance)
+        out = FixedPinSearch(TRAPEZOID, pins, s.friction, claims, s.verify, s.search)
+        if reuse is not None:
+            out.reuse_rollouts(reuse)
+        return out
+
+    first = search(MAX_TOLERANCE)
+    first.run(2, keep=1)
+    alone, reusing = search(20.0).run(2, keep=3), search(20.0, reuse=first).run(2, keep=3)
+    assert [(p.labels, p.verdict) for p in alone.plans] == [(p.labels, p.verdict) for p in reusing.plans]
+    assert [(p.labels, p.verdict) for p in alone.best_effort] == [(p.labels, p.verdict) for p in reusing.best_effort]
+    assert alone.levels == reusing.levels
+    assert reusing.rollouts < alone.rollouts

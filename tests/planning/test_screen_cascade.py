@@ -73,3 +73,45 @@ def test_the_cascade_changes_no_plan_and_no_count(monkeypatch):
         assert a["judged"] <= b["judged"]
         assert a["judged"] + a.get("cascade_out", 0) == b["judged"]
     assert sum(lv.get("cascade_out", 0) for lv in with_cascade.levels) > 0  # the cascade was used
+
+
+@pytest.mark.parametrize("tolerance", [5.0, 8.0])
+def test_hard_trials_learned_from_judged_sequences_change_no_plan(tolerance):
+    """A search that keeps no evidence (the moving-pin stage's) screens with
+    the trials its judged sequences failed most: the same plans, verdicts and
+    counts of orienting sequences as the search without it (at 8 deg a plan
+    of three pins; at 5 deg none, where the hard trials reject a sequence
+    that the full judgement rejects too), and no evidence gathered."""
+    part = Part.from_vertices([[0, 0], [50, 0], [10, 30]], name="sharp_triangle")
+    top = max(y for _, y in part.stable_states()) * 1.8
+    pins = {f"Q{k}": float(y) for k, y in enumerate(np.linspace(0.05 * part.a, top, 9), start=1)}
+
+    def search(evidence):
+        s = FixedPinSearch(part, pins, MU, ClaimSettings(tolerance, 0.99, rule="point"), VERIFY, SEARCH)
+        s.evidence = evidence
+        return s.run(3, candidates=1, keep=5)
+
+    learned, plain = search(False), search(True)
+    assert [p.labels for p in learned.plans] == [p.labels for p in plain.plans]
+    assert bool(learned.plans) == (tolerance == 8.0)
+    for a, b in zip(learned.plans, plain.plans):
+        assert a.verdict == b.verdict
+    for a, b in zip(learned.levels, plain.levels):
+        assert a["orienting"] == b["orienting"] and a["certified"] == b["certified"]
+        assert (a["judged"] + a.get("cascade_out", 0) + a.get("hard_trials_out", 0)
+                == b["judged"] + b.get("cascade_out", 0))
+    if tolerance == 5.0:
+        assert sum(lv.get("hard_trials_out", 0) for lv in learned.levels) > 0  # the hard trials were used
+    assert learned.best_effort == [] and (plain.plans or plain.best_effort)
+
+
+def test_the_failing_trials_are_those_outside_the_best_arc():
+    part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]])
+    bench = _bench(part)
+    rng = np.random.default_rng(3)
+    finals = np.concatenate([rng.normal(40.0, 4.0, (5, 30)), rng.uniform(0, 360, (5, 10))], axis=1) % 360
+    jammed = rng.random(finals.shape) < 0.05
+    failing = bench.failing(finals, jammed)
+    for k in range(finals.shape[0]):
+        held, _ = orient.best_arc(finals[k][~jammed[k]], bench.tolerance, bench.order)
+        assert (~failing[k]).sum() == held and not (~failing[k] & jammed[k]).any()

@@ -176,7 +176,8 @@ def test_a_cut_enumeration_with_time_left_screens_what_it_enumerated(monkeypatch
     complete search's verdict, the levels before are complete, and the
     result says the level was only partly enumerated."""
     monkeypatch.setattr(enumerate_module, "FIRST_PARENTS", 4)
-    monkeypatch.setattr(enumerate_module, "ENUMERATION_SHARE", 1e-9)  # stop after the first chunk
+    monkeypatch.setattr(enumerate_module, "ENUMERATION_SHARE", 1e-9)  # stop after the first chunk ...
+    monkeypatch.setattr(enumerate_module, "finishes_in_time", lambda *args: False)  # ... as if the rest were slow
     result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
     assert not result.complete and result.complete_to == 1
     cut = result.levels[-1]
@@ -186,3 +187,13 @@ def test_a_cut_enumeration_with_time_left_screens_what_it_enumerated(monkeypatch
     assert [list(best.labels), best.verdict["in_tolerance"], best.verdict["trials"],
             round(best.verdict["width_deg"], 4)] == BEFORE[10.0]["plans"][0]
     assert result.evidence().startswith("2 fixed pins orient this part")
+
+
+@pytest.mark.parametrize("now, done, search_end, goes_on", [
+    (70.0, 60, 100.0, True),   # 70 s for 60 of 80 parents: the other 20 take 23.3 s, ending at 93.3 s
+    (70.0, 60, 93.5, True),    # before the search ends: it goes on past its share, as without one
+    (70.0, 60, 90.0, False),   # after: it would be cut anyway, so it stops now and screens what it has
+    (10.0, 1, 50.0, False),    # one parent in 10 s: 79 more do not fit in 40 s
+])
+def test_a_level_that_ends_in_time_is_never_cut_for_its_share(now, done, search_end, goes_on):
+    assert enumerate_module.finishes_in_time(now, 0.0, done, 80, search_end) is goes_on

@@ -167,3 +167,17 @@ def test_the_nearest_yes_columns_read_the_plan_file():
             row["nearest_moving_pins"]) == (0.26, "none", 17.5, "none")
     plan_file["tight"][0].pop("nearest_yes")
     assert atlas_row(plan_file)["nearest_tolerance_deg"] is None
+
+
+def test_an_axis_a_time_limit_cut_is_not_read_as_none():
+    """"none" means the axis was searched and found nothing; an axis answered
+    from the kept plans only, or cut by a time limit, is not known (None)."""
+    from pipeline.workflow.atlas import atlas_row
+    axes = [{"axis": "tolerance", "found": False, "kept_plans_only": True},
+            {"axis": "moving pins", "found": False, "partial": True}]
+    plan_file = {"part": {"name": "p", "id": "p-1"},
+                 "tight": [{"recommended": None, "fixed_pin_search": {}, "nearest_yes": {"axes": axes}}]}
+    row = atlas_row(plan_file)
+    assert (row["nearest_tolerance_deg"], row["nearest_moving_pins"]) == (None, None)
+    axes[0]["kept_plans_only"] = False
+    assert atlas_row(plan_file)["nearest_tolerance_deg"] == "none"

@@ -79,9 +79,14 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
 
     from pipeline.planning.tight.complete import FixedPinSearch
 
+    searches = []  # the first search's rollouts serve the later ones (tolerance changes no outcome)
+
     def found(t):
         claims = dataclasses.replace(settings.claims, tolerance_deg=float(t))
         search = FixedPinSearch(part, pins, settings.friction, claims, settings.verify, settings.search)
+        if searches:
+            search.reuse_rollouts(searches[0])
+        searches.append(search)
         result = search.run(depth, candidates=candidates, keep=1, progress=_at(progress, t), deadline=deadline)
         if not result.complete:
             raise OutOfTime(f"the search at {t:g} deg was not finished")
@@ -115,19 +120,19 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
     speeds)``) orients ``part`` on held-out trials; when none does within
     ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
     complete search over them finds a plan (:func:`searched_tolerance`).
-    Raises :class:`~pipeline.progress.OutOfTime` when ``deadline`` passes
-    before the answer is whole. Without ``pins`` (a search cut by its time
-    limit: a bisection over searches would be cut too) only the kept plans
-    are replayed, those the limit leaves time for, and the axis says so
-    (``kept_plans_only``)."""
+
+    Without ``pins`` (a search cut by its time limit: a bisection over
+    searches would be cut too) only the kept plans are replayed. Under a
+    time limit (``deadline``) the kept plans are replayed while it lasts,
+    and a bisection it cuts gives no tolerance: the axis then answers from
+    the kept plans replayed and says so (``kept_plans_only``, ``replayed``;
+    ``searches_cut`` when the limit cut the searches at looser tolerances)."""
     bench = TrialBench(part, settings.friction, settings.claims, settings.verify, settings.search)
     claims = settings.claims
     best, tried = None, 0
     for labels, heights, speeds in plans:
         if deadline.over():
-            if pins:  # the bisection would follow: a part answer would mislead
-                raise OutOfTime("the held-out replays of the kept plans were not finished")
-            break  # kept plans only: the answer names the plans it replayed
+            break  # the answer names the plans it replayed
         tried += 1
         rows = bench.held_out(len(heights))
         tf, jam = bench.replay(np.atleast_2d(np.asarray(heights, float)),
@@ -138,24 +143,35 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
             verdict = orient.judge(tf[0][~jam[0]], rows[0].size, tol, bench.order, claims.required,
                                    claims.confidence, rule=claims.rule)
             best = (tol, labels, heights, speeds, verdict)
-    if best is None and pins:
-        searched = searched_tolerance(part, settings, pins, depth or settings.search.depth,
-                                      settings.search.candidates, progress, deadline)
-        if searched is not None:
-            tol, plan = searched
-            best = (tol, plan.labels, plan.heights, plan.speeds, plan.verdict)
-    kept_only = "" if pins else f" (among the {tried} kept plan(s) replayed; no search at looser tolerances)"
+    cut = tried < len(plans)  # the limit passed before every kept plan was replayed
+    searches_cut = False
+    if best is None and pins is not None and not cut:
+        try:
+            searched = searched_tolerance(part, settings, pins, depth or settings.search.depth,
+                                          settings.search.candidates, progress, deadline)
+        except OutOfTime:
+            searches_cut = True
+        else:
+            if searched is not None:
+                tol, plan = searched
+                best = (tol, plan.labels, plan.heights, plan.speeds, plan.verdict)
+    kept_only = pins is None or cut or searches_cut
+    flags = {"kept_plans_only": kept_only, "replayed": tried, "searches_cut": searches_cut}
+    if best is None and tried == 0 and plans:
+        return _axis("tolerance", False, "not searched: no time was left to replay the kept plans", **flags)
+    if best is None and kept_only:
+        how = "cut by the time limit" if searches_cut else "not run"
+        return _axis("tolerance", False, f"none of the {tried} kept plan(s) replayed orients the part within "
+                                         f"{MAX_TOLERANCE:g} deg on held-out trials; the search at looser "
+                                         f"tolerances was {how}", **flags)
     if best is None:
-        if not pins:
-            return _axis("tolerance", False, f"none of the {tried} kept plan(s) replayed orients the part within "
-                                             f"{MAX_TOLERANCE:g} deg on held-out trials; the search at looser "
-                                             "tolerances was not run", kept_plans_only=True)
         return _axis("tolerance", False, f"no plan of up to {depth or settings.search.depth} fixed pins orients "
-                                         f"the part within {MAX_TOLERANCE:g} deg on held-out trials")
+                                         f"the part within {MAX_TOLERANCE:g} deg on held-out trials", **flags)
     tol, labels, heights, speeds, verdict = best
-    return _axis("tolerance", True, f"a tolerance of {tol:g} deg (asked: {claims.tolerance_deg:g} deg){kept_only}",
+    scope = f"; among the {tried} kept plan(s) replayed, no search at looser tolerances" if kept_only else ""
+    return _axis("tolerance", True, f"a tolerance of {tol:g} deg (asked: {claims.tolerance_deg:g} deg{scope})",
                  value=tol, unit="deg", plan=list(labels), pin_heights_mm=[float(h) for h in heights],
-                 pin_speeds=[float(v) for v in (speeds or ())], verdict=verdict, kept_plans_only=not pins)
+                 pin_speeds=[float(v) for v in (speeds or ())], verdict=verdict, **flags)
 
 
 def moving_axis(entry: dict, cut: bool = False) -> dict:
@@ -163,7 +179,12 @@ def moving_axis(entry: dict, cut: bool = False) -> dict:
     ended the search before that stage)."""
     stage = entry.get("moving_pin_search")
     if not stage and cut:
-        return _axis("moving pins", False, "not searched: the time limit ended the search before the moving pins")
+        return _axis("moving pins", False, "not searched: the time limit ended the search before the moving pins",
+                     partial=True)
+    if stage and stage.get("complete") is False and not stage.get("orients"):
+        return _axis("moving pins", False, "searched in part: the time limit cut the moving-pin search "
+                                           f"(not searched: {'; '.join(stage.get('unsearched') or [])})",
+                     partial=True)
     if not stage:
         return _axis("moving pins", False, "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
     rec = entry.get("recommended") or {}
@@ -192,12 +213,16 @@ def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = Non
     module docstring); ``entry``: its tight entry; ``plans``: the kept plans
     ``(labels, heights, speeds)``, best first; ``pins``: the fixed pins the
     search chose from (label -> height, mm), searched again at looser
-    tolerances when no kept plan answers. ``deadline``: a time limit; raises
-    :class:`~pipeline.progress.OutOfTime` when it passes before the answer
-    is whole (the answer is then never a part one). Without ``pins`` only the
-    kept plans are replayed (see :func:`tolerance_axis`); ``moving_cut``: a
+    tolerances when no kept plan answers. ``deadline``: a time limit; one
+    that passes before the tolerance answer is whole leaves it to the kept
+    plans replayed, and the axis says so (see :func:`tolerance_axis`).
+    Without ``pins`` only the kept plans are replayed; ``moving_cut``: a
     time limit ended the search before its moving pins."""
     depth = entry.get("depth")
-    return {"plans_tried": [list(p[0]) for p in plans],
-            "axes": [tolerance_axis(part, settings, plans, pins, depth, progress, deadline), moving_axis(entry, moving_cut),
-                     sensor_axis(entry), more_pins_axis(entry)]}
+    tolerance = tolerance_axis(part, settings, plans, pins, depth, progress, deadline)
+    more = more_pins_axis(entry)
+    if entry.get("fixed_pin_search", {}).get("complete") is False:  # depth N itself was not searched in full
+        more = _axis("more pins", False, "not searched: the time limit cut the search before its depth; "
+                                         "run with a longer --time-limit first", partial=True)
+    return {"plans_tried": [list(p[0]) for p in plans[:tolerance["replayed"]]],
+            "axes": [tolerance, moving_axis(entry, moving_cut), sensor_axis(entry), more]}

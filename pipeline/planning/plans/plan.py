@@ -20,9 +20,10 @@ With ``planner.time_limit_s`` (``pinfeed plan --time-limit``) a
 searches stop between their steps once their time is over, the chosen plans
 are carried and verified one by one while the limit lasts, and the moving
 pins and the untruncated replay are skipped when there is no time left for
-them; the nearest "yes" runs its searches under the same limit and is left
-out whole if one is cut (after a cut search it replays the kept plans only,
-and says so); the family certificate (a search of its own) is
+them; the nearest "yes" runs its searches under the same limit, and after
+a cut search, or when the limit cuts its own searches, answers from the
+kept plans' held-out replays only, and says so; the family certificate (a
+search of its own) is
 skipped under a limit. The entry then says so (``time_limit_s``,
 ``complete``, ``unsearched``).
 
@@ -58,11 +59,12 @@ from pipeline.planning.core.settings import (TRUNCATE_SIGMA, Friction, PlannerSe
 from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.claims.verify import ReplayMemo, holdout_settings, verify_plan
 from pipeline.planning.claims.tails import describe_untruncated, untruncated_check
-from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat, OutOfTime
+from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat
 
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
 MOVING_PREFIXES = 3  # best fixed-pin results (besides none) that moving pins may follow
+MOVING_NOT_REACHED = "moving pins: not reached"  # how a time limit that came first is listed
 
 
 def planner_belt(search: SearchSettings, part: Part | None = None):
@@ -171,7 +173,7 @@ def _add_moving_pins(part: Part, settings: PlannerSettings, planner, fixed: Fixe
     if moving is None:
         return planner, None
     if deadline.search_over():
-        unsearched.append(f"moving pins: not reached (up to {settings.search.dynamic_depth} moving pin(s) after "
+        unsearched.append(f"{MOVING_NOT_REACHED} (up to {settings.search.dynamic_depth} moving pin(s) after "
                           f"no fixed pin and after the {MOVING_PREFIXES} best fixed-pin results)")
         return planner, None
     moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker, deadline)
@@ -204,20 +206,19 @@ def _add_certificate_or_nearest_yes(result: dict, part: Part, settings: PlannerS
         fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
         if deadline.over():
             unsearched.append('the nearest "yes": skipped (no time left)')
-        elif deadline.search_over() or not fixed.complete:  # its searches would be cut (or mislead)
-            # The kept plans' held-out replays still answer "which tolerance would do"; only the
-            # searches at looser tolerances (the answer when no kept plan does) are left out.
-            moving_cut = any(u.startswith("moving pins: not reached") for u in unsearched)
-            result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, None, progress, deadline,
-                                                     moving_cut)
-            unsearched.append('the nearest "yes": kept plans only (no complete searches at looser tolerances)')
-        else:
-            try:
-                result["nearest_yes"] = part_nearest_yes(part, settings, result, kept, fixed_pins, progress,
-                                                         deadline)
-            except OutOfTime:  # a part answer would mislead: none
-                unsearched.append('the nearest "yes" (complete searches at looser tolerances): not finished '
-                                  'within the time limit')
+            return
+        # After a cut search the kept plans' held-out replays still answer "which tolerance would
+        # do"; only the searches at looser tolerances (the answer when no kept plan does) are left out.
+        cut = deadline.search_over() or not fixed.complete
+        moving_cut = any(u.startswith(MOVING_NOT_REACHED) for u in unsearched)
+        nearest = part_nearest_yes(part, settings, result, kept, None if cut else fixed_pins, progress, deadline,
+                                   moving_cut)
+        result["nearest_yes"] = nearest
+        tolerance = next(a for a in nearest["axes"] if a["axis"] == "tolerance")
+        if tolerance["kept_plans_only"]:
+            how = "cut by the time limit" if tolerance["searches_cut"] else "not run"
+            unsearched.append(f'the nearest "yes": kept plans only ({tolerance["replayed"]} of {len(kept)} '
+                              f'replayed; the complete searches at looser tolerances {how})')
 
 
 def _carried(planner, chosen, verify, family, progress, deadline: Deadline = NO_DEADLINE,
@@ -258,6 +259,7 @@ def _pin_search(part, settings: PlannerSettings, planner, moving: bool, family=N
                             settings.verify, settings.search,
                             speeds={k: p.v_pin for k, p in pins.items()}, family=family)
     search.member_check = checker
+    search.evidence = not moving  # the moving-pin stage keeps its plans only
     return search
 
 

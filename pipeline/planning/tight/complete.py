@@ -108,6 +108,7 @@ SCREEN = (12, 8)  # random trials and corners per resting state in the screen
 # what the full judgement would, at a fraction of its cost.
 CASCADE = ((48, 64), (150, 384))
 SCREEN_BLOCK = 96  # candidates screened at once
+HARD_TRIALS = 64  # trials that failed most often in a level's judged sequences, tried first (moving pins)
 PROBE_CHUNK = 1024  # candidates probed at once under a time limit (the clock is read between chunks)
 EVIDENCE_PER_LEVEL = 4  # several-set sequences judged per level when nothing orients
 WIDTH_SLACK_DEG = schema_default("planner", "width_slack_deg")  # a safe margin outranks this much width
@@ -389,13 +390,20 @@ class LevelScreen:
     bench : the :class:`~pipeline.planning.tight.judge.TrialBench` that replays and judges.
     certifier : the :class:`~pipeline.planning.tight.judge.Certifier` of orienting verdicts.
     name : the level for people (progress lines).
+    learn : when the search keeps no evidence (the moving-pin stage keeps its
+        plans only), the trials that fail most often in the sequences judged
+        so far (``HARD_TRIALS``) screen the later ones first, with the
+        cascade: a subset rejects exactly (see ``CASCADE``), and the
+        orienting sequences, the only ones kept, pass any subset.
     """
 
     def __init__(self, level: Level, n_pins: int, prefix: FixedPlan, pins: CandidatePins, bench: TrialBench,
-                 certifier: Certifier, name: str):
+                 certifier: Certifier, name: str, learn: bool = False):
         self.level, self.n_pins, self.prefix, self.pins = level, n_pins, prefix, pins
         self.bench, self.certifier, self.name = bench, certifier, name
         self.unverified = []  # orienting on the selection trials, left uncertified by a time limit
+        self.learn = learn
+        self.fail_counts = None  # per trial of the full set: the judged sequences it failed (learn)
 
     def sequences(self, idx) -> tuple:
         """``(heights, speeds)`` of the level's rows ``idx`` (:meth:`CandidatePins.rows`)."""
@@ -542,6 +550,7 @@ class LevelScreen:
             chunk = self._drop_known_broken(alive[start:start + step], screen, allowed, record)
             if len(got.judged) >= candidates:  # the first ones are judged in full, for the evidence
                 size = chunk.size
+                chunk = self._hard_trials(chunk, full, allowed, record)
                 chunk = self._cascade(chunk, cascade, allowed, record)
                 got.cascaded += size - chunk.size
             if chunk.size == 0:
@@ -576,8 +585,11 @@ class LevelScreen:
         """Judge the level's rows ``chunk`` on all the trials ``rows``: each
         plan joins ``judged``, and ``(row, plan)`` joins ``pending`` when it
         orients (its family check still to come)."""
-        verdicts = self.bench.judge(*self.sequences(chunk), rows, stretch=stretch)
-        for idx, verdict in zip(chunk, verdicts):
+        finals, jammed = self.bench.replay(*self.sequences(chunk), rows, stretch)
+        if self.learn:
+            failed = self.bench.failing(finals, jammed).sum(axis=0)
+            self.fail_counts = failed if self.fail_counts is None else self.fail_counts + failed
+        for idx, verdict in zip(chunk, self.bench.verdicts(finals, jammed)):
             plan = self.plan(idx, span[idx], verdict)
             judged.append(plan)
             if verdict["orients"]:
@@ -619,6 +631,22 @@ class LevelScreen:
                     if i not in left:
                         rest.verdict = dict(rest.verdict, orients=False, broken_by_known_member=True)
                 queue = [(i, rest) for i, rest in queue if i in left]
+
+    def _hard_trials(self, alive, full, allowed: int, record):
+        """``alive`` without the sequences that fail more than ``allowed`` of the
+        ``HARD_TRIALS`` trials of ``full`` that failed most often in the
+        sequences judged so far (``learn`` only; exact, as the ``CASCADE``);
+        counted in ``record``."""
+        counts = self.fail_counts
+        if not self.learn or counts is None or alive.size == 0 or np.count_nonzero(counts) <= allowed:
+            return alive
+        order = np.lexsort((np.arange(counts.size), -counts))
+        hard = order[:min(HARD_TRIALS, np.count_nonzero(counts))]
+        fails = self.bench.failures(*self.sequences(alive), tuple(np.asarray(x)[hard] for x in full))
+        out = int((fails > allowed).sum())
+        record["screened_out"] += out
+        record["hard_trials_out"] = record.get("hard_trials_out", 0) + out
+        return alive[fails <= allowed]
 
     def _cascade(self, alive, cascade, allowed: int, record):
         """``alive`` without the sequences that fail more than ``allowed`` trials
@@ -736,6 +764,19 @@ class FixedPinSearch:
                                 bench.kernel, float(bench.cfg["pin_halfwidth"]), search.d_min, search.d_max,
                                 belt=bench.belt, speeds=self.pins.speeds, supports=nominal)
         self.prefix = FixedPlan((), (), 0.0, np.inf)  # the pins every sequence starts with (run)
+        # The best results when nothing orients (``best_effort``): the moving-pin stage keeps
+        # only the plans, so it turns this off (and its screens learn their hardest trials).
+        self.evidence = True
+
+    def reuse_rollouts(self, other: "FixedPinSearch") -> None:
+        """Take the nominal outcomes and the trials' states after each prefix
+        that ``other`` (a search of the same part, pins, friction, trials and
+        rollout settings, at another tolerance, say) has rolled out: both
+        are functions of their keys alone (a rounded pose; a prefix and a
+        trial), so this search finds exactly what it would alone, with fewer
+        rollouts."""
+        self.tree = other.tree
+        self.bench.kept = other.bench.kept
 
     @property
     def member_check(self):
@@ -759,7 +800,7 @@ class FixedPinSearch:
         (:class:`pipeline.progress.Heartbeat`). ``deadline``: a time limit
         (see the module's docstring); the result then says what it left
         unsearched."""
-        t0 = time.perf_counter()
+        t0, rollouts_before = time.perf_counter(), self.tree.rollouts
         bench = self.bench
         result = FixedSearch([], [], int(depth), bench.tolerance, bench.required,
                              confidence=bench.confidence, rule=bench.rule, time_limit=deadline.seconds)
@@ -778,9 +819,9 @@ class FixedPinSearch:
         if deadline.limited and not result.plans:
             self._not_reached(result, last, int(depth))
         result.unverified = self.ranked(result.unverified)[:keep]
-        if not result.plans:  # the evidence: the best several-set results of every level
+        if not result.plans and self.evidence:  # the best several-set results of every level
             self._gather_evidence(result, levels, runners_up, candidates, keep, progress, deadline)
-        result.rollouts = self.tree.rollouts
+        result.rollouts = self.tree.rollouts - rollouts_before
         result.seconds = time.perf_counter() - t0
         return result
 
@@ -803,7 +844,7 @@ class FixedPinSearch:
                 result.unsearched.append(record["unsearched"])
                 break
             screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier,
-                                 self._name(n_pins))
+                                 self._name(n_pins), learn=not self.evidence)
             found, judged, record = screen.search(candidates, progress, deadline)
             result.levels.append({"pins": n_pins, **record})
             if progress:
@@ -850,8 +891,11 @@ class FixedPinSearch:
         record = self._cut_record(level, n_pins)
         if level.size == 0 or deadline.search_over():
             return record
-        screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier, self._name(n_pins))
+        screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier, self._name(n_pins),
+                             learn=not self.evidence)
         found, judged, screened = screen.search(candidates, progress, deadline)
+        if progress:
+            progress(self._level_summary(n_pins, screened) + " (of the sequences enumerated)")
         runners_up.extend(judged)
         result.unverified += screen.unverified
         if found:

@@ -65,8 +65,9 @@ QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one no
 MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
 FIRST_PARENTS = 64  # parents of the first batch of a level under a time limit (it sets the pace)
 MAX_OUTCOMES = 8_000_000  # nominal outcomes kept for reuse (about 200 MB)
-# Under a time limit a level's enumeration may use this share of the search
-# time left when it starts; the rest screens the sequences it enumerated.
+# Under a time limit a level's enumeration that will not end before the search
+# time does stops after this share of the search time left when it started;
+# the rest screens the sequences it enumerated.
 ENUMERATION_SHARE = 0.7
 
 
@@ -155,9 +156,11 @@ class NominalTree:
         ``n`` sequences of ``length`` pins after ``root`` reports to.
         ``deadline``: no level starts once its search is over
         (:meth:`~pipeline.progress.Deadline.search_over`); a level's
-        enumeration stops once it has used ``ENUMERATION_SHARE`` of the search
-        time left when it started (the rest is for screening what it
-        enumerated), and a level it cuts short is the last (``Level.cut``)."""
+        enumeration that at its pace would not end before the search time
+        does stops once it has used ``ENUMERATION_SHARE`` of the search time
+        left when it started (the rest is for screening what it enumerated;
+        :func:`finishes_in_time`), and a level it cuts short is the last
+        (``Level.cut``)."""
         heartbeat = heartbeat or (lambda length, n: Heartbeat("", n))
         level = self.root() if root is None else root
         for _ in range(depth):
@@ -182,8 +185,9 @@ class NominalTree:
         ``stretch`` is told the share of parents done. Under a time limit
         (``deadline``) the chunks are about ``BATCH_SECONDS`` of work each and
         the enumeration stops between them once the search is over, or once
-        ``stop_at`` seconds of the deadline have passed: the level returned
-        is then ``cut``. (An outcome depends on its rounded pose only, so the
+        ``stop_at`` seconds of the deadline have passed and the rest would
+        not end before the search is over (:func:`finishes_in_time`): the
+        level returned is then ``cut``. (An outcome depends on its rounded pose only, so the
         sequences enumerated are the same in any chunks.)"""
         per_parent = max(1, self.heights.size * level.theta.shape[1])
         step = max(1, MAX_PAIRS // per_parent)
@@ -204,9 +208,16 @@ class NominalTree:
         if level.size == 0:
             return self._extend(level, stretch)
         parts, done, size = [], 0, min(step, FIRST_PARENTS)
+        started = deadline.elapsed() if stop_at is not None else 0.0
 
         def stop() -> bool:
-            return deadline.search_over() or (stop_at is not None and deadline.elapsed() >= stop_at)
+            if deadline.search_over():
+                return True
+            if stop_at is None:
+                return False
+            now = deadline.elapsed()
+            return now >= stop_at and not finishes_in_time(now, started, done, level.size,
+                                                           deadline.seconds - deadline.reserve)
 
         while done < level.size and not (parts and stop()):
             hi = min(level.size, done + size)
@@ -298,6 +309,15 @@ class NominalTree:
         self.rollouts += new.size
         shape = theta.shape
         return status[inverse].reshape(shape), theta_f[inverse].reshape(shape), dy[inverse].reshape(shape)
+
+
+def finishes_in_time(now: float, started: float, done: int, total: int, search_end: float) -> bool:
+    """Whether a level's enumeration, begun at ``started`` with ``done`` of its
+    ``total`` parents done at ``now``, ends at that pace before ``search_end``
+    (seconds on the deadline's clock): then it goes on past its share of the
+    time, as it would without one (a level that ends in time is never cut)."""
+    pace = (now - started) / max(done, 1)
+    return now + pace * (total - done) <= search_end
 
 
 class _Outcomes:

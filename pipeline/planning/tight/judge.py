@@ -174,9 +174,24 @@ class TrialBench:
         of each sequence on ``rows``, one at a time; ``interval`` adds the
         width's bootstrap interval. The replay runs when the first is asked for."""
         tf, jam = self.replay(heights, speeds, rows, stretch)
-        for k in range(heights.shape[0]):
-            yield orient.judge(tf[k][~jam[k]], rows[0].size, self.tolerance, self.order, self.required,
+        yield from self.verdicts(tf, jam, interval)
+
+    def verdicts(self, finals, jammed, interval: bool = False):
+        """The claim's verdict of each row of replayed ``finals`` (``jammed``:
+        its trials that jammed), one at a time."""
+        for k in range(finals.shape[0]):
+            yield orient.judge(finals[k][~jammed[k]], finals.shape[1], self.tolerance, self.order, self.required,
                                self.confidence, interval, self.rule)
+
+    def failing(self, finals, jammed) -> np.ndarray:
+        """``(sequences, trials)``: the trials each row of replayed ``finals``
+        leaves out of its best arc of the tolerance (or that jammed)."""
+        period = 360.0 / self.order
+        out = np.ones(finals.shape, dtype=bool)
+        for k in range(finals.shape[0]):
+            _, start = orient.best_arc(finals[k][~jammed[k]], self.tolerance, self.order)
+            out[k] = jammed[k] | (np.mod(finals[k] - start, period) > self.tolerance + 1e-9)
+        return out
 
 
 class PrefixStates:
