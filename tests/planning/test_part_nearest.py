@@ -20,7 +20,8 @@ from pipeline.config import load_config
 from pipeline.parts.part import Part
 from pipeline.planning import PlannerSettings, nearest_yes_lines
 from pipeline.planning.claims import orient
-from pipeline.planning.plans.nearest_part import LADDER, MAX_TOLERANCE, loosest_needed, moving_axis, part_nearest_yes
+from pipeline.planning.plans.nearest_part import (LADDER, MAX_TOLERANCE, loosest_needed, moving_axis, part_nearest_yes,
+                                                 tolerance_axis)
 from pipeline.planning.plans.plan import plan_tight
 from pipeline.progress import Deadline
 
@@ -107,11 +108,10 @@ class _SearchCut(Deadline):
 
 
 def test_a_search_cut_by_its_time_limit_still_answers_from_the_kept_plans(no_plan):
-    """A cut search (here after its first level) gets the kept plans'
-    tolerance answer, marked as kept plans only, with no search at looser
-    tolerances, the cut named in ``unsearched``, only the plans replayed
-    listed, and no advice to search deeper before the depth asked for was
-    searched in full."""
+    """A cut search (here its evidence: both levels were searched in full)
+    gets the kept plans' tolerance answer, marked as kept plans only, with no
+    search at looser tolerances, the cut named in ``unsearched`` and only the
+    plans replayed listed."""
     full, settings_ = no_plan
     cut = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=3))
     assert cut["complete"] is False and not cut["orients"]
@@ -123,7 +123,9 @@ def test_a_search_cut_by_its_time_limit_still_answers_from_the_kept_plans(no_pla
     kept = [p["pins"] for p in cut["plans"] + cut["rejected"]]
     assert all(p in kept for p in nearest["plans_tried"])
     more = next(a for a in nearest["axes"] if a["axis"] == "more pins")
-    assert "--time-limit" in more["statement"] and "--depth" not in more["statement"]
+    searched = cut["fixed_pin_search"]
+    assert searched["complete_to_pins"] == 2 and any("fewest-set" in u for u in searched["unsearched"])
+    assert "--depth 3" in more["statement"]  # both levels searched in full: only the evidence was cut
     # the plans kept here end far apart: none orients within the widest tolerance (checked by the
     # oracle's replays), so there is no answer, and the statement says the search was not run
     heights = {tuple(p["pins"]): p["pin_heights_mm"] for p in cut["plans"] + cut["rejected"]}
@@ -200,3 +202,49 @@ def test_searches_that_reuse_rollouts_find_what_they_find_alone(no_plan):
     assert [(p.labels, p.verdict) for p in alone.best_effort] == [(p.labels, p.verdict) for p in reusing.best_effort]
     assert alone.levels == reusing.levels
     assert reusing.rollouts < alone.rollouts
+
+
+def test_a_bisection_the_limit_cuts_keeps_its_certified_bound(no_plan, monkeypatch):
+    """When the limit cuts the bisection after its first search (at the widest
+    tolerance) found a plan, the answer is that plan's tolerance, said to be
+    an upper bound, not nothing."""
+    from pipeline.planning.tight import complete
+    full, settings_ = no_plan
+    real_run, calls = complete.FixedPinSearch.run, []
+
+    def run(self, *args, **kwargs):
+        result = real_run(self, *args, **kwargs)
+        calls.append(self.bench.tolerance)
+        if len(calls) > 1:  # every search after the first is cut
+            result.unsearched.append("cut by the test's time limit")
+        return result
+
+    monkeypatch.setattr(complete.FixedPinSearch, "run", run)
+    axis = tolerance_axis(TRAPEZOID, settings_.at(0.2), [], dict(full["pins_used"]), 2)
+    assert calls[0] == MAX_TOLERANCE and len(calls) == 2
+    assert axis["found"] and axis["value"] == MAX_TOLERANCE and axis["searches_cut"]
+    assert not axis["kept_plans_only"] and "at most 45 deg" in axis["statement"]
+    assert "upper bound" in axis["statement"] and axis["verdict"]["orients"]
+
+
+def test_more_pins_asks_for_a_longer_limit_only_when_the_depth_was_not_searched(no_plan):
+    full, settings_ = no_plan
+    kept = [(p["pins"], p["pin_heights_mm"], ()) for p in full["plans"]][:1]
+
+    def more(complete_to):
+        entry = dict(full, fixed_pin_search=dict(full["fixed_pin_search"], complete=False,
+                                                 complete_to_pins=complete_to))
+        return next(a for a in part_nearest_yes(TRAPEZOID, settings_.at(0.2), entry, kept)["axes"]
+                    if a["axis"] == "more pins")["statement"]
+
+    assert "--time-limit" in more(1)
+    assert "--depth 3" in more(2)  # depth 2 searched in full: only the evidence was cut
+
+
+def test_a_moving_plan_found_but_not_recommended_is_never_called_none():
+    stage = {"orients": True, "found": [["P1", "P2v+1"]], "complete": False}
+    unverified = moving_axis({"moving_pin_search": stage, "recommended": {"pins": ["P1"], "pin_speeds": [0.0]}})
+    assert not unverified["found"] and unverified["partial"] and "not verified" in unverified["statement"]
+    failed = moving_axis({"moving_pin_search": stage, "recommended": None,
+                          "rejected": [{"pins": ["P1", "P2v+1"]}]})
+    assert not failed["found"] and "fails the final verification" in failed["statement"]

@@ -190,9 +190,10 @@ def test_a_cut_enumeration_with_time_left_screens_what_it_enumerated(monkeypatch
 
 
 @pytest.mark.parametrize("now, done, search_end, goes_on", [
-    (70.0, 60, 100.0, True),   # 70 s for 60 of 80 parents: the other 20 take 23.3 s, ending at 93.3 s
-    (70.0, 60, 93.5, True),    # before the search ends: it goes on past its share, as without one
-    (70.0, 60, 90.0, False),   # after: it would be cut anyway, so it stops now and screens what it has
+    (70.0, 60, 104.0, True),   # 70 s for 60 of 80 parents: the other 20 take 23.3 s, ending at 93.3 s,
+                               # with 10.7 s (over a tenth of the 104 s) left to screen: it goes on
+    (70.0, 60, 100.0, False),  # ending at 93.3 s leaves under a tenth of 100 s: it stops and screens now
+    (70.0, 60, 90.0, False),   # it would not end at all before the search does
     (10.0, 1, 50.0, False),    # one parent in 10 s: 79 more do not fit in 40 s
 ])
 def test_a_level_that_ends_in_time_is_never_cut_for_its_share(now, done, search_end, goes_on):

@@ -63,7 +63,7 @@ def loosest_needed(finals, jammed, n_trials: int, order: int, required: float, c
 
 def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, progress=None,
                        deadline: Deadline = NO_DEADLINE) -> tuple | None:
-    """``(tolerance, plan)``: the smallest tolerance on the ``LADDER`` up to
+    """``(tolerance, plan, exact)``: the smallest tolerance on the ``LADDER`` up to
     ``MAX_TOLERANCE`` at which the complete fixed-pin search over ``pins``
     (label -> height, mm) finds a plan of up to ``depth`` pins, certified on
     its held-out trials, by bisection; None when none does at ``MAX_TOLERANCE``.
@@ -72,9 +72,12 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
     orients within any looser tolerance, and its nominal finals pass the
     looser filter too, so "some plan orients" is monotone in ``t``.
 
-    Under a time limit (``deadline``) a search it cuts short raises
-    :class:`~pipeline.progress.OutOfTime`: a bisection over part searches
-    would give a wrong tolerance."""
+    Under a time limit (``deadline``) a search it cuts short gives no
+    answer at its tolerance (over part searches the bisection would give a
+    wrong one): the first raises :class:`~pipeline.progress.OutOfTime`; a
+    later one ends the bisection with the loosest tolerance it certified, an
+    upper bound (``exact`` False). Its searches keep no evidence (only their
+    plans are read)."""
     import dataclasses
 
     from pipeline.planning.tight.complete import FixedPinSearch
@@ -86,6 +89,7 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
         search = FixedPinSearch(part, pins, settings.friction, claims, settings.verify, settings.search)
         if searches:
             search.reuse_rollouts(searches[0])
+        search.evidence = False
         searches.append(search)
         result = search.run(depth, candidates=candidates, keep=1, progress=_at(progress, t), deadline=deadline)
         if not result.complete:
@@ -99,12 +103,15 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
         return None
     while hi - lo > LADDER + 1e-9:
         mid = math.floor((lo + hi) / 2 / LADDER) * LADDER
-        plan = found(mid)
+        try:
+            plan = found(mid)
+        except OutOfTime:
+            return hi, best, False  # certified at hi; tighter ones not decided
         if plan is None:
             lo = mid
         else:
             hi, best = mid, plan
-    return hi, best
+    return hi, best, True
 
 
 def _at(progress, tolerance):
@@ -144,7 +151,7 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
                                    claims.confidence, rule=claims.rule)
             best = (tol, labels, heights, speeds, verdict)
     cut = tried < len(plans)  # the limit passed before every kept plan was replayed
-    searches_cut = False
+    searches_cut, bound = False, False
     if best is None and pins is not None and not cut:
         try:
             searched = searched_tolerance(part, settings, pins, depth or settings.search.depth,
@@ -153,9 +160,10 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
             searches_cut = True
         else:
             if searched is not None:
-                tol, plan = searched
+                tol, plan, exact = searched
                 best = (tol, plan.labels, plan.heights, plan.speeds, plan.verdict)
-    kept_only = pins is None or cut or searches_cut
+                searches_cut = bound = not exact
+    kept_only = pins is None or cut or (searches_cut and not bound)
     flags = {"kept_plans_only": kept_only, "replayed": tried, "searches_cut": searches_cut}
     if best is None and tried == 0 and plans:
         return _axis("tolerance", False, "not searched: no time was left to replay the kept plans", **flags)
@@ -169,7 +177,10 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
                                          f"the part within {MAX_TOLERANCE:g} deg on held-out trials", **flags)
     tol, labels, heights, speeds, verdict = best
     scope = f"; among the {tried} kept plan(s) replayed, no search at looser tolerances" if kept_only else ""
-    return _axis("tolerance", True, f"a tolerance of {tol:g} deg (asked: {claims.tolerance_deg:g} deg{scope})",
+    if bound:
+        scope = "; an upper bound: the time limit cut the search at tighter tolerances"
+    return _axis("tolerance", True, f"a tolerance of {'at most ' if bound else ''}{tol:g} deg "
+                                    f"(asked: {claims.tolerance_deg:g} deg{scope})",
                  value=tol, unit="deg", plan=list(labels), pin_heights_mm=[float(h) for h in heights],
                  pin_speeds=[float(v) for v in (speeds or ())], verdict=verdict, **flags)
 
@@ -181,6 +192,14 @@ def moving_axis(entry: dict, cut: bool = False) -> dict:
     if not stage and cut:
         return _axis("moving pins", False, "not searched: the time limit ended the search before the moving pins",
                      partial=True)
+    rec = entry.get("recommended") or {}
+    if stage and stage.get("orients") and not any(rec.get("pin_speeds") or ()):
+        found = list((stage.get("found") or [[]])[0])
+        if found in [list(r.get("pins") or ()) for r in entry.get("rejected") or ()]:
+            return _axis("moving pins", False, f"searched: {' '.join(found)} orients on the search's trials "
+                                               "but fails the final verification")
+        return _axis("moving pins", False, f"found, not verified: {' '.join(found)} orients on the search's "
+                                           "trials; the time limit left no time to verify it", partial=True)
     if stage and stage.get("complete") is False and not stage.get("orients"):
         return _axis("moving pins", False, "searched in part: the time limit cut the moving-pin search "
                                            f"(not searched: {'; '.join(stage.get('unsearched') or [])})",
@@ -221,7 +240,9 @@ def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = Non
     depth = entry.get("depth")
     tolerance = tolerance_axis(part, settings, plans, pins, depth, progress, deadline)
     more = more_pins_axis(entry)
-    if entry.get("fixed_pin_search", {}).get("complete") is False:  # depth N itself was not searched in full
+    searched = entry.get("fixed_pin_search") or {}
+    if searched.get("complete") is False and searched.get("complete_to_pins", 0) < (depth or 0):
+        # depth N itself was not searched in full
         more = _axis("more pins", False, "not searched: the time limit cut the search before its depth; "
                                          "run with a longer --time-limit first", partial=True)
     return {"plans_tried": [list(p[0]) for p in plans[:tolerance["replayed"]]],

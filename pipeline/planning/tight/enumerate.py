@@ -69,6 +69,7 @@ MAX_OUTCOMES = 8_000_000  # nominal outcomes kept for reuse (about 200 MB)
 # time does stops after this share of the search time left when it started;
 # the rest screens the sequences it enumerated.
 ENUMERATION_SHARE = 0.7
+SCREEN_SHARE = 0.1  # ... and one that will end in time goes on if it leaves at least this share to screen
 
 
 @dataclass
@@ -313,11 +314,12 @@ class NominalTree:
 
 def finishes_in_time(now: float, started: float, done: int, total: int, search_end: float) -> bool:
     """Whether a level's enumeration, begun at ``started`` with ``done`` of its
-    ``total`` parents done at ``now``, ends at that pace before ``search_end``
-    (seconds on the deadline's clock): then it goes on past its share of the
-    time, as it would without one (a level that ends in time is never cut)."""
+    ``total`` parents done at ``now``, ends at that pace with ``SCREEN_SHARE``
+    of its time to ``search_end`` (seconds on the deadline's clock) left for
+    its screen: then it goes on past its share of the time (a level that ends
+    in time with room to screen it is never cut)."""
     pace = (now - started) / max(done, 1)
-    return now + pace * (total - done) <= search_end
+    return now + pace * (total - done) <= search_end - SCREEN_SHARE * (search_end - started)
 
 
 class _Outcomes:
