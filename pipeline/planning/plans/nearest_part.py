@@ -121,19 +121,11 @@ def _at(progress, tolerance):
     return lambda line: progress(f"nearest yes, tolerance {tolerance:g} deg: {line}")
 
 
-def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None,
-                   progress=None, deadline: Deadline = NO_DEADLINE) -> dict:
-    """The smallest tolerance at which one of ``plans`` (``(labels, heights,
-    speeds)``) orients ``part`` on held-out trials; when none does within
-    ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
-    complete search over them finds a plan (:func:`searched_tolerance`).
-
-    Without ``pins`` (a search cut by its time limit: a bisection over
-    searches would be cut too) only the kept plans are replayed. Under a
-    time limit (``deadline``) the kept plans are replayed while it lasts,
-    and a bisection it cuts gives no tolerance: the axis then answers from
-    the kept plans replayed and says so (``kept_plans_only``, ``replayed``;
-    ``searches_cut`` when the limit cut the searches at looser tolerances)."""
+def _kept_tolerance(part, settings, plans, deadline: Deadline) -> tuple:
+    """``(best, replayed)``: the kept ``plans`` replayed on held-out trials
+    while ``deadline`` lasts; ``best`` is ``(tolerance, labels, heights,
+    speeds, verdict)`` of the one with the smallest tolerance (None if none
+    orients within ``MAX_TOLERANCE``), ``replayed`` how many were replayed."""
     bench = TrialBench(part, settings.friction, settings.claims, settings.verify, settings.search)
     claims = settings.claims
     best, tried = None, 0
@@ -150,6 +142,24 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
             verdict = orient.judge(tf[0][~jam[0]], rows[0].size, tol, bench.order, claims.required,
                                    claims.confidence, rule=claims.rule)
             best = (tol, labels, heights, speeds, verdict)
+    return best, tried
+
+
+def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None,
+                   progress=None, deadline: Deadline = NO_DEADLINE) -> dict:
+    """The smallest tolerance at which one of ``plans`` (``(labels, heights,
+    speeds)``) orients ``part`` on held-out trials; when none does within
+    ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
+    complete search over them finds a plan (:func:`searched_tolerance`).
+
+    Without ``pins`` (a search cut by its time limit: a bisection over
+    searches would be cut too) only the kept plans are replayed. Under a
+    time limit (``deadline``) the kept plans are replayed while it lasts,
+    and a bisection it cuts gives no tolerance: the axis then answers from
+    the kept plans replayed and says so (``kept_plans_only``, ``replayed``;
+    ``searches_cut`` when the limit cut the searches at looser tolerances)."""
+    claims = settings.claims
+    best, tried = _kept_tolerance(part, settings, plans, deadline)
     cut = tried < len(plans)  # the limit passed before every kept plan was replayed
     searches_cut, bound = False, False
     if best is None and pins is not None and not cut:
