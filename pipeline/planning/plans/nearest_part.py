@@ -216,7 +216,6 @@ def moving_axis(entry: dict, cut: bool = False) -> dict:
                      partial=True)
     if not stage:
         return _axis("moving pins", False, "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
-    rec = entry.get("recommended") or {}
     if stage.get("orients") and any(rec.get("pin_speeds") or ()):
         n = sum(1 for v in rec["pin_speeds"] if v)
         return _axis("moving pins", True, f"{n} moving pin(s)", value=n, unit="moving pins",

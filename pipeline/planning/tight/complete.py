@@ -843,24 +843,34 @@ class FixedPinSearch:
                 result.levels.append(record)
                 result.unsearched.append(record["unsearched"])
                 break
-            screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier,
-                                 self._name(n_pins), learn=not self.evidence)
-            found, judged, record = screen.search(candidates, progress, deadline)
+            record = self._screen(result, level, n_pins, candidates, keep, progress, deadline, runners_up, levels)
             result.levels.append({"pins": n_pins, **record})
-            if progress:
-                progress(self._level_summary(n_pins, record))
-            runners_up.extend(judged)
-            result.unverified += screen.unverified
             if record.get("unsearched"):
                 result.unsearched.append(record["unsearched"])
             last = level
-            if found:
-                result.plans = self.ranked(found)[:keep]
-                break
-            levels.append(screen)
-            if record.get("complete") is False:
+            if result.plans or record.get("complete") is False:
                 break
         return last
+
+    def _screen(self, result: FixedSearch, level: Level, n_pins: int, candidates: int, keep: int, progress,
+                deadline: Deadline, runners_up: list, levels: list, whose: str = "") -> dict:
+        """Screen, judge and certify the sequences of ``level`` (a
+        :class:`LevelScreen`) and return its counts: its certified plans
+        become ``result.plans`` (best first), its judged plans join
+        ``runners_up`` and, when none is certified, its screen joins
+        ``levels`` (for the evidence); ``whose`` ends its progress line."""
+        screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier, self._name(n_pins),
+                             learn=not self.evidence)
+        found, judged, record = screen.search(candidates, progress, deadline)
+        if progress:
+            progress(self._level_summary(n_pins, record) + whose)
+        runners_up.extend(judged)
+        result.unverified += screen.unverified
+        if found:
+            result.plans = self.ranked(found)[:keep]
+        else:
+            levels.append(screen)
+        return record
 
     def _level_heralds(self, progress, deadline: Deadline):
         """The function ``NominalTree.levels`` calls as each level's
@@ -891,17 +901,8 @@ class FixedPinSearch:
         record = self._cut_record(level, n_pins)
         if level.size == 0 or deadline.search_over():
             return record
-        screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier, self._name(n_pins),
-                             learn=not self.evidence)
-        found, judged, screened = screen.search(candidates, progress, deadline)
-        if progress:
-            progress(self._level_summary(n_pins, screened) + " (of the sequences enumerated)")
-        runners_up.extend(judged)
-        result.unverified += screen.unverified
-        if found:
-            result.plans = self.ranked(found)[:keep]
-        else:
-            levels.append(screen)
+        screened = self._screen(result, level, n_pins, candidates, keep, progress, deadline, runners_up, levels,
+                                " (of the sequences enumerated)")
         done, total = level.cut
         return {**record, **screened, "complete": False,
                 "unsearched": "; ".join(filter(None, [
