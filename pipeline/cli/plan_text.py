@@ -20,25 +20,27 @@ def _verification_counts(plan) -> dict | None:
 
 
 def _plan_summary(plan, pins=None) -> dict:
+    """One plan of ``plan --json``: its pins, its one ``claim`` (None for a
+    plan never replayed on held-out trials, e.g. paper mode's), then, named
+    for what they are, the carried sets, the selection trials' verdict and
+    the held-out replay's counts."""
     heights = plan.get("pin_heights_mm") or [pins[p] for p in plan["pins"]]
-    orientation = (plan.get("verification") or {}).get("orientation")
+    claim = plan.get("claim")
+    older = claim if isinstance(claim, str) else None  # files written before claims were records
+    kind = plan.get("carried_sets_kind") or older or ("propagated" if plan.get("mode") == "tight" else "paper bands")
     return {"pins": list(plan["pins"]), "pin_heights_mm": list(heights),
-            "final_sets": plan["final_sets"], "n_final_sets": plan["n_final_sets"],
-            "claimed_width_deg": _claimed_width(plan), "claim": plan.get("claim"),
-            "verified_width_deg": orientation["width_deg"] if orientation else None,
-            "orients": orientation["orients"] if orientation else None,
-            **_claim_numbers(orientation),
-            "truncation_sigma": (plan.get("verification") or {}).get("truncation_sigma"),
-            "untruncated": (plan.get("verification") or {}).get("untruncated"),
+            "claim": claim if isinstance(claim, dict) else None,
+            "carried_sets": {"kind": kind, "n_sets": plan.get("n_final_sets"), "sets": plan["final_sets"],
+                             "note": CARRIED_NOTE.get(kind, "not the claim")},
             "selection": _selection_counts(plan),
             "verification": _verification_counts(plan)}
 
 
-def _claim_numbers(orientation) -> dict:
-    """The held-out claim's share with its lower confidence bound, and the width's interval."""
-    o = orientation or {}
-    return {key: o.get(key) for key in ("share", "share_lower_bound", "confidence", "point_rule",
-                                        "width_interval_deg")}
+CARRIED_NOTE = {
+    "propagated": "the tight propagation's sound bound over the perturbation box; not the claim",
+    "sampled": "the hull of a sampled replay of the perturbation box; not the claim",
+    "paper bands": "the paper's adjusted bands; not the claim",
+}
 
 
 def _selection_counts(plan) -> dict | None:
@@ -47,12 +49,6 @@ def _selection_counts(plan) -> dict | None:
     if not s:
         return None
     return {key: s.get(key) for key in ("orients", "in_tolerance", "trials", "width_deg")}
-
-
-def _claimed_width(plan) -> float | None:
-    """Width (deg) of the claimed final orientation, if it is one arc."""
-    sets = plan.get("final_sets") or []
-    return float(sets[0]["width"]) if len(sets) == 1 else None
 
 
 def plan_json(result, mode) -> dict:
@@ -122,11 +118,9 @@ def print_plan_result(result, part, config, mode):
             v = plan.verification
             heights = ", ".join(f"{q} at {y:g} mm" for q, y in zip(plan.pins, plan.pin_heights_mm))
             mark = " (recommended)" if t.recommended is not None and plan == t.recommended else ""
-            print(f"  #{k}{mark}: {heights} -> claimed {plan.n_final_sets} set(s) "
-                  f"({plan.extra.get('claim', 'propagated')}): {sets_text(plan.final_arcs, order)}; "
-                  f"{_orientation_text(v)}; margin in d "
+            print(f"  #{k}{mark}: {heights}; margin in d "
                   + (f"{plan.margin:+.3f}" if plan.margin is not None else "n/a (touches nothing)"))
-            _print_claim(plan, isinstance(t.mu_c, (tuple, list)))
+            _print_claim(plan, order, isinstance(t.mu_c, (tuple, list)))
     if mode == "tight" or result.plans is None:
         return
     print(f"paper-mode planner (adjusted bands), {result.extra['selection']}:")
@@ -152,11 +146,43 @@ def sets_text(arcs, order: int) -> str:
     return f"{format_arcs(merge_modulo(pairs, order))} (x{order} by symmetry)"
 
 
-def _print_claim(plan, mu_range: bool = False) -> None:
-    """The held-out claim with its uncertainty and how its trials were drawn,
-    the untruncated replay beside it, the selection trials apart, the margin
-    in words (``mu_range``: the friction is a range, drawn uniformly)."""
-    from pipeline.planning import describe_claim, describe_untruncated, margin_text, truncation_text
+def _print_claim(plan, order: int, mu_range: bool = False) -> None:
+    """The plan's one claim (what it promises, how sure, on which trials),
+    then, apart and named for what they are, the checks beside it: the
+    untruncated replay, the trials that chose the plan and the carried sets;
+    then the margin in words (``mu_range``: the friction is a range, drawn
+    uniformly). A plan file written before claims were recorded prints its
+    held-out verdict instead."""
+    from pipeline.planning import Claim, describe_untruncated, margin_text
+    v = plan.verification
+    claim = plan.extra.get("claim")
+    kind = plan.extra.get("carried_sets_kind", claim if isinstance(claim, str) else "propagated")
+    if isinstance(claim, dict):
+        c = Claim.from_dict(claim)
+        print(f"      claim: {c.statement()}")
+        print(f"      its trials: {c.trials_text()}")
+        if c.untruncated:
+            u = c.untruncated
+            print(f"      beside it: untruncated normals ({', '.join(u['not_cut'])} not cut; random draws only, "
+                  f"no box corners): {u['in_best_arc']}/{u['trials']} in one arc of {c.tolerance_deg:g} deg, "
+                  f"at least {100 * u['share_lower_bound']:.2f} % with {100 * c.confidence:g} % confidence"
+                  + (f"; width {u['width_deg']:.1f} deg" if u.get("width_deg") is not None else ""))
+    else:
+        _print_verdict(plan, mu_range)
+    sel = v.extra.get("selection") if v else None
+    if sel:
+        print(f"      beside it: the selection trials (chose the plan; no claim): {sel['in_tolerance']}/"
+              f"{sel['trials']} in one set" + (f", width {sel['width_deg']:.1f} deg"
+                                                if sel.get("width_deg") is not None else ""))
+    what = "a sound bound over the perturbation box" if kind == "propagated" else "the hull of a sampled replay"
+    hits = f"; {v.successes}/{v.trials} held-out trials in them" if v else ""
+    print(f"      beside it: carried sets ({what}, not the claim): {sets_text(plan.final_arcs, order)}{hits}")
+    print(f"      {margin_text(plan.margin)}")
+
+
+def _print_verdict(plan, mu_range: bool = False) -> None:
+    """A plan file without a claim record: its held-out verdict, as written then."""
+    from pipeline.planning import describe_claim, describe_untruncated, truncation_text
     v = plan.verification
     o = v.extra.get("orientation") if v else None
     if o and "share_lower_bound" in o:
@@ -166,11 +192,8 @@ def _print_claim(plan, mu_range: bool = False) -> None:
         print(f"      {where}: {describe_claim(o)}{drawn}")
         if v.extra.get("untruncated"):
             print(f"      {describe_untruncated(v.extra['untruncated'], sigma)}")
-        sel = v.extra.get("selection")
-        if sel:
-            print(f"      selection trials (chose the plan; no claim): {sel['in_tolerance']}/{sel['trials']} "
-                  "in one set" + (f", width {sel['width_deg']:.1f} deg" if sel.get("width_deg") is not None else ""))
-    print(f"      {margin_text(plan.margin)}")
+    else:
+        print(f"      {_orientation_text(v)}")
 
 
 def _orientation_text(v) -> str:

@@ -50,6 +50,7 @@ _WHERE = {
     "core.settings": "BandSettings ClaimSettings Friction Perturbation PlannerSettings SearchSettings "
                      "SpeedSettings VerifySettings candidate_pins fitted_pins friction_label "
                      "nominal_friction parse_friction",
+    "core.claim": "Claim",
     "core.types": "PlanFile as_plan_file load_plan validate_plan_file",
     "claims.orient": "check_tolerance describe_claim min_trials narrowest_arc",
     "claims.tails": "describe_untruncated truncation_text untruncated_check",

@@ -176,10 +176,8 @@ def _support_section(res: dict, files: dict, base) -> list[str]:
     fp = res.get("family_plan")
     if fp:
         if fp.get("orients"):
-            v = fp["verification"]["orientation"]
             p.append(f"<li><b>The plan that does: {html.escape(' '.join(fp['pins']))}</b> (heights "
-                     f"{', '.join(f'{y:g}' for y in fp['pin_heights_mm'])} mm): {v['in_tolerance']}/"
-                     f"{v['trials']} trials of the family in one set, verified width {v['width_deg']:.1f} deg. "
+                     f"{', '.join(f'{y:g}' for y in fp['pin_heights_mm'])} mm). {_family_claim_text(fp)} "
                      f"{html.escape(fp['evidence'])}.</li>")
         else:
             p.append(f'<li class="warn">No plan orients the part for every member: '
@@ -191,6 +189,17 @@ def _support_section(res: dict, files: dict, base) -> list[str]:
     p.append("</ul>")
     return p + _figure(files, "support_maps", base, "Configuration maps: uniform (black), the family (grey), "
                        "its extremes (colours)")
+
+
+def _family_claim_text(fp: dict) -> str:
+    """The family plan's one claim (an older study without one: its verdict on
+    the family's trials), escaped."""
+    if isinstance(fp.get("claim"), dict):
+        from pipeline.planning import Claim
+        return html.escape(f"Claim: {Claim.from_dict(fp['claim']).statement()}.")
+    v = fp["verification"]["orientation"]
+    return html.escape(f"{v['in_tolerance']}/{v['trials']} trials of the family in one arc of "
+                       f"{v['tolerance_deg']:g} deg.")
 
 
 def _layout_section(lay: dict, files: dict, base, caption: str | None = None) -> list[str]:
@@ -312,7 +321,16 @@ def _search_evidence(res: dict) -> list[str]:
 
 
 def _width_cell(plan: dict) -> str:
-    """The verified width beside the claim: red when the plan does not orient the part."""
+    """The plan's one claim and how its trials were drawn (a plan file written
+    before claims were records: its held-out verdict); red when the plan does
+    not orient the part."""
+    claim = plan.get("claim")
+    if isinstance(claim, dict):
+        from pipeline.planning import Claim
+        c = Claim.from_dict(claim)
+        text = f"{c.statement()}. Its trials: {c.trials_text()}" + "".join(
+            f"; {n}" for n in _tails_notes(plan.get("verification") or {})[1:])
+        return f"<td>{html.escape(text)}</td>" if c.orients else f"<td style='color:#b00'>{html.escape(text)}</td>"
     o = (plan.get("verification") or {}).get("orientation")
     if not o:
         return "<td>n/a</td>"
@@ -347,8 +365,8 @@ def _tails_notes(verification: dict) -> list[str]:
         if None not in iv:
             width += f" ({iv[0]:.1f}-{iv[1]:.1f})"
         verdict = "orients" if u["orients"] else "does not orient"
-        notes.append(f"untruncated normals: width {width}, {u['in_one_set']}/{u['trials']} in one set, "
-                     f"{verdict}")
+        notes.append(f"beside the claim, untruncated normals (random draws only, no box corners): width {width}, "
+                     f"{u['in_one_set']}/{u['trials']} in one set, {verdict}")
     return notes
 
 
@@ -357,9 +375,9 @@ def _side_by_side(res: dict, ver: dict | None, speed: dict | None = None) -> lis
     and the speed limit (mm/s, dynamic model) of the plan the speed stage replayed."""
     checks = {c["kind"]: c for c in (ver or {}).get("checks", [])}
     p = ['<h4>Paper mode beside the tight planner</h4><table class="side-by-side"><tr><th>planner</th>'
-         "<th>friction mu_c</th><th>pins (height, mm)</th><th>final sets</th>"
-         "<th>orientation sets</th><th>verified (successes/trials)</th>"
-         "<th>verified width (deg): trials in one set of the tolerance</th>"
+         "<th>friction mu_c</th><th>pins (height, mm)</th><th>carried sets (count)</th>"
+         "<th>carried sets (deg; not the claim)</th><th>replayed in the carried sets (successes/trials)</th>"
+         "<th>the claim</th>"
          "<th>speed limit (mm/s)</th></tr>"]
     static = res.get("best_static")
     if static:

@@ -149,7 +149,7 @@ def test_sampled_claim_splits_outliers_and_holds_in_an_independent_replay():
     labels = [k for k, p in planner.pins.items() if p.y in (10.0, 27.5, 47.5)]
     labels = sorted(labels, key=lambda k: [10.0, 27.5, 47.5].index(planner.pins[k].y))
     plan = sampled_plan(planner, labels, 0.0, {"trials": 100})
-    assert plan.claim == "sampled"
+    assert plan.carried == "sampled"
     for label, branches in plan.branches.items():
         finals = sorted(br[-1].after.start for br in branches)
         assert all(br[-1].after.width < 20.0 for br in branches), (label, finals)

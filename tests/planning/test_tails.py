@@ -8,6 +8,7 @@ file carries the keys and ``pinfeed plan`` prints the line."""
 from __future__ import annotations
 
 import contextlib
+import html
 import io
 import json
 import math
@@ -136,15 +137,21 @@ def _part():
 
 def test_pinfeed_plan_prints_the_truncation_and_the_untruncated_line(planned):
     _, plan_file, printed = planned
-    u = plan_file["tight"][0]["recommended"]["verification"]["untruncated"]
+    rec = plan_file["tight"][0]["recommended"]
+    u = rec["verification"]["untruncated"]
     lines = printed.splitlines()
-    held = [k for k, ln in enumerate(lines) if ln.strip().startswith("held-out trials:")]
-    assert held and all("(theta and mu_c drawn from normals truncated at 2 sigma)" in lines[k] for k in held)
+    claims = [k for k, ln in enumerate(lines) if ln.strip().startswith("claim:")]
+    assert claims and len(claims) == len(plan_file["tight"][0]["plans"])  # one claim per plan
+    # Each claim is followed by its trials, which say where the normals are cut.
+    assert all(lines[k + 1].strip().startswith("its trials: held-out trials") and
+               "normals cut at 2 sigma" in lines[k + 1] for k in claims)
     untruncated = [k for k, ln in enumerate(lines) if "untruncated normals" in ln]
-    assert len(untruncated) == 1 and untruncated[0] == held[0] + 1  # under the recommended plan's claim
-    assert lines[untruncated[0]].strip() == describe_untruncated(u)
-    assert f"{u['in_one_set']}/{u['trials']} in one set of 10 deg" in lines[untruncated[0]]
-    assert "(theta, mu_c not cut at 2 sigma)" in lines[untruncated[0]]
+    assert len(untruncated) == 1 and untruncated[0] == claims[0] + 2  # under the recommended plan's claim
+    line = lines[untruncated[0]]
+    assert line.strip().startswith("beside it: untruncated normals (theta, mu_c not cut; random draws only, "
+                                   "no box corners)")
+    assert f"{u['in_one_set']}/{u['trials']} in one arc of 10 deg" in line
+    assert rec["claim"]["untruncated"]["box_corners"] is False
 
 
 def test_the_untruncated_line_says_a_friction_range_stays_uniform():
@@ -162,10 +169,10 @@ def test_the_report_shows_the_untruncated_width_beside_the_claimed_one(planned):
     from pipeline.present.report import _width_cell
     _, plan_file, _ = planned
     plan = plan_file["tight"][0]["recommended"]
-    o, u = plan["verification"]["orientation"], plan["verification"]["untruncated"]
+    claim, u = plan["claim"], plan["verification"]["untruncated"]
     cell = _width_cell(plan)
-    assert cell.split(">", 1)[1].startswith(f"{o['width_deg']:.1f}: {o['in_tolerance']}/{o['trials']} in 10 deg (")
+    assert cell.split(">", 1)[1].startswith(html.escape(claim["statement"]))
     lo, hi = u["width_interval_deg"]
-    assert "theta, mu_c normals cut at 2 sigma" in cell
-    assert (f"untruncated normals: width {u['width_deg']:.1f} deg ({lo:.1f}-{hi:.1f}), "
-            f"{u['in_one_set']}/{u['trials']} in one set") in cell
+    assert "normals cut at 2 sigma" in cell
+    assert (f"untruncated normals (random draws only, no box corners): width {u['width_deg']:.1f} deg "
+            f"({lo:.1f}-{hi:.1f}), {u['in_one_set']}/{u['trials']} in one set") in cell

@@ -207,12 +207,16 @@ def test_plan_command_lists_verified_plans_best_first(tmp_path, capsys, monkeypa
     out = json.loads(capsys.readouterr().out)
     assert out["part"] == "tri" and out["mu_c"] == 0.0 and out["plans"]
     for plan in out["plans"]:
-        assert set(plan) >= {"pins", "pin_heights_mm", "final_sets", "n_final_sets", "verification"}
-        v = plan["verification"]
+        assert set(plan) >= {"pins", "pin_heights_mm", "claim", "carried_sets", "verification"}
+        v, claim = plan["verification"], plan["claim"]
         assert v["trials"] >= 3 * 300 and v["failures"] <= 0.01 * v["trials"]
-        for s in plan["final_sets"]:
+        # One claim, with its trials: the held-out replay, every trial in its arc or not.
+        assert claim["trials"] == v["trials"] and claim["in_arc"] <= claim["trials"]
+        assert claim["trials_drawn"]["kind"] == "held-out" and claim["arc"]["width"] == claim["tolerance_deg"]
+        assert "not the claim" in plan["carried_sets"]["note"]
+        for s in plan["carried_sets"]["sets"]:
             assert 0.0 <= s["start"] < 360.0
-    assert out["plans"][0]["n_final_sets"] == min(p["n_final_sets"] for p in out["plans"])
+    assert out["plans"][0]["carried_sets"]["n_sets"] == min(p["carried_sets"]["n_sets"] for p in out["plans"])
     assert (tmp_path / "cat" / "refine").is_dir()
     assert main(args) == 0
     text = capsys.readouterr().out

@@ -59,6 +59,8 @@ from pipeline.planning.core.settings import (TRUNCATE_SIGMA, Friction, PlannerSe
 from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
 from pipeline.planning.claims.verify import ReplayMemo, holdout_settings, verify_plan
 from pipeline.planning.claims.tails import describe_untruncated, untruncated_check
+from pipeline.planning.claims.plan_claim import (family_claim, held_out_claim, perturbations, trials_drawn,
+                                                 with_untruncated)
 from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat
 
 
@@ -368,6 +370,7 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
                           mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1), memo=memo)
         verdict = judge_verification(res, claims.tolerance_deg, planner.order, claims.required,
                                      claims.confidence, claims.rule)
+        plan.claim = _held_out_claim(settings, res, verdict, planner.order, verify_cfg["seed"])
         plan.verification = {"held_out": True, "seed": verify_cfg["seed"],
                              "trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
@@ -381,6 +384,15 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
             progress(f"mu_c {settings.friction.label}: verified {' '.join(plan.pins)} on held-out trials: "
                      + describe_claim(verdict))
     beat.finish()
+
+
+def _held_out_claim(settings: PlannerSettings, res: dict, verdict: dict, order: int, seed: int):
+    """The plan's one claim on its held-out replay ``res`` (``verify_plan``),
+    judged as ``verdict``."""
+    finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
+    drawn = trials_drawn(settings.verify, res["rows"], seed, held_out=True)
+    return held_out_claim(verdict, finals, settings.claims, order, drawn,
+                          perturbations(settings.verify, settings.friction.value))
 
 
 def _check_tails(part: Part, settings: PlannerSettings, planner, plan, states, progress=None,
@@ -400,6 +412,7 @@ def _check_tails(part: Part, settings: PlannerSettings, planner, plan, states, p
                                kernel=search.kernel_settings, belt_speed=planner.belt_speed,
                                mu_s=planner.mu_s, family=family)
     plan.verification["untruncated"] = record
+    plan.claim = with_untruncated(plan.claim, record)
     if progress:
         progress(f"mu_c {settings.friction.label}: {' '.join(plan.pins)} on "
                  + describe_untruncated(record, TRUNCATE_SIGMA))
@@ -604,6 +617,7 @@ def judge_for_family(candidates, checker: FamilyChecker | None) -> None:
         check = {k: v for k, v in checker.result(plan.pins, plan.pin_heights_mm).items()
                  if not k.startswith("_")}
         plan.verification["family_check"] = check
+        plan.claim = family_claim(plan.claim, checker.family.label, check)
         if not check["holds"]:
             plan.verification["orientation"] = dict(plan.verification["orientation"], orients=False,
                                                     broken_by_worst_member=True)
@@ -623,6 +637,9 @@ def certify_for_family(result: dict, part: Part, settings: PlannerSettings, fami
                                   speeds=rec.pin_speeds, progress=checker.progress)
         result["family_certificate"] = cert
         result["recommended"]["family_certificate"] = cert
+        rec.claim = family_claim(rec.claim, family.label, check, cert)
+        for entry in [result["recommended"], *result["plans"][:1]]:
+            entry["claim"] = rec.claim.to_dict()
         if not any(rec.pin_speeds or ()):
             return
         # A moving-pin plan holds: the nearest "yes" without one is still asked for.

@@ -119,6 +119,7 @@ def support_study(part: Part, settings: PlannerSettings, family, uniform_entry: 
             "evidence": res["fixed_pin_search"]["evidence"],
             "pins": best and list(best["pins"]), "pin_heights_mm": best and best["pin_heights_mm"],
             "pin_speeds": best and best.get("pin_speeds"),
-            "verification": best and best["verification"], "plans": res["plans"],
+            "verification": best and best["verification"], "claim": best and best.get("claim"),
+            "plans": res["plans"],
             "worst_member": res.get("family_worst_member"), "nearest_yes": res.get("nearest_yes")}
     return out

@@ -2,13 +2,13 @@
 
 A sequence the complete search picked (``complete.py``) is first followed by
 the tight propagation (``search.TightPlanner.follow``): its carried sets are
-then a sound claim (``"claim": "propagated"``), checked again by the
-verification. When the propagation forbids one of its pins (the uncertainty
+then a sound bound (``"carried_sets_kind": "propagated"``), checked again by
+the verification. When the propagation forbids one of its pins (the uncertainty
 box reaches a jam or a centroid on both sides, or holds too many jumps),
-the sets are *sampled* instead (``"claim": "sampled"``): the hull of a
+the sets are *sampled* instead (``"carried_sets_kind": "sampled"``): the hull of a
 separate replay of the perturbation box (the verification's settings with
 the next seed) after each pin, one branch per cluster of final
-orientations. A sampled claim is weaker: the verification, with its own
+orientations. Sampled sets are weaker: the verification, with its own
 seed, is what then checks it.
 """
 from __future__ import annotations
@@ -36,7 +36,7 @@ def carried_plan(planner: TightPlanner, labels, margin: float, verify: VerifySet
     pressure). ``memo``: as for :func:`sampled_plan`."""
     plan = planner.follow(labels) if family is None or family.is_uniform else None
     if plan is not None:
-        plan.claim = "propagated"
+        plan.carried = "propagated"
         return plan
     return sampled_plan(planner, labels, margin, verify, family, memo)
 
@@ -81,7 +81,7 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: VerifySet
     plan = TightPlan(tuple(labels), tuple(p.y for p in pins), tuple(p.v_pin for p in pins),
                      merge_arcs(finals), len(merge_modulo(finals, planner.order)), float(margin), 0,
                      branches, dict(starts), ())
-    plan.claim = "sampled"
+    plan.carried = "sampled"
     return plan
 
 

@@ -31,6 +31,7 @@ from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import merge_arcs, merge_modulo
+from pipeline.planning.core.claim import Claim
 from pipeline.planning.tight.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
                         initial_state_sets, propagate)
 
@@ -76,7 +77,8 @@ class TightPlan:
     initial: dict  # initial-state label -> StateSet
     sets_after: tuple = ()
     verification: dict | None = None  # filled in by verify
-    claim: str = "propagated"  # how the carried sets were found: "propagated" or "sampled"
+    carried: str = "propagated"  # how the carried sets were found: "propagated" or "sampled"
+    claim: Claim | None = None  # the plan's one claim, set once it is verified on held-out trials
 
     @property
     def n_dynamic(self) -> int:
@@ -114,7 +116,8 @@ class TightPlan:
             "initial_sets": {k: v.to_dict() for k, v in self.initial.items()},
             "initial_states": {label: [[st.to_dict() for st in br] for br in brs]
                                for label, brs in self.branches.items()},
-            "claim": self.claim,
+            "carried_sets_kind": self.carried,
+            "claim": None if self.claim is None else self.claim.to_dict(),
             "verification": self.verification,
         }
 

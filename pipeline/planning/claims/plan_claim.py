@@ -1,0 +1,129 @@
+"""Build a plan's one claim (:class:`~pipeline.planning.core.claim.Claim`)
+from its held-out replay, or from its support family's check.
+
+The claimed arc is the verified set (the narrowest arc holding the required
+share of the trials) widened about its middle to the tolerance: the widest
+arc the promise "one arc of at most T" allows around the trials, and the
+arc the support-family and shape-tolerance certificates check. The counts
+of the claim are the trials inside that arc, so a replay that counts the
+finals in the printed arc gets the printed numbers.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.planning.claims.confidence import share_lower_bound
+from pipeline.planning.core.claim import Claim
+from pipeline.planning.core.settings import TRUNCATE_SIGMA, ClaimSettings, VerifySettings
+
+UNIFORM = "the part (uniform pressure)"
+
+
+def promised_arc(verdict: dict, tolerance: float) -> tuple | None:
+    """``(start, width)``: the verdict's set widened about its middle to
+    ``tolerance`` (deg); ``None`` when the verdict has no set (too many
+    trials jammed)."""
+    s = verdict.get("set")
+    if not s:
+        return None
+    grow = max(0.0, tolerance - s["width"]) / 2.0
+    return (round((s["start"] - grow) % 360.0, 4), round(max(s["width"], tolerance), 4))
+
+
+def count_in_arc(finals, arc: tuple, order: int = 1) -> int:
+    """How many of ``finals`` (deg) lie in ``arc`` on the circle of the part's
+    distinct orientations (period ``360 / order``)."""
+    period = 360.0 / order
+    x = np.mod(np.asarray(finals, float) - arc[0], period)
+    return int(np.count_nonzero(x <= arc[1] + 1e-9))
+
+
+def trials_drawn(verify: VerifySettings, rows: list, seed: int, held_out: bool) -> dict:
+    """How the claim's trials were drawn: held-out or not, the seed, and per
+    resting state the random trials and the box corners (``rows``: the
+    verification's per-state rows)."""
+    random = int(verify.holdout_trials or verify.trials) if held_out else int(verify.trials)
+    per_state = sorted({int(r["trials"]) for r in rows})
+    corners = sorted({max(0, n - random) for n in per_state}) if verify.corners else [0]
+    return {"kind": "held-out" if held_out else "selection", "seed": int(seed), "states": len(rows),
+            "random_per_state": random, "corners_per_state": corners[0] if len(corners) == 1 else corners}
+
+
+def perturbations(verify: VerifySettings, mu_c) -> dict:
+    """The sizes of the errors each trial draws, and where the normals are cut."""
+    p = verify.perturbation
+    friction = ({"uniform": [float(mu_c[0]), float(mu_c[1])]} if isinstance(mu_c, (tuple, list))
+                else {"normal_sigma": p.mu_sigma, "cut_at_sigma": TRUNCATE_SIGMA, "floor": 0.0})
+    return {"theta_deg": {"normal_sigma": p.theta_sigma, "cut_at_sigma": TRUNCATE_SIGMA},
+            "y_c_mm": {"uniform_halfwidth": p.y_halfwidth},
+            "mu_c": friction, "pin_offset_mm": {"uniform_halfwidth": p.pin_halfwidth},
+            "corners": "every corner of the box: theta and mu_c at their cuts, y_c and each pin at their "
+                       "half-widths" if verify.corners else "none"}
+
+
+def held_out_claim(verdict: dict, finals, claims: ClaimSettings, order: int, drawn: dict, perturbed: dict,
+                   subject: str = UNIFORM) -> Claim:
+    """The claim of a plan judged on held-out trials: ``verdict`` is
+    ``orient.judge`` of its ``finals`` (the trials that did not jam)."""
+    tol = float(claims.tolerance_deg)
+    arc = promised_arc(verdict, tol) or (0.0, tol)
+    n = int(verdict["trials"])
+    inside = count_in_arc(finals, arc, order) if verdict.get("set") else 0
+    lower = share_lower_bound(inside, n, claims.confidence) if n else 0.0
+    share = inside / n if n else 0.0
+    clears = share >= claims.required and (claims.rule == "point" or lower >= claims.required)
+    interval = verdict.get("width_interval_deg")
+    return Claim(subject, bool(verdict["orients"] and clears), arc, tol, claims.rule, claims.required,
+                 claims.confidence, inside, n, int(verdict["jammed"]), round(share, 6), round(lower, 6),
+                 verdict.get("width_deg"), verdict.get("spread_deg"), drawn, perturbed,
+                 tuple(interval) if interval else None, int(order))
+
+
+def with_untruncated(claim: Claim, record: dict | None) -> Claim:
+    """``claim`` with the untruncated replay beside it (the plan file's
+    ``untruncated`` record, see :mod:`~pipeline.planning.claims.tails`): its
+    trials are random draws only, so it says that it does not replay the
+    box corners (those are in the claim's own trials)."""
+    if not record:
+        return claim
+    beside = {"trials": record["trials"], "in_best_arc": record["in_one_set"], "share": record["share"],
+              "share_lower_bound": record["lower_bound"], "width_deg": record["width_deg"],
+              "orients": record["orients"], "not_cut": list(record["normal"]), "seed": record["seed"],
+              "box_corners": False,
+              "note": "random draws from normals that are not cut; the box corners are not replayed here "
+                      "(they are among the claim's own trials)"}
+    return _replace(claim, untruncated=beside)
+
+
+def family_claim(claim: Claim, label: str, check: dict, certificate: dict | None = None) -> Claim:
+    """The claim of a plan for the support family ``label``: the family
+    check's set (the arc its worst members and fresh members are checked
+    against), its counts over the drawn members and the worst members that
+    joined them, and its spread (every such trial, the worst member's
+    included), not the drawn members' own width."""
+    verdict = check["verdict"]
+    arc = tuple(check["set_deg"]) if check.get("set_deg") else claim.arc
+    family = {"label": label, "members": check.get("members"), "holds": bool(check.get("holds")),
+              "worst_member_outside_deg": (check.get("worst_member") or {}).get("outside_deg"),
+              "worst_member_search": "a heuristic: evidence about the family's edge, not a proof"}
+    if certificate:
+        fresh = certificate["fresh"]
+        family.update(fresh_members=fresh["members"], fresh_members_outside=fresh["members_outside"],
+                      share_outside_upper_bound=fresh["share_outside_upper_bound"],
+                      epsilon=certificate["claim"]["epsilon"], beta=certificate["claim"]["beta"],
+                      holds=bool(certificate["holds"]))
+    n = int(verdict["trials"])
+    inside = int(verdict["in_tolerance"])
+    lower = share_lower_bound(inside, n, claim.confidence) if n else 0.0
+    return _replace(claim, subject=f"every member of the support family {label}", arc=arc, in_arc=inside,
+                    trials=n, jammed=int(verdict.get("jammed", 0)), share=round(inside / n, 6) if n else 0.0,
+                    share_lower_bound=round(lower, 6), orients=bool(verdict["orients"] and family["holds"]),
+                    width_deg=verdict.get("width_deg"), spread_deg=verdict.get("spread_deg"),
+                    width_interval_deg=None, trials_drawn=dict(claim.trials_drawn, kind="family check",
+                                                               members=check.get("members")),
+                    family=family)
+
+
+def _replace(claim: Claim, **changes) -> Claim:
+    from dataclasses import replace
+    return replace(claim, **changes)
