@@ -87,7 +87,7 @@ def test_sets_text(arcs, order, text):
     assert sets_text(arcs, order) == text
 
 
-def test_symmetric_part_plan_lists_one_arc_per_claimed_set(tmp_path, capsys, monkeypatch):
+def test_symmetric_part_plan_lists_one_arc_per_carried_set(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     config = small_config_file(tmp_path)
     out_file = tmp_path / "rect.json"
@@ -97,16 +97,19 @@ def test_symmetric_part_plan_lists_one_arc_per_claimed_set(tmp_path, capsys, mon
     assert code == 0, err
     tight = json.loads(out_file.read_text())["tight"][0]
     assert tight["symmetry_order"] == 2
-    lines = [ln for ln in out.splitlines() if "-> claimed" in ln]
-    assert len(lines) == len(tight["plans"]) >= 1
-    for line, plan in zip(lines, tight["plans"]):
-        claimed = int(re.search(r"claimed (\d+) set\(s\)", line).group(1))
-        assert claimed == plan["n_final_sets"]
-        shown = re.findall(r"(\d+\.\d)-(\d+\.\d) deg", line.split("): ", 1)[1].split(";")[0])
+    lines = [ln for ln in out.splitlines() if "beside it: carried sets" in ln]
+    claims = [ln for ln in out.splitlines() if ln.strip().startswith("claim:")]
+    assert len(lines) == len(claims) == len(tight["plans"]) >= 1
+    for line, claim, plan in zip(lines, claims, tight["plans"]):
+        # The claim names one arc in [0, 180) and says its copy is the same set.
+        assert "or a copy of it every 180 deg, by symmetry" in claim
+        assert plan["claim"]["arc"]["start"] % 180 == pytest.approx(
+            float(re.search(r"in (\d+\.\d)-", claim).group(1)), abs=0.051)
+        shown = re.findall(r"(\d+\.\d)-(\d+\.\d) deg", line.split("not the claim): ", 1)[1].split(";")[0])
         assert line.split(";")[0].endswith("(x2 by symmetry)")
-        assert len(shown) == claimed  # one arc per set, not its copy 180 deg away
+        assert len(shown) == plan["n_final_sets"]  # one arc per set, not its copy 180 deg away
         stored = [(s["start"] % 360, s["width"]) for s in plan["final_sets"]]
-        assert len(stored) == 2 * claimed  # the plan file keeps both copies
+        assert len(stored) == 2 * len(shown)  # the plan file keeps both copies
         for lo, hi in shown:
             lo = float(lo)
             for copy in (lo, (lo + 180) % 360):

@@ -130,21 +130,16 @@ def test_report_numbers_match_the_verify_json(workflow):
             want.append([str(best["n_final_sets"]), f"{ok}/{sum(r['trials'] for r in checks[kind]['rows'])}"])
     assert [[r[3], r[5]] for r in side] == want
     assert [r[7] for r in side if r[0].startswith("tight") and r[7] != "n/a"] == limits
-    cells = []  # the verified width beside the claim, from the plan file's orientation verdict
+    cells = []  # the recommended plan's one claim, from the plan file, with its trials
     for name in ("tri", "rect"):
         for t in json.loads((results / "plans" / f"{name}.json").read_text())["tight"]:
-            o = (t["recommended"] or {}).get("verification", {}).get("orientation")
-            if o:  # the width with its bootstrap interval, the held-out share with its lower bound
-                lo, hi = o["width_interval_deg"]
-                width = f"{o['width_deg']:.1f}" if o["width_deg"] is not None else "n/a"
-                notes = (["held-out trials"] if t["recommended"]["verification"]["held_out"] else [])
-                notes += ([f"width {100 * o['confidence']:g} % interval {lo:.1f}-{hi:.1f} deg"]
-                          if lo is not None and hi is not None else [])
-                notes.append(f"share >= {100 * o['share_lower_bound']:.2f} % at {100 * o['confidence']:g} % "
-                             "confidence")
-                cells.append((f"{width}: {o['in_tolerance']}/{o['trials']} in {o['tolerance_deg']:g} deg", notes))
+            claim = (t["recommended"] or {}).get("claim")
+            if claim:
+                cells.append((claim["statement"], [f"{claim['in_arc']}/{claim['trials']} held-out trials in it",
+                                                   f"seed {claim['trials_drawn']['seed']}"]))
     shown = [r[6] for r in side if r[0].startswith("tight")]
-    assert [c.split(" (")[0] for c in shown] == [head for head, _ in cells]
+    assert len(shown) == len(cells) and cells
+    assert all(cell.startswith(head) for cell, (head, _) in zip(shown, cells))
     assert all(note in cell for cell, (_, notes) in zip(shown, cells) for note in notes)
     assert all(int(r[3]) == 3 + 2 ** (3 + len(r[0].split())) for r in table)  # verify.trials 3 + corners
 
