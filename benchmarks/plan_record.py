@@ -1,7 +1,7 @@
 """Record what the planner answers, and compare two records: a refactor's
 witness that no result changed.
 
-    .venv/bin/python benchmarks/plan_record.py record OUT.json [--atlas-plans DIR]
+    .venv/bin/python benchmarks/plan_record.py record OUT.json [--atlas-plans DIR] [--benchmark-parts]
     .venv/bin/python benchmarks/plan_record.py compare BEFORE.json AFTER.json
 
 ``record`` plans, through the ``pinfeed plan`` command line (so the record
@@ -55,6 +55,15 @@ RUNS = {
     "gusset_dxf_belt": ["--outline", str(CAD / "gusset_bracket.dxf"), "--mu-c", "0.2",
                         "--belt-speed", "150"],
 }
+# The ten parts of benchmarks/plan_speed.py, as it plans them (--benchmark-parts).
+BENCHMARK_PARTS = {
+    "asym_triangle": "0,0 60,0 15,35", "sym_triangle": "0,0 40,0 20,60", "right_triangle": "0,0 50,0 0,30",
+    "scalene_triangle": "0,0 70,0 20,30", "t_bracket": "0,0 60,0 60,10 35,10 35,40 25,40 25,10 0,10",
+    "l_bracket": "0,0 60,0 60,15 15,15 15,40 0,40", "trapezoid": "0,0 70,0 50,25 10,25",
+    "hexagon_slot": "0,0 50,0 60,10 50,20 0,20 -10,10", "small_20mm": "0,0 20,0 5,11.666666666666666",
+    "large_150mm": "0,0 125,0 150,75 25,62.5",
+}
+BENCHMARK_ARGS = ["--mu-c", "0.1:0.3", "--depth", "4", "--pins", "auto", "--tolerance", "10"]
 VOLATILE = {"created", "git_commit", "pinfeed_version"}
 
 
@@ -70,20 +79,24 @@ def stable(value):
 
 def plan_one(name: str, args: list, work: Path) -> dict:
     """The stable plan file of one ``pinfeed plan`` run, from an empty catalog."""
-    out = work / f"{name}.json"
-    named = [] if args[0] == "--part" else ["--name", name]
+    out = work / f"{name.replace('/', '_')}.json"
+    named = [] if args[0] == "--part" else ["--name", name.replace("/", "_")]
     cmd = [sys.executable, "-m", "pipeline.cli", "plan", *args, *named,
-           "--catalog", str(work / f"catalog_{name}"), "--out", str(out)]
+           "--catalog", str(work / f"catalog_{name.replace('/', '_')}"), "--out", str(out)]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
         raise SystemExit(f"{name}: pinfeed plan failed:\n{done.stderr[-2000:]}")
     return stable(json.loads(out.read_text()))
 
 
-def record(out: Path, atlas_plans: Path | None) -> None:
+def record(out: Path, atlas_plans: Path | None, benchmark_parts: bool = False) -> None:
     plans = {}
+    runs = dict(RUNS)
+    if benchmark_parts:
+        runs.update({f"bench/{name}": ["--vertices", vertices, *BENCHMARK_ARGS]
+                     for name, vertices in BENCHMARK_PARTS.items()})
     with tempfile.TemporaryDirectory() as tmp:
-        for name, args in RUNS.items():
+        for name, args in runs.items():
             print(f"planning {name} ...", file=sys.stderr, flush=True)
             plans[name] = plan_one(name, args, Path(tmp))
     if atlas_plans is not None:
@@ -126,12 +139,14 @@ def main(argv=None) -> int:
     rec = sub.add_parser("record")
     rec.add_argument("out", type=Path)
     rec.add_argument("--atlas-plans", type=Path, default=None)
+    rec.add_argument("--benchmark-parts", action="store_true",
+                     help="also the ten parts of benchmarks/plan_speed.py (mu_c 0.1:0.3, depth 4, fitted pins)")
     cmp_ = sub.add_parser("compare")
     cmp_.add_argument("before", type=Path)
     cmp_.add_argument("after", type=Path)
     args = ap.parse_args(argv)
     if args.command == "record":
-        record(args.out, args.atlas_plans)
+        record(args.out, args.atlas_plans, args.benchmark_parts)
         return 0
     return compare(args.before, args.after)
 

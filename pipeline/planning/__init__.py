@@ -64,8 +64,9 @@ _WHERE = {
     "family.members": "check_family_mechanics",
     "family.nearest": "nearest_yes_lines",
     "family.shape": "attach_shape_tolerance shape_line",
-    "plans.plan": "best_fixed_plan mechanics_label pick_tight_plan plan_hint plan_tight_all planner_belt "
-                  "tight_entry",
+    "plans.plan": "plan_tight_all",
+    "plans.planner": "mechanics_label planner_belt",
+    "plans.stored_plan": "best_fixed_plan pick_tight_plan plan_hint tight_entry",
     "plans.speed_limit": "DEFAULT_SPEEDS attach_speed_limits perturbation_from_verify speed_curve "
                          "speed_label stored_plan_speed stored_speed_limit",
     "plans.support_study": "support_study",

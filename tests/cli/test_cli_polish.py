@@ -83,7 +83,7 @@ def test_rollout_trajectory_table(capsys):
 
 
 def test_sense_hint_names_pinfeed_plan_for_an_ad_hoc_part(tmp_path):
-    from pipeline.planning.plans.plan import plan_hint
+    from pipeline.planning.plans.stored_plan import plan_hint
     planned = ["asym_triangle"]
     assert "make run" in plan_hint(planned, "asym_triangle", tmp_path)
     hint = plan_hint(planned, "bracket", tmp_path)

@@ -141,7 +141,7 @@ def test_sampled_claim_splits_outliers_and_holds_in_an_independent_replay():
     end in the claimed sets."""
     from pipeline.config import load_config
     from pipeline.planning.tight.certify import CLUSTER_GAP_DEG, sampled_plan
-    from pipeline.planning.plans.plan import planner_for
+    from pipeline.planning.plans.planner import planner_for
     from pipeline.planning.claims.verify import verify_plan
     part = Part.from_vertices([[0, 0], [60, 0], [15, 35]])
     config = load_config()
@@ -214,6 +214,7 @@ def _thin_triangle_entry(depth: int, prune: bool, monkeypatch):
     """The tight plan of a 60 x 20 mm right triangle that no fixed pin of up to
     ``depth`` orients, with (or, ``prune`` False, without) the moving search's
     pruning of prefixes that cannot beat a plan already found."""
+    import pipeline.planning.plans.candidates as candidates
     import pipeline.planning.plans.plan as plan_module
     from pipeline.config import load_config
     config = load_config()
@@ -223,7 +224,7 @@ def _thin_triangle_entry(depth: int, prune: bool, monkeypatch):
     part = Part.from_vertices([[0, 0], [60, 0], [0, 20]], name="thin_triangle")
     with monkeypatch.context() as patch:
         if not prune:
-            patch.setattr(plan_module, "moving_room", lambda found, n_prefix, depth, **kw: depth)
+            patch.setattr(candidates, "moving_room", lambda found, n_prefix, depth, **kw: depth)
         return plan_module.plan_tight(part, PlannerSettings.from_config(config).at(0.15))
 
 
@@ -267,7 +268,7 @@ def test_with_a_family_later_prefixes_look_only_for_fewer_pins():
     """moving_room: without a family a later prefix may tie the shortest plan
     found (same pins, maybe narrower); with one it must beat it."""
     from types import SimpleNamespace
-    from pipeline.planning.plans.plan import moving_room
+    from pipeline.planning.plans.candidates import moving_room
     found = [SimpleNamespace(labels=("P1", "P2", "P3v-1"))]
     assert moving_room([], 2, 2) == 2
     assert moving_room(found, 2, 2) == 1 and moving_room(found, 2, 2, fewer=True) == 0

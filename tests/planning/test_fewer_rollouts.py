@@ -142,7 +142,7 @@ def test_sampled_carried_sets_with_a_memo_are_the_same():
     from pipeline.config import load_config
     from pipeline.planning.claims.verify import ReplayMemo
     from pipeline.planning.core.settings import PlannerSettings
-    from pipeline.planning.plans.plan import planner_for
+    from pipeline.planning.plans.planner import planner_for
     from pipeline.planning.tight.certify import sampled_plan
 
     part = PARTS["triangle"]()

@@ -30,7 +30,7 @@ from pipeline.parts.contact import contact_parameter
 from pipeline.planning.core.settings import PlannerSettings, nominal_friction
 from pipeline.planning.core.types import as_plan_file
 from pipeline.planning.feeder.lanes import build_lane, pin_reach, rotated, run_trials, trial_lanes
-from pipeline.planning.plans.plan import pick_tight_plan
+from pipeline.planning.plans.stored_plan import pick_tight_plan
 
 
 def roll_plan(part, heights, speeds, states: dict, mu_c, model, pin_radius, spacing=None):

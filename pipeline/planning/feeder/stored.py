@@ -15,7 +15,7 @@ from pipeline.planning.core.settings import PlannerSettings, friction_label
 from pipeline.planning.core.types import as_plan_file
 from pipeline.planning.family.certificate import family_assumption
 from pipeline.planning.feeder.layout import check_layout_settings, layout_plan
-from pipeline.planning.plans.plan import pick_tight_plan
+from pipeline.planning.plans.stored_plan import pick_tight_plan
 from pipeline.planning.plans.speed_limit import (DEFAULT_SPEEDS, perturbation_from_verify, speed_curve,
                                                  stored_speed_limit)
 from pipeline.provenance import provenance_attrs
@@ -129,7 +129,7 @@ def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, planner, cfg) -> tu
 def _fixed_pin_plan(result, plan_number, mu_text):
     """``(plan, mu_c, states)``: tight plan ``plan_number`` at friction ``mu_text``
     of the :class:`~pipeline.planning.core.types.PlanFile` ``result``
-    (:func:`~pipeline.planning.plans.plan.pick_tight_plan`), refused with a one-line
+    (:func:`~pipeline.planning.plans.stored_plan.pick_tight_plan`), refused with a one-line
     :class:`PinfeedError` if it has moving pins; ``states``: label ->
     ``(theta_deg, y_c_mm)``, the entry's resting states, else the file's."""
     plan, mu_c, entry = pick_tight_plan(result, int(plan_number), mu_text)

@@ -212,7 +212,7 @@ def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=
     ``progress`` hears about each belt speed tried (:func:`speed_curve`).
     """
     from pipeline.planning.family.certificate import family_assumption
-    from pipeline.planning.plans.plan import pick_tight_plan
+    from pipeline.planning.plans.stored_plan import pick_tight_plan
     from pipeline.planning.core.settings import friction_label
     from pipeline.planning.core.types import as_plan_file
     if not (isinstance(trials, int) and trials >= 1):
