@@ -42,8 +42,8 @@ from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import format_arcs
 from pipeline.planning.tight.certify import carried_plan
-from pipeline.planning.tight.complete import (FixedPinSearch, FixedPlan, FixedSearch, orientation_rank,
-                                              robust_order)
+from pipeline.planning.tight.complete import FixedPinSearch
+from pipeline.planning.tight.records import FixedPlan, FixedSearch, orientation_rank, robust_order
 from pipeline.planning.family.members import planning_family
 from pipeline.planning.family.certificate import family_certificate
 from pipeline.planning.family.nearest import nearest_yes
@@ -286,7 +286,7 @@ def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progre
     best first.
 
     A plan that orients ranks before every plan with more pins
-    (:func:`~pipeline.planning.tight.complete.orientation_rank`), so once some
+    (:func:`~pipeline.planning.tight.records.orientation_rank`), so once some
     sequence orients with ``k`` pins a prefix of ``L`` fixed pins is searched
     only up to ``k - L`` moving pins, and not at all when ``L >= k``
     (``skipped`` in the search's record): the plans left out could only rank
