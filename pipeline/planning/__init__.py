@@ -56,7 +56,7 @@ _WHERE = {
     "claims.tails": "describe_untruncated truncation_text untruncated_check",
     "claims.verify": "VERIFY_DEFAULTS=DEFAULTS PERTURB_DEFAULTS corner_inputs perturbed_batch "
                      "perturbed_inputs predicted_sets replay replayed_paths verify_plan",
-    "tight.complete": "margin_text",
+    "tight.records": "margin_text",
     "paper.bands": "extract_bands",
     "paper.coarse": "COARSE_MU_C=MU_C COARSE_PIN_RADIUS=PIN_RADIUS best_coarse_plan coarse_plan_paths",
     "paper.planner": "Planner build_planner load_maps paper_depth",

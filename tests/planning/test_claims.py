@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from pipeline.errors import PinfeedError
 from pipeline.planning.claims import orient
-from pipeline.planning.tight.complete import FixedPlan, margin_text, orientation_rank, robust_order
+from pipeline.planning.tight.records import FixedPlan, margin_text, orientation_rank, robust_order
 from pipeline.planning.claims.confidence import share_lower_bound
 from pipeline.planning.claims.verify import holdout_settings, trial_inputs
 

@@ -8,8 +8,9 @@ import pytest
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
-from pipeline.planning.tight import complete
-from pipeline.planning.tight.complete import CASCADE, FixedPinSearch
+from pipeline.planning.tight import screen
+from pipeline.planning.tight.complete import FixedPinSearch
+from pipeline.planning.tight.screen import CASCADE
 from pipeline.planning.tight.judge import TrialBench, stack
 
 MU = (0.1, 0.3)
@@ -63,7 +64,7 @@ def test_the_cascade_changes_no_plan_and_no_count(monkeypatch):
     top = max(y for _, y in part.stable_states()) * 1.8
     pins = {f"Q{k}": float(y) for k, y in enumerate(np.linspace(0.05 * part.a, top, 9), start=1)}
     with_cascade = _thin_search(part, pins)
-    monkeypatch.setattr(complete, "CASCADE", ())
+    monkeypatch.setattr(screen, "CASCADE", ())
     without = _thin_search(part, pins)
     assert [p.labels for p in with_cascade.plans] == [p.labels for p in without.plans]
     for a, b in zip(with_cascade.plans, without.plans):

@@ -7,7 +7,8 @@ from pipeline.parts.part import Part
 from pipeline.planning.core.settings import PlannerSettings
 from pipeline.planning.plans.planner import planner_for
 from pipeline.planning.tight.certify import carried_plan
-from pipeline.planning.tight.complete import FixedPinSearch, FixedPlan, FixedSearch
+from pipeline.planning.tight.complete import FixedPinSearch
+from pipeline.planning.tight.records import FixedPlan, FixedSearch
 from pipeline.planning.claims.verify import ReplayMemo
 from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat
 
@@ -85,7 +86,7 @@ def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progre
     best first.
 
     A plan that orients ranks before every plan with more pins
-    (:func:`~pipeline.planning.tight.complete.orientation_rank`), so once some
+    (:func:`~pipeline.planning.tight.records.orientation_rank`), so once some
     sequence orients with ``k`` pins a prefix of ``L`` fixed pins is searched
     only up to ``k - L`` moving pins, and not at all when ``L >= k``
     (``skipped`` in the search's record): the plans left out could only rank

@@ -39,7 +39,7 @@ import time
 
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import format_arcs
-from pipeline.planning.tight.complete import FixedSearch, orientation_rank, robust_order
+from pipeline.planning.tight.records import FixedSearch, orientation_rank, robust_order
 from pipeline.planning.family.members import planning_family
 from pipeline.planning.plans.candidates import (MOVING_NOT_REACHED, MOVING_PREFIXES, add_moving_pins,
                                                 carried_sets, fixed_search)

@@ -21,6 +21,8 @@ planner) and orient the part on the held-out trials as well.
 """
 from __future__ import annotations
 
+from typing import Protocol
+
 import numpy as np
 
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAMMED, TRUNCATED
@@ -244,6 +246,25 @@ class PrefixStates:
         self.at.update(zip(((nodes << 32) | trials).tolist(), range(start, start + nodes.size)))
 
 
+class FamilyCheck(Protocol):
+    """What the complete search asks of a support family
+    (``worst_member.FamilyChecker``, made by the planner): called with a
+    plan's ``(labels, heights, verdict, speeds)``, True when the family's worst
+    member keeps the plan in its set; ``breakers``, the worst members kept
+    from plans they broke, and :meth:`prescreen`, which asks of many
+    sequences at once whether those members break them whatever their set."""
+
+    breakers: list
+
+    def __call__(self, labels, heights, verdict: dict | None = None, speeds=()) -> bool: ...
+
+    def prescreen(self, heights: np.ndarray, speeds: np.ndarray, tolerance: float, screened=None,
+                  allowed: int = 0) -> np.ndarray:
+        """True for each sequence (rows of ``heights``, ``speeds``) that the kept
+        ``breakers`` break whatever the sequence's set."""
+        ...
+
+
 class Certifier:
     """Which orienting verdicts count: those that hold for the support
     family's worst member and are confirmed on held-out trials.
@@ -252,15 +273,22 @@ class Certifier:
     ----------
     bench : the :class:`TrialBench` whose held-out trials certify.
 
-    ``member_check`` is ``None`` (no family check) or a function of a plan's
-    ``(labels, heights, verdict, speeds)`` that is True when the family's
-    worst member keeps the plan in its set (``worst_member.FamilyChecker``,
-    set by the planner).
+    ``member_check`` is ``None`` (no family check) or the family's
+    :class:`FamilyCheck` (set by the planner, through
+    ``FixedPinSearch.member_check``); the search asks about the family
+    through this class alone (:attr:`checks_family`,
+    :meth:`holds_for_family`, :attr:`keeps_members`,
+    :meth:`broken_by_known_members`).
     """
 
     def __init__(self, bench: TrialBench):
         self.bench = bench
-        self.member_check = None
+        self.member_check: FamilyCheck | None = None
+
+    @property
+    def checks_family(self) -> bool:
+        """True when plans must hold for a support family (``member_check`` set)."""
+        return self.member_check is not None
 
     def holds_for_family(self, plan) -> bool:
         """True without a family check; else whether the family's worst member
@@ -277,7 +305,7 @@ class Certifier:
     @property
     def keeps_members(self) -> bool:
         """True when the family check keeps worst members that broke earlier plans."""
-        return bool(getattr(self.member_check, "breakers", None))
+        return self.member_check is not None and bool(self.member_check.breakers)
 
     def broken_by_known_members(self, heights, speeds, screened=None, allowed: int = 0) -> np.ndarray:
         """True for each sequence (rows of ``heights``, ``speeds``) that a worst
@@ -285,10 +313,9 @@ class Certifier:
         (``FamilyChecker.prescreen``; ``screened``: the sequences' finals and
         jams on some of the trials, of which at most ``allowed`` may fall
         outside the set); all False without a family check."""
-        prescreen = getattr(self.member_check, "prescreen", None)
-        if prescreen is None:
+        if self.member_check is None:
             return np.zeros(np.atleast_2d(heights).shape[0], bool)
-        return prescreen(heights, speeds, self.bench.tolerance, screened, allowed)
+        return self.member_check.prescreen(heights, speeds, self.bench.tolerance, screened, allowed)
 
     def certify(self, found: list, heights, speeds, n_pins: int, beat: Heartbeat) -> list:
         """The plans of ``found`` (whose pins are the rows of ``heights`` and
