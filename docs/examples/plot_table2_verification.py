@@ -15,7 +15,8 @@ import os
 import matplotlib.pyplot as plt
 
 from pipeline.parts.part import Part
-from pipeline.planning import COARSE_MU_C as MU_C, COARSE_PIN_RADIUS as PIN_RADIUS, best_coarse_plan, verify_plan
+from pipeline.planning import COARSE_MU_C as MU_C, COARSE_PIN_RADIUS as PIN_RADIUS
+from pipeline.planning import VerifySettings, best_coarse_plan, verify_plan
 from pipeline.present.figures.tables import FAIL_COLOUR, HEADER, verification_rows
 
 # A coarser grid (e.g. PINFEED_EXAMPLE_THETA_STEP=6) runs faster; the tests use it.
@@ -24,7 +25,7 @@ THETA_STEP = float(os.environ.get("PINFEED_EXAMPLE_THETA_STEP", "2"))
 part = Part.from_vertices([(0, 0), (60, 0), (15, 35)], name="asym_triangle")
 planner, pins, plan = best_coarse_plan(part, theta_step=THETA_STEP)
 states = {label: (s.arc[0], s.y_lo) for label, s in planner.initial_states().items()}
-result = verify_plan(part, plan, pins, states, MU_C, PIN_RADIUS, settings={"trials": 30})
+result = verify_plan(part, plan, pins, states, MU_C, PIN_RADIUS, settings=VerifySettings(trials=30))
 rows = verification_rows({part.name: {"checks": [{"plan": plan["pins"], "kind": "fixed pins",
                                                   "rows": result["rows"]}]}})
 

@@ -39,7 +39,7 @@ def cmd_layout(args):
     """A feeder to build: pin stations, pitch, belt width, throughput and a drawing."""
     from pipeline.checks import check_out_path
     from pipeline.config import load_config
-    from pipeline.planning import PlannerSettings, layout_stored
+    from pipeline.planning import LayoutSettings, PlannerSettings, layout_stored
     from pipeline.present.layout import check_drawing_path, write_drawing
     from pipeline.workflow.commands import layout_settings, stored_plan
     config = load_config(args.config)
@@ -50,7 +50,7 @@ def cmd_layout(args):
     result, _ = stored_plan(config, results_arg(args, config), args.part, args.config)
     out = layout_stored(result, PlannerSettings.from_config(config), args.plan, args.mu_c,
                         belt_speed=args.belt_speed, mu_s=args.mu_s, quasi_static=args.quasi_static,
-                        settings={**config.get("layout", {}), **settings})
+                        settings=LayoutSettings.from_section({**config.get("layout", {}), **settings}))
     for warning in out["warnings"]:
         print(f"pinfeed: warning: {warning}", file=sys.stderr)
     if as_json:

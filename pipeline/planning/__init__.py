@@ -47,15 +47,17 @@ import importlib
 # where the door gives a name of its own).
 _WHERE = {
     "core.arcs": "arc_within format_arcs merge_arcs merge_modulo",
-    "core.settings": "BandSettings ClaimSettings Friction Perturbation PlannerSettings SearchSettings "
-                     "SpeedSettings VerifySettings candidate_pins fitted_pins friction_label "
+    "core.settings": "BandSettings ClaimSettings DESIGN_KINDS DesignGrid DesignLimits DesignSettings Friction "
+                     "KernelSettings LayoutSettings Perturbation PlannerSettings SearchSettings "
+                     "SpeedPerturbation SpeedSettings VerifySettings candidate_pins fitted_pins friction_label "
                      "nominal_friction parse_friction",
     "core.claim": "Claim",
     "core.types": "PlanFile as_plan_file load_plan validate_plan_file",
     "claims.orient": "check_tolerance describe_claim min_trials narrowest_arc",
     "claims.tails": "describe_untruncated truncation_text untruncated_check",
-    "claims.verify": "VERIFY_DEFAULTS=DEFAULTS PERTURB_DEFAULTS corner_inputs perturbed_batch "
-                     "perturbed_inputs predicted_sets replay replayed_paths verify_plan",
+    "claims.trials": "VERIFY_DEFAULTS=DEFAULTS PERTURB_DEFAULTS corner_inputs perturbed_batch perturbed_inputs",
+    "claims.replay": "replay replayed_paths",
+    "claims.verify": "predicted_sets verify_plan",
     "tight.records": "margin_text",
     "paper.bands": "extract_bands",
     "paper.coarse": "COARSE_MU_C=MU_C COARSE_PIN_RADIUS=PIN_RADIUS best_coarse_plan coarse_plan_paths",
@@ -67,15 +69,14 @@ _WHERE = {
     "plans.plan": "plan_tight_all",
     "plans.planner": "mechanics_label planner_belt",
     "plans.stored_plan": "best_fixed_plan pick_tight_plan plan_hint tight_entry",
-    "plans.speed_limit": "DEFAULT_SPEEDS attach_speed_limits perturbation_from_verify speed_curve "
-                         "speed_label stored_plan_speed stored_speed_limit",
+    "plans.speed_limit": "DEFAULT_SPEEDS attach_speed_limits speed_curve speed_label stored_plan_speed "
+                         "stored_speed_limit",
     "plans.support_study": "support_study",
-    "design.edits": "DESIGN_KINDS=KINDS ChangeRefused DesignGrid OutlineChange apply_change ccw_outline "
-                    "changed_area edge_lengths",
-    "design.search": "DesignLimits DesignSettings design_part",
+    "design.edits": "ChangeRefused OutlineChange apply_change ccw_outline changed_area edge_lengths",
+    "design.search": "design_part",
     "feeder.contact": "mechanics_scene",
     "feeder.lanes": "Lane Trial pin_height pin_reach run_trials trial_lanes",
-    "feeder.layout": "LAYOUT_DEFAULTS check_layout_settings layout_plan",
+    "feeder.layout": "layout_plan",
     "feeder.passages": "StationScene layout_inputs plan_inputs recommended_index roll_plan station_scene",
     "feeder.stored": "final_sets_warning layout_stored",
 }

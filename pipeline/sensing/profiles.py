@@ -53,7 +53,7 @@ from scipy.ndimage import uniform_filter1d
 from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning import PERTURB_DEFAULTS, perturbed_inputs  # one set of perturbation sizes for every check
+from pipeline.planning import PERTURB_DEFAULTS, Perturbation, perturbed_inputs  # one set of sizes for every check
 
 
 @dataclass
@@ -240,12 +240,13 @@ def reference_profiles(part, states: dict, y_pin, mu_c, pin_radius, model, senso
 def synthetic_measurement(part, state: dict, y_pin, mu_c, pin_radius, model, sensor: Sensor,
                           perturb: dict, rng) -> Profile:
     """One synthetic reading of ``state`` at the pin: inputs drawn from the
-    verify stage's perturbation box (:func:`pipeline.planning.claims.verify.perturbed_inputs`:
+    verify stage's perturbation box (:func:`pipeline.planning.claims.trials.perturbed_inputs`:
     theta_i and a friction value normal, truncated at 2 sigma, friction
     clipped at 0, a friction range ``(lo, hi)`` uniform; y_c and the pin
     position uniform; sizes from ``perturb``) rolled out again, sampled at the
     sensor rate, then sensor bias and noise."""
-    theta, y_c, mu, offsets = perturbed_inputs(state["theta"], state["y_c"], mu_c, 1, perturb, rng)
+    theta, y_c, mu, offsets = perturbed_inputs(state["theta"], state["y_c"], mu_c, 1,
+                                               Perturbation.from_section(perturb), rng)
     r = first_pin_rollout(part, theta, y_c, y_pin + float(offsets[0]), mu, pin_radius, model)
     prof = profile_from_rollout(r.force_s.values, r.force_x.values, r.force_y.values, sensor)
     return measure(prof, sensor, rng)

@@ -255,11 +255,12 @@ def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor
     import numpy as np
 
     from pipeline.maps.simulate import rollout
-    from pipeline.planning import VERIFY_DEFAULTS, perturbed_inputs
+    from pipeline.planning import VERIFY_DEFAULTS, Perturbation, perturbed_inputs
     from pipeline.progress import progress
     from pipeline.sensing.profiles import classify, measure, profile_from_rollout, sign_matrix
     cfg = dict(VERIFY_DEFAULTS, **(settings or {}))
     cfg["corners"] = False
+    sizes = Perturbation.from_section(cfg)
     kernel = {k: v for k, v in (kernel or {}).items() if k in ("ds_max", "tol")}
     rng = np.random.default_rng(cfg["seed"])
     refs = {k: np.asarray(v) for k, v in result["score_table"]["reference_signs"].items()}
@@ -272,7 +273,7 @@ def verify_sensor_plan(part, result: dict, pin_radius: float, model: str, sensor
     for label, st in progress(states.items(), len(states), "verify sensor plan", unit="initial state"):
         row = {"trials": 0, "right": 0, "wrong": 0, "ambiguous": 0, "jammed": 0}
         for _ in range(int(cfg["trials"])):
-            theta, y_c, mu, offsets = perturbed_inputs(st["theta"], st["y_c"], mu_c, len(heights), cfg, rng)
+            theta, y_c, mu, offsets = perturbed_inputs(st["theta"], st["y_c"], mu_c, len(heights), sizes, rng)
             row["trials"] += 1
             claimed, jammed = None, False
             for k, (y_pin, v_pin, off) in enumerate(zip(heights, speeds, offsets)):

@@ -419,20 +419,22 @@ def speed_command(result, config: dict, plan: int = 1, mu_text=None, mu_s=None, 
     default to those of the speed limit stored with the plan (else the config's
     ``speed`` section); with the same settings the stored figure is returned
     (``source``: ``stored with the plan``), else it is computed (``computed``)."""
-    from pipeline.planning import PlannerSettings, pick_tight_plan, stored_plan_speed, stored_speed_limit
+    from dataclasses import replace
+
+    from pipeline.planning import PlannerSettings, SpeedSettings, pick_tight_plan, stored_plan_speed, stored_speed_limit
     planner = PlannerSettings.from_config(config)
     chosen, _, _ = pick_tight_plan(result, plan, mu_text)
     stored = stored_speed_limit(chosen)
-    settings = dict(stored["settings"]) if stored else planner.speed.as_kwargs()
+    speed = SpeedSettings.from_json(stored["settings"]) if stored else planner.speed
     if mu_s is not None:
         if not mu_s > 0:
             raise PinfeedError(f"--mu-s must be > 0, got {mu_s}")
-        settings["mu_s"] = float(mu_s)
+        speed = replace(speed, mu_s=float(mu_s))
     if trials is not None:
         if trials < 1:
             raise PinfeedError(f"--trials must be at least 1, got {trials}")
-        settings["trials"] = int(trials)
-    if stored and stored["settings"] == settings:
+        speed = replace(speed, trials=int(trials))
+    if stored and SpeedSettings.from_json(stored["settings"]) == speed:
         return dict({k: v for k, v in stored.items() if k != "settings"}, source="stored with the plan"), stored
-    out = stored_plan_speed(result, planner, plan=plan, mu_text=mu_text, **settings)
+    out = stored_plan_speed(result, planner, plan=plan, mu_text=mu_text, speed=speed)
     return dict(out, source="computed"), stored

@@ -1,7 +1,7 @@
 """The function of ``rules/layout.smk``: the feeder to build for one part."""
 from __future__ import annotations
 
-from pipeline.planning import PlannerSettings, as_plan_file, layout_stored, validate_plan_file
+from pipeline.planning import LayoutSettings, PlannerSettings, as_plan_file, layout_stored, validate_plan_file
 from pipeline.present.layout import write_drawing, write_note_drawings
 
 
@@ -32,7 +32,7 @@ def layout_part(plan_result, config: dict, outputs: dict) -> str:
         write_note_drawings(note, outputs)
         return note
     out = layout_stored(plan_result, PlannerSettings.from_config(config), number,
-                        settings=config.get("layout", {}))
+                        settings=LayoutSettings.from_section(config.get("layout")))
     out["method"]["seconds"] = round(time.perf_counter() - start, 1)
     for key in ("dxf", "svg", "png"):
         write_drawing(out, outputs[key])

@@ -118,7 +118,7 @@ def verify_part(plan_result: dict, settings: PlannerSettings) -> dict:
     out = {"part": name, "checks": [], **provenance_attrs()}
     part = Part.from_dict(plan_result["part"], name=name)
     states = {k: (v["theta"], v["y_c"]) for k, v in plan_result["initial_states"].items()}
-    radius, kernel = settings.search.pin_radius, settings.search.kernel_settings
+    radius, kernel = settings.search.pin_radius, settings.search.kernel_step
     for kind, plan in plans_to_check(plan_result).items():
         res = verify_plan(part, plan, plan_result["pins"], states, plan_result["mu_c"], radius,
                           plan_result["model"], settings.verify,

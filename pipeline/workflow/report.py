@@ -12,7 +12,8 @@ from pipeline.maps.io import read_json
 from pipeline.parts.families import config_part_source
 from pipeline.parts.part import Part
 from pipeline.planning import Friction
-from pipeline.planning import PlanFile, recommended_index, replayed_paths, validate_plan_file
+from pipeline.planning import (KernelSettings, PlanFile, VerifySettings, recommended_index, replayed_paths,
+                               validate_plan_file)
 from pipeline.present.figures import placeholder, placeholder_gif
 from pipeline.present.figures.bands import plot_band_maps
 from pipeline.present.figures.carried import plot_carried
@@ -162,7 +163,8 @@ def carried_figure(config, res, path):
     part = Part.from_dict(res["part"], name=name)
     starts = {k: (v["theta"], v["y_c"]) for k, v in res["initial_states"].items()}
     replays = replayed_paths(part, plan, starts, tight.mu_c, config["sweep"]["pin_radius"], res["model"],
-                             config.get("verify", {}), kernel=config["sweep"].get("kernel"),
+                             VerifySettings.from_section(config.get("verify")),
+                             kernel=KernelSettings.from_section(config["sweep"].get("kernel")),
                              belt_speed=tight.belt_speed, mu_s=tight.mu_s or 0.5)
     plot_carried(plan, replays, f"{name}: carried sets of plan {' '.join(plan['pins'])} (mu_c "
                  f"{tight.friction}) against {len(next(iter(replays.values()))[0])} replayed "

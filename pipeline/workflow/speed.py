@@ -24,12 +24,11 @@ def speed_part(plan_result: dict, settings: PlannerSettings) -> dict:
         why = tight.warning if tight else "no tight plan"
         return {"part": name, "speed_limit_mm_s": None, "curve": [], "note": why,
                 **provenance_attrs()}
-    speed = settings.speed.as_kwargs()
     stored_limit = stored_speed_limit(tight.plans[0])
-    if stored_limit and stored_limit.get("settings") == speed:  # the plan file's own figure
+    if stored_limit and stored_limit.get("settings") == settings.speed.to_json():  # the plan file's own figure
         res = {k: v for k, v in stored_limit.items() if k != "settings"}
     else:
-        res = stored_plan_speed(plan_result, settings, plan=1, **speed)
+        res = stored_plan_speed(plan_result, settings, plan=1)
     return {**res, **provenance_attrs()}
 
 

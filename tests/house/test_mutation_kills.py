@@ -8,6 +8,7 @@ import pytest
 from conftest import TRIANGLE, circular_diff
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
+from pipeline.planning.core.settings import KernelSettings
 from pipeline.planning.tight.store import load_lattice, save_lattice
 from pipeline.planning.tight.propagate import OutcomeLattice
 
@@ -56,12 +57,12 @@ def test_stored_lattice_is_not_reused_under_other_settings(tmp_path, changed):
     lattice.add(keys, np.zeros(2, np.int8), np.array([10.0, 20.0]), np.zeros(2))
     save_lattice(tmp_path, lattice)
     same = load_lattice(tmp_path, PART, "minpower", 0.0, base["pin_radius"],
-                        {"ds_max": base["ds_max"], "tol": base["tol"]})
+                        KernelSettings(ds_max=base["ds_max"], tol=base["tol"]))
     assert same.known == lattice.known and len(same.known) == 2
     other = dict(base)
     other[changed] = base[changed] * 2.0
     moved = load_lattice(tmp_path, PART, "minpower", 0.0, other["pin_radius"],
-                         {"ds_max": other["ds_max"], "tol": other["tol"]})
+                         KernelSettings(ds_max=other["ds_max"], tol=other["tol"]))
     assert not moved.known, f"lattice reused with another {changed}"
 
 
@@ -71,7 +72,7 @@ def test_stored_lattice_tells_tiny_tolerances_apart(tmp_path):
     lattice = OutcomeLattice(PART, "minpower", R_PIN, 0.0, 0.05, 1e-9)
     lattice.add(np.array([[0, 50, 20]]), np.zeros(1, np.int8), np.array([10.0]), np.zeros(1))
     save_lattice(tmp_path, lattice)
-    assert not load_lattice(tmp_path, PART, "minpower", 0.0, R_PIN, {"ds_max": 0.05, "tol": 2e-9}).known
+    assert not load_lattice(tmp_path, PART, "minpower", 0.0, R_PIN, KernelSettings(ds_max=0.05, tol=2e-9)).known
 
 
 # ---------------------------------------- a stored plan's predicted sets: every branch

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +32,7 @@ from conftest import fewer_examples
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.planning.paper.planner import Planner, load_maps
-from pipeline.planning.core.settings import candidate_pins
+from pipeline.planning.core.settings import VerifySettings, candidate_pins
 from pipeline.planning.paper.planner import dynamic_label
 from pipeline.planning.claims.verify import verify_plan
 from test_invariants import (R_PIN, _contact_fraction, assert_maps_agree, d_values, models,
@@ -175,7 +176,8 @@ def test_dynamic_pins_bring_default_triangles_to_one_orientation(default_planner
     # Full rollouts with perturbed inputs confirm the single orientation set.
     res = verify_plan(planner.part, best.to_dict(), planner.pins, planner.initial_states(),
                       PAPER_MU, cfg["sweep"]["pin_radius"], cfg["planner"]["model"],
-                      settings=dict(cfg["verify"], trials=30, corners=False), speeds=planner.speeds)
+                      settings=replace(VerifySettings.from_section(cfg["verify"]), trials=30, corners=False),
+                      speeds=planner.speeds)
     for row in res["rows"]:
         assert row["trials"] == 30 and row["successes"] >= 28, row
 

@@ -196,6 +196,7 @@ def test_speed_limit_of_a_small_plan_holds_on_replay():
     final set is the quasi-static outcome +- 3 deg. The limit is found by
     bisection to 5 mm/s, the next 5 mm/s fail, and a replay with fresh random
     draws at the limit holds (99% in-sample; 97% allows for sampling noise)."""
+    from pipeline.planning.core.settings import SpeedPerturbation
     from pipeline.planning.plans.speed_limit import _draws, speed_curve, success_fraction
     theta, yc = ASYM.stable_states()[1]
     y_pin = yc - 0.3 * ASYM.a
@@ -210,7 +211,7 @@ def test_speed_limit_of_a_small_plan_holds_on_replay():
     assert 10.0 <= limit < 300.0 and limit % 5.0 == 0.0
     assert curve[10.0] >= 0.99 and curve[limit] >= 0.99
     assert curve[limit + 5.0] < 0.99
-    fresh = _draws(ASYM, [y_pin], [(theta, yc)], 0.3, {"theta_deg": 1.0, "y_mm": 0.5, "pin_mm": 0.2},
+    fresh = _draws(ASYM, [y_pin], [(theta, yc)], 0.3, SpeedPerturbation(theta_deg=1.0, y_mm=0.5, pin_mm=0.2),
                    200, seed=7)
     assert success_fraction(ASYM, [y_pin], [0.0], fresh, arcs, limit) >= 0.97
     assert success_fraction(ASYM, [y_pin], [0.0], fresh, arcs, 300.0) < 0.9

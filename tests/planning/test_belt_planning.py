@@ -18,7 +18,7 @@ from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.planning.tight.store import lattice_path, load_lattice
 from pipeline.planning.tight.propagate import UNITS
-from pipeline.planning.claims.verify import replay
+from pipeline.planning.claims.replay import replay
 
 TRI = Part.from_vertices([[0, 0], [60, 0], [15, 35]], name="tri")
 BELT = 150.0
@@ -182,10 +182,11 @@ def test_config_belt_speed_where_the_part_is_thrown_is_refused():
 
 
 def test_batched_success_fraction_equals_passages_one_at_a_time():
+    from pipeline.planning.core.settings import SpeedPerturbation
     from pipeline.planning.plans.speed_limit import _draws, success_fraction
     heights, arcs = [27.5, 7.5], [(0.0, 40.0), (120.0, 30.0)]
     draws = _draws(TRI, heights, [(0.0, 11.67), (217.9, 12.28)], (0.1, 0.3),
-                   {"theta_deg": 2.0, "y_mm": 0.5, "pin_mm": 0.3}, 3, seed=5)
+                   SpeedPerturbation(theta_deg=2.0, y_mm=0.5, pin_mm=0.3), 3, seed=5)
     good = total = 0
     for th, yc, mu, pins in draws:
         for i in range(th.size):

@@ -1,6 +1,7 @@
 """What "orients" claims: the held-out step against the winner's curse, the
 confidence bound, and the ranking (near misses, robustness before width)."""
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -11,7 +12,8 @@ from pipeline.errors import PinfeedError
 from pipeline.planning.claims import orient
 from pipeline.planning.tight.records import FixedPlan, margin_text, orientation_rank, robust_order
 from pipeline.planning.claims.confidence import share_lower_bound
-from pipeline.planning.claims.verify import holdout_settings, trial_inputs
+from pipeline.planning.claims.trials import holdout_settings, trial_inputs
+from pipeline.planning.core.settings import VerifySettings
 
 N, REQUIRED = 1092, 0.995  # the default triangle's trials: 3 states x (300 + 64 corners)
 
@@ -79,18 +81,37 @@ def test_judge_reports_share_bound_and_interval():
 
 
 def test_held_out_trials_are_fresh_and_not_fewer():
-    cfg = {"trials": 40, "seed": 1}
-    held = holdout_settings(cfg)
-    assert held["trials"] == 40 and held["seed"] != 1
-    assert holdout_settings(cfg) == held  # reproducible
-    assert holdout_settings(dict(cfg, holdout_trials=80))["trials"] == 80
+    chosen = VerifySettings(trials=40, seed=1)
+    held = chosen.held_out()
+    assert held.trials == 40 and held.seed != 1 and held.holdout
+    assert chosen.held_out() == held  # reproducible
+    assert VerifySettings(trials=40, seed=1, holdout_trials=80).held_out().trials == 80
     states = {"s": (10.0, 5.0)}
-    a = trial_inputs(states, 0.15, 2, dict(cfg, corners=False))[0][0]
-    b = trial_inputs(states, 0.15, 2, dict(held, corners=False))[0][0]
+    a = trial_inputs(states, 0.15, 2, replace(chosen, corners=False))[0][0]
+    b = trial_inputs(states, 0.15, 2, replace(held, corners=False))[0][0]
     assert not np.intersect1d(a, b).size  # no selection trial is reused
     with pytest.raises(PinfeedError) as err:
-        holdout_settings(dict(cfg, holdout_trials=10))
+        VerifySettings(trials=40, seed=1, holdout_trials=10).held_out()
     assert "\n" not in str(err.value) and "holdout_trials" in str(err.value)
+
+
+def test_the_flat_dicts_not_yet_switched_callers_pass_give_the_same_trials():
+    # plans/plan.py and family/* still pass the flat dicts of VerifySettings.as_dict();
+    # read back, they are the same settings and draw the same trials.
+    chosen = VerifySettings(trials=40, seed=1)
+    held = chosen.held_out()
+    assert holdout_settings(chosen) == held.as_dict() == dict(chosen.as_dict(), trials=40, seed=held.seed,
+                                                              holdout=True)
+    assert list(held.as_dict()) == list(chosen.as_dict()) + ["holdout"]  # the record's key order
+    assert list(chosen.untruncated(12).as_dict()) == list(chosen.as_dict()) + ["truncate_sigma", "holdout"]
+    assert VerifySettings.from_section(held.as_dict()) == held
+    assert VerifySettings.from_section({"trials": 40, "seed": 1}) == chosen
+    states = {"s": (10.0, 5.0), "t": (200.0, 7.0)}
+    for typed in (chosen, held, chosen.untruncated(12)):
+        a, b = trial_inputs(states, 0.15, 2, typed), trial_inputs(states, 0.15, 2, typed.as_dict())
+        for x, y in zip(a, b):
+            for u, v in zip(x, y):
+                np.testing.assert_array_equal(u, v)
 
 
 @pytest.mark.parametrize("bad", [0.0, 1.0, -0.5, 2])

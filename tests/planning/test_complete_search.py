@@ -148,7 +148,7 @@ def test_sampled_claim_splits_outliers_and_holds_in_an_independent_replay():
     planner = planner_for(part, PlannerSettings.from_config(config).at(0.3))
     labels = [k for k, p in planner.pins.items() if p.y in (10.0, 27.5, 47.5)]
     labels = sorted(labels, key=lambda k: [10.0, 27.5, 47.5].index(planner.pins[k].y))
-    plan = sampled_plan(planner, labels, 0.0, {"trials": 100})
+    plan = sampled_plan(planner, labels, 0.0, VerifySettings(trials=100))
     assert plan.carried == "sampled"
     for label, branches in plan.branches.items():
         finals = sorted(br[-1].after.start for br in branches)
@@ -156,7 +156,7 @@ def test_sampled_claim_splits_outliers_and_holds_in_an_independent_replay():
         assert len(branches) == 1 or min(np.diff(finals)) > CLUSTER_GAP_DEG - 1.0
     states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
     res = verify_plan(part, plan.to_dict(), {k: p.y for k, p in planner.pins.items()}, states, 0.3, 3.0,
-                      settings={"trials": 100})
+                      settings=VerifySettings(trials=100))
     assert res["successes"] >= 0.98 * res["trials"]
 
 

@@ -85,7 +85,7 @@ def test_moving_pins_enumerate_the_same_levels():
 
 
 def test_replays_reuse_the_states_of_earlier_calls_and_give_the_same_numbers():
-    from pipeline.planning.claims.verify import replay_shared
+    from pipeline.planning.claims.replay import replay_shared
     from pipeline.planning.core.settings import ClaimSettings, SearchSettings, VerifySettings
     from pipeline.planning.tight.complete import FixedPinSearch
     from pipeline.planning.tight.judge import stack
@@ -105,7 +105,8 @@ def test_replays_reuse_the_states_of_earlier_calls_and_give_the_same_numbers():
         tf, jam = bench.replay(heights[lo:hi], speeds[lo:hi], rows)
         th, yc, mu, offs, sup = rows
         ref_tf, ref_jam = replay_shared(part, heights[lo:hi], speeds[lo:hi], th, yc, mu, offs, bench.pin_radius,
-                                        bench.model, bench.kernel["ds_max"], bench.kernel["tol"], **bench.belt,
+                                        bench.model, bench.step.ds_max, bench.step.tol,
+                                        belt_speed=bench.belt_speed, mu_s=bench.mu_s,
                                         support=sup, supports=bench.supports)
         np.testing.assert_array_equal(tf, ref_tf)
         np.testing.assert_array_equal(jam, ref_jam)
@@ -113,35 +114,37 @@ def test_replays_reuse_the_states_of_earlier_calls_and_give_the_same_numbers():
 
 
 def test_verifying_plans_with_a_memo_gives_the_same_records():
-    from pipeline.planning.claims import verify as verify_module
-    from pipeline.planning.claims.verify import ReplayMemo, verify_plan
+    from pipeline.planning.claims import replay as replay_module
+    from pipeline.planning.claims.replay import ReplayMemo
+    from pipeline.planning.claims.verify import verify_plan
     from pipeline.planning.core.resting import resting_states
+    from pipeline.planning.core.settings import VerifySettings
 
     part = PARTS["l_bracket"]()
     heights = _pins(part, 6)
     pins = {f"P{k}": float(y) for k, y in enumerate(heights)}
     states = resting_states(part)
-    cfg = {"trials": 12, "seed": 5}
+    trials = VerifySettings(trials=12, seed=5)
     plans = [["P1", "P3", "P2"], ["P1", "P3", "P4"], ["P1", "P3", "P2"], ["P2", "P3", "P4"], ["P1", "P3"]]
     memo, counted = ReplayMemo(), []
-    original = verify_module.pin_step
+    original = replay_module.pin_step
     try:
-        verify_module.pin_step = lambda *a, **k: counted.append(np.size(a[1])) or original(*a, **k)
-        with_memo = [verify_plan(part, {"pins": p, "initial_states": {k: [] for k in states}}, pins, states, (0.1, 0.3), 3.0, settings=cfg, memo=memo)
+        replay_module.pin_step = lambda *a, **k: counted.append(np.size(a[1])) or original(*a, **k)
+        with_memo = [verify_plan(part, {"pins": p, "initial_states": {k: [] for k in states}}, pins, states, (0.1, 0.3), 3.0, settings=trials, memo=memo)
                      for p in plans]
         used = sum(counted)
         counted.clear()
-        without = [verify_plan(part, {"pins": p, "initial_states": {k: [] for k in states}}, pins, states, (0.1, 0.3), 3.0, settings=cfg) for p in plans]
+        without = [verify_plan(part, {"pins": p, "initial_states": {k: [] for k in states}}, pins, states, (0.1, 0.3), 3.0, settings=trials) for p in plans]
     finally:
-        verify_module.pin_step = original
+        replay_module.pin_step = original
     assert with_memo == without
     assert used < sum(counted)
 
 
 def test_sampled_carried_sets_with_a_memo_are_the_same():
     from pipeline.config import load_config
-    from pipeline.planning.claims.verify import ReplayMemo
-    from pipeline.planning.core.settings import PlannerSettings
+    from pipeline.planning.claims.replay import ReplayMemo
+    from pipeline.planning.core.settings import PlannerSettings, VerifySettings
     from pipeline.planning.plans.planner import planner_for
     from pipeline.planning.tight.certify import sampled_plan
 
@@ -152,7 +155,7 @@ def test_sampled_carried_sets_with_a_memo_are_the_same():
     sequences = [first + [by_height[47.5]], first + [by_height[10.0]], first + [by_height[47.5]]]
     memo = ReplayMemo()
     for labels in sequences:
-        kept, plain = sampled_plan(planner, labels, 0.0, {"trials": 30}, memo=memo), \
-            sampled_plan(planner, labels, 0.0, {"trials": 30})
+        kept, plain = sampled_plan(planner, labels, 0.0, VerifySettings(trials=30), memo=memo), \
+            sampled_plan(planner, labels, 0.0, VerifySettings(trials=30))
         assert kept.to_dict() == plain.to_dict()
     assert len(memo.at) < 3 * 3 * len(memo.trials)  # the shared first pins were kept once

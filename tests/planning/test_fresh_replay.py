@@ -6,6 +6,8 @@ config (its full verification settings: 300 trials per state plus every box
 corner, the confidence bound) is replayed once more from a seed neither of
 them used, through the public ``verify_plan`` replay, and judged by the same
 claim rule. This is the check the winner's curse would fail."""
+from dataclasses import replace
+
 import pytest
 
 from pipeline.config import load_config
@@ -35,8 +37,8 @@ def test_recommended_plan_passes_a_fresh_replay(name, tmp_path):
     speeds = dict(zip(rec["pins"], rec.get("pin_speeds") or [0.0] * len(rec["pins"])))
     fresh = verify_plan(part, rec, dict(zip(rec["pins"], rec["pin_heights_mm"])), resting_states(part), settings.friction.value,
                         config["sweep"]["pin_radius"], config["planner"]["model"],
-                        dict(config["verify"], seed=FRESH_SEED), speeds=speeds,
-                        kernel=config["sweep"].get("kernel"))
+                        replace(settings.verify, seed=FRESH_SEED), speeds=speeds,
+                        kernel=settings.search.kernel_step)
     verdict = judge_verification(fresh, entry["tolerance_deg"], entry["symmetry_order"],
                                  config["verify"]["required"], config["verify"]["confidence"])
     assert verdict["orients"], verdict

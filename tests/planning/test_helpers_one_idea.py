@@ -4,7 +4,7 @@
 - ``planning.arcs.format_arcs``: orientation sets for people (both styles);
 - ``parts.contact.contact_parameter``: d from a pin height, the spec's sign;
 - ``planning.paper.load_maps``: the one reader of a map set's bands;
-- ``sensing.profiles.synthetic_measurement`` draws through ``verify.perturbed_inputs``;
+- ``sensing.profiles.synthetic_measurement`` draws through ``trials.perturbed_inputs``;
 - ``workflow.commands``: what ``pinfeed plan`` / ``layout`` decide below the CLI.
 """
 from __future__ import annotations
@@ -135,7 +135,8 @@ def test_load_maps_sorts_by_d_and_keeps_each_maps_bands():
 
 
 def test_synthetic_measurement_draws_through_perturbed_inputs(monkeypatch):
-    from pipeline.planning.claims.verify import PERTURB_DEFAULTS, perturbed_inputs
+    from pipeline.planning.claims.trials import PERTURB_DEFAULTS, perturbed_inputs
+    from pipeline.planning.core.settings import Perturbation
     from pipeline.sensing import profiles
     from pipeline.sensing.profiles import Sensor
 
@@ -149,21 +150,22 @@ def test_synthetic_measurement_draws_through_perturbed_inputs(monkeypatch):
         raise Drawn
 
     monkeypatch.setattr(profiles, "first_pin_rollout", record)
-    cfg = dict(PERTURB_DEFAULTS, theta_sigma=3.0)
+    perturb = dict(PERTURB_DEFAULTS, theta_sigma=3.0)  # as the sensing section gives it
+    sizes = Perturbation(theta_sigma=3.0)
     for mu_c in (0.2, (0.1, 0.3)):
         seen.clear()
         rng = np.random.default_rng(7)
         for _ in range(50):
             with pytest.raises(Drawn):
                 profiles.synthetic_measurement(None, {"theta": 30.0, "y_c": 10.0}, 20.0, mu_c, 3.0,
-                                               "minpower", Sensor(), cfg, rng)
+                                               "minpower", Sensor(), perturb, rng)
         ref = np.random.default_rng(7)
         for theta, y_c, y_pin, mu in seen:
-            th, yc, m, offs = perturbed_inputs(30.0, 10.0, mu_c, 1, cfg, ref)
+            th, yc, m, offs = perturbed_inputs(30.0, 10.0, mu_c, 1, sizes, ref)
             assert (theta, y_c, y_pin, mu) == pytest.approx((th, yc, 20.0 + offs[0], m))
         thetas = np.array([s[0] for s in seen])
         assert np.all(np.abs(thetas - 30.0) <= 2 * 3.0)  # truncated at 2 sigma, as verification
-        assert np.all(np.abs(np.array([s[2] for s in seen]) - 20.0) <= cfg["pin_halfwidth"])
+        assert np.all(np.abs(np.array([s[2] for s in seen]) - 20.0) <= sizes.pin_halfwidth)
 
 
 # ---------------------------------------------------------------- the commands below the CLI

@@ -217,7 +217,7 @@ def test_the_verify_stage_replays_the_recommended_tight_plan_as_stored(tight_fil
                        {k: (v["theta"], v["y_c"]) for k, v in entry["initial_states"].items()},
                        entry["mu_c"], config["sweep"]["pin_radius"], data["model"],
                        PlannerSettings.from_config(config).verify,
-                       kernel=config["sweep"].get("kernel"))
+                       kernel=PlannerSettings.from_config(config).search.kernel_step)
     want.pop("trials_detail")
     got = dict(out["checks"][0])
     got.pop("kind")

@@ -14,6 +14,7 @@ from pipeline.parts.part import Part
 from pipeline.planning.paper.bands import circular_mean_std, extract_bands, in_arc
 from pipeline.planning.paper.planner import Planner, State, load_maps, merge_arcs
 from pipeline.planning.claims.verify import verify_plan
+from pipeline.planning.core.settings import VerifySettings
 
 GRID = np.arange(0.0, 360.0, 1.0)
 
@@ -201,7 +202,7 @@ def test_triangle_plan_is_confirmed_by_full_rollouts(triangle_plan):
     thetas = [t for rows in finals for t, _ in rows]
     assert best.n_sets == n_clusters(thetas, TRIANGLE.symmetry_order()), (best.final_sets, sorted(thetas))
     res = verify_plan(TRIANGLE, best.to_dict(), pl.pins, pl.initial_states(), 0.15, 3.0,
-                      settings={"trials": 30, "seed": 3, "corners": False})
+                      settings=VerifySettings(trials=30, seed=3, corners=False))
     for row in res["rows"]:
         assert row["trials"] == 30 and row["successes"] >= 29, row
 
@@ -214,7 +215,7 @@ def test_verification_counts_a_plan_that_fails_for_one_state(triangle_plan):
         branch[-1]["band"]["start"] = (branch[-1]["band"]["start"] + 90.0) % 360.0
     plan["final_sets"] = []
     res = verify_plan(TRIANGLE, plan, pl.pins, pl.initial_states(), 0.15, 3.0,
-                      settings={"trials": 30, "seed": 3})
+                      settings=VerifySettings(trials=30, seed=3))
     rows = {r["state"]: r for r in res["rows"]}
     n = 30 + 2 ** (3 + len(plan["pins"]))  # random trials plus the corners of the box
     assert rows["state 1"]["failures"] == n and rows["state 1"]["reasons"] == {"other band": n}
@@ -225,9 +226,9 @@ def test_verification_counts_a_plan_that_fails_for_one_state(triangle_plan):
 def test_verification_is_reproducible(triangle_plan):
     pl, plans = triangle_plan
     a = verify_plan(TRIANGLE, plans[0].to_dict(), pl.pins, pl.initial_states(), 0.15, 3.0,
-                    settings={"trials": 5, "seed": 7})
+                    settings=VerifySettings(trials=5, seed=7))
     b = verify_plan(TRIANGLE, plans[0].to_dict(), pl.pins, pl.initial_states(), 0.15, 3.0,
-                    settings={"trials": 5, "seed": 7})
+                    settings=VerifySettings(trials=5, seed=7))
     assert [t["final_theta"] for t in a["trials_detail"]] == [t["final_theta"] for t in b["trials_detail"]]
 
 

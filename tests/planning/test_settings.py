@@ -97,7 +97,7 @@ def test_one_truncation_for_the_planners_box_and_the_trials_corners(mu):
     verify = VerifySettings(perturbation=Perturbation(mu_sigma=0.03))
     friction = Friction.parse(mu, verify.perturbation.mu_sigma)
     box = friction_interval(friction.value, Uncertainty.from_verify(verify))
-    _, _, corner_mu, _ = corner_inputs(30.0, 5.0, friction.value, 1, verify.as_dict())
+    _, _, corner_mu, _ = corner_inputs(30.0, 5.0, friction.value, 1, verify)
     assert box == friction.interval() == (corner_mu.min(), corner_mu.max())
     assert np.all(np.isin(corner_mu, box))
 

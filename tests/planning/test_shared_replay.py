@@ -1,6 +1,6 @@
 """Replaying many sequences that share their first pins once per distinct
-prefix (``verify.replay_shared``) gives exactly the numbers of replaying
-every sequence on every trial (``verify.replay`` on the tiled rows): the
+prefix (``replay.replay_shared``) gives exactly the numbers of replaying
+every sequence on every trial (``replay.replay`` on the tiled rows): the
 same finals to the last bit, the same jams, with fixed and moving pins,
 uniform pressure and a support family's members."""
 import numpy as np
@@ -8,12 +8,14 @@ import pytest
 
 from pipeline.parts.part import Part
 from pipeline.parts.support_family import parse_support_family
-from pipeline.planning.claims.verify import replay, replay_shared, trial_inputs
+from pipeline.planning.claims.replay import replay, replay_shared
+from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.resting import resting_states
+from pipeline.planning.core.settings import VerifySettings
 from pipeline.planning.tight.judge import stack
 
 MU = (0.1, 0.3)
-CFG = {"trials": 20, "seed": 3}
+TRIALS = VerifySettings(trials=20, seed=3)
 
 
 def _tiled(part, heights, speeds, rows, supports=None):
@@ -50,7 +52,7 @@ def _sequences(part, n_pins, seed, moving=False):
 ])
 def test_shared_prefixes_replay_exactly_as_every_row(vertices, n_pins, moving):
     part = Part.from_vertices(vertices)
-    rows = stack(trial_inputs(resting_states(part), MU, n_pins, CFG))
+    rows = stack(trial_inputs(resting_states(part), MU, n_pins, TRIALS))
     heights, speeds = _sequences(part, n_pins, seed=n_pins, moving=moving)
     tf0, jam0 = _tiled(part, heights, speeds, rows)
     tf1, jam1 = replay_shared(part, heights, speeds, *rows[:4], 3.0, "minpower", support=rows[4])
@@ -62,7 +64,7 @@ def test_shared_prefixes_replay_exactly_as_every_row(vertices, n_pins, moving):
 def test_shared_prefixes_with_support_family_members():
     part = Part.from_vertices([[0, 0], [60, 0], [45, 50]])
     family = parse_support_family("tripods:4", part)
-    rows = stack(trial_inputs(resting_states(part), MU, 3, CFG, family))
+    rows = stack(trial_inputs(resting_states(part), MU, 3, TRIALS, family))
     supports = family.kernel_supports
     assert len(set(rows[4].tolist())) > 1  # the trials rest on several members
     heights, speeds = _sequences(part, 3, seed=7)

@@ -21,7 +21,7 @@ from pipeline.parts.support_family import parse_support_family
 from pipeline.planning.core.settings import ClaimSettings, PlannerSettings, SearchSettings, VerifySettings
 from pipeline.planning.tight.complete import FixedPinSearch
 from pipeline.planning.family.members import planning_family
-from pipeline.planning.claims.verify import DEFAULTS, corner_inputs, perturbed_batch, trial_inputs
+from pipeline.planning.claims.trials import corner_inputs, perturbed_batch, trial_inputs
 
 MU = (0.1, 0.2)
 VERIFY = VerifySettings(trials=20, seed=3)
@@ -101,17 +101,17 @@ def test_trials_sample_every_member_and_leave_uniform_trials_as_they_were():
     family = planning_family(TRIANGLE, family, PlannerSettings.from_config(load_config(None)))
     assert 1 <= len(family.extremes) <= 3
     states = {"a": (10.0, 12.0), "b": (200.0, 14.0)}
-    cfg = dict(DEFAULTS, trials=23, seed=5)
-    plain = trial_inputs(states, MU, 2, cfg)
+    chosen = VerifySettings(trials=23, seed=5)
+    plain = trial_inputs(states, MU, 2, chosen)
     rng = np.random.default_rng(5)
     for (theta, y_c), rows in zip(states.values(), plain):  # built here from the two samplers
-        th, yc, mu, offs = perturbed_batch(theta, y_c, MU, 2, cfg, rng, 23)
-        corners = corner_inputs(theta, y_c, MU, 2, cfg)
+        th, yc, mu, offs = perturbed_batch(theta, y_c, MU, 2, chosen.perturbation, rng, 23)
+        corners = corner_inputs(theta, y_c, MU, 2, chosen.perturbation)
         want = [np.concatenate([a, b]) for a, b in zip((th, yc, mu, offs), corners)]
         for got, exp in zip(rows[:4], want):
             np.testing.assert_array_equal(got, exp)
         assert not rows[4].any()
-    sampled = trial_inputs(states, MU, 2, cfg, family)
+    sampled = trial_inputs(states, MU, 2, chosen, family)
     for rows, ref in zip(sampled, plain):
         np.testing.assert_array_equal(rows[0][:23], ref[0][:23])  # same perturbations
         counts = np.bincount(rows[4][:23], minlength=5)

@@ -18,41 +18,43 @@ import pytest
 import yaml
 
 from pipeline.planning import replay
-from pipeline.planning.claims.tails import UNTRUNCATED_STREAM, describe_untruncated, untruncated_settings
-from pipeline.planning.claims.verify import HOLDOUT_STREAM, holdout_settings, perturbed_batch, trial_inputs
-from pipeline.planning.core.settings import TRUNCATE_SIGMA
+from pipeline.planning.claims.tails import describe_untruncated
+from pipeline.planning.claims.trials import perturbed_batch, trial_inputs
+from pipeline.planning.core.settings import HOLDOUT_STREAM, TRUNCATE_SIGMA, UNTRUNCATED_STREAM, VerifySettings
 
 VERTICES = "0,0 60,0 15,35"
 MU_C = 0.15
 
 
-def _draws(cfg, n=40_000, mu_c=MU_C):
+def _draws(settings, n=40_000, mu_c=MU_C):
     """Perturbations of theta and mu_c about 0 and ``mu_c`` (``n`` of each)."""
-    th, _, mu, _ = perturbed_batch(0.0, 0.0, mu_c, 1, cfg, np.random.default_rng(3), n)
+    th, _, mu, _ = perturbed_batch(0.0, 0.0, mu_c, 1, settings, np.random.default_rng(3), n)
     return th, mu - mu_c
 
 
 def test_untruncated_draws_reach_beyond_two_sigma_with_the_normals_spread():
-    base = holdout_settings({"seed": 7})
-    cfg = untruncated_settings({"seed": 7}, 10)
-    dth, dmu = _draws(cfg, mu_c=1.0)  # far from 0: the clip at 0 never bites
-    for x, sigma in ((dth, cfg["theta_sigma"]), (dmu, cfg["mu_sigma"])):
+    base = VerifySettings(seed=7).held_out()
+    tails = VerifySettings(seed=7).untruncated(10)
+    sizes = tails.perturbation
+    assert tails.truncate_sigma is None and not tails.corners and tails.holdout is False
+    dth, dmu = _draws(tails, mu_c=1.0)  # far from 0: the clip at 0 never bites
+    for x, sigma in ((dth, sizes.theta_sigma), (dmu, sizes.mu_sigma)):
         beyond = np.mean(np.abs(x) > TRUNCATE_SIGMA * sigma)
         assert 0.040 < beyond < 0.051  # a normal leaves 4.55 % beyond 2 sigma
         assert abs(np.std(x) / sigma - 1.0) < 0.02
     dth, dmu = _draws(base, mu_c=1.0)
-    assert np.abs(dth).max() <= TRUNCATE_SIGMA * base["theta_sigma"]
-    assert np.abs(dmu).max() <= TRUNCATE_SIGMA * base["mu_sigma"]
+    assert np.abs(dth).max() <= TRUNCATE_SIGMA * base.perturbation.theta_sigma
+    assert np.abs(dmu).max() <= TRUNCATE_SIGMA * base.perturbation.mu_sigma
     # the 2-sigma cut leaves a spread of about 0.88 sigma
-    assert abs(np.std(dth) / base["theta_sigma"] - 0.880) < 0.02
+    assert abs(np.std(dth) / base.perturbation.theta_sigma - 0.880) < 0.02
 
 
 def test_untruncated_trials_have_a_seed_and_count_of_their_own():
-    cfg = {"seed": 11, "trials": 20}
-    held = holdout_settings(cfg)
-    tails = untruncated_settings(cfg, 52)
-    assert tails["seed"] not in (cfg["seed"], held["seed"])
-    assert tails["seed"] == int(np.random.SeedSequence([11, UNTRUNCATED_STREAM]).generate_state(1)[0])
+    chosen = VerifySettings(seed=11, trials=20)
+    held = chosen.held_out()
+    tails = chosen.untruncated(52)
+    assert tails.seed not in (chosen.seed, held.seed)
+    assert tails.seed == int(np.random.SeedSequence([11, UNTRUNCATED_STREAM]).generate_state(1)[0])
     assert UNTRUNCATED_STREAM != HOLDOUT_STREAM
     rows = trial_inputs({"s1": (0.0, 10.0), "s2": (90.0, 12.0)}, (0.1, 0.3), 2, tails)
     assert [r[0].size for r in rows] == [52, 52]  # random trials only: the box has no corners

@@ -17,7 +17,7 @@ from pipeline.config import load_config
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.planning import check_layout_settings, layout_stored
+from pipeline.planning import LayoutSettings, layout_stored
 
 TRIANGLE = "0,0 60,0 15,35"
 SPEED = 100.0
@@ -130,7 +130,7 @@ def stored(tmp_path_factory):
     config = load_config()
     from pipeline.planning import PlannerSettings
     layout = layout_stored(result, PlannerSettings.from_config(config), belt_speed=SPEED, quasi_static=True,
-                           settings={"trials": 4, "speed_trials": 3})
+                           settings=LayoutSettings(trials=4, speed_trials=3))
     return {"root": root, "results": root / "results", "result": result, "layout": layout,
             "config": config}
 
@@ -267,7 +267,7 @@ def test_bad_input_one_line_errors(stored, capsys, tmp_path):
     assert "suffix" in _one_line(capsys, ["layout", "--part", "tri", "--results", res,
                                           "--out", str(tmp_path / "feeder.pdf")])
     with pytest.raises(PinfeedError, match="station_margin_mm"):
-        check_layout_settings({"station_margin_mm": -0.5})
+        LayoutSettings(station_margin_mm=-0.5)
 
 
 def test_belt_speed_above_limit_warns_naming_the_limit(stored, capsys):

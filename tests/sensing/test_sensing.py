@@ -383,7 +383,9 @@ def test_final_sets_per_verdict_hold_in_full_rollout_replay(sensed):
     # corner of the box), ends in that verdict's final sets.
     from pipeline.parts.part import Part
     from pipeline.planning.core.arcs import in_arc
-    from pipeline.planning.claims.verify import DEFAULTS, corner_inputs, perturbed_batch, replay
+    from pipeline.planning.claims.replay import replay
+    from pipeline.planning.claims.trials import corner_inputs, perturbed_batch
+    from pipeline.planning.core.settings import VerifySettings
     res = sensed["partial"]
     kernel = _sense_config()["sweep"]["kernel"]  # the verify stage's rollout settings
     part = Part.from_vertices(res["part"]["vertices"])
@@ -392,8 +394,9 @@ def test_final_sets_per_verdict_hold_in_full_rollout_replay(sensed):
     for group in res["groups"]:
         for label in group["states"]:
             st = res["initial_states"][label]
-            draws = [perturbed_batch(st["theta"], st["y_c"], res["mu_c"], len(heights), DEFAULTS, rng, 100),
-                     corner_inputs(st["theta"], st["y_c"], res["mu_c"], len(heights), DEFAULTS)]
+            sizes = VerifySettings().perturbation
+            draws = [perturbed_batch(st["theta"], st["y_c"], res["mu_c"], len(heights), sizes, rng, 100),
+                     corner_inputs(st["theta"], st["y_c"], res["mu_c"], len(heights), sizes)]
             th, yc, mu, offs = (np.concatenate(x) for x in zip(*draws))
             theta, _, jam, _ = replay(part, heights, speeds, th, yc, mu, offs, res["pin_radius"],
                                       res["model"], kernel["ds_max"], kernel["tol"])

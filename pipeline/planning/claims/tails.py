@@ -7,31 +7,18 @@ of the trials in one set is a claim about the tails. So the recommended plan
 is replayed once more on trials whose normals are not cut (same sigmas;
 y_c and the pin offsets keep their uniform boxes; a friction range stays
 uniform over the range, only theta's normal is uncut), from a seed of its
-own, as many per initial state as its held-out trials, and judged by the
-same rule (:func:`pipeline.planning.claims.orient.judge`). The record says
-what the plan does beyond the box; the claim itself stays the held-out one.
+own (:meth:`VerifySettings.untruncated
+<pipeline.planning.core.settings.VerifySettings.untruncated>`), as many per
+initial state as its held-out trials, and judged by the same rule
+(:func:`pipeline.planning.claims.orient.judge`). The record says what the
+plan does beyond the box; the claim itself stays the held-out one.
 """
 from __future__ import annotations
 
-import numpy as np
-
 from pipeline.planning.claims.orient import judge_verification
-from pipeline.planning.claims.verify import verify_dict, verify_plan
-from pipeline.planning.core.settings import TRUNCATE_SIGMA, ClaimSettings
-
-UNTRUNCATED_STREAM = 4_002  # salt of the untruncated trials' seed: no selection or held-out trial draws from it
-
-
-def untruncated_settings(settings, trials_per_state: int) -> dict:
-    """The verification settings of the untruncated trials, from the
-    verification's (selection) ``settings``: ``trials_per_state`` random
-    trials per initial state (no box corners: the box has no edge), normals
-    not cut, seed derived from ``(seed, UNTRUNCATED_STREAM)``, which neither
-    the selection nor the held-out trials draw from."""
-    cfg = verify_dict(settings)
-    seed = int(np.random.SeedSequence([int(cfg["seed"]), UNTRUNCATED_STREAM]).generate_state(1)[0])
-    return dict(cfg, trials=int(trials_per_state), seed=seed, corners=False, truncate_sigma=None,
-                holdout=False)
+from pipeline.planning.claims.verify import verify_plan
+from pipeline.planning.core.settings import (TRUNCATE_SIGMA, UNTRUNCATED_STREAM,  # noqa: F401 (re-exported)
+                                             ClaimSettings, VerifySettings)
 
 
 def normal_quantities(mu_c) -> list[str]:
@@ -40,15 +27,17 @@ def normal_quantities(mu_c) -> list[str]:
 
 
 def untruncated_check(part, plan: dict, pins: dict, initial_states: dict, mu_c, pin_radius: float,
-                      model: str, settings, trials_per_state: int, claims: ClaimSettings, order: int = 1,
-                      **replay) -> dict:
+                      model: str, settings: VerifySettings, trials_per_state: int, claims: ClaimSettings,
+                      order: int = 1, **replay) -> dict:
     """Replay ``plan`` (a plan's ``to_dict()``) on untruncated trials and judge it.
 
     Parameters
     ----------
     part, plan, pins, initial_states, mu_c, pin_radius, model : as
         :func:`~pipeline.planning.claims.verify.verify_plan` takes them.
-    settings : the verification's settings (sigmas, boxes, seed).
+    settings : the verification's settings (sigmas, boxes, seed), whose
+        :meth:`~pipeline.planning.core.settings.VerifySettings.untruncated`
+        trials these are.
     trials_per_state : random trials per initial state (as many as the held-out trials).
     claims : the claim's tolerance, required share, confidence and rule.
     order : the part's rotational symmetry order.
@@ -60,11 +49,11 @@ def untruncated_check(part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     dict
         :func:`untruncated_record` of the verdict.
     """
-    cfg = untruncated_settings(settings, trials_per_state)
-    res = verify_plan(part, plan, pins, initial_states, mu_c, pin_radius, model, cfg, **replay)
+    tails = settings.untruncated(trials_per_state)
+    res = verify_plan(part, plan, pins, initial_states, mu_c, pin_radius, model, tails, **replay)
     verdict = judge_verification(res, claims.tolerance_deg, order, claims.required, claims.confidence,
                                  claims.rule)
-    return untruncated_record(verdict, cfg["seed"], mu_c)
+    return untruncated_record(verdict, tails.seed, mu_c)
 
 
 def untruncated_record(verdict: dict, seed: int, mu_c) -> dict:

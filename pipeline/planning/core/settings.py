@@ -7,8 +7,18 @@ friction a plan must work for: a value or a range, its sigma and the
 truncation both widenings use), :class:`Perturbation` and
 :class:`VerifySettings` (the trials), :class:`ClaimSettings` (tolerance,
 required share, confidence, rule), :class:`SearchSettings` (pins, depth,
-limits in d, model, belt, moving pins) and :class:`SpeedSettings`. Every
-default comes from ``config/schema.yaml`` (:func:`pipeline.config.schema_default`).
+limits in d, model, belt, moving pins; the rollout kernel's step,
+:class:`KernelSettings`) and :class:`SpeedSettings` (with the uniform box
+of its trials, :class:`SpeedPerturbation`). Beside them, the settings of
+the stages that stand on plans: :class:`LayoutSettings` (``layout``) and
+:class:`DesignSettings` (``design``). Every default comes from
+``config/schema.yaml`` (:func:`pipeline.config.schema_default`).
+
+This is the one place in the planner where a config's dicts are read: each
+type has a reader of its section (``from_config``, ``from_section``), and
+:func:`as_verify_settings` and :func:`as_kernel_settings` turn the flat
+dicts that callers not yet switched to the typed settings still pass into
+the typed ones.
 
 Three frictions have three names: the planner's ``friction`` (a
 :class:`Friction`, ``planner.mu_c``), the sweep's ``swept_frictions`` (the
@@ -31,6 +41,8 @@ from pipeline.config import schema_default
 from pipeline.errors import PinfeedError
 
 TRUNCATE_SIGMA = 2.0  # normal perturbations are drawn within +-2 sigma; the planner's box is as wide
+HOLDOUT_STREAM = 4_001  # salt of the held-out trials' seed: a stream no screen or selection draws from
+UNTRUNCATED_STREAM = 4_002  # salt of the untruncated trials' seed: no selection or held-out trial draws from it
 
 
 def parse_friction(value):
@@ -192,23 +204,128 @@ class Perturbation:
     mu_sigma: float = _default("verify", "mu_sigma")
     pin_halfwidth: float = _default("verify", "pin_halfwidth")
 
+    @classmethod
+    def from_section(cls, section) -> "Perturbation":
+        """The sizes of a ``verify``-style section (``theta_sigma``,
+        ``y_halfwidth``, ``mu_sigma``, ``pin_halfwidth``; the schema's where
+        one is absent; other keys ignored), values as given."""
+        sizes = dict(dataclasses.asdict(cls()), **(section or {}))
+        return cls(sizes["theta_sigma"], sizes["y_halfwidth"], sizes["mu_sigma"], sizes["pin_halfwidth"])
+
 
 @dataclass(frozen=True)
 class VerifySettings:
     """The perturbed trials a plan is replayed on: ``trials`` per resting state,
     the perturbation box's ``corners``, the ``seed``, and ``holdout_trials``
-    (``None``: as many as ``trials``) for the held-out trials that certify it."""
+    (``None``: as many as ``trials``) for the held-out trials that certify it.
+
+    ``truncate_sigma`` is where the normals of theta and of a single friction
+    are cut (``None``: not cut, the tails' trials of :meth:`untruncated`);
+    ``holdout`` says which trials these are, for the record: ``None`` the
+    trials that screen and select plans, ``True`` the held-out ones
+    (:meth:`held_out`), ``False`` the untruncated ones."""
 
     trials: int = _default("verify", "trials")
     corners: bool = _default("verify", "corners")
     seed: int = _default("verify", "seed")
     holdout_trials: int | None = _default("verify", "holdout_trials")
     perturbation: Perturbation = field(default_factory=Perturbation)
+    truncate_sigma: float | None = TRUNCATE_SIGMA
+    holdout: bool | None = None
+
+    @classmethod
+    def from_section(cls, section) -> "VerifySettings":
+        """The trials of a ``verify`` section, whole or partial (the schema's
+        defaults for what it leaves out; the claim's keys ``required``,
+        ``confidence`` and ``rule`` ignored), values as given. Also reads the
+        flat dict of :meth:`as_dict` back (``truncate_sigma``, ``holdout``)."""
+        d = dict(cls().as_dict(), **(section or {}))
+        return cls(d["trials"], d["corners"], d["seed"], d["holdout_trials"], Perturbation.from_section(d),
+                   d.get("truncate_sigma", TRUNCATE_SIGMA), d.get("holdout"))
+
+    def held_out(self, attempt: int = 0) -> "VerifySettings":
+        """The settings of the held-out trials that certify a plan.
+
+        The search screens and selects plans on these trials (seed ``seed``);
+        the plan it picks is certified on fresh trials from a seed derived
+        from ``(seed, HOLDOUT_STREAM, attempt)``, which no screen or selection
+        draws from, ``holdout_trials`` per state (default: as many as
+        ``trials``; fewer is refused with a one-line :class:`PinfeedError`).
+        The same settings give the same held-out trials. The box corners are
+        replayed again (they are not random)."""
+        n = int(self.trials) if self.holdout_trials is None else int(self.holdout_trials)
+        if n < int(self.trials):
+            raise PinfeedError(f"verify.holdout_trials ({n}) must be at least verify.trials ({self.trials}): "
+                               "the trials that certify a plan may not be fewer than those that chose it")
+        seed = int(np.random.SeedSequence([int(self.seed), HOLDOUT_STREAM, int(attempt)]).generate_state(1)[0])
+        return dataclasses.replace(self, trials=n, seed=seed, holdout=True)
+
+    def untruncated(self, trials_per_state: int) -> "VerifySettings":
+        """The settings of the untruncated trials (the tails,
+        :mod:`pipeline.planning.claims.tails`): ``trials_per_state`` random
+        trials per initial state (no box corners: the box has no edge),
+        normals not cut, seed derived from ``(seed, UNTRUNCATED_STREAM)``,
+        which neither the selection nor the held-out trials draw from."""
+        seed = int(np.random.SeedSequence([int(self.seed), UNTRUNCATED_STREAM]).generate_state(1)[0])
+        return dataclasses.replace(self, trials=int(trials_per_state), seed=seed, corners=False,
+                                   truncate_sigma=None, holdout=False)
 
     def as_dict(self) -> dict:
-        """The flat dict of the trial drawing functions (``claims.verify``)."""
-        return {"trials": self.trials, "corners": self.corners, "seed": self.seed,
-                "holdout_trials": self.holdout_trials, **dataclasses.asdict(self.perturbation)}
+        """The flat dict a verification record keeps under ``settings``: the
+        trials, corners, seed, ``holdout_trials`` and the perturbation sizes;
+        then ``truncate_sigma`` when the normals are not cut at
+        ``TRUNCATE_SIGMA`` and ``holdout`` when it is set."""
+        out = {"trials": self.trials, "corners": self.corners, "seed": self.seed,
+               "holdout_trials": self.holdout_trials, **dataclasses.asdict(self.perturbation)}
+        if self.truncate_sigma != TRUNCATE_SIGMA:
+            out["truncate_sigma"] = self.truncate_sigma
+        if self.holdout is not None:
+            out["holdout"] = self.holdout
+        return out
+
+
+def as_verify_settings(settings) -> VerifySettings:
+    """``settings`` as a :class:`VerifySettings`: one as it is, ``None`` as the
+    schema's, and a flat dict of :meth:`VerifySettings.as_dict` keys (whole or
+    partial) read with :meth:`VerifySettings.from_section`: the dicts that
+    callers not yet switched to the typed settings still pass."""
+    if isinstance(settings, VerifySettings):
+        return settings
+    return VerifySettings.from_section(settings)
+
+
+@dataclass(frozen=True)
+class KernelSettings:
+    """The rollout kernel's integrator step (``sweep.kernel``): the largest
+    step ``ds_max`` (units of a) and the tolerance ``tol``; ``None``: the
+    kernel's own default."""
+
+    ds_max: float | None = None
+    tol: float | None = None
+
+    @classmethod
+    def from_section(cls, section) -> "KernelSettings":
+        """The step of a ``sweep.kernel`` section (``None`` or ``{}``: the kernel's defaults)."""
+        section = section or {}
+        return cls(section.get("ds_max"), section.get("tol"))
+
+    def with_defaults(self, ds_max: float, tol: float) -> "KernelSettings":
+        """The same step with ``ds_max`` and ``tol`` where it leaves them to the kernel."""
+        return KernelSettings(ds_max if self.ds_max is None else self.ds_max, tol if self.tol is None else self.tol)
+
+    def as_kwargs(self) -> dict:
+        """The keywords of a rollout: ``ds_max`` and ``tol``, those that are set."""
+        return {k: v for k, v in (("ds_max", self.ds_max), ("tol", self.tol)) if v is not None}
+
+
+def as_kernel_settings(kernel) -> KernelSettings:
+    """``kernel`` as a :class:`KernelSettings`: one as it is, ``None`` as the
+    kernel's defaults, a dict (``ds_max``, ``tol``; other keys ignored) read
+    with :meth:`KernelSettings.from_section`: the dicts that callers not yet
+    switched to the typed settings still pass."""
+    if isinstance(kernel, KernelSettings):
+        return kernel
+    return KernelSettings.from_section(kernel)
 
 
 def check_tolerance(value, what: str = "tolerance (--tolerance, planner.tolerance_deg)") -> float:
@@ -309,8 +426,13 @@ class SearchSettings:
         object.__setattr__(self, "time_limit_s", check_time_limit(self.time_limit_s))
 
     @property
+    def kernel_step(self) -> KernelSettings:
+        """The kernel's step settings (``ds_max``, ``tol``)."""
+        return KernelSettings.from_section(dict(self.kernel))
+
+    @property
     def kernel_settings(self) -> dict:
-        """The kernel's step settings as keyword arguments (``ds_max``, ``tol``)."""
+        """The kernel's step settings as a dict, for callers not yet switched to :attr:`kernel_step`."""
         return dict(self.kernel)
 
     @property
@@ -332,11 +454,168 @@ class SpeedSettings:
     required: float = _default("speed", "required")
     seed: int = _default("speed", "seed")
 
-    def as_kwargs(self) -> dict:
-        """Keyword arguments of ``stored_plan_speed``."""
+    @classmethod
+    def from_json(cls, record: dict) -> "SpeedSettings":
+        """The settings a stored speed limit keeps (:meth:`to_json`; the schema's for any it lacks)."""
+        d = dict(cls().to_json(), **record)
+        return cls(float(d["mu_s"]), int(d["trials"]), tuple(float(v) for v in d["speeds"]),
+                   float(d["resolution"]), float(d["required"]), int(d["seed"]))
+
+    def to_json(self) -> dict:
+        """The settings as a speed limit stored with a plan keeps them (``speed_limit.settings``)."""
         return {"mu_s": float(self.mu_s), "trials": int(self.trials), "speeds": [float(v) for v in self.speeds],
                 "resolution": float(self.resolution), "required": float(self.required),
                 "seed": int(self.seed)}
+
+
+@dataclass(frozen=True)
+class SpeedPerturbation:
+    """The uniform half-widths of a speed limit's trials: orientation
+    ``theta_deg`` (deg), centroid height ``y_mm`` and pin position ``pin_mm`` (mm)."""
+
+    theta_deg: float = 1.0
+    y_mm: float = 0.5
+    pin_mm: float = 0.2
+
+    @classmethod
+    def from_verify(cls, perturbation: Perturbation) -> "SpeedPerturbation":
+        """The box of the verification's perturbation sizes: orientation +-
+        ``TRUNCATE_SIGMA`` sigma (verification truncates its normal there),
+        centroid height and pin position as verified."""
+        return cls(TRUNCATE_SIGMA * perturbation.theta_sigma, perturbation.y_halfwidth, perturbation.pin_halfwidth)
+
+    @classmethod
+    def from_section(cls, section) -> "SpeedPerturbation":
+        """A dict of half-widths (``theta_deg``, ``y_mm``, ``pin_mm``; 0 where one is absent)."""
+        return cls(section.get("theta_deg", 0.0), section.get("y_mm", 0.0), section.get("pin_mm", 0.0))
+
+
+def _layout_number(key: str, value) -> float:
+    """A layout setting as a finite number, or a one-line :class:`PinfeedError`."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise PinfeedError(f"layout setting {key} must be a finite number, got {value!r}")
+    return float(value)
+
+
+LAYOUT_MARGINS = ("station_margin_mm", "pitch_margin_mm", "belt_margin_mm")
+
+
+@dataclass(frozen=True)
+class LayoutSettings:
+    """The feeder's layout (``layout`` section): ``trials`` per resting state
+    (and the box ``corners``), the ``seed``, the station, pitch and belt
+    margins (mm), the belt at ``speed_fraction`` of the plan's speed limit
+    (found with ``speed_trials`` trials per state at belt friction ``mu_s``),
+    the clock's ``time_step_mm`` and the slabs' height ``slab_mm``. Values are
+    kept as given; a negative margin or a bad count or step is a one-line
+    :class:`PinfeedError` when made."""
+
+    trials: int = _default("layout", "trials")
+    corners: bool = _default("layout", "corners")
+    station_margin_mm: float = _default("layout", "station_margin_mm")
+    pitch_margin_mm: float = _default("layout", "pitch_margin_mm")
+    belt_margin_mm: float = _default("layout", "belt_margin_mm")
+    speed_fraction: float = _default("layout", "speed_fraction")
+    speed_trials: int = _default("layout", "speed_trials")
+    mu_s: float = _default("layout", "mu_s")
+    time_step_mm: float = _default("layout", "time_step_mm")
+    slab_mm: float = _default("layout", "slab_mm")
+    seed: int = _default("layout", "seed")
+
+    def __post_init__(self):
+        for key in LAYOUT_MARGINS:
+            if _layout_number(key, getattr(self, key)) < 0:
+                raise PinfeedError(f"layout margin {key} must be a length >= 0 mm, got {getattr(self, key)!r}")
+        for key in ("time_step_mm", "slab_mm"):
+            if _layout_number(key, getattr(self, key)) <= 0:
+                raise PinfeedError(f"layout setting {key} must be > 0 mm, got {getattr(self, key)!r}")
+        if not 0 < _layout_number("speed_fraction", self.speed_fraction) <= 1:
+            raise PinfeedError(f"layout speed_fraction must be in (0, 1], got {self.speed_fraction!r}")
+        for key in ("trials", "speed_trials"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise PinfeedError(f"layout {key} must be a whole number >= 1, got {value!r}")
+
+    @classmethod
+    def from_section(cls, section) -> "LayoutSettings":
+        """The settings of a ``layout`` section with any overrides (whole or
+        partial: the schema's defaults for what it leaves out), checked."""
+        return cls(**dict(dataclasses.asdict(cls()), **(section or {})))
+
+    @property
+    def margins(self) -> dict:
+        """The margins by name (mm), as given."""
+        return {key: getattr(self, key) for key in LAYOUT_MARGINS}
+
+
+DESIGN_KINDS = ("chamfer", "notch", "tab")  # the kinds of outline change design for feeding tries
+
+
+@dataclass(frozen=True)
+class DesignGrid:
+    """The sizes of the outline changes design for feeding tries, as fractions
+    of the part's size ``a``.
+
+    Attributes
+    ----------
+    kinds : which kinds of change to try (of :data:`DESIGN_KINDS`).
+    chamfer : chamfer legs (both the same), fractions of ``a``.
+    notch, tab : ``(width, depth)`` pairs, fractions of ``a``.
+    positions : where a notch or tab is centred along its edge (fractions of its length).
+    """
+
+    kinds: tuple = DESIGN_KINDS
+    chamfer: tuple = (0.05, 0.1, 0.15, 0.2)
+    notch: tuple = ((0.1, 0.05), (0.2, 0.1))
+    tab: tuple = ((0.1, 0.05), (0.2, 0.1))
+    positions: tuple = (0.5,)
+
+
+@dataclass(frozen=True)
+class DesignLimits:
+    """What the user allows: ``keep_edges`` (edges that must not change),
+    ``min_wall_mm`` (material left behind every new edge) and ``max_change``
+    (largest area removed or added, a fraction of the part's area)."""
+
+    keep_edges: tuple = ()
+    min_wall_mm: float = 1.0
+    max_change: float = 0.1
+
+
+@dataclass(frozen=True)
+class DesignSettings:
+    """The design search: the changes tried (:class:`DesignGrid`), the user's
+    :class:`DesignLimits` and the planner's ``depth`` (``None``: the planner's own)."""
+
+    grid: DesignGrid = field(default_factory=DesignGrid)
+    limits: DesignLimits = field(default_factory=DesignLimits)
+    depth: int | None = None
+
+    @classmethod
+    def from_section(cls, design: dict, keep_edges=()) -> "DesignSettings":
+        """The settings of a validated config's ``design`` section, with the edges to keep."""
+        grid = DesignGrid(kinds=tuple(design["kinds"]), chamfer=tuple(design["chamfer"]),
+                          notch=tuple(tuple(p) for p in design["notch"]),
+                          tab=tuple(tuple(p) for p in design["tab"]),
+                          positions=tuple(design["positions"]))
+        limits = DesignLimits(keep_edges=tuple(int(k) for k in keep_edges),
+                              min_wall_mm=float(design["min_wall_mm"]), max_change=float(design["max_change"]))
+        return cls(grid=grid, limits=limits, depth=design.get("depth"))
+
+    def check(self, n_edges: int) -> None:
+        """One-line :class:`PinfeedError` for a setting this outline cannot take."""
+        bad = [k for k in self.limits.keep_edges if not 0 <= k < n_edges]
+        if bad:
+            raise PinfeedError(f"--keep-edges {bad[0]}: the outline has edges 0 to {n_edges - 1}")
+        if not 0 < self.limits.max_change <= 1:
+            raise PinfeedError(f"--max-change must be a fraction in (0, 1], got {self.limits.max_change:g}")
+        if not (math.isfinite(self.limits.min_wall_mm) and self.limits.min_wall_mm >= 0):
+            raise PinfeedError(f"--min-wall must be a length >= 0 mm, got {self.limits.min_wall_mm:g}")
+        unknown = [k for k in self.grid.kinds if k not in DESIGN_KINDS]
+        if unknown or not self.grid.kinds:
+            raise PinfeedError(f"--kinds {','.join(self.grid.kinds)}: choose from {','.join(DESIGN_KINDS)}")
+        if self.depth is not None and self.depth < 1:
+            raise PinfeedError(f"--depth must be at least 1, got {self.depth}")
 
 
 @dataclass(frozen=True)

@@ -35,8 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pipeline.errors import PinfeedError
-
-KINDS = ("chamfer", "notch", "tab")
+from pipeline.planning.core.settings import DESIGN_KINDS as KINDS
+from pipeline.planning.core.settings import DesignGrid
 WALL_SAMPLES = (0.1, 0.3, 0.5, 0.7, 0.9)  # where along a new edge its wall is measured
 
 
@@ -248,25 +248,6 @@ def _ray_hit(origin, direction, start, along) -> float | None:
     if s > 1e-9 and -1e-12 <= u <= 1 + 1e-12:
         return float(s)
     return None
-
-
-@dataclass(frozen=True)
-class DesignGrid:
-    """The sizes of the changes tried, as fractions of the part's size ``a``.
-
-    Attributes
-    ----------
-    kinds : which kinds of change to try (of :data:`KINDS`).
-    chamfer : chamfer legs (both the same), fractions of ``a``.
-    notch, tab : ``(width, depth)`` pairs, fractions of ``a``.
-    positions : where a notch or tab is centred along its edge (fractions of its length).
-    """
-
-    kinds: tuple = KINDS
-    chamfer: tuple = (0.05, 0.1, 0.15, 0.2)
-    notch: tuple = ((0.1, 0.05), (0.2, 0.1))
-    tab: tuple = ((0.1, 0.05), (0.2, 0.1))
-    positions: tuple = (0.5,)
 
 
 def candidate_changes(xy: np.ndarray, a: float, grid: DesignGrid) -> list[OutlineChange]:

@@ -14,67 +14,18 @@ the same verdicts.
 """
 from __future__ import annotations
 
-import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 from pipeline.planning.claims.orient import describe_claim
-from pipeline.planning.core.settings import PlannerSettings
-from pipeline.planning.design.edits import (KINDS, ChangeRefused, DesignGrid, OutlineChange, apply_change,
+from pipeline.planning.core.settings import DesignSettings, PlannerSettings
+from pipeline.planning.design.edits import (KINDS, ChangeRefused, OutlineChange, apply_change,
                                             candidate_changes, ccw_outline, changed_area, edge_lengths)
 from pipeline.planning.plans.plan import plan_tight_all
 from pipeline.progress import reporting
-
-
-@dataclass(frozen=True)
-class DesignLimits:
-    """What the user allows: ``keep_edges`` (edges that must not change),
-    ``min_wall_mm`` (material left behind every new edge) and ``max_change``
-    (largest area removed or added, a fraction of the part's area)."""
-
-    keep_edges: tuple = ()
-    min_wall_mm: float = 1.0
-    max_change: float = 0.1
-
-
-@dataclass(frozen=True)
-class DesignSettings:
-    """The design search: the changes tried (:class:`DesignGrid`), the user's
-    :class:`DesignLimits` and the planner's ``depth`` (``None``: the planner's own)."""
-
-    grid: DesignGrid = field(default_factory=DesignGrid)
-    limits: DesignLimits = field(default_factory=DesignLimits)
-    depth: int | None = None
-
-    @classmethod
-    def from_section(cls, design: dict, keep_edges=()) -> "DesignSettings":
-        """The settings of a validated config's ``design`` section, with the edges to keep."""
-        grid = DesignGrid(kinds=tuple(design["kinds"]), chamfer=tuple(design["chamfer"]),
-                          notch=tuple(tuple(p) for p in design["notch"]),
-                          tab=tuple(tuple(p) for p in design["tab"]),
-                          positions=tuple(design["positions"]))
-        limits = DesignLimits(keep_edges=tuple(int(k) for k in keep_edges),
-                              min_wall_mm=float(design["min_wall_mm"]), max_change=float(design["max_change"]))
-        return cls(grid=grid, limits=limits, depth=design.get("depth"))
-
-    def check(self, n_edges: int) -> None:
-        """One-line :class:`PinfeedError` for a setting this outline cannot take."""
-        bad = [k for k in self.limits.keep_edges if not 0 <= k < n_edges]
-        if bad:
-            raise PinfeedError(f"--keep-edges {bad[0]}: the outline has edges 0 to {n_edges - 1}")
-        if not 0 < self.limits.max_change <= 1:
-            raise PinfeedError(f"--max-change must be a fraction in (0, 1], got {self.limits.max_change:g}")
-        if not (math.isfinite(self.limits.min_wall_mm) and self.limits.min_wall_mm >= 0):
-            raise PinfeedError(f"--min-wall must be a length >= 0 mm, got {self.limits.min_wall_mm:g}")
-        unknown = [k for k in self.grid.kinds if k not in KINDS]
-        if unknown or not self.grid.kinds:
-            raise PinfeedError(f"--kinds {','.join(self.grid.kinds)}: choose from {','.join(KINDS)}")
-        if self.depth is not None and self.depth < 1:
-            raise PinfeedError(f"--depth must be at least 1, got {self.depth}")
 
 
 @dataclass(frozen=True)

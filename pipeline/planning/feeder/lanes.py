@@ -25,8 +25,8 @@ import numpy as np
 from pipeline.maps import simulate
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
-from pipeline.planning.claims.verify import PERTURB_DEFAULTS, corner_inputs, perturbed_batch
-from pipeline.planning.core.settings import nominal_friction
+from pipeline.planning.claims.trials import corner_inputs, perturbed_batch
+from pipeline.planning.core.settings import Perturbation, nominal_friction
 from pipeline.progress import Heartbeat
 
 
@@ -199,7 +199,7 @@ class Trial:
 
 
 def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model: str,
-               belt_speed: float | None = None, mu_s: float = 0.5, perturb: dict | None = None,
+               belt_speed: float | None = None, mu_s: float = 0.5, perturb: Perturbation | None = None,
                trials: int = 20, corners: bool = False, seed: int = 1,
                nominal: bool = False) -> list[Trial]:
     """Replay ``trials`` perturbed parts per initial state past the pins.
@@ -211,8 +211,7 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
     mu_c : a value, or a range ``(lo, hi)`` drawn uniformly.
     model : the quasi-static model (``belt_speed`` None) or ignored: with a
         ``belt_speed`` (mm/s) the dynamic model runs with belt friction ``mu_s``.
-    perturb : ``verify``-style sizes (``theta_sigma``, ``y_halfwidth``,
-        ``mu_sigma``, ``pin_halfwidth``).
+    perturb : the verification's perturbation sizes (``None``: the schema's).
     corners : also replay every corner of the perturbation box.
     nominal : one unperturbed trial per state instead (nominal friction).
 
@@ -223,7 +222,7 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
     How far the trials have got goes to the progress report of
     :func:`pipeline.progress.reporting`, if any.
     """
-    cfg = dict(PERTURB_DEFAULTS, **(perturb or {}))
+    sizes = perturb or Perturbation()
     rng = np.random.default_rng(seed)
     heights = np.asarray(heights, float)
     n_pins = heights.size
@@ -236,9 +235,9 @@ def run_trials(part: Part, heights, states: dict, mu_c, pin_radius: float, model
             th, yc = np.array([theta0], float), np.array([yc0], float)
             mu, offs = np.array([nominal_friction(mu_c)]), np.zeros((1, n_pins))
         else:
-            th, yc, mu, offs = perturbed_batch(theta0, yc0, mu_c, n_pins, cfg, rng, int(trials))
+            th, yc, mu, offs = perturbed_batch(theta0, yc0, mu_c, n_pins, sizes, rng, int(trials))
             if corners:
-                extra = corner_inputs(theta0, yc0, mu_c, n_pins, cfg)
+                extra = corner_inputs(theta0, yc0, mu_c, n_pins, sizes)
                 th, yc, mu = (np.concatenate([x, c]) for x, c in zip((th, yc, mu), extra[:3]))
                 offs = np.concatenate([offs, extra[3]])
         for j in range(th.size):

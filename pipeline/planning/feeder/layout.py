@@ -52,49 +52,9 @@ import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
+from pipeline.planning.core.settings import ClaimSettings, LayoutSettings, VerifySettings
 from pipeline.planning.feeder.lanes import (Lane, Trial, outlines, passage_poses, pin_reach, rotated, run_trials,
                                             trial_lanes)
-
-LAYOUT_DEFAULTS = {
-    "trials": 20,
-    "corners": False,
-    "station_margin_mm": 5.0,
-    "pitch_margin_mm": 5.0,
-    "belt_margin_mm": 5.0,
-    "speed_fraction": 0.8,
-    "speed_trials": 20,
-    "mu_s": 0.5,
-    "time_step_mm": 0.5,
-    "slab_mm": 0.5,
-    "seed": 1,
-}
-MARGIN_KEYS = ("station_margin_mm", "pitch_margin_mm", "belt_margin_mm")
-
-
-def check_layout_settings(settings: dict | None) -> dict:
-    """``settings`` over :data:`LAYOUT_DEFAULTS`, checked: a one-line
-    :class:`PinfeedError` for a negative margin or a bad count or step."""
-    cfg = dict(LAYOUT_DEFAULTS, **(settings or {}))
-
-    def number(key):
-        v = cfg[key]
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise PinfeedError(f"layout setting {key} must be a finite number, got {v!r}")
-        return float(v)
-
-    for key in MARGIN_KEYS:
-        if number(key) < 0:
-            raise PinfeedError(f"layout margin {key} must be a length >= 0 mm, got {cfg[key]!r}")
-    for key in ("time_step_mm", "slab_mm"):
-        if number(key) <= 0:
-            raise PinfeedError(f"layout setting {key} must be > 0 mm, got {cfg[key]!r}")
-    if not 0 < number("speed_fraction") <= 1:
-        raise PinfeedError(f"layout speed_fraction must be in (0, 1], got {cfg['speed_fraction']!r}")
-    for key in ("trials", "speed_trials"):
-        if isinstance(cfg[key], bool) or not isinstance(cfg[key], int) or cfg[key] < 1:
-            raise PinfeedError(f"layout {key} must be a whole number >= 1, got {cfg[key]!r}")
-    return cfg
-
 
 def place_stations(part: Part, trials: list[Trial], pin_radius: float, margin: float):
     """Stations of the pins along the belt (the first at x = 0; see the module notes).
@@ -193,7 +153,8 @@ def touch_free_spacing(part: Part, lanes: list[Lane], clock, slab_mm: float, y_r
 
 def layout_plan(part: Part, labels, heights, states: dict, mu_c, pin_radius: float,
                 model: str = "minpower", belt_speed: float | None = None, mu_s: float = 0.5,
-                settings: dict | None = None, perturb: dict | None = None) -> dict:
+                settings: LayoutSettings | None = None, verify: VerifySettings | None = None,
+                claims: ClaimSettings | None = None) -> dict:
     """Stations, pitch, belt width and throughput of one plan of fixed pins.
 
     Parameters
@@ -206,8 +167,9 @@ def layout_plan(part: Part, labels, heights, states: dict, mu_c, pin_radius: flo
     model : the quasi-static model used when ``belt_speed`` is None.
     belt_speed : mm/s: trials with the dynamic model (and belt friction
         ``mu_s``); None: the quasi-static ``model``, and no throughput.
-    settings : :data:`LAYOUT_DEFAULTS` keys (margins, trials, grid steps).
-    perturb : the verification's perturbation sizes.
+    settings : margins, trials, grid steps (``None``: the schema's ``layout`` section).
+    verify, claims : the trials draw from ``verify``'s perturbation sizes (``None``: the
+        schema's); the method records both (:func:`perturbation_record`).
 
     Returns
     -------
@@ -217,47 +179,56 @@ def layout_plan(part: Part, labels, heights, states: dict, mu_c, pin_radius: flo
     belt speed), ``drawing`` (outlines at entry and exit) and ``method`` (how
     each number was obtained).
     """
-    cfg = check_layout_settings(settings)
+    layout = settings or LayoutSettings()
     if len(labels) != len(heights) or not len(heights):
         raise PinfeedError("give one label per pin height, and at least one pin")
     if not states:
         raise PinfeedError("give at least one initial state")
-    kw = dict(model=model, belt_speed=belt_speed, mu_s=mu_s, perturb=perturb)
-    trials, good, nominal = _layout_trials(part, heights, states, mu_c, pin_radius, cfg, kw)
-    margin = cfg["station_margin_mm"]
+    kw = dict(model=model, belt_speed=belt_speed, mu_s=mu_s, perturb=None if verify is None else verify.perturbation)
+    trials, good, nominal = _layout_trials(part, heights, states, mu_c, pin_radius, layout, kw)
+    margin = layout.station_margin_mm
     stations, bounds = place_stations(part, good, pin_radius, margin)
     entry = _entry_distance(part, good + nominal, pin_radius, margin)
     lanes = trial_lanes(part, good, stations, pin_radius, entry)
     nominal_lanes = trial_lanes(part, nominal, stations, pin_radius, entry)
-    spacing, y_min, y_max, busy, pitch = _pitch(part, good, lanes, len(heights), entry, cfg)
-    belt_top = y_max + cfg["belt_margin_mm"]
-    belt_bottom = min(0.0, y_min - cfg["belt_margin_mm"]) if y_min < 0 else 0.0
+    spacing, y_min, y_max, busy, pitch = _pitch(part, good, lanes, len(heights), entry, layout)
+    belt_top = y_max + layout.belt_margin_mm
+    belt_bottom = min(0.0, y_min - layout.belt_margin_mm) if y_min < 0 else 0.0
     fence_end = _fence_end(part, lanes, pin_radius)
     throughput = 60.0 * belt_speed / pitch if belt_speed else None
     drawing = entry_exit_outlines(part, states, nominal_lanes, stations, pitch, entry, pin_radius, margin)
     dynamic = belt_speed is not None
     return {
-        "part": part.name, "part_id": part.id,
-        "pins": list(labels),
+        "part": part.name, "part_id": part.id, "pins": list(labels),
         "stations": [{"label": str(lbl), "x_mm": float(x), "y_mm": float(h), "radius_mm": float(pin_radius)}
                      for lbl, x, h in zip(labels, stations, heights)],
         "fence_y_mm": 0.0, "fence_end_x_mm": float(fence_end),
         "belt_width_mm": float(belt_top - belt_bottom), "belt_y_mm": [float(belt_bottom), float(belt_top)],
-        "pitch_mm": float(pitch),
-        "belt_speed_mm_s": None if belt_speed is None else float(belt_speed),
+        "pitch_mm": float(pitch), "belt_speed_mm_s": None if belt_speed is None else float(belt_speed),
         "mu_s": float(mu_s) if dynamic else None,
-        "throughput_per_min": throughput,
-        "drawing": drawing,
-        "method": _layout_method(cfg, "dynamic" if dynamic else model, trials, good, perturb, bounds,
-                                 spacing, busy, y_min, y_max, dynamic),
+        "throughput_per_min": throughput, "drawing": drawing,
+        "method": _layout_method(layout, "dynamic" if dynamic else model, trials, good,
+                                 perturbation_record(verify, claims), bounds, spacing, busy, y_min, y_max, dynamic),
     }
 
 
-def _layout_trials(part, heights, states, mu_c, pin_radius, cfg, kw):
+def perturbation_record(verify: VerifySettings | None, claims: ClaimSettings | None) -> dict:
+    """The verification's settings as a layout's method records them: the
+    trials' settings (:meth:`~pipeline.planning.core.settings.VerifySettings.as_dict`),
+    then the claim's ``required`` share, ``confidence`` and ``rule``; ``{}``
+    without ``verify``."""
+    if verify is None:
+        return {}
+    claim = {} if claims is None else {"required": claims.required, "confidence": claims.confidence,
+                                       "rule": claims.rule}
+    return {**verify.as_dict(), **claim}
+
+
+def _layout_trials(part, heights, states, mu_c, pin_radius, layout: LayoutSettings, kw):
     """``(trials, good, nominal)``: the perturbed trials, those that did not
     jam (none left raises :class:`PinfeedError`) and the nominal replays."""
-    trials = run_trials(part, heights, states, mu_c, pin_radius, trials=cfg["trials"],
-                        corners=cfg["corners"], seed=cfg["seed"], **kw)
+    trials = run_trials(part, heights, states, mu_c, pin_radius, trials=layout.trials,
+                        corners=layout.corners, seed=layout.seed, **kw)
     good = [t for t in trials if not t.jam]
     if not good:
         raise PinfeedError(f"every layout trial jammed ({trials[0].jam}); this plan cannot be laid out")
@@ -273,40 +244,40 @@ def _entry_distance(part, trials, pin_radius, margin) -> float:
     return max([r for r in first_touch if math.isfinite(r)] + [part.a + pin_radius]) + margin
 
 
-def _pitch(part, good, lanes, n_pins, entry, cfg):
+def _pitch(part, good, lanes, n_pins, entry, layout: LayoutSettings):
     """``(spacing, y_min, y_max, busy, pitch)`` in mm: the touch-free spacing of
     two consecutive parts, the swept y range, each pin's contact span and the
     pitch (the larger of spacing and busy span on the time grid, plus margin)."""
-    step = cfg["time_step_mm"]
+    step = layout.time_step_mm
     course = max(float(lane.B[-1]) for lane in lanes) + entry + 4.0 * part.a
     clock = step * np.arange(-int(math.ceil(course / step)), int(math.ceil(2 * course / step)) + 1)
     y_lanes = np.concatenate([lane.y for lane in lanes])
     spacing, y_min, y_max = touch_free_spacing(
-        part, lanes, clock, cfg["slab_mm"],
+        part, lanes, clock, layout.slab_mm,
         (float(y_lanes.min()) - part.a, float(y_lanes.max()) + part.a))
     starts, ends = contact_windows(good, lanes, n_pins)
     busy = [max(e) - min(s) if s else 0.0 for s, e in zip(starts, ends)]
     pin_spacing = step * (math.floor(max(busy) / step) + 1)
-    pitch = max(spacing, pin_spacing) + cfg["pitch_margin_mm"]
+    pitch = max(spacing, pin_spacing) + layout.pitch_margin_mm
     return spacing, y_min, y_max, busy, pitch
 
 
-def _layout_method(cfg, model, trials, good, perturb, bounds, spacing, busy, y_min, y_max,
-                   dynamic) -> dict:
+def _layout_method(layout: LayoutSettings, model, trials, good, perturbation: dict, bounds, spacing, busy,
+                   y_min, y_max, dynamic) -> dict:
     """The ``method`` entry of a layout: how each number was obtained."""
     return {
         "model": model,
-        "trials": {"per_state": int(cfg["trials"]), "corners": bool(cfg["corners"]),
+        "trials": {"per_state": int(layout.trials), "corners": bool(layout.corners),
                    "replayed": len(trials), "jammed_left_out": len(trials) - len(good),
-                   "jams": sorted({t.jam for t in trials if t.jam}), "seed": int(cfg["seed"]),
-                   "perturbation": perturb or {}},
-        "margins_mm": {k: float(cfg[k]) for k in MARGIN_KEYS},
+                   "jams": sorted({t.jam for t in trials if t.jam}), "seed": int(layout.seed),
+                   "perturbation": perturbation},
+        "margins_mm": {k: float(v) for k, v in layout.margins.items()},
         "stations": "first pin at x = 0; each next pin where its disc misses every pose of "
                     "every trial from first touch at any earlier pin until the part rests, "
                     "plus the station margin",
         "station_bounds": bounds,
         "pitch": {"touch_free_spacing_mm": spacing, "pin_busy_mm": [float(b) for b in busy],
-                  "time_step_mm": cfg["time_step_mm"], "slab_mm": cfg["slab_mm"],
+                  "time_step_mm": layout.time_step_mm, "slab_mm": layout.slab_mm,
                   "rule": "max(touch-free spacing of two consecutive parts over every pair "
                           "of trials, the longest span of any pin's contacts) + pitch margin"},
         "belt_width": "fence y = 0 (or the lowest swept point minus the margin) to the "

@@ -11,19 +11,18 @@ from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import format_arcs
-from pipeline.planning.core.settings import PlannerSettings, friction_label
+from pipeline.planning.core.settings import LayoutSettings, PlannerSettings, SpeedPerturbation, friction_label
 from pipeline.planning.core.types import as_plan_file
 from pipeline.planning.family.certificate import family_assumption
-from pipeline.planning.feeder.layout import check_layout_settings, layout_plan
+from pipeline.planning.feeder.layout import layout_plan
 from pipeline.planning.plans.stored_plan import pick_tight_plan
-from pipeline.planning.plans.speed_limit import (DEFAULT_SPEEDS, perturbation_from_verify, speed_curve,
-                                                 stored_speed_limit)
+from pipeline.planning.plans.speed_limit import DEFAULT_SPEEDS, speed_curve, stored_speed_limit
 from pipeline.provenance import provenance_attrs
 
 
 def layout_stored(result, planner: PlannerSettings, plan_number: int = 1, mu_text=None,
                   belt_speed: float | None = None, mu_s: float | None = None,
-                  quasi_static: bool = False, settings: dict | None = None) -> dict:
+                  quasi_static: bool = False, settings: LayoutSettings | None = None) -> dict:
     """The layout of tight plan ``plan_number`` of a stored plan result
     (``RESULTS/plans/NAME.json``; a :class:`~pipeline.planning.core.types.PlanFile`
     or its dict), as ``pinfeed layout`` and the workflow make it.
@@ -40,26 +39,27 @@ def layout_stored(result, planner: PlannerSettings, plan_number: int = 1, mu_tex
     throughput, and ``warnings`` says so).
 
     ``planner``: the planner's settings (pin radius, the verification's
-    perturbation sizes); ``settings``: the config's ``layout`` section with
-    any overrides (:data:`LAYOUT_DEFAULTS` keys).
+    perturbation sizes and claim); ``settings``: the layout's
+    (``LayoutSettings.from_section`` of the config's ``layout`` section with
+    any overrides; ``None``: the schema's).
     """
-    cfg = check_layout_settings(settings)
+    layout = settings or LayoutSettings()
     result = as_plan_file(result)
     plan, mu_c, states = _fixed_pin_plan(result, plan_number, mu_text)
     part = Part.from_dict(result.part, name=result.name)
     pin_radius = float(result.extra.get("pin_radius", planner.search.pin_radius))
-    mu_s = float(cfg["mu_s"] if mu_s is None else mu_s)
+    mu_s = float(layout.mu_s if mu_s is None else mu_s)
     heights = [float(h) for h in plan.pin_heights_mm]
     # A bad belt speed or mu_s is refused before any work.
     simulate.check_belt(part, min(DEFAULT_SPEEDS) if belt_speed is None else belt_speed, mu_s)
     curve, trials, stored = _speed_limit(plan, part, list(states.values()), mu_c, mu_s, pin_radius,
-                                         planner, cfg)
+                                         planner, layout)
     limit = curve["speed_limit_mm_s"]
-    belt_speed, source, quasi_static, warnings = _belt_speed_choice(belt_speed, limit, cfg,
+    belt_speed, source, quasi_static, warnings = _belt_speed_choice(belt_speed, limit, layout,
                                                                     quasi_static)
     out = layout_plan(part, list(plan.pins), heights, states, mu_c, pin_radius, model=result.model,
-                      belt_speed=None if quasi_static else belt_speed, mu_s=mu_s, settings=cfg,
-                      perturb=_verify_section(planner))
+                      belt_speed=None if quasi_static else belt_speed, mu_s=mu_s, settings=layout,
+                      verify=planner.verify, claims=planner.claims)
     out["belt_speed_mm_s"] = None if belt_speed is None else float(belt_speed)
     out["mu_s"] = mu_s
     out["throughput_per_min"] = None if belt_speed is None else 60.0 * belt_speed / out["pitch_mm"]
@@ -103,16 +103,7 @@ def _record_speed_limit(out: dict, curve: dict, trials: int, stored: dict | None
         "curve": curve["curve"]}
 
 
-def _verify_section(planner: PlannerSettings) -> dict:
-    """The verification's settings as the config's ``verify`` section gives them
-    (the trials' sizes and the claim's share, confidence and rule): the
-    perturbation the layout's trials draw, recorded whole in its ``method``."""
-    claims = planner.claims
-    return dict(planner.verify.as_dict(), required=claims.required, confidence=claims.confidence,
-                rule=claims.rule)
-
-
-def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, planner, cfg) -> tuple:
+def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, planner, layout: LayoutSettings) -> tuple:
     """``(curve, trials, stored)``: the speed limit stored with ``plan`` when it was
     computed at belt friction ``mu_s`` (one speed limit per plan), else one computed
     here with ``speed_trials`` trials per state; ``stored``: the plan's record or None."""
@@ -121,9 +112,9 @@ def _speed_limit(plan, part, states, mu_c, mu_s, pin_radius, planner, cfg) -> tu
         return stored, stored["trials"], stored
     heights = [float(h) for h in plan.pin_heights_mm]
     curve = speed_curve(part, heights, [0.0] * len(heights), states, plan.final_arcs, mu_c, mu_s=mu_s,
-                        perturb=perturbation_from_verify(planner.verify.perturbation),
-                        trials=cfg["speed_trials"], r_pin=pin_radius, seed=cfg["seed"])
-    return curve, cfg["speed_trials"], stored
+                        perturb=SpeedPerturbation.from_verify(planner.verify.perturbation),
+                        trials=layout.speed_trials, r_pin=pin_radius, seed=layout.seed)
+    return curve, layout.speed_trials, stored
 
 
 def _fixed_pin_plan(result, plan_number, mu_text):
@@ -144,7 +135,7 @@ def _fixed_pin_plan(result, plan_number, mu_text):
     return plan, mu_c, {k: (float(s.theta), float(s.y_c)) for k, s in stored_states.items()}
 
 
-def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
+def _belt_speed_choice(belt_speed, limit, layout: LayoutSettings, quasi_static):
     """``(belt_speed, source, quasi_static, warnings)`` of a stored plan's layout.
 
     Without ``belt_speed`` (mm/s): ``speed_fraction`` of the speed ``limit``
@@ -153,8 +144,8 @@ def _belt_speed_choice(belt_speed, limit, cfg, quasi_static):
     """
     warnings = []
     if belt_speed is None and limit > 0:
-        belt_speed = cfg["speed_fraction"] * limit
-        source = f"{100 * cfg['speed_fraction']:g} % of the plan's speed limit {limit:g} mm/s"
+        belt_speed = layout.speed_fraction * limit
+        source = f"{100 * layout.speed_fraction:g} % of the plan's speed limit {limit:g} mm/s"
     elif belt_speed is None:
         source = "none"
         quasi_static = True

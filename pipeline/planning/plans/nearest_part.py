@@ -7,7 +7,7 @@ fits the tolerance, the engineer asks what would. For one part the axes are:
   ladder, up to ``MAX_TOLERANCE``) at which one of the plans the search
   kept (the recommended one and the other verified candidates) orients the
   part on *held-out* trials: trials from a seed no search or selection drew
-  from (``verify.holdout_settings``). For each plan the answer is the
+  from (``VerifySettings.held_out``). For each plan the answer is the
   narrowest arc that holds the claim's count of those trials (the rule's
   ``max_failures`` left out), rounded up to the ladder, and the verdict at
   that tolerance is the claim's own judgement of the same finals. When no

@@ -3,7 +3,7 @@
 This is what ``pinfeed plan`` and the workflow's plan stage call: it runs the
 search (``search.TightPlanner``), replays the best candidates by full
 rollouts on held-out trials (``verify.verify_plan`` with
-``verify.holdout_settings``: perturbed trials from a seed no screen or
+``VerifySettings.held_out``: perturbed trials from a seed no screen or
 selection drew from, at least as many per initial state as the
 verification's, plus every corner of the perturbation box), re-ranks them
 with that verdict and recommends the best plan that fails at most
@@ -50,7 +50,8 @@ from pipeline.planning.tight.store import load_lattice, save_lattice
 from pipeline.planning.claims.orient import describe_claim, judge_verification
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import TRUNCATE_SIGMA, PlannerSettings
-from pipeline.planning.claims.verify import ReplayMemo, holdout_settings, verify_plan
+from pipeline.planning.claims.replay import ReplayMemo
+from pipeline.planning.claims.verify import verify_plan
 from pipeline.planning.claims.tails import describe_untruncated, untruncated_check
 from pipeline.planning.claims.plan_claim import held_out_claim, perturbations, trials_drawn, with_untruncated
 from pipeline.progress import NO_DEADLINE, Deadline, Heartbeat
@@ -166,13 +167,13 @@ def _acceptable(plan) -> bool:
 def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidates, states, progress,
                        family=None, selections=None) -> None:
     """Replay each candidate by perturbed full rollouts on the held-out trials
-    (``verify_plan`` with ``holdout_settings``) and attach the summary as
+    (``verify_plan`` with ``VerifySettings.held_out``) and attach the summary as
     ``plan.verification``, with the orientation verdict (``orient.judge``: one
     set within the tolerance, with confidence?) as ``orientation`` and the
     verdict on the trials that chose it (``selections``, in order) as
     ``selection``. The candidates' replays share the states after their
     common first pins (``verify.ReplayMemo``: same numbers, fewer rollouts)."""
-    verify_cfg = holdout_settings(settings.verify)
+    held_out = settings.verify.held_out()
     memo = ReplayMemo()
     claims, search = settings.claims, settings.search
     selections = list(selections or []) + [None] * len(candidates)
@@ -180,13 +181,13 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
     beat = Heartbeat("verifying the chosen plans on held-out trials", len(candidates), "plan", progress).start()
     for k, (plan, selection) in enumerate(zip(candidates, selections)):
         res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, settings.friction.value,
-                          search.pin_radius, search.model, verify_cfg, speeds=speeds,
-                          kernel=search.kernel_settings, belt_speed=planner.belt_speed,
+                          search.pin_radius, search.model, held_out, speeds=speeds,
+                          kernel=search.kernel_step, belt_speed=planner.belt_speed,
                           mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1), memo=memo)
         verdict = judge_verification(res, claims.tolerance_deg, planner.order, claims.required,
                                      claims.confidence, claims.rule)
-        plan.claim = _held_out_claim(settings, res, verdict, planner.order, verify_cfg["seed"])
-        plan.verification = {"held_out": True, "seed": verify_cfg["seed"],
+        plan.claim = _held_out_claim(settings, res, verdict, planner.order, held_out.seed)
+        plan.verification = {"held_out": True, "seed": held_out.seed,
                              "trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
                              **({"belt_speed": res["belt_speed"], "mu_s": res["mu_s"]}
@@ -224,7 +225,7 @@ def _check_tails(part: Part, settings: PlannerSettings, planner, plan, states, p
     record = untruncated_check(part, plan.to_dict(), planner_pin_heights(planner), states,
                                settings.friction.value, search.pin_radius, search.model, settings.verify,
                                per_state, settings.claims, planner.order, speeds=speeds,
-                               kernel=search.kernel_settings, belt_speed=planner.belt_speed,
+                               kernel=search.kernel_step, belt_speed=planner.belt_speed,
                                mu_s=planner.mu_s, family=family)
     plan.verification["untruncated"] = record
     plan.claim = with_untruncated(plan.claim, record)
@@ -325,7 +326,7 @@ def plan_tight_all(part: Part, settings: PlannerSettings, catalog_root, keep: in
     belt_speed, mu_s = planner_belt(search, part)
     speeds = [0.0, *search.dynamic_speeds]
     lattices = {v: load_lattice(catalog_root, part, search.model, v, search.pin_radius,
-                                search.kernel_settings or None, belt_speed=belt_speed, mu_s=mu_s)
+                                search.kernel_step, belt_speed=belt_speed, mu_s=mu_s)
                 for v in speeds}
     out = []
     try:

@@ -38,7 +38,7 @@ def planner_for(part: Part, settings: PlannerSettings, lattices=None, moving: bo
     moving_pins = {f"{k}v{v:+g}": (y, v) for k, y in static.items() for v in speeds}
     return TightPlanner(part, static, search.d_min, search.d_max, settings.friction.value,
                         search.pin_radius, search.model, Uncertainty.from_verify(settings.verify),
-                        Tolerances(), moving=moving_pins, lattices=lattices, kernel=search.kernel_settings or None,
+                        Tolerances(), moving=moving_pins, lattices=lattices, kernel=search.kernel_step,
                         max_branches=search.max_branches, hard_limits=search.hard_d_limits,
                         belt_speed=belt_speed, mu_s=mu_s)
 

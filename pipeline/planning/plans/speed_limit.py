@@ -25,18 +25,10 @@ from pipeline.errors import PinfeedError
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import in_arc
-from pipeline.planning.core.settings import TRUNCATE_SIGMA, Perturbation, PlannerSettings, SpeedSettings
+from pipeline.planning.core.settings import PlannerSettings, SpeedPerturbation, SpeedSettings
 from pipeline.progress import SILENT, Heartbeat, Stretch, prefixed
 
 DEFAULT_SPEEDS = SpeedSettings().speeds  # the schema's speed grid, mm/s
-
-
-def perturbation_from_verify(perturbation: Perturbation) -> dict:
-    """The uniform half-widths of :func:`speed_curve` from the verification's
-    perturbation sizes: orientation +- ``TRUNCATE_SIGMA`` sigma (verification
-    truncates its normal there), centroid height and pin position as verified."""
-    return {"theta_deg": TRUNCATE_SIGMA * perturbation.theta_sigma, "y_mm": perturbation.y_halfwidth,
-            "pin_mm": perturbation.pin_halfwidth}
 
 
 def _in_arcs(theta_deg, arcs) -> np.ndarray:
@@ -49,19 +41,19 @@ def _in_arcs(theta_deg, arcs) -> np.ndarray:
     return inside
 
 
-def _draws(part, pin_heights, states, mu_c, perturb, trials, seed):
+def _draws(part, pin_heights, states, mu_c, perturb: SpeedPerturbation, trials, seed):
     rng = np.random.default_rng(seed)
     lo, hi = (mu_c, mu_c) if np.isscalar(mu_c) else (float(mu_c[0]), float(mu_c[1]))
     out = []
     for theta, y_c in states:
         n = int(trials)
-        th = theta + rng.uniform(-1, 1, n) * perturb.get("theta_deg", 0.0)
-        yc = y_c + rng.uniform(-1, 1, n) * perturb.get("y_mm", 0.0)
+        th = theta + rng.uniform(-1, 1, n) * perturb.theta_deg
+        yc = y_c + rng.uniform(-1, 1, n) * perturb.y_mm
         mu = rng.uniform(lo, hi, n)
         pins = np.asarray(pin_heights, float)[None, :] + \
-            rng.uniform(-1, 1, (n, len(pin_heights))) * perturb.get("pin_mm", 0.0)
+            rng.uniform(-1, 1, (n, len(pin_heights))) * perturb.pin_mm
         # The corners of the perturbation box of the initial state.
-        corners = [(theta + sa * perturb.get("theta_deg", 0.0), y_c + sb * perturb.get("y_mm", 0.0))
+        corners = [(theta + sa * perturb.theta_deg, y_c + sb * perturb.y_mm)
                    for sa in (-1, 1) for sb in (-1, 1)]
         th = np.concatenate([th, [c[0] for c in corners]])
         yc = np.concatenate([yc, [c[1] for c in corners]])
@@ -108,8 +100,8 @@ def success_fraction(part: Part, pin_heights, pin_speed_ratios, draws, final_arc
 
 
 def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final_arcs, mu_c,
-                mu_s=0.5, perturb=None, trials=300, speeds=DEFAULT_SPEEDS, resolution=5.0,
-                required=0.99, r_pin=1.0, seed=0, progress=None):
+                mu_s=0.5, perturb: SpeedPerturbation | None = None, trials=300, speeds=DEFAULT_SPEEDS,
+                resolution=5.0, required=0.99, r_pin=1.0, seed=0, progress=None):
     """Success fraction against belt speed and the plan's speed limit.
 
     Parameters
@@ -121,8 +113,8 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
     final_arcs : the plan's final set as ``(start_deg, width_deg)`` arcs.
     mu_c : contact friction, a number or a ``(lo, hi)`` range drawn uniformly.
     mu_s : belt friction.
-    perturb : half-widths of the uniform perturbations,
-        ``{"theta_deg": .., "y_mm": .., "pin_mm": ..}``.
+    perturb : half-widths of the uniform perturbations (a
+        :class:`~pipeline.planning.core.settings.SpeedPerturbation`; ``None``: its defaults).
     trials : random trials per initial state (plus its four corners).
     speeds : coarse grid of belt speeds, mm/s (capped where the pin would
         throw the part, see ``checks.FROUDE_MAX``).
@@ -140,7 +132,7 @@ def speed_curve(part: Part, pin_heights, pin_speed_ratios, initial_states, final
         raise PinfeedError("give one speed ratio per pin")
     if not initial_states or not final_arcs:
         raise PinfeedError("give at least one initial state and one final arc")
-    perturb = dict(perturb or {"theta_deg": 1.0, "y_mm": 0.5, "pin_mm": 0.2})
+    perturb = perturb or SpeedPerturbation()
     v_thrown = math.sqrt(FROUDE_MAX * mu_s * G_MM_S2 * part.a)
     grid = sorted(v for v in speeds if 0 < v <= v_thrown)
     if not grid:
@@ -195,13 +187,13 @@ def _speed_limit(frac, grid, required, resolution) -> float:
 
 
 def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=None,
-                      mu_s: float = SpeedSettings.mu_s, trials: int = 300, speeds=DEFAULT_SPEEDS,
-                      resolution: float = SpeedSettings.resolution, required: float = SpeedSettings.required,
-                      seed: int = SpeedSettings.seed, progress=None) -> dict:
+                      speed: SpeedSettings | None = None, progress=None) -> dict:
     """The speed curve and speed limit of a stored tight plan (a plan file's
     ``tight`` entry, see :func:`pick_tight_plan`; ``result`` a
     :class:`~pipeline.planning.core.types.PlanFile` or its dict), with the
-    verification's perturbation sizes and the pin radius of ``settings``.
+    verification's perturbation sizes and the pin radius of ``settings`` and
+    the speed settings ``speed`` (``None``: ``settings.speed``: belt friction,
+    trials per state, speed grid, bisection resolution, required share, seed).
 
     Returns the JSON of ``pinfeed speed`` and the workflow's speed stage:
     ``part``, ``pin_labels``, ``pin_heights_mm``, ``pin_speeds``,
@@ -215,20 +207,22 @@ def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=
     from pipeline.planning.plans.stored_plan import pick_tight_plan
     from pipeline.planning.core.settings import friction_label
     from pipeline.planning.core.types import as_plan_file
+    speed = speed or settings.speed
+    mu_s, trials, required, resolution = speed.mu_s, speed.trials, speed.required, speed.resolution
     if not (isinstance(trials, int) and trials >= 1):
         raise PinfeedError(f"trials must be a whole number >= 1, got {trials!r}")
     result = as_plan_file(result)
     chosen, mu_c, entry = pick_tight_plan(result, plan, mu_text)
     part = Part.from_dict(result.part, name=result.name)
-    perturb = perturbation_from_verify(settings.verify.perturbation)
+    perturb = SpeedPerturbation.from_verify(settings.verify.perturbation)
     # A tight-only plan file keeps the resting states per friction entry.
     stored_states = entry.initial_states or result.initial_states or {}
     states = [(s.theta, s.y_c) for s in stored_states.values()]
     arcs = chosen.final_arcs
     res = speed_curve(part, chosen.pin_heights_mm, chosen.pin_speeds, states, arcs, mu_c,
-                      mu_s=mu_s, perturb=perturb, trials=trials, speeds=speeds,
+                      mu_s=mu_s, perturb=perturb, trials=trials, speeds=speed.speeds,
                       resolution=resolution, required=required,
-                      r_pin=settings.search.pin_radius, seed=seed, progress=progress)
+                      r_pin=settings.search.pin_radius, seed=speed.seed, progress=progress)
     return {"part": part.name, "pin_labels": list(chosen.pins),
             "pin_heights_mm": list(chosen.pin_heights_mm),
             "pin_speeds": list(chosen.pin_speeds),
@@ -271,17 +265,17 @@ def attach_speed_limits(result: dict, settings: PlannerSettings) -> dict:
     tight = result.get("tight") or []
     if not tight or not tight[0]["plans"]:
         return result
-    entry, speed = tight[0], settings.speed.as_kwargs()
+    entry = tight[0]
     plans = entry["plans"]
     fixed = [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.get("pin_speeds") or ())]
     for number in sorted({1, *fixed[:1]}):
         try:
-            record = stored_plan_speed(result, settings, plan=number, **speed,
+            record = stored_plan_speed(result, settings, plan=number,
                                        progress=prefixed(f"mu_c {entry['friction']}: plan {number}"))
         except PinfeedError:
             continue
         record.pop("seconds", None)  # a timing would make the same plan differ between runs
-        plans[number - 1]["speed_limit"] = dict(record, settings=speed)
+        plans[number - 1]["speed_limit"] = dict(record, settings=settings.speed.to_json())
     if entry.get("recommended") is not None and "speed_limit" in plans[0]:
         entry["recommended"]["speed_limit"] = plans[0]["speed_limit"]
     return result

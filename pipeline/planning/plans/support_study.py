@@ -55,7 +55,7 @@ def verify_under_family(part: Part, settings: PlannerSettings, plan: dict, famil
                    progress) as beat:
         res = verify_plan(part, plan, pins, states, settings.friction.value, settings.search.pin_radius,
                           settings.search.model, settings.verify,
-                          speeds={k: v for k, v in speeds.items() if v}, kernel=settings.search.kernel_settings,
+                          speeds={k: v for k, v in speeds.items() if v}, kernel=settings.search.kernel_step,
                           family=family, stretch=beat.stretch(0, len(states)))
     verdict = judge_verification(res, settings.claims.tolerance_deg, part.symmetry_order(),
                                  settings.claims.required)

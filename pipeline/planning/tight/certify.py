@@ -13,6 +13,8 @@ seed, is what then checks it.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from pipeline.parts.contact import contact_parameter
@@ -21,7 +23,8 @@ from pipeline.planning.claims.orient import narrowest_arc
 from pipeline.planning.tight.propagate import friction_interval, snapped_state
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.tight.search import Step, TightPlan, TightPlanner
-from pipeline.planning.claims.verify import replay, trial_inputs, verify_dict
+from pipeline.planning.claims.replay import replay
+from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.settings import VerifySettings
 
 CLUSTER_GAP_DEG = 3.0  # sampled final orientations further apart than this are separate sets
@@ -49,10 +52,9 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: VerifySet
     whose final orientations form one cluster (gaps of more than
     ``CLUSTER_GAP_DEG`` split clusters) are one branch, and each step of a
     branch carries the hull of its trials after that pin. ``memo`` (a
-    ``verify.ReplayMemo`` shared by the plans of one planner): plans that
+    ``replay.ReplayMemo`` shared by the plans of one planner): plans that
     share their first pins share those rollouts (the same numbers)."""
-    cfg = verify_dict(verify)
-    cfg["seed"] = int(cfg["seed"]) + 1
+    sampling = dataclasses.replace(verify, seed=int(verify.seed) + 1)
     part, unc = planner.part, planner.unc
     pins = [planner.pins[p] for p in labels]
     starts = planner.initial_states()
@@ -60,7 +62,8 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: VerifySet
     mu_lo, mu_hi = friction_interval(planner.mu_c, unc)
     branches, finals = {}, []
     supports = None if family is None else family.kernel_supports
-    for label, (th, yc, mu, offs, sup) in zip(starts, trial_inputs(resting, planner.mu_c, len(pins), cfg, family)):
+    inputs = trial_inputs(resting, planner.mu_c, len(pins), sampling, family)
+    for label, (th, yc, mu, offs, sup) in zip(starts, inputs):
         path = []
         replay(part, [p.y for p in pins], [p.v_pin for p in pins], th, yc, mu, offs,
                planner.pin_radius, planner.model, path=path, belt_speed=planner.belt_speed,

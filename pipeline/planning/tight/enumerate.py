@@ -58,7 +58,7 @@ import numpy as np
 from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from pipeline.parts.part import Part
-from pipeline.planning.claims.verify import rollouts_by_speed
+from pipeline.planning.claims.replay import rollouts_by_speed
 from pipeline.progress import BATCH_SECONDS, NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
 
 QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout

@@ -8,7 +8,7 @@ trials say.
 :class:`TrialBench` holds everything a judgement needs besides the pins
 themselves: the part and its resting states, the rollout settings (pin
 radius, model, kernel, belt, support family), the verification's trials
-(``verify.trial_inputs``; its held-out trials, ``verify.holdout_settings``)
+(``trials.trial_inputs``; its held-out trials, ``VerifySettings.held_out``)
 and the claim (tolerance, required share, confidence, rule). It replays
 sequences given as arrays of pin heights and speeds (one row per sequence)
 on rows of trials, counts the trials no one arc of the tolerance can hold
@@ -29,7 +29,8 @@ from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAMMED, TRUNCATED
 
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
-from pipeline.planning.claims.verify import holdout_settings, kernel_kw, pin_step, trial_inputs
+from pipeline.planning.claims.replay import kernel_kw, pin_step
+from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
 from pipeline.progress import SILENT, Heartbeat, Stretch
@@ -67,26 +68,41 @@ class TrialBench:
     def __init__(self, part: Part, friction: Friction, claims: ClaimSettings, verify: VerifySettings,
                  search: SearchSettings, family=None):
         self.part, self.mu_c, self.model = part, friction.value, search.model
-        belt_speed, mu_s = search.belt_speed, search.mu_s
-        self.belt = {} if belt_speed is None else {"belt_speed": float(belt_speed), "mu_s": float(mu_s)}
+        self.belt_speed = None if search.belt_speed is None else float(search.belt_speed)
+        self.mu_s = 0.5 if search.belt_speed is None else float(search.mu_s)
         self.tolerance, self.required = claims.tolerance_deg, claims.required
         self.confidence, self.rule = claims.confidence, claims.rule
-        self.cfg = verify.as_dict()
-        self.holdout = holdout_settings(self.cfg)
+        self.verify, self.holdout = verify, verify.held_out()
         self.pin_radius = float(search.pin_radius)
-        self.kernel = {"ds_max": DEFAULT_DS_MAX, "tol": DEFAULT_TOL, **search.kernel_settings}
+        self.step = search.kernel_step.with_defaults(DEFAULT_DS_MAX, DEFAULT_TOL)
         self.order = part.symmetry_order()
         self.states = resting_states(part)
         self.family = None if family is None or family.is_uniform else family
         self.supports = None if self.family is None else self.family.kernel_supports
         self.kept = PrefixStates()
 
+    # The bench as dicts, for tight/complete.py until it reads the typed settings above.
+    @property
+    def cfg(self) -> dict:
+        """The verification's trials as a flat dict (:meth:`VerifySettings.as_dict`); read ``verify``."""
+        return self.verify.as_dict()
+
+    @property
+    def kernel(self) -> dict:
+        """The kernel's step as rollout keywords; read ``step``."""
+        return self.step.as_kwargs()
+
+    @property
+    def belt(self) -> dict:
+        """``{"belt_speed", "mu_s"}`` of the dynamic model, ``{}`` quasi-static; read ``belt_speed``, ``mu_s``."""
+        return {} if self.belt_speed is None else {"belt_speed": self.belt_speed, "mu_s": self.mu_s}
+
     def trials(self, n_pins: int) -> list:
-        """The verification's trials for plans of ``n_pins`` pins (``verify.trial_inputs``), per state."""
-        return trial_inputs(self.states, self.mu_c, n_pins, self.cfg, self.family)
+        """The verification's trials for plans of ``n_pins`` pins (``trials.trial_inputs``), per state."""
+        return trial_inputs(self.states, self.mu_c, n_pins, self.verify, self.family)
 
     def held_out(self, n_pins: int) -> tuple:
-        """The held-out trials for plans of ``n_pins`` pins, as rows (``verify.holdout_settings``)."""
+        """The held-out trials for plans of ``n_pins`` pins, as rows (``VerifySettings.held_out``)."""
         return stack(trial_inputs(self.states, self.mu_c, n_pins, self.holdout, self.family))
 
     def allowed_failures(self, n_trials: int) -> int:
@@ -98,7 +114,7 @@ class TrialBench:
         """A subset of the trials ``inputs`` (per state), as rows: the first
         ``n_first`` random trials and ``n_corners_wanted`` evenly spread corners
         of each state."""
-        n_random = int(self.cfg["trials"])
+        n_random = int(self.verify.trials)
         rows = []
         for trials in inputs:
             n_corners = trials[0].size - n_random
@@ -112,7 +128,7 @@ class TrialBench:
     def replay(self, heights, speeds, rows, stretch: Stretch = SILENT):
         """Final orientations ``(sequences, trials)`` and jam flags of the
         sequences ``heights``, ``speeds`` on ``rows`` (``stretch`` is told how
-        far the replay has got), as ``verify.replay_shared`` gives them:
+        far the replay has got), as ``replay.replay_shared`` gives them:
         sequences that share their first pins share those rollouts, and so do
         the calls of this bench (:class:`PrefixStates`: the probe, the screen,
         the cascade and the full judgement replay subsets of one level's
@@ -126,8 +142,7 @@ class TrialBench:
         n = np.size(th0)
         kept = self.kept
         trial = kept.trial_ids(rows)
-        kw = kernel_kw(self.kernel["ds_max"], self.kernel["tol"], self.belt.get("belt_speed"),
-                       self.belt.get("mu_s", 0.5))
+        kw = kernel_kw(self.step.ds_max, self.step.tol, self.belt_speed, self.mu_s)
         node, key = np.zeros(n_plans, int), np.zeros(1, dtype=np.int64)  # distinct prefixes; their keys
         th, yc = np.asarray(th0, float)[None, :].copy(), np.asarray(yc0, float)[None, :].copy()
         jam = np.zeros((1, n), bool)

@@ -32,6 +32,7 @@ from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import merge_arcs, merge_modulo
 from pipeline.planning.core.claim import Claim
+from pipeline.planning.core.settings import KernelSettings, as_kernel_settings
 from pipeline.planning.tight.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
                         initial_state_sets, propagate)
 
@@ -146,6 +147,7 @@ class TightPlanner:
         range ``(lo, hi)`` that every plan must cover.
     moving : optional moving pins ``{label: (height_mm, v_pin)}``.
     lattices : optional ``{v_pin: OutcomeLattice}`` holding stored outcomes.
+    kernel : the rollout kernel's step (a ``KernelSettings``; ``None``: its defaults).
     max_branches : a node whose state has more branches than this is dropped
         (reported in ``stats.pruned_branching``).
     belt_speed : belt speed in mm/s (the part in mm): plan with the dynamic
@@ -163,7 +165,7 @@ class TightPlanner:
     def __init__(self, part: Part, pins: dict, d_min: float, d_max: float, mu_c,
                  pin_radius: float, model: str = "minpower", uncertainty: Uncertainty = Uncertainty(),
                  tolerances: Tolerances = Tolerances(), moving: dict | None = None,
-                 lattices: dict | None = None, kernel: dict | None = None, max_branches: int = 4,
+                 lattices: dict | None = None, kernel: KernelSettings | None = None, max_branches: int = 4,
                  hard_limits: bool = False, belt_speed: float | None = None, mu_s: float = 0.5):
         if not pins:
             raise PinfeedError("the planner needs at least one candidate pin")
@@ -178,12 +180,12 @@ class TightPlanner:
         self.pins = {lab: Pin(lab, float(y), 0.0) for lab, y in pins.items()}
         for lab, (y, v) in (moving or {}).items():
             self.pins[lab] = Pin(lab, float(y), float(v))
-        kernel = kernel or {}
+        kernel = as_kernel_settings(kernel)  # plans/plan.py still passes the kernel's dict
         self.lattices = dict(lattices or {})
         for v in {p.v_pin for p in self.pins.values()}:
             if v not in self.lattices:
                 self.lattices[v] = OutcomeLattice(part, model, pin_radius, v,
-                                                  kernel.get("ds_max"), kernel.get("tol"),
+                                                  kernel.ds_max, kernel.tol,
                                                   belt_speed=self.belt_speed, mu_s=self.mu_s)
         for v, lattice in self.lattices.items():
             if lattice.belt_speed != self.belt_speed or (

@@ -38,6 +38,7 @@ from pipeline.maps.catalog import REFINE_FOLDER
 from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_atomic
 from pipeline.parts.part import Part
+from pipeline.planning.core.settings import KernelSettings, as_kernel_settings
 from pipeline.planning.tight.propagate import UNITS, OutcomeLattice
 from pipeline.provenance import provenance_attrs
 
@@ -94,14 +95,17 @@ def _settings(lattice: OutcomeLattice) -> dict:
 
 
 def load_lattice(root, part: Part, model: str, v_pin: float, pin_radius: float,
-                 kernel: dict | None = None, belt_speed: float | None = None,
+                 kernel: KernelSettings | None = None, belt_speed: float | None = None,
                  mu_s: float = 0.5) -> OutcomeLattice:
     """The stored lattice of this part, model, speed and belt, or an empty one
-    when none is stored or the stored one was made with other settings.
-    ``belt_speed`` (mm/s) selects the dynamic model at that speed with belt
-    friction ``mu_s``; ``None`` is the quasi-static ``model``."""
-    kernel = kernel or {}
-    lattice = OutcomeLattice(part, model, pin_radius, v_pin, kernel.get("ds_max"), kernel.get("tol"),
+    when none is stored or the stored one was made with other settings
+    (``kernel``: the rollout kernel's step, ``None`` its defaults; the
+    kernel's dict, which plans/plan.py still passes, is read with
+    ``as_kernel_settings``). ``belt_speed`` (mm/s) selects the dynamic model
+    at that speed with belt friction ``mu_s``; ``None`` is the quasi-static
+    ``model``."""
+    kernel = as_kernel_settings(kernel)
+    lattice = OutcomeLattice(part, model, pin_radius, v_pin, kernel.ds_max, kernel.tol,
                              belt_speed=belt_speed, mu_s=mu_s)
     # the catalog's own, then what a run against it read-only kept in the cache
     for where in (root, cache_root(root)):
