@@ -1,7 +1,7 @@
 """Record what the planner answers, and compare two records: a refactor's
 witness that no result changed.
 
-    .venv/bin/python benchmarks/plan_record.py record OUT.json [--atlas-plans DIR] [--benchmark-parts]
+    .venv/bin/python benchmarks/plan_record.py record OUT.json [--atlas-plans DIR] [--benchmark-parts also|only]
     .venv/bin/python benchmarks/plan_record.py compare BEFORE.json AFTER.json
 
 ``record`` plans, through the ``pinfeed plan`` command line (so the record
@@ -63,7 +63,7 @@ BENCHMARK_PARTS = {
     "hexagon_slot": "0,0 50,0 60,10 50,20 0,20 -10,10", "small_20mm": "0,0 20,0 5,11.666666666666666",
     "large_150mm": "0,0 125,0 150,75 25,62.5",
 }
-BENCHMARK_ARGS = ["--mu-c", "0.1:0.3", "--depth", "4", "--pins", "auto", "--tolerance", "10"]
+BENCHMARK_ARGS = ["--mu-c", "0.1:0.3", "--depth", "4", "--tolerance", "10"]  # pins: the default, fitted
 VOLATILE = {"created", "git_commit", "pinfeed_version"}
 
 
@@ -89,9 +89,9 @@ def plan_one(name: str, args: list, work: Path) -> dict:
     return stable(json.loads(out.read_text()))
 
 
-def record(out: Path, atlas_plans: Path | None, benchmark_parts: bool = False) -> None:
+def record(out: Path, atlas_plans: Path | None, benchmark_parts: str | None = None) -> None:
     plans = {}
-    runs = dict(RUNS)
+    runs = {} if benchmark_parts == "only" else dict(RUNS)
     if benchmark_parts:
         runs.update({f"bench/{name}": ["--vertices", vertices, *BENCHMARK_ARGS]
                      for name, vertices in BENCHMARK_PARTS.items()})
@@ -139,8 +139,9 @@ def main(argv=None) -> int:
     rec = sub.add_parser("record")
     rec.add_argument("out", type=Path)
     rec.add_argument("--atlas-plans", type=Path, default=None)
-    rec.add_argument("--benchmark-parts", action="store_true",
-                     help="also the ten parts of benchmarks/plan_speed.py (mu_c 0.1:0.3, depth 4, fitted pins)")
+    rec.add_argument("--benchmark-parts", choices=("also", "only"), default=None,
+                     help="also (or only) the ten parts of benchmarks/plan_speed.py (mu_c 0.1:0.3, depth 4, "
+                          "fitted pins)")
     cmp_ = sub.add_parser("compare")
     cmp_.add_argument("before", type=Path)
     cmp_.add_argument("after", type=Path)

@@ -161,7 +161,8 @@ def test_the_untruncated_line_says_a_friction_range_stays_uniform():
               "lower_bound": 0.9884, "confidence": 0.95, "width_deg": 8.44, "width_interval_deg": [8.1, 8.9],
               "orients": False, "point_rule": True}
     line = describe_untruncated(record)
-    assert line.startswith("untruncated normals (theta not cut at 2 sigma; mu_c uniform over its range): "
+    assert line.startswith("untruncated normals (theta not cut at 2 sigma; mu_c uniform over its range; random "
+                           "draws only, no box corners): "
                            "990/996 in one set of 10 deg, at least 98.84 % with 95 % confidence; width 8.4 deg "
                            "(95 % bootstrap interval 8.1-8.9 deg)")
     assert line.endswith("clears the point rule but not its confidence bound")

@@ -80,7 +80,8 @@ def describe_untruncated(record: dict, sigma: float | None = TRUNCATE_SIGMA) -> 
     r, sigma = record, TRUNCATE_SIGMA if sigma is None else sigma
     uncut = ", ".join(r["normal"])
     what = f"untruncated normals ({uncut} not cut at {sigma:g} sigma"
-    what += "; mu_c uniform over its range)" if "mu_c" not in r["normal"] else ")"
+    what += "; mu_c uniform over its range" if "mu_c" not in r["normal"] else ""
+    what += "; random draws only, no box corners)"
     text = (f"{what}: {r['in_one_set']}/{r['trials']} in one set of {r['tolerance_deg']:g} deg, "
             f"at least {100 * r['lower_bound']:.2f} % with {100 * r['confidence']:g} % confidence")
     if r["width_deg"] is not None:

@@ -20,6 +20,19 @@ from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE
 WIDTH_SLACK_DEG = schema_default("planner", "width_slack_deg")  # a safe margin outranks this much width
 
 
+def rejected_because(verdict: dict) -> str:
+    """Why a judged sequence is not a plan, in words (its verdict does not orient the part)."""
+    if verdict.get("broken_by_worst_member"):
+        return "a worst member of the support family ends outside its set"
+    if verdict.get("broken_by_known_member"):
+        return "a member of the support family that broke an earlier plan ends outside its set"
+    if verdict.get("point_rule"):
+        return "its share in one set clears the point rule but not the confidence bound"
+    if verdict.get("sets_within_tolerance", 2) > 1:
+        return f"its trials end in {verdict['sets_within_tolerance']} sets"
+    return "too few of its trials end in one set (jams count as failures)"
+
+
 def orientation_rank(verdict: dict | None, n_pins: int, margin: float | None, n_moving: int = 0) -> tuple:
     """The ranking of plans (best first): plans that orient the part, by fewest
     pins, narrowest verified width, largest margin in d; then the near misses
@@ -180,11 +193,9 @@ class FixedSearch:
         if self.best_effort:
             b = self.best_effort[0]
             v = b.verdict
-            text += (f"; best fixed-pin result: {' '.join(b.labels)} ends in {v['sets_within_tolerance']} "
-                     f"set(s) of at most {self.tolerance:g} deg, at most {v['in_tolerance']} of "
-                     f"{v['trials']} trials in one"
-                     + (", but a member of the support family ends outside that set"
-                        if v.get("broken_by_worst_member") else ""))
+            text += (f"; best fixed-pin result, rejected because {rejected_because(v)}: {' '.join(b.labels)} "
+                     f"ends in {v['sets_within_tolerance']} set(s) of at most {self.tolerance:g} deg, at most "
+                     f"{v['in_tolerance']} of {v['trials']} trials in one")
         return text + self._too_few_trials()
 
     def _time_limit_text(self) -> str:
