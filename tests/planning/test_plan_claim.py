@@ -33,11 +33,13 @@ def test_count_in_arc_is_the_brute_force_count(finals, start, width, order):
     lo = start % period
     ends = [lo, lo + width]
     # An angle within a hair of either end may round either way: not a case worth testing.
-    assume(all(min(abs((x - e + period / 2) % period - period / 2) for e in ends) > 1e-6 for x in finals))
+    assume(all(min(abs((x - e + period / 2) % period - period / 2) for e in ends) > 1e-3 for x in finals))
     brute = 0
     for x in finals:  # every copy of the angle on the plain line against the arc [lo, lo + width]
         brute += any(lo <= x + k * period <= lo + width for k in range(-4 * order, 4 * order + 1))
     assert count_in_arc(finals, (start, width), order) == brute
+    # Finals exactly on an end (as when many trials come to rest on one vertex) are inside.
+    assert count_in_arc([lo, lo + width], (lo + 5e-5, width - 1e-4), order) == 2
 
 
 @settings(max_examples=60, deadline=None)

@@ -13,10 +13,17 @@ from __future__ import annotations
 import numpy as np
 
 from pipeline.planning.claims.confidence import share_lower_bound
+from pipeline.planning.claims.orient import best_arc
 from pipeline.planning.core.claim import Claim
 from pipeline.planning.core.settings import TRUNCATE_SIGMA, ClaimSettings, VerifySettings
 
 UNIFORM = "the part (uniform pressure)"
+
+
+def drawn_members(label: str) -> str:
+    """The subject of a claim on a support family's drawn members, before (or
+    without) the family's own check."""
+    return f"the part on the drawn members of the support family {label}"
 
 
 def promised_arc(verdict: dict, tolerance: float) -> tuple | None:
@@ -30,12 +37,17 @@ def promised_arc(verdict: dict, tolerance: float) -> tuple | None:
     return (round((s["start"] - grow) % 360.0, 4), round(max(s["width"], tolerance), 4))
 
 
+EDGE_DEG = 1e-4  # arcs are stored to 4 decimals: a final this close to an end counts as inside
+
+
 def count_in_arc(finals, arc: tuple, order: int = 1) -> int:
     """How many of ``finals`` (deg) lie in ``arc`` on the circle of the part's
-    distinct orientations (period ``360 / order``)."""
+    distinct orientations (period ``360 / order``), its ends widened by
+    ``EDGE_DEG`` (many trials can end at exactly the same orientation, on
+    the end of the arc that holds them)."""
     period = 360.0 / order
-    x = np.mod(np.asarray(finals, float) - arc[0], period)
-    return int(np.count_nonzero(x <= arc[1] + 1e-9))
+    x = np.mod(np.asarray(finals, float) - (arc[0] - EDGE_DEG), period)
+    return int(np.count_nonzero(x <= arc[1] + 2 * EDGE_DEG))
 
 
 def trials_drawn(verify: VerifySettings, rows: list, seed: int, held_out: bool) -> dict:
@@ -64,11 +76,16 @@ def perturbations(verify: VerifySettings, mu_c) -> dict:
 def held_out_claim(verdict: dict, finals, claims: ClaimSettings, order: int, drawn: dict, perturbed: dict,
                    subject: str = UNIFORM) -> Claim:
     """The claim of a plan judged on held-out trials: ``verdict`` is
-    ``orient.judge`` of its ``finals`` (the trials that did not jam)."""
+    ``orient.judge`` of its ``finals`` (the trials that did not jam). When
+    no arc of the tolerance holds the required share (the plan ends in
+    several sets), the arc named is the one of the tolerance that holds the
+    most trials, and the claim says that the plan does not orient the part."""
     tol = float(claims.tolerance_deg)
-    arc = promised_arc(verdict, tol) or (0.0, tol)
+    arc = promised_arc(verdict, tol)
+    if arc is None or arc[1] > tol + 1e-9:  # no arc of the tolerance holds the required share: name the best one
+        arc = (round(best_arc(finals, tol, order)[1] % 360.0, 4), tol)
     n = int(verdict["trials"])
-    inside = count_in_arc(finals, arc, order) if verdict.get("set") else 0
+    inside = count_in_arc(finals, arc, order)
     lower = share_lower_bound(inside, n, claims.confidence) if n else 0.0
     share = inside / n if n else 0.0
     clears = share >= claims.required and (claims.rule == "point" or lower >= claims.required)
@@ -76,7 +93,8 @@ def held_out_claim(verdict: dict, finals, claims: ClaimSettings, order: int, dra
     return Claim(subject, bool(verdict["orients"] and clears), arc, tol, claims.rule, claims.required,
                  claims.confidence, inside, n, int(verdict["jammed"]), round(share, 6), round(lower, 6),
                  verdict.get("width_deg"), verdict.get("spread_deg"), drawn, perturbed,
-                 tuple(interval) if interval else None, int(order))
+                 tuple(interval) if interval else None, int(order),
+                 sets_within_tolerance=verdict.get("sets_within_tolerance"))
 
 
 def with_untruncated(claim: Claim, record: dict | None) -> Claim:

@@ -60,13 +60,14 @@ class Claim:
     perturbations: dict
     width_interval_deg: tuple | None = None
     symmetry_order: int = 1
+    sets_within_tolerance: int | None = None
     untruncated: dict | None = None
     family: dict | None = None
     extra: dict = field(default_factory=dict)
 
     KEYS = ("statement", "subject", "orients", "arc", "tolerance_deg", "rule", "required", "confidence",
             "in_arc", "trials", "jammed", "share", "share_lower_bound", "width_deg", "spread_deg",
-            "width_interval_deg", "symmetry_order", "trials_drawn", "perturbations", "untruncated", "family")
+            "width_interval_deg", "symmetry_order", "sets_within_tolerance", "trials_drawn", "perturbations", "untruncated", "family")
 
     @classmethod
     def from_dict(cls, d: dict) -> "Claim":
@@ -77,7 +78,7 @@ class Claim:
                    d["required"], d["confidence"], d["in_arc"], d["trials"], d["jammed"], d["share"],
                    d["share_lower_bound"], d.get("width_deg"), d.get("spread_deg"), dict(d["trials_drawn"]),
                    dict(d["perturbations"]), tuple(interval) if interval is not None else None,
-                   int(d.get("symmetry_order", 1)), d.get("untruncated"), d.get("family"), {k: v for k, v in d.items() if k not in cls.KEYS})
+                   int(d.get("symmetry_order", 1)), d.get("sets_within_tolerance"), d.get("untruncated"), d.get("family"), {k: v for k, v in d.items() if k not in cls.KEYS})
 
     def to_dict(self) -> dict:
         """The stored dict (with its one-line ``statement`` first)."""
@@ -88,7 +89,7 @@ class Claim:
                 "share_lower_bound": self.share_lower_bound, "width_deg": self.width_deg,
                 "spread_deg": self.spread_deg,
                 "width_interval_deg": list(self.width_interval_deg) if self.width_interval_deg else None,
-                "symmetry_order": self.symmetry_order,
+                "symmetry_order": self.symmetry_order, "sets_within_tolerance": self.sets_within_tolerance,
                 "trials_drawn": dict(self.trials_drawn), "perturbations": dict(self.perturbations),
                 "untruncated": self.untruncated, "family": self.family, **self.extra}
 
@@ -125,6 +126,14 @@ class Claim:
                     f"({held} in it; required {_pct(self.required)})")
         else:
             sure = f"{_pct(self.share)} by the point rule, no confidence claim ({held} in it)"
+        copies = (f"; or a copy of it every {360.0 / self.symmetry_order:g} deg, by symmetry"
+                  if self.symmetry_order > 1 else "")
+        if not self.orients and (self.sets_within_tolerance or 1) > 1:
+            return (f"{self.subject} does NOT end in one arc of {self.tolerance_deg:g} deg: the best one, "
+                    f"{self.arc_text}{copies}, holds {held} ({_pct(self.share)}; at least "
+                    f"{_pct(self.share_lower_bound)} with {100 * self.confidence:g} % confidence, required "
+                    f"{_pct(self.required)}); its trials end in {self.sets_within_tolerance} sets of at most "
+                    f"{self.tolerance_deg:g} deg")
         verb = "ends" if self.orients else "does NOT reliably end"
         width = "" if self.width_deg is None else f"; {_pct(self.required)} of them within {self.width_deg:.1f} deg"
         if self.width_deg is not None and self.width_interval_deg and self.width_interval_deg[0] is not None:
@@ -133,7 +142,5 @@ class Claim:
                       + ("inf" if hi is None else f"{hi:.1f}") + " deg)")
         if self.family and self.spread_deg is not None:
             width += f"; every trial, the worst member's included, within {self.spread_deg:.1f} deg"
-        copies = (f"; or a copy of it every {360.0 / self.symmetry_order:g} deg, by symmetry"
-                  if self.symmetry_order > 1 else "")
         return (f"{self.subject} {verb} in {self.arc_text} (one arc of {self.tolerance_deg:g} deg{copies}): "
                 f"{sure}{width}")

@@ -53,7 +53,8 @@ from pipeline.planning.core.settings import TRUNCATE_SIGMA, PlannerSettings
 from pipeline.planning.claims.replay import ReplayMemo
 from pipeline.planning.claims.verify import verify_plan
 from pipeline.planning.claims.tails import describe_untruncated, untruncated_check
-from pipeline.planning.claims.plan_claim import held_out_claim, perturbations, trials_drawn, with_untruncated
+from pipeline.planning.claims.plan_claim import (UNIFORM, drawn_members, held_out_claim, perturbations,
+                                                 trials_drawn, with_untruncated)
 from pipeline.progress import NO_DEADLINE, Deadline, Heartbeat
 
 
@@ -186,7 +187,7 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
                           mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1), memo=memo)
         verdict = judge_verification(res, claims.tolerance_deg, planner.order, claims.required,
                                      claims.confidence, claims.rule)
-        plan.claim = _held_out_claim(settings, res, verdict, planner.order, held_out.seed)
+        plan.claim = _held_out_claim(settings, res, verdict, planner.order, held_out.seed, family)
         plan.verification = {"held_out": True, "seed": held_out.seed,
                              "trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
@@ -202,13 +203,15 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
     beat.finish()
 
 
-def _held_out_claim(settings: PlannerSettings, res: dict, verdict: dict, order: int, seed: int):
+def _held_out_claim(settings: PlannerSettings, res: dict, verdict: dict, order: int, seed: int, family=None):
     """The plan's one claim on its held-out replay ``res`` (``verify_plan``),
-    judged as ``verdict``."""
+    judged as ``verdict`` (with a support ``family``: on its drawn members,
+    until the family's own check makes it the family's claim)."""
     finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
     drawn = trials_drawn(settings.verify, res["rows"], seed, held_out=True)
     return held_out_claim(verdict, finals, settings.claims, order, drawn,
-                          perturbations(settings.verify, settings.friction.value))
+                          perturbations(settings.verify, settings.friction.value),
+                          UNIFORM if family is None else drawn_members(family.label))
 
 
 def _check_tails(part: Part, settings: PlannerSettings, planner, plan, states, progress=None,
