@@ -36,15 +36,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import re
 
 import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.support import material_distance
-from pipeline.parts.support_family import DEFAULT_INSET, parse_support_family
+from pipeline.parts.support_family import DEFAULT_INSET, FamilySpec, parse_support_family
 from pipeline.planning.family.certificate import MIN_FRESH_MEMBERS, family_certificate, fresh_finals, fresh_members
-from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family, member_space
+from pipeline.planning.family.member_spaces import member_space
+from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family
 
 STEPS = 5  # bisection halvings per axis
 PLANS_TRIED = 3  # rejected plans tried on each axis, best first
@@ -96,7 +96,7 @@ def _kept_screen(part, family, st, kept):
     def broken(heights, speeds) -> bool:
         speeds = list(speeds) or [0.0] * len(heights)
         return bool(screen.prescreen(np.atleast_2d(np.asarray(heights, float)),
-                                     np.atleast_2d(np.asarray(speeds, float)), st.tolerance)[0])
+                                     np.atleast_2d(np.asarray(speeds, float)), st.claims.tolerance_deg)[0])
     return broken
 
 
@@ -162,34 +162,25 @@ def _not_found(axis: str, words: str) -> dict:
     return {"axis": axis, "found": False, "statement": words}
 
 
-def _with_inset(label: str, inset: float) -> str:
-    """The family text ``label`` with its tripods' inset set to ``inset``."""
-    def one(item: str) -> str:
-        item = item.strip()
-        if not item.startswith("tripods"):
-            return item
-        fields = [f for f in item.split(":") if not f.startswith("inset=")]
-        return ":".join(fields + [f"inset={inset:.4g}"])
-    return ";".join(one(i) for i in label.split(";"))
+def with_inset(spec: FamilySpec, inset: float) -> str:
+    """The text of the family ``spec`` with its tripods' inset set to ``inset`` (to 4 digits)."""
+    return spec.with_option("tripods", "inset", f"{inset:.4g}").format()
 
 
-def _tripod_inset(label: str) -> float | None:
-    """The tripods' inset of family text ``label`` (None: no tripods item)."""
-    for item in label.split(";"):
-        if item.strip().startswith("tripods"):
-            m = re.search(r"inset=([0-9.eE+-]+)", item)
-            return float(m.group(1)) if m else DEFAULT_INSET
-    return None
+def tripod_inset(spec: FamilySpec) -> float | None:
+    """The tripods' inset of the family ``spec`` (None: no tripods item)."""
+    tripods = spec.first("tripods")
+    return None if tripods is None else float(tripods.option("inset", DEFAULT_INSET))
 
 
-def largest_inset(part, label: str, lo: float) -> float:
+def largest_inset(part, spec: FamilySpec, lo: float) -> float:
     """The largest tripod inset (share of ``a``) that still has members (the
-    search's space and the family text's drawn sample), to
-    ``INSET_RESOLUTION``, searched above ``lo``."""
+    search's space and the family's drawn sample), to ``INSET_RESOLUTION``,
+    searched above ``lo``."""
     def has_member(f):  # the search's space and the family text's sample both exist
         try:
-            member_space(part, _with_inset(label, f))
-            parse_support_family(_with_inset(label, f), part)
+            member_space(part, with_inset(spec, f))
+            parse_support_family(with_inset(spec, f), part)
             return True
         except PinfeedError:
             return False
@@ -206,15 +197,16 @@ def largest_inset(part, label: str, lo: float) -> float:
 def inset_axis(part, family, plans, st, make_family, progress=None, kept=()) -> dict:
     """The smallest tripod inset for which one of ``plans`` holds (the
     largest sub-family of legs far enough inside the outline)."""
-    inset0 = _tripod_inset(family.label)
+    spec = FamilySpec.parse(family.label)
+    inset0 = tripod_inset(spec)
     if inset0 is None:
         return _not_found("inset", "the family has no tripods: no inset to narrow")
-    top = largest_inset(part, family.label, inset0)
+    top = largest_inset(part, spec, inset0)
     families = {}
 
     def holds_at(f):
         key = round(f, 4)
-        families[key] = families.get(key) or make_family(_with_inset(family.label, key))
+        families[key] = families.get(key) or make_family(with_inset(spec, key))
         return _holds(part, plans, families[key], st, progress, kept_members(part, kept, key))
     value, found = _bisect(holds_at, inset0, top)
     if found is None:
@@ -252,8 +244,8 @@ def tolerance_axis(part, family, plans, st, progress=None, kept=()) -> dict:
     top = min(MAX_TOLERANCE, 180.0 / part.symmetry_order())
 
     def holds_at(t):
-        return _holds(part, plans, family, dataclasses.replace(st, tolerance=math.ceil(2 * t) / 2), progress, kept)
-    value, found = _bisect(holds_at, st.tolerance, top)
+        return _holds(part, plans, family, st.with_tolerance(math.ceil(2 * t) / 2), progress, kept)
+    value, found = _bisect(holds_at, st.claims.tolerance_deg, top)
     if found is None:
         return _not_found("tolerance", f"no plan tried holds for the family within {top:g} deg")
     value = math.ceil(2 * value) / 2
