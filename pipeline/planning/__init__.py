@@ -51,6 +51,7 @@ _WHERE = {
                      "SpeedSettings VerifySettings candidate_pins fitted_pins friction_label "
                      "nominal_friction parse_friction",
     "core.types": "PlanFile as_plan_file load_plan validate_plan_file",
+    "core.nearest_axes": "nearest_yes_lines",
     "claims.orient": "check_tolerance describe_claim min_trials narrowest_arc",
     "claims.tails": "describe_untruncated truncation_text untruncated_check",
     "claims.verify": "VERIFY_DEFAULTS=DEFAULTS PERTURB_DEFAULTS corner_inputs perturbed_batch "
@@ -61,7 +62,6 @@ _WHERE = {
     "paper.planner": "Planner build_planner load_maps paper_depth",
     "family.certificate": "family_assumption family_certificate_line",
     "family.members": "check_family_mechanics",
-    "family.nearest": "nearest_yes_lines",
     "family.shape": "attach_shape_tolerance shape_line",
     "plans.plan": "best_fixed_plan mechanics_label pick_tight_plan plan_hint plan_tight_all planner_belt "
                   "tight_entry",

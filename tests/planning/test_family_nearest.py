@@ -16,6 +16,7 @@ import pytest
 from pipeline.parts.part import Part
 from pipeline.parts.support import point_support
 from pipeline.parts.support_family import FamilySpec, parse_support_family
+from pipeline.planning.core.nearest_axes import MAX_TOLERANCE, bisect_smallest, nearest_yes_lines
 from pipeline.planning.core.settings import ClaimSettings, Perturbation, SearchSettings, VerifySettings
 from pipeline.planning.family import nearest
 from pipeline.planning.family.member_spaces import member_space
@@ -34,10 +35,10 @@ def test_the_smallest_tolerance_holds_and_half_a_degree_less_does_not():
     pins = _pins(RECTANGLE, 6)
     heights = (pins["Q5"], pins["Q1"], pins["Q5"])
     plans = [(("Q5", "Q1", "Q5"), heights, ())]
-    answer = nearest.tolerance_axis(RECTANGLE, family, plans, st)
+    answer = nearest.family_tolerance_axis(RECTANGLE, family, plans, st)
     assert answer["found"] and answer["holds"], answer["statement"]
     value = answer["value"]
-    assert 10.0 < value <= nearest.MAX_TOLERANCE
+    assert 10.0 < value <= MAX_TOLERANCE
     # the smallest on the half-degree ladder: half a degree tighter is not a "yes"
     assert nearest._holds(RECTANGLE, plans, family, st.with_tolerance(value - 0.5), None) is None
     claim = answer["certificate"]["claim"]
@@ -58,7 +59,7 @@ def test_a_jam_is_never_a_yes():
     st = FamilyCheckSettings((0.1, 0.3), ClaimSettings(10.0, 0.995),
                              VerifySettings(100, True, 3, None, Perturbation(**BOX)),
                              SearchSettings(3.0, model="minpower", worst_member_budget=40), 3)
-    answer = nearest.tolerance_axis(TRIANGLE, family, [(("P11", "P3", "P11", "P19"), HEIGHTS, ())], st)
+    answer = nearest.family_tolerance_axis(TRIANGLE, family, [(("P11", "P3", "P11", "P19"), HEIGHTS, ())], st)
     assert not answer["found"] and "45 deg" in answer["statement"]
 
 
@@ -66,9 +67,9 @@ def test_a_jam_is_never_a_yes():
 def test_the_bisection_finds_the_threshold_of_a_sweep(threshold):
     grid = np.linspace(0.0, 1.0, 1001)
     first = grid[grid >= threshold][0]  # the sweep's answer
-    value, found = nearest._bisect(lambda x: "yes" if x >= threshold else None, 0.0, 1.0, steps=10)
+    value, found = bisect_smallest(lambda x: "yes" if x >= threshold else None, 0.0, 1.0, steps=10)
     assert found == "yes" and first <= value <= first + 1.0 / 2 ** 10
-    assert nearest._bisect(lambda x: None, 0.0, 1.0) == (None, None)
+    assert bisect_smallest(lambda x: None, 0.0, 1.0, nearest.STEPS) == (None, None)
 
 
 def test_the_inset_text():
@@ -111,10 +112,10 @@ def test_a_moving_plan_that_holds_is_the_moving_axis_and_the_rest_ask_without_it
     assert [p[0] for p in nearest.rejected_plans(checker, fixed_only=True)] == [("P5",), ("P3", "P4")]
     cert = {"holds": True, "claim": {"epsilon": 0.01, "beta": 0.05, "violations": 0, "members": 299}}
     moving = {"labels": ("P1", "P2v-1"), "heights": (1.0, 2.0), "speeds": (0.0, -1.0), "certificate": cert}
-    axis = nearest.moving_axis({"support_family": {"label": "tripods:12"}}, moving)
+    axis = nearest.family_moving_axis({"support_family": {"label": "tripods:12"}}, moving)
     assert axis["found"] and axis["holds"] and axis["value"] == 1 and axis["plan"] == ["P1", "P2v-1"]
-    assert "holds" in nearest.nearest_yes_lines({"axes": [axis]})[1]
-    assert not nearest.moving_axis({"moving_pin_search": {"levels": []}})["found"]
+    assert "holds" in nearest_yes_lines({"axes": [axis]})[1]
+    assert not nearest.family_moving_axis({"moving_pin_search": {"levels": []}})["found"]
 
 
 @pytest.mark.parametrize("tolerance", [10.0, 30.0])
