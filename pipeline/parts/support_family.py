@@ -34,7 +34,9 @@ sampled and how its extremes are found is spec section 9
     (``uniform``, ``tripod``, ``rim:N``, ``points:"x,y,w ..."``, where a
     ``points`` item separates its points by spaces only).
 
-The same text and part give the same members (seeded).
+The same text and part give the same members (seeded). The text itself,
+item by item, is a :class:`FamilySpec`: change an item's option (the
+tripods' inset) and write the text back.
 """
 from __future__ import annotations
 
@@ -103,6 +105,71 @@ class SupportFamily:
         """Label, members and extremes as a JSON-ready dict."""
         return {"label": self.label, "members": [m.to_dict() for m in self.members],
                 "extremes": [self.members[k].label for k in self.extremes]}
+
+
+@dataclass(frozen=True)
+class FamilyItem:
+    """One item of a family text as written: its ``kind`` (``tripods``,
+    ``warp``, ``rim``, ...) and the ``:``-separated ``fields`` after it
+    (``tripods:12:inset=0.3`` is ``("tripods", ("12", "inset=0.3"))``)."""
+
+    kind: str
+    fields: tuple = ()
+
+    @classmethod
+    def parse(cls, text: str) -> "FamilyItem":
+        """The item ``text`` (stripped) split at its colons; nothing is checked."""
+        kind, *fields = text.strip().split(":")
+        return cls(kind, tuple(fields))
+
+    def is_kind(self, kind: str) -> bool:
+        """Whether the item is of ``kind`` (``"tripods"``)."""
+        return self.kind.strip() == kind
+
+    def option(self, key: str, default=None):
+        """The value of the item's option ``key=value`` as the family parser
+        reads it (stripped; the last one given), else ``default``."""
+        _, opts = _options(list(self.fields), self.format())
+        return opts.get(key, default)
+
+    def with_option(self, key: str, value: str) -> "FamilyItem":
+        """The item with its option ``key`` set to ``value`` (text): any
+        ``key=...`` field dropped, ``key=value`` added last."""
+        kept = tuple(f for f in self.fields if not ("=" in f and f.partition("=")[0].strip() == key))
+        return FamilyItem(self.kind, kept + (f"{key}={value}",))
+
+    def format(self) -> str:
+        """The item's text."""
+        return ":".join((self.kind,) + self.fields)
+
+
+@dataclass(frozen=True)
+class FamilySpec:
+    """A family text parsed into its items (``SPEC; SPEC; ...``), each as
+    written: a value to change (an option of the tripods, say) and write
+    back as text (:meth:`format`), items left alone as they were. It checks
+    nothing; :func:`parse_support_family` draws the members and says what is
+    wrong with a text."""
+
+    items: tuple
+
+    @classmethod
+    def parse(cls, text: str) -> "FamilySpec":
+        """The items of the family ``text``."""
+        return cls(tuple(FamilyItem.parse(item) for item in str(text).split(";")))
+
+    def first(self, kind: str) -> FamilyItem | None:
+        """The first item of ``kind`` (None: there is none)."""
+        return next((item for item in self.items if item.is_kind(kind)), None)
+
+    def with_option(self, kind: str, key: str, value: str) -> "FamilySpec":
+        """The family with option ``key`` of every item of ``kind`` set to ``value`` (text)."""
+        return FamilySpec(tuple(item.with_option(key, value) if item.is_kind(kind) else item
+                                for item in self.items))
+
+    def format(self) -> str:
+        """The family text: the items, stripped, joined by ``;``."""
+        return ";".join(item.format() for item in self.items)
 
 
 def _options(fields: list[str], text: str) -> tuple[list[str], dict]:

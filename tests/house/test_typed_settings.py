@@ -36,17 +36,7 @@ DICT_NAMES = frozenset({"dict", "Dict", "Mapping", "MutableMapping"})
 # ``path:function:parameter`` -> why it is still a dict. Files another branch
 # edits in parallel (plans/plan.py, tight/complete.py, family/*, core/types.py)
 # switch to the typed settings when that work is merged; then this empties.
-NOT_YET_SWITCHED: dict[str, str] = {
-    "pipeline/planning/family/shape.py:ShapeProbe.__init__:verify":
-        "the shape probe takes the flat verify dict; switch to VerifySettings",
-    "pipeline/planning/family/worst_member.py:probe_inputs:cfg":
-        "the worst member's probe takes the flat verify dict; switch to VerifySettings",
-    "pipeline/planning/family/worst_member.py:PlanProbe:settings":
-        "a field holding the flat verify dict; switch to VerifySettings",
-    "pipeline/planning/family/worst_member.py:FamilyCheckSettings:verify":
-        "a field holding the flat verify dict with the claim's confidence and rule; switch to "
-        "VerifySettings and ClaimSettings",
-}
+NOT_YET_SWITCHED: dict[str, str] = {}
 
 
 def is_dict_annotation(node) -> bool:

@@ -27,7 +27,7 @@ from pipeline.parts.support import (INSIDE_TOL, _ears, boundary_distance, filled
                                     material_distance, material_triangles, parse_support,
                                     point_support, rim_support, tripod_support)
 from pipeline.parts.support_family import parse_support_family, sample_tripods, sample_warps
-from pipeline.planning.family.worst_member import TripodSpace, inset_corners, member_space
+from pipeline.planning.family.member_spaces import TripodSpace, inset_corners, member_space
 
 
 def _circle(cx, cy, r, n):

@@ -10,16 +10,17 @@ claimed set at the answer. On the triangle's plan P11 P3 P11 P19 a fresh
 tripod jams: no tolerance is a "yes", and the axis says so. The bisection is checked against a sweep of a monotone predicate;
 the inset text and the largest inset with members against brute force.
 """
-import dataclasses
-
 import numpy as np
 import pytest
 
 from pipeline.parts.part import Part
 from pipeline.parts.support import point_support
-from pipeline.parts.support_family import parse_support_family
+from pipeline.parts.support_family import FamilySpec, parse_support_family
+from pipeline.planning.core.nearest_axes import MAX_TOLERANCE, bisect_smallest, nearest_yes_lines
+from pipeline.planning.core.settings import ClaimSettings, Perturbation, SearchSettings, VerifySettings
 from pipeline.planning.family import nearest
-from pipeline.planning.family.worst_member import FamilyCheckSettings, check_plan_for_family, member_space
+from pipeline.planning.family.member_spaces import member_space
+from pipeline.planning.family.worst_member import FamilyCheckSettings, check_plan_for_family
 
 from test_worst_member import RECTANGLE, _corner_finals, _grid_tripods, _outside, _pins, _settings
 
@@ -34,12 +35,12 @@ def test_the_smallest_tolerance_holds_and_half_a_degree_less_does_not():
     pins = _pins(RECTANGLE, 6)
     heights = (pins["Q5"], pins["Q1"], pins["Q5"])
     plans = [(("Q5", "Q1", "Q5"), heights, ())]
-    answer = nearest.tolerance_axis(RECTANGLE, family, plans, st)
+    answer = nearest.family_tolerance_axis(RECTANGLE, family, plans, st)
     assert answer["found"] and answer["holds"], answer["statement"]
     value = answer["value"]
-    assert 10.0 < value <= nearest.MAX_TOLERANCE
+    assert 10.0 < value <= MAX_TOLERANCE
     # the smallest on the half-degree ladder: half a degree tighter is not a "yes"
-    assert nearest._holds(RECTANGLE, plans, family, dataclasses.replace(st, tolerance=value - 0.5), None) is None
+    assert nearest._holds(RECTANGLE, plans, family, st.with_tolerance(value - 0.5), None) is None
     claim = answer["certificate"]["claim"]
     assert claim["violations"] == 0 and claim["members"] >= 300  # a "yes" has no fresh member outside
     # the grid: every tripod 0.2 a inside, replayed without the planner's code, ends in the claimed set
@@ -55,9 +56,10 @@ def test_the_smallest_tolerance_holds_and_half_a_degree_less_does_not():
 def test_a_jam_is_never_a_yes():
     """On the triangle's plan P11 P3 P11 P19 one fresh tripod jams: no tolerance makes it a "yes"."""
     family = parse_support_family("tripods:12", TRIANGLE)
-    st = FamilyCheckSettings((0.1, 0.3), 10.0, 0.995, {**BOX, "trials": 100, "seed": 3, "corners": True},
-                             3.0, "minpower", {}, 40, 3)
-    answer = nearest.tolerance_axis(TRIANGLE, family, [(("P11", "P3", "P11", "P19"), HEIGHTS, ())], st)
+    st = FamilyCheckSettings((0.1, 0.3), ClaimSettings(10.0, 0.995),
+                             VerifySettings(100, True, 3, None, Perturbation(**BOX)),
+                             SearchSettings(3.0, model="minpower", worst_member_budget=40), 3)
+    answer = nearest.family_tolerance_axis(TRIANGLE, family, [(("P11", "P3", "P11", "P19"), HEIGHTS, ())], st)
     assert not answer["found"] and "45 deg" in answer["statement"]
 
 
@@ -65,21 +67,24 @@ def test_a_jam_is_never_a_yes():
 def test_the_bisection_finds_the_threshold_of_a_sweep(threshold):
     grid = np.linspace(0.0, 1.0, 1001)
     first = grid[grid >= threshold][0]  # the sweep's answer
-    value, found = nearest._bisect(lambda x: "yes" if x >= threshold else None, 0.0, 1.0, steps=10)
+    value, found = bisect_smallest(lambda x: "yes" if x >= threshold else None, 0.0, 1.0, steps=10)
     assert found == "yes" and first <= value <= first + 1.0 / 2 ** 10
-    assert nearest._bisect(lambda x: None, 0.0, 1.0) == (None, None)
+    assert bisect_smallest(lambda x: None, 0.0, 1.0, nearest.STEPS) == (None, None)
 
 
 def test_the_inset_text():
-    assert nearest._with_inset("tripods:12", 0.25) == "tripods:12:inset=0.25"
-    assert nearest._with_inset("tripods:12:inset=0.1:seed=4; rim:8", 0.3) == "tripods:12:seed=4:inset=0.3;rim:8"
-    assert nearest._tripod_inset("tripods:12") == 0.2
-    assert nearest._tripod_inset("tripods:12:inset=0.15") == 0.15
-    assert nearest._tripod_inset("warp:0.3") is None
+    spec = FamilySpec.parse
+    assert nearest.with_inset(spec("tripods:12"), 0.25) == "tripods:12:inset=0.25"
+    assert nearest.with_inset(spec("tripods:12:inset=0.1:seed=4; rim:8"), 0.3) == "tripods:12:seed=4:inset=0.3;rim:8"
+    assert nearest.with_inset(spec("warp:0.3 ;uniform"), 0.3) == "warp:0.3;uniform"
+    assert nearest.tripod_inset(spec("tripods:12")) == 0.2
+    assert nearest.tripod_inset(spec("tripods:12:inset=0.15")) == 0.15
+    assert nearest.tripod_inset(spec("warp:0.3")) is None
+    assert spec("tripods:12:inset=0.1:seed=4; rim:8").format() == "tripods:12:inset=0.1:seed=4;rim:8"
 
 
 def test_the_largest_inset_with_members_against_brute_force():
-    top = nearest.largest_inset(TRIANGLE, "tripods:12", 0.2)
+    top = nearest.largest_inset(TRIANGLE, FamilySpec.parse("tripods:12"), 0.2)
 
     def has(f):
         try:
@@ -107,10 +112,10 @@ def test_a_moving_plan_that_holds_is_the_moving_axis_and_the_rest_ask_without_it
     assert [p[0] for p in nearest.rejected_plans(checker, fixed_only=True)] == [("P5",), ("P3", "P4")]
     cert = {"holds": True, "claim": {"epsilon": 0.01, "beta": 0.05, "violations": 0, "members": 299}}
     moving = {"labels": ("P1", "P2v-1"), "heights": (1.0, 2.0), "speeds": (0.0, -1.0), "certificate": cert}
-    axis = nearest.moving_axis({"support_family": {"label": "tripods:12"}}, moving)
+    axis = nearest.family_moving_axis({"support_family": {"label": "tripods:12"}}, moving)
     assert axis["found"] and axis["holds"] and axis["value"] == 1 and axis["plan"] == ["P1", "P2v-1"]
-    assert "holds" in nearest.nearest_yes_lines({"axes": [axis]})[1]
-    assert not nearest.moving_axis({"moving_pin_search": {"levels": []}})["found"]
+    assert "holds" in nearest_yes_lines({"axes": [axis]})[1]
+    assert not nearest.family_moving_axis({"moving_pin_search": {"levels": []}})["found"]
 
 
 @pytest.mark.parametrize("tolerance", [10.0, 30.0])
@@ -121,7 +126,7 @@ def test_fresh_finals_that_fit_no_arc_leave_a_member_outside_of_every_set(tolera
     has a fresh member outside, so the certificate cannot be a "yes"; when
     they fit, some set on the sweep holds them all."""
     from pipeline.planning.family.certificate import fresh_finals, fresh_fit
-    from pipeline.planning.family.worst_member import outside
+    from pipeline.planning.family.member_search import outside
     family = parse_support_family("tripods:4", RECTANGLE)
     st = _settings((0.1, 0.2), tolerance, 20, budget=40)
     pins = _pins(RECTANGLE, 6)
@@ -161,7 +166,7 @@ def test_a_kept_member_refutes_only_where_no_arc_holds_its_finals():
     for tolerance in (10.0, 20.0, 30.0, 45.0):
         fits = any(_outside(finals, s, tolerance, period).max() == 0.0 for s in starts)
         seen.add(fits)
-        broken = nearest._kept_screen(RECTANGLE, family, dataclasses.replace(st, tolerance=tolerance),
+        broken = nearest._kept_screen(RECTANGLE, family, st.with_tolerance(tolerance),
                                       [member])(heights, ())
         assert broken == (not fits), tolerance
     assert seen == {True, False}  # both answers met

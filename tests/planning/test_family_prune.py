@@ -16,7 +16,9 @@ import pytest
 from pipeline.parts.part import Part
 from pipeline.parts.support_family import parse_support_family
 from pipeline.planning.family.certificate import members_needed, scenario_claim
-from pipeline.planning.family.worst_member import FamilyChecker, FamilyCheckSettings, member_space
+from pipeline.planning.core.settings import ClaimSettings, Perturbation, SearchSettings, VerifySettings
+from pipeline.planning.family.member_spaces import member_space
+from pipeline.planning.family.worst_member import FamilyChecker, FamilyCheckSettings
 
 from test_worst_member import _corner_finals
 
@@ -37,8 +39,9 @@ def _fits(theta, width):
 
 def test_the_prescreen_agrees_with_an_independent_replay():
     family = parse_support_family("tripods:12", TRIANGLE)
-    st = FamilyCheckSettings(MU, 10.0, 0.995, {**BOX, "trials": 20, "seed": 3, "corners": True}, 3.0,
-                             "minpower", {}, 20, 3)
+    st = FamilyCheckSettings(MU, ClaimSettings(10.0, 0.995),
+                             VerifySettings(20, True, 3, None, Perturbation(**BOX)),
+                             SearchSettings(3.0, model="minpower", worst_member_budget=20), 3)
     checker = FamilyChecker(TRIANGLE, family, st)
     space = member_space(TRIANGLE, family).spaces[0]
     widest = space.member(space.corners()[0], "legs at the inset outline's corners")
@@ -55,7 +58,9 @@ def test_the_prescreen_agrees_with_an_independent_replay():
 
 def test_without_a_kept_member_nothing_is_prescreened():
     family = parse_support_family("tripods:12", TRIANGLE)
-    st = FamilyCheckSettings(MU, 10.0, 0.995, {**BOX, "trials": 20, "seed": 3}, 3.0, "minpower", {}, 20, 3)
+    st = FamilyCheckSettings(MU, ClaimSettings(10.0, 0.995),
+                             VerifySettings(20, seed=3, perturbation=Perturbation(**BOX)),
+                             SearchSettings(3.0, model="minpower", worst_member_budget=20), 3)
     sequences = np.array([(15.0, -5.0, 15.0, 35.0)])
     assert not FamilyChecker(TRIANGLE, family, st).prescreen(sequences, np.zeros_like(sequences), 10.0).any()
 

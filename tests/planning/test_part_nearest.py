@@ -20,8 +20,8 @@ from pipeline.config import load_config
 from pipeline.parts.part import Part
 from pipeline.planning import PlannerSettings, nearest_yes_lines
 from pipeline.planning.claims import orient
-from pipeline.planning.plans.nearest_part import (LADDER, MAX_TOLERANCE, loosest_needed, moving_axis, part_nearest_yes,
-                                                 tolerance_axis)
+from pipeline.planning.plans.nearest_part import (LADDER, MAX_TOLERANCE, loosest_needed, part_moving_axis,
+                                                 part_nearest_yes, part_tolerance_axis)
 from pipeline.planning.plans.plan import plan_tight
 from pipeline.progress import Deadline
 
@@ -170,11 +170,11 @@ def test_the_kept_plans_answer_needs_no_search(no_plan):
 
 
 def test_moving_pins_cut_by_the_limit_are_not_called_unconfigured():
-    axis = moving_axis({}, cut=True)
+    axis = part_moving_axis({}, cut=True)
     assert not axis["found"] and "time limit" in axis["statement"]
-    assert "no pin speeds given" in moving_axis({})["statement"]
-    part_way = moving_axis({"moving_pin_search": {"orients": False, "complete": False,
-                                                  "unsearched": ["2 moving pin(s) after P1: not reached"]}})
+    assert "no pin speeds given" in part_moving_axis({})["statement"]
+    part_way = part_moving_axis({"moving_pin_search": {"orients": False, "complete": False,
+                                                       "unsearched": ["2 moving pin(s) after P1: not reached"]}})
     assert not part_way["found"] and part_way["statement"].startswith("searched in part")
     assert "2 moving pin(s) after P1: not reached" in part_way["statement"]
 
@@ -220,7 +220,7 @@ def test_a_bisection_the_limit_cuts_keeps_its_certified_bound(no_plan, monkeypat
         return result
 
     monkeypatch.setattr(complete.FixedPinSearch, "run", run)
-    axis = tolerance_axis(TRAPEZOID, settings_.at(0.2), [], dict(full["pins_used"]), 2)
+    axis = part_tolerance_axis(TRAPEZOID, settings_.at(0.2), [], dict(full["pins_used"]), 2)
     assert calls[0] == MAX_TOLERANCE and len(calls) == 2
     assert axis["found"] and axis["value"] == MAX_TOLERANCE and axis["searches_cut"]
     assert not axis["kept_plans_only"] and "at most 45 deg" in axis["statement"]
@@ -243,8 +243,8 @@ def test_more_pins_asks_for_a_longer_limit_only_when_the_depth_was_not_searched(
 
 def test_a_moving_plan_found_but_not_recommended_is_never_called_none():
     stage = {"orients": True, "found": [["P1", "P2v+1"]], "complete": False}
-    unverified = moving_axis({"moving_pin_search": stage, "recommended": {"pins": ["P1"], "pin_speeds": [0.0]}})
+    unverified = part_moving_axis({"moving_pin_search": stage, "recommended": {"pins": ["P1"], "pin_speeds": [0.0]}})
     assert not unverified["found"] and unverified["partial"] and "not verified" in unverified["statement"]
-    failed = moving_axis({"moving_pin_search": stage, "recommended": None,
-                          "rejected": [{"pins": ["P1", "P2v+1"]}]})
+    failed = part_moving_axis({"moving_pin_search": stage, "recommended": None,
+                               "rejected": [{"pins": ["P1", "P2v+1"]}]})
     assert not failed["found"] and "fails the final verification" in failed["statement"]

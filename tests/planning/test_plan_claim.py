@@ -20,8 +20,9 @@ from pipeline.config import load_config
 from pipeline.parts.part import Part
 from pipeline.planning.claims.confidence import share_lower_bound
 from pipeline.planning.claims.plan_claim import count_in_arc, promised_arc
-from pipeline.planning.claims.verify import holdout_settings, trial_inputs
+from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.claim import Claim
+from pipeline.planning.core.settings import VerifySettings
 
 angles = st.lists(st.floats(0.0, 720.0, allow_nan=False), min_size=1, max_size=40)
 
@@ -87,7 +88,7 @@ def test_an_independent_replay_puts_the_printed_count_in_the_printed_arc(planned
     claim = plan["claim"]
     part = Part.from_dict(planned["part"])
     states = {k: (v["theta"], v["y_c"]) for k, v in entry["initial_states"].items()}
-    inputs = trial_inputs(states, 0.0, len(plan["pins"]), holdout_settings(load_config(None)["verify"]))
+    inputs = trial_inputs(states, 0.0, len(plan["pins"]), VerifySettings.from_section(load_config(None)["verify"]).held_out())
     trials = [(th, yc, mu, offs) for th, yc, mu, offs, _ in inputs]
     finals = replay_box(part, plan["pin_heights_mm"], trials, strict=False)
     assert finals.size == claim["trials"]

@@ -21,15 +21,17 @@ from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.planning.family import shape
-from pipeline.planning.family.worst_member import FamilyCheckSettings, claimed_arc
+from pipeline.planning.core.settings import ClaimSettings, Perturbation, SearchSettings, VerifySettings
+from pipeline.planning.claims.plan_claim import claimed_arc
+from pipeline.planning.family.worst_member import FamilyCheckSettings
 
 TRIANGLE = Part.from_vertices([(0, 0), (60, 0), (15, 35)], "asym_triangle")
 BOX = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth": 0.3}
 MU = (0.1, 0.3)
 HEIGHTS = (10.0, 27.5, 50.0)  # the default config's recommended plan P9 P16 P25
 ARC = claimed_arc({"set": {"start": 21.0834, "width": 5.504}}, 10.0)
-ST = FamilyCheckSettings(MU, 10.0, 0.995, {**BOX, "trials": 100, "seed": 1, "corners": True}, 3.0, "minpower",
-                         {}, 40, 1)
+ST = FamilyCheckSettings(MU, ClaimSettings(10.0, 0.995), VerifySettings(100, True, 1, None, Perturbation(**BOX)),
+                         SearchSettings(3.0, model="minpower", worst_member_budget=40), 1)
 
 
 def _member(offsets):

@@ -24,8 +24,9 @@ from pipeline.parts.support import point_support
 from pipeline.parts.support_family import parse_support_family
 from pipeline.planning.core.settings import ClaimSettings, Perturbation, SearchSettings, VerifySettings
 from pipeline.planning.tight.complete import FixedPinSearch
-from pipeline.planning.family.worst_member import (FamilyChecker, FamilyCheckSettings, check_budget,
-                                            check_plan_for_family, member_space)
+from pipeline.planning.family.member_search import check_budget
+from pipeline.planning.family.member_spaces import member_space
+from pipeline.planning.family.worst_member import FamilyChecker, FamilyCheckSettings, check_plan_for_family
 
 TRIANGLE = Part.from_vertices([(0, 0), (60, 0), (15, 35)], "asym_triangle")
 RECTANGLE = Part.from_vertices([(0, 0), (40, 0), (40, 20), (0, 20)], "rectangle")
@@ -33,8 +34,9 @@ BOX = {"theta_sigma": 1.0, "y_halfwidth": 0.5, "mu_sigma": 0.02, "pin_halfwidth"
 
 
 def _settings(mu, tolerance, trials, budget=60):
-    return FamilyCheckSettings(mu, tolerance, 0.995, {**BOX, "trials": trials, "seed": 3, "corners": True},
-                               3.0, "minpower", {}, budget, 3)
+    return FamilyCheckSettings(mu, ClaimSettings(tolerance, 0.995),
+                               VerifySettings(trials, True, 3, None, Perturbation(**BOX)),
+                               SearchSettings(3.0, model="minpower", worst_member_budget=budget), 3)
 
 
 # --------------------------------------------------------------------------- the reference (no search code)
@@ -205,10 +207,10 @@ def test_the_search_scores_members_on_a_subset_of_a_many_pin_probe():
     import numpy as np
     from pipeline.parts.part import Part
     from pipeline.parts.support_family import parse_support_family
-    from pipeline.planning.family.worst_member import (SEARCH_CORNERS, PlanProbe, coarse_rows, member_space,
-                                                       score)
+    from pipeline.planning.family.member_search import SEARCH_CORNERS, PlanProbe, coarse_rows, score
+    from pipeline.planning.family.member_spaces import member_space
     part = Part.from_vertices([[0, 0], [60, 0], [45, 50]])
-    probe = PlanProbe(part, (8.0, 20.0, 30.0, 12.0, 25.0), (0.1, 0.3), {"trials": 10})
+    probe = PlanProbe(part, (8.0, 20.0, 30.0, 12.0, 25.0), (0.1, 0.3), VerifySettings(trials=10))
     offsets = probe.inputs[3]
     rows = coarse_rows(offsets, probe.nominal, SEARCH_CORNERS)
     assert probe.coarse is not None and probe.coarse[0].size == rows.size
@@ -232,7 +234,7 @@ def test_the_quick_weight_test_changes_no_drawn_tripod(monkeypatch):
     plain floats before the full feasibility test: it never rejects a triple
     the statics' weights accept (random triples, some near the weight bound),
     and the drawn tripods are the same with it and without it."""
-    from pipeline.planning.family import worst_member as wm
+    from pipeline.planning.family import member_spaces as wm
     rng = np.random.default_rng(4)
     near = 0
     for _ in range(4000):

@@ -26,15 +26,24 @@ def drawn_members(label: str) -> str:
     return f"the part on the drawn members of the support family {label}"
 
 
-def promised_arc(verdict: dict, tolerance: float) -> tuple | None:
-    """``(start, width)``: the verdict's set widened about its middle to
-    ``tolerance`` (deg); ``None`` when the verdict has no set (too many
-    trials jammed)."""
+def claimed_arc(verdict: dict, tolerance: float) -> tuple | None:
+    """The set a plan claims: its verified set widened about its middle to
+    the tolerance (the widest arc the claim "one arc of at most T" allows
+    around the trials), ``(start, width)`` in degrees; ``None`` when the
+    verdict has no set (too many trials jammed). The support-family and
+    shape-tolerance checks test members against this arc."""
     s = verdict.get("set")
     if not s:
         return None
     grow = max(0.0, tolerance - s["width"]) / 2.0
-    return (round((s["start"] - grow) % 360.0, 4), round(max(s["width"], tolerance), 4))
+    return (s["start"] - grow, max(s["width"], tolerance))
+
+
+def promised_arc(verdict: dict, tolerance: float) -> tuple | None:
+    """:func:`claimed_arc` as the plan file stores it: the start in [0, 360)
+    and both to 4 decimals."""
+    arc = claimed_arc(verdict, tolerance)
+    return None if arc is None else (round(arc[0] % 360.0, 4), round(arc[1], 4))
 
 
 EDGE_DEG = 1e-4  # arcs are stored to 4 decimals: a final this close to an end counts as inside

@@ -29,8 +29,11 @@ from pipeline.planning.claims import orient
 from pipeline.planning.claims.confidence import DEFAULT_CONFIDENCE, share_upper_bound
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import nominal_friction
-from pipeline.planning.claims.verify import perturbed_batch, replay
-from pipeline.planning.family.worst_member import JAM_SCORE, arc_holds, member_space, outside
+from pipeline.planning.claims.replay import replay
+from pipeline.planning.claims.trials import perturbed_batch
+from pipeline.planning.family.member_search import JAM_SCORE, kernel_steps, outside
+from pipeline.planning.family.member_spaces import member_space
+from pipeline.planning.family.worst_member import arc_holds
 from pipeline.progress import SILENT, Heartbeat, Stretch
 
 MIN_FRESH_MEMBERS = 300
@@ -64,7 +67,8 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
     n_pins = len(heights)
     rows = []
     for theta, y_c in resting_states(part).values():
-        th, yc, mu, offs = perturbed_batch(theta, y_c, st.mu_c, n_pins, st.verify, rng, trials * len(members))
+        th, yc, mu, offs = perturbed_batch(theta, y_c, st.mu_c, n_pins, st.verify.as_dict(), rng,
+                                           trials * len(members))
         mid = nominal_friction(st.mu_c)
         rows.append((np.full(len(members), theta), np.full(len(members), y_c), np.full(len(members), mid),
                      np.zeros((len(members), n_pins)), np.arange(len(members))))
@@ -72,13 +76,13 @@ def fresh_replay(part, heights, members, st, speeds=(), trials: int = FRESH_TRIA
     th, yc, mu, offs, sup = (np.concatenate([r[k] for r in rows]) for k in range(5))
     order = np.argsort(sup, kind="stable")  # member by member, each in the order above
     per = th.size // len(members)
-    kw = {k: st.kernel[k] for k in ("ds_max", "tol") if k in st.kernel}
+    search, kw = st.search, kernel_steps(st.search.kernel_settings)
     tf, jam = np.empty((len(members), per)), np.empty((len(members), per), bool)
     for lo in range(0, len(members), FRESH_CHUNK):
         hi = min(len(members), lo + FRESH_CHUNK)
         idx = order[lo * per:hi * per]
         out, _, jams, _ = replay(part, list(heights), list(speeds) or [0.0] * n_pins, th[idx], yc[idx], mu[idx],
-                                 offs[idx], st.pin_radius, st.model, **kw, support=sup[idx] - lo,
+                                 offs[idx], search.pin_radius, search.model, **kw, support=sup[idx] - lo,
                                  supports=[None if m.is_uniform else m for m in members[lo:hi]],
                                  stretch=stretch.part(lo / len(members), hi / len(members)))
         tf[lo:hi], jam[lo:hi] = out.reshape(hi - lo, per), (jams != "").reshape(hi - lo, per)
@@ -104,7 +108,7 @@ def fresh_finals(part, heights, family, st, n_members: int = MIN_FRESH_MEMBERS, 
 
     def give_up(tf, jam):
         replayed[0] = tf.shape[0]
-        return must_fit and not fresh_fit((None, tf, jam), st.tolerance, order)
+        return must_fit and not fresh_fit((None, tf, jam), st.claims.tolerance_deg, order)
     with Heartbeat(f"fresh members of {family.label}", len(members), "member", progress) as beat:
         got = fresh_replay(part, heights, members, st, speeds, seed=st.seed, stretch=beat.stretch(0, len(members)),
                            give_up=give_up)
@@ -137,11 +141,12 @@ def family_certificate(part, heights, family, check: dict, st, n_members: int = 
     arc = check.get("set_deg")
     dist = np.where(jam, JAM_SCORE, outside(tf, tuple(arc), period)) if arc else np.full(tf.shape, JAM_SCORE)
     leaving = int(np.sum(dist.max(axis=1) > 0.0))
-    verdict = orient.judge(tf[~jam], tf.size, st.tolerance, part.symmetry_order(), st.required)
+    claims = st.claims
+    verdict = orient.judge(tf[~jam], tf.size, claims.tolerance_deg, part.symmetry_order(), claims.required)
     worst = check.get("worst_member") or {}
     return {
         "family": family.label, "holds": bool(check["holds"] and verdict["orients"]),
-        "set_deg": arc, "tolerance_deg": st.tolerance, "required": st.required,
+        "set_deg": arc, "tolerance_deg": claims.tolerance_deg, "required": claims.required,
         "verification": {"members": check["members"], "trials": check["trials"],
                          "in_tolerance": check["verdict"]["in_tolerance"],
                          "width_deg": check["verdict"]["width_deg"]},

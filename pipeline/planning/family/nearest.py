@@ -27,7 +27,8 @@ The axes:
 * **more pins or a wider pin grid**: not searched here (a deeper complete
   search costs more than the rest together); the entry says how to run it.
 
-Each number is found by bisection (``STEPS`` halvings) on the assumption
+Each number is found by bisection (``STEPS`` halvings,
+:func:`~pipeline.planning.core.nearest_axes.bisect_smallest`) on the assumption
 that holding is monotone along the axis (a smaller family or a looser
 tolerance does not break a plan that held): an assumption of the search,
 not a guarantee; the certificate at the answer is the evidence.
@@ -35,20 +36,20 @@ not a guarantee; the certificate at the answer is the evidence.
 from __future__ import annotations
 
 import dataclasses
-import math
-import re
 
 import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.support import material_distance
-from pipeline.parts.support_family import DEFAULT_INSET, parse_support_family
+from pipeline.parts.support_family import DEFAULT_INSET, FamilySpec, parse_support_family
+from pipeline.planning.core.nearest_axes import (MAX_TOLERANCE, bisect_smallest, ladder_up, more_pins_axis,
+                                                 unanswered_axis)
 from pipeline.planning.family.certificate import MIN_FRESH_MEMBERS, family_certificate, fresh_finals, fresh_members
-from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family, member_space
+from pipeline.planning.family.member_spaces import member_space
+from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family
 
 STEPS = 5  # bisection halvings per axis
 PLANS_TRIED = 3  # rejected plans tried on each axis, best first
-MAX_TOLERANCE = 45.0  # deg: the loosest tolerance asked about
 INSET_RESOLUTION = 0.005  # of a: the largest inset with a member is found to this
 
 
@@ -96,7 +97,7 @@ def _kept_screen(part, family, st, kept):
     def broken(heights, speeds) -> bool:
         speeds = list(speeds) or [0.0] * len(heights)
         return bool(screen.prescreen(np.atleast_2d(np.asarray(heights, float)),
-                                     np.atleast_2d(np.asarray(speeds, float)), st.tolerance)[0])
+                                     np.atleast_2d(np.asarray(speeds, float)), st.claims.tolerance_deg)[0])
     return broken
 
 
@@ -130,25 +131,6 @@ def _holds(part, plans, family, st, progress, kept=()) -> tuple | None:
     return None
 
 
-def _bisect(holds_at, lo: float, hi: float, steps: int = STEPS):
-    """``(x, found)`` with ``x`` the smallest value in ``[lo, hi]`` found to
-    hold (``holds_at(x)`` not None), assuming it holds from some value on;
-    ``found`` is ``holds_at``'s answer there. ``(None, None)`` when ``hi``
-    does not hold."""
-    top = holds_at(hi)
-    if top is None:
-        return None, None
-    best = (hi, top)
-    for _ in range(steps):
-        mid = 0.5 * (lo + hi)
-        got = holds_at(mid)
-        if got is None:
-            lo = mid
-        else:
-            hi, best = mid, (mid, got)
-    return best
-
-
 def _answer(axis: str, value, unit: str, words: str, found, family) -> dict:
     """The record of one axis's answer, with its certificate on fresh members."""
     (labels, heights, speeds), _, cert = found
@@ -158,38 +140,25 @@ def _answer(axis: str, value, unit: str, words: str, found, family) -> dict:
             "certificate": cert}
 
 
-def _not_found(axis: str, words: str) -> dict:
-    return {"axis": axis, "found": False, "statement": words}
+def with_inset(spec: FamilySpec, inset: float) -> str:
+    """The text of the family ``spec`` with its tripods' inset set to ``inset`` (to 4 digits)."""
+    return spec.with_option("tripods", "inset", f"{inset:.4g}").format()
 
 
-def _with_inset(label: str, inset: float) -> str:
-    """The family text ``label`` with its tripods' inset set to ``inset``."""
-    def one(item: str) -> str:
-        item = item.strip()
-        if not item.startswith("tripods"):
-            return item
-        fields = [f for f in item.split(":") if not f.startswith("inset=")]
-        return ":".join(fields + [f"inset={inset:.4g}"])
-    return ";".join(one(i) for i in label.split(";"))
+def tripod_inset(spec: FamilySpec) -> float | None:
+    """The tripods' inset of the family ``spec`` (None: no tripods item)."""
+    tripods = spec.first("tripods")
+    return None if tripods is None else float(tripods.option("inset", DEFAULT_INSET))
 
 
-def _tripod_inset(label: str) -> float | None:
-    """The tripods' inset of family text ``label`` (None: no tripods item)."""
-    for item in label.split(";"):
-        if item.strip().startswith("tripods"):
-            m = re.search(r"inset=([0-9.eE+-]+)", item)
-            return float(m.group(1)) if m else DEFAULT_INSET
-    return None
-
-
-def largest_inset(part, label: str, lo: float) -> float:
+def largest_inset(part, spec: FamilySpec, lo: float) -> float:
     """The largest tripod inset (share of ``a``) that still has members (the
-    search's space and the family text's drawn sample), to
-    ``INSET_RESOLUTION``, searched above ``lo``."""
+    search's space and the family's drawn sample), to ``INSET_RESOLUTION``,
+    searched above ``lo``."""
     def has_member(f):  # the search's space and the family text's sample both exist
         try:
-            member_space(part, _with_inset(label, f))
-            parse_support_family(_with_inset(label, f), part)
+            member_space(part, with_inset(spec, f))
+            parse_support_family(with_inset(spec, f), part)
             return True
         except PinfeedError:
             return False
@@ -206,19 +175,20 @@ def largest_inset(part, label: str, lo: float) -> float:
 def inset_axis(part, family, plans, st, make_family, progress=None, kept=()) -> dict:
     """The smallest tripod inset for which one of ``plans`` holds (the
     largest sub-family of legs far enough inside the outline)."""
-    inset0 = _tripod_inset(family.label)
+    spec = FamilySpec.parse(family.label)
+    inset0 = tripod_inset(spec)
     if inset0 is None:
-        return _not_found("inset", "the family has no tripods: no inset to narrow")
-    top = largest_inset(part, family.label, inset0)
+        return unanswered_axis("inset", "the family has no tripods: no inset to narrow")
+    top = largest_inset(part, spec, inset0)
     families = {}
 
     def holds_at(f):
         key = round(f, 4)
-        families[key] = families.get(key) or make_family(_with_inset(family.label, key))
+        families[key] = families.get(key) or make_family(with_inset(spec, key))
         return _holds(part, plans, families[key], st, progress, kept_members(part, kept, key))
-    value, found = _bisect(holds_at, inset0, top)
+    value, found = bisect_smallest(holds_at, inset0, top, STEPS)
     if found is None:
-        return _not_found("inset", f"no plan tried holds even for tripods at the largest inset with a "
+        return unanswered_axis("inset", f"no plan tried holds even for tripods at the largest inset with a "
                                    f"member ({top:.3f} a)")
     value = round(value, 4)
     return _answer("inset", value, "a", f"tripods whose legs stay at least {value:.3f} a "
@@ -229,7 +199,7 @@ def inset_axis(part, family, plans, st, make_family, progress=None, kept=()) -> 
 def friction_axis(part, family, plans, st, progress=None, kept=()) -> dict:
     """The widest friction range about the middle of ``st.mu_c`` for which one of ``plans`` holds."""
     if not isinstance(st.mu_c, (tuple, list)):
-        return _not_found("friction", f"the friction is one value ({st.mu_c:g}): no range to narrow")
+        return unanswered_axis("friction", f"the friction is one value ({st.mu_c:g}): no range to narrow")
     lo, hi = (float(x) for x in st.mu_c)
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
 
@@ -239,29 +209,31 @@ def friction_axis(part, family, plans, st, progress=None, kept=()) -> dict:
 
     def holds_at(h):
         return _holds(part, plans, family, dataclasses.replace(st, mu_c=at(h)), progress, kept)
-    value, found = _bisect(holds_at, 0.0, 1.0)
+    value, found = bisect_smallest(holds_at, 0.0, 1.0, STEPS)
     if found is None:
-        return _not_found("friction", f"no plan tried holds even at the middle friction {mid:g}")
+        return unanswered_axis("friction", f"no plan tried holds even at the middle friction {mid:g}")
     mu = at(value)
     text = f"{mu[0]:g}:{mu[1]:g}" if isinstance(mu, tuple) else f"{mu:g}"
     return _answer("friction", text, "", f"a friction range {text} (the family as given)", found, family)
 
 
-def tolerance_axis(part, family, plans, st, progress=None, kept=()) -> dict:
-    """The smallest tolerance (deg, to 0.5 deg) for which one of ``plans`` holds for the whole family."""
+def family_tolerance_axis(part, family, plans, st, progress=None, kept=()) -> dict:
+    """The smallest tolerance (deg, on the ladder of
+    :func:`~pipeline.planning.core.nearest_axes.ladder_up`) for which one of
+    ``plans`` holds for the whole family."""
     top = min(MAX_TOLERANCE, 180.0 / part.symmetry_order())
 
     def holds_at(t):
-        return _holds(part, plans, family, dataclasses.replace(st, tolerance=math.ceil(2 * t) / 2), progress, kept)
-    value, found = _bisect(holds_at, st.tolerance, top)
+        return _holds(part, plans, family, st.with_tolerance(ladder_up(t)), progress, kept)
+    value, found = bisect_smallest(holds_at, st.claims.tolerance_deg, top, STEPS)
     if found is None:
-        return _not_found("tolerance", f"no plan tried holds for the family within {top:g} deg")
-    value = math.ceil(2 * value) / 2
+        return unanswered_axis("tolerance", f"no plan tried holds for the family within {top:g} deg")
+    value = ladder_up(value)
     return _answer("tolerance", value, "deg", f"a tolerance of {value:g} deg (the family as given)", found,
                    family)
 
 
-def moving_axis(result: dict, moving_yes: dict | None = None) -> dict:
+def family_moving_axis(result: dict, moving_yes: dict | None = None) -> dict:
     """What the search's moving-pin stage found for the family: ``moving_yes``,
     the recommended moving-pin plan with its check and certificate, when one
     holds."""
@@ -275,9 +247,9 @@ def moving_axis(result: dict, moving_yes: dict | None = None) -> dict:
                 "certificate": cert}
     stage = result.get("moving_pin_search")
     if not stage:
-        return _not_found("moving pins", "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
-    return _not_found("moving pins", "searched after the fixed pins: no moving-pin plan holds for the family "
-                                     "either")
+        return unanswered_axis("moving pins", "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
+    return unanswered_axis("moving pins", "searched after the fixed pins: no moving-pin plan holds for the "
+                                          "family either")
 
 
 def nearest_yes(part, family, checker: FamilyChecker, result: dict, make_family, progress=None,
@@ -291,40 +263,13 @@ def nearest_yes(part, family, checker: FamilyChecker, result: dict, make_family,
     plans = rejected_plans(checker, fixed_only=moving_yes is not None)
     st = checker.settings
     if not plans:
-        return {"plans_tried": [], "axes": [_not_found(a, "no plan passed the sampled verification: nothing "
-                                                         "to loosen") for a in ("inset", "friction", "tolerance")]
-                + [moving_axis(result, moving_yes), more_pins_axis(result)]}
+        nothing = "no plan passed the sampled verification: nothing to loosen"
+        return {"plans_tried": [], "axes": [unanswered_axis(a, nothing) for a in ("inset", "friction", "tolerance")]
+                + [family_moving_axis(result, moving_yes), more_pins_axis(result)]}
     kept = kept_members(part, checker.breakers)
     axes = [inset_axis(part, family, plans, st, make_family, progress, kept),
             friction_axis(part, family, plans, st, progress, kept),
-            tolerance_axis(part, family, plans, st, progress, kept),
-            moving_axis(result, moving_yes), more_pins_axis(result)]
+            family_tolerance_axis(part, family, plans, st, progress, kept),
+            family_moving_axis(result, moving_yes), more_pins_axis(result)]
     return {"plans_tried": [list(p[0]) for p in plans], "steps": STEPS,
             "assumes": "holding is monotone along each axis (bisection)", "axes": axes}
-
-
-def more_pins_axis(result: dict) -> dict:
-    """The more-pins axis: not searched; the line says how to run the deeper search."""
-    depth = result.get("depth")
-    return _not_found("more pins", f"not searched (a deeper complete search costs more than the rest): "
-                                   f"run with --depth {depth + 1 if depth else 'N+1'} or a finer --pins grid")
-
-
-def nearest_yes_lines(nearest: dict) -> list[str]:
-    """The nearest "yes" for people: a heading and one line per axis."""
-    family = any("certificate" in axis for axis in nearest["axes"]) or "steps" in nearest
-    out = ["the nearest \"yes\" (each verified: worst-member search, then fresh members):" if family
-           else "the nearest \"yes\" (each verified by full rollouts):"]
-    for axis in nearest["axes"]:
-        if not axis["found"] or "certificate" not in axis:
-            verdict = axis.get("verdict") if axis["found"] else None
-            tail = (f": {' '.join(axis['plan'])} holds {verdict['in_tolerance']} of {verdict['trials']} "
-                    f"trials in one set" if verdict and axis.get("plan") else "")
-            out.append(f"  {axis['axis']}: {axis['statement']}{tail}")
-            continue
-        claim = axis["certificate"]["claim"]
-        verdict = "holds" if axis["holds"] else "does NOT hold on fresh members"
-        out.append(f"  {axis['axis']}: {axis['statement']}: {' '.join(axis['plan'])} {verdict} "
-                   f"(epsilon {100 * claim['epsilon']:.2f} % at beta {claim['beta']:g}, "
-                   f"{claim['violations']} of {claim['members']} fresh members outside)")
-    return out

@@ -10,7 +10,7 @@ its middle); a jam is outside.
 
 * :func:`shape_worst_member` searches the 2n vertex offsets for the member
   farthest outside the set, with the same seeded multi-start Nelder-Mead
-  as the support families (:func:`~pipeline.planning.family.worst_member.search_worst_member`),
+  as the support families (:func:`~pipeline.planning.family.member_search.search_worst_member`),
   started from every vertex pushed outwards and inwards along its bisector
   and from seeded random members.
 * :func:`shape_certificate` adds a fresh seeded sample of members (uniform
@@ -30,10 +30,14 @@ import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
-from pipeline.planning.claims.verify import replay, verify_dict
+from pipeline.planning.claims.replay import replay
+from pipeline.planning.core.settings import VerifySettings
 from pipeline.planning.family.certificate import scenario_claim
-from pipeline.planning.family.worst_member import (FamilyCheckSettings, MemberSpace, WorstMember, claimed_arc,
-                                                   outside, probe_inputs, search_worst_member)
+from pipeline.planning.family.member_search import (WorstMember, kernel_steps, outside, probe_inputs,
+                                                    search_worst_member)
+from pipeline.planning.family.member_spaces import MemberSpace
+from pipeline.planning.claims.plan_claim import claimed_arc
+from pipeline.planning.family.worst_member import FamilyCheckSettings
 
 FRESH_MEMBERS = 300
 STEPS = 5
@@ -54,10 +58,11 @@ class ShapeProbe:
     """Scores a member part on a plan: its own resting states, nominal and
     at every box corner, past the plan's pins."""
 
-    def __init__(self, part: Part, heights, mu_c, verify: dict, pin_radius=3.0, model="minpower", kernel=None):
+    def __init__(self, part: Part, heights, mu_c, verify: VerifySettings, pin_radius=3.0, model="minpower",
+                 kernel=None):
         self.part, self.heights, self.mu_c = part, tuple(float(h) for h in heights), mu_c
-        self.cfg, self.pin_radius, self.model = verify_dict(verify), float(pin_radius), model
-        self.kernel = {k: v for k, v in (kernel or {}).items() if k in ("ds_max", "tol")}
+        self.verify, self.pin_radius, self.model = verify, float(pin_radius), model
+        self.kernel = kernel_steps(kernel)
         self.nominal = np.zeros(0, int)
 
     def finals(self, member: Part | None) -> tuple[np.ndarray, np.ndarray]:
@@ -66,10 +71,16 @@ class ShapeProbe:
         if member is None:
             return np.array([np.nan]), np.array([True])
         n = len(self.heights)
-        (th, yc, mu, offs), self.nominal = probe_inputs(member, self.mu_c, n, self.cfg)
+        (th, yc, mu, offs), self.nominal = probe_inputs(member, self.mu_c, n, self.verify)
         tf, _, jam, _ = replay(member, list(self.heights), [0.0] * n, th, yc, mu, offs, self.pin_radius,
                                self.model, **self.kernel)
         return tf, jam != ""
+
+
+def _probe(part: Part, heights, st: FamilyCheckSettings) -> ShapeProbe:
+    """The shape probe of the plan of pins at ``heights`` under ``st``'s trials and mechanics."""
+    return ShapeProbe(part, heights, st.mu_c, st.verify, st.search.pin_radius, st.search.model,
+                      st.search.kernel_settings)
 
 
 class ShapeSpace:
@@ -133,7 +144,7 @@ def shape_worst_member(part: Part, heights, arc: tuple, tol: float, st, budget: 
     """The member within ``tol`` mm whose probe finals lie farthest outside
     ``arc`` (``(start, width)`` deg) for the plan of pins at ``heights``;
     ``st`` is a :class:`~pipeline.planning.family.worst_member.FamilyCheckSettings`."""
-    probe = ShapeProbe(part, heights, st.mu_c, st.verify, st.pin_radius, st.model, st.kernel)
+    probe = _probe(part, heights, st)
     space = MemberSpace(f"shape:tol:{tol:g}", [ShapeSpace(part, tol)], [])
     worst = search_worst_member(probe, space, arc, 360.0 / part.symmetry_order(), budget or st.budget, seed)
     worst.finals, _ = probe.finals(worst.support)  # the rows of the worst member's own resting states
@@ -147,7 +158,7 @@ def shape_certificate(part: Part, heights, arc: tuple, tol: float, st, members: 
     found and a fresh seeded sample (stream ``[verify.seed, 36]``), as a
     JSON-ready dict with ``holds`` and the ``claim`` (epsilon, beta)."""
     worst = shape_worst_member(part, heights, arc, tol, st)
-    probe = ShapeProbe(part, heights, st.mu_c, st.verify, st.pin_radius, st.model, st.kernel)
+    probe = _probe(part, heights, st)
     space = ShapeSpace(part, tol)
     rng = np.random.default_rng([int(st.seed), 36])
     period = 360.0 / part.symmetry_order()
@@ -224,7 +235,7 @@ def attach_shape_tolerance(result: dict, part: Part, settings, tol: float, progr
                                         "note": "no fixed-pin plan orients the part: nothing to certify"}
             continue
         st = FamilyCheckSettings.from_settings(settings.at(entry["mu_c"]))
-        arc = claimed_arc(rec["verification"]["orientation"], st.tolerance)
+        arc = claimed_arc(rec["verification"]["orientation"], st.claims.tolerance_deg)
         if progress:
             progress(f"shape tolerance {tol:g} mm for {' '.join(rec['pins'])} at mu_c {entry['friction']}")
         entry["shape_tolerance"] = certified_radius(part, rec["pin_heights_mm"], arc, tol, st)

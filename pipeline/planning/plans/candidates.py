@@ -9,7 +9,7 @@ from pipeline.planning.plans.planner import planner_for
 from pipeline.planning.tight.certify import carried_plan
 from pipeline.planning.tight.complete import FixedPinSearch
 from pipeline.planning.tight.records import FixedPlan, FixedSearch
-from pipeline.planning.claims.verify import ReplayMemo
+from pipeline.planning.claims.replay import ReplayMemo
 from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat
 
 

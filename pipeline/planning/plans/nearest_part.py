@@ -32,11 +32,9 @@ import math
 import numpy as np
 
 from pipeline.planning.claims import orient
-from pipeline.planning.family.nearest import MAX_TOLERANCE, more_pins_axis
+from pipeline.planning.core.nearest_axes import LADDER, MAX_TOLERANCE, more_pins_axis
 from pipeline.planning.tight.judge import TrialBench
 from pipeline.progress import NO_DEADLINE, Deadline, OutOfTime
-
-LADDER = 0.5  # deg: tolerances are answered on this ladder
 
 
 def _axis(axis: str, found: bool, statement: str, **extra) -> dict:
@@ -145,8 +143,8 @@ def _kept_tolerance(part, settings, plans, deadline: Deadline) -> tuple:
     return best, tried
 
 
-def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None,
-                   progress=None, deadline: Deadline = NO_DEADLINE) -> dict:
+def part_tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None,
+                        progress=None, deadline: Deadline = NO_DEADLINE) -> dict:
     """The smallest tolerance at which one of ``plans`` (``(labels, heights,
     speeds)``) orients ``part`` on held-out trials; when none does within
     ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
@@ -195,7 +193,7 @@ def tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int |
                  pin_speeds=[float(v) for v in (speeds or ())], verdict=verdict, **flags)
 
 
-def moving_axis(entry: dict, cut: bool = False) -> dict:
+def part_moving_axis(entry: dict, cut: bool = False) -> dict:
     """What the moving-pin stage found for the part (``cut``: a time limit
     ended the search before that stage)."""
     stage = entry.get("moving_pin_search")
@@ -243,11 +241,11 @@ def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = Non
     search chose from (label -> height, mm), searched again at looser
     tolerances when no kept plan answers. ``deadline``: a time limit; one
     that passes before the tolerance answer is whole leaves it to the kept
-    plans replayed, and the axis says so (see :func:`tolerance_axis`).
+    plans replayed, and the axis says so (see :func:`part_tolerance_axis`).
     Without ``pins`` only the kept plans are replayed; ``moving_cut``: a
     time limit ended the search before its moving pins."""
     depth = entry.get("depth")
-    tolerance = tolerance_axis(part, settings, plans, pins, depth, progress, deadline)
+    tolerance = part_tolerance_axis(part, settings, plans, pins, depth, progress, deadline)
     more = more_pins_axis(entry)
     searched = entry.get("fixed_pin_search") or {}
     if searched.get("complete") is False and searched.get("complete_to_pins", 0) < (depth or 0):
@@ -255,4 +253,4 @@ def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = Non
         more = _axis("more pins", False, "not searched: the time limit cut the search before its depth; "
                                          "run with a longer --time-limit first", partial=True)
     return {"plans_tried": [list(p[0]) for p in plans[:tolerance["replayed"]]],
-            "axes": [tolerance, moving_axis(entry, moving_cut), sensor_axis(entry), more]}
+            "axes": [tolerance, part_moving_axis(entry, moving_cut), sensor_axis(entry), more]}

@@ -27,7 +27,7 @@ trying every sequence, level by level:
 4. replay all the verification trials for the survivors and judge them
    (the *selection* trials);
 5. certify each sequence that orients on them on *held-out* trials
-   (``verify.holdout_settings``: a fresh seed no screen or selection drew
+   (``VerifySettings.held_out``: a fresh seed no screen or selection drew
    from, at least as many trials): only a sequence whose held-out verdict
    orients the part counts, so a sequence chosen because its sample was
    lucky does not pass (the winner's curse);
@@ -97,7 +97,7 @@ from pipeline.planning.tight.judge import Certifier, FamilyCheck, TrialBench, st
 from pipeline.planning.tight.records import CandidatePins, FixedPlan, FixedSearch, robust_order
 from pipeline.planning.tight.screen import LevelScreen
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
-from pipeline.planning.claims.verify import replay
+from pipeline.planning.claims.replay import replay
 from pipeline.progress import NO_DEADLINE, Deadline, Heartbeat, duration_text
 
 EVIDENCE_PER_LEVEL = 4  # several-set sequences judged per level when nothing orients
