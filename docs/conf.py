@@ -27,7 +27,16 @@ shutil.rmtree(HERE / "reference" / "generated", ignore_errors=True)
 import default_run  # noqa: E402
 
 DEFAULT_RUN = default_run.default_run()
-myst_substitutions = {"plans": DEFAULT_RUN["parts"]}
+
+# Plans of other parts and settings that pages state (the tutorial's drawings,
+# a support family, a shape tolerance, ...): run once by hand and kept in
+# docs/plans/NAME.json (docs/_ext/stored_plans.py, its registry names the
+# command of each). Pages quote them as {{ stored.NAME.KEY }} (e.g.
+# {{ stored.wedge.width }}; the keys are plan_numbers.numbers') and include
+# their console output from docs/_generated/stored/NAME.txt.
+import stored_plans  # noqa: E402
+
+myst_substitutions = {"plans": DEFAULT_RUN["parts"], "stored": stored_plans.write_generated()}
 
 project = "pinfeed"
 author = "pinfeed developers"
