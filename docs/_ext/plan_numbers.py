@@ -49,8 +49,21 @@ def candidate_heights(plan: dict) -> list[float]:
     return sorted(float(h) for h in entry(plan)["pins_used"].values())
 
 
-def claimed_set(plan: dict) -> list[tuple[float, float]]:
-    """The final orientation sets the plan claims: (start, width) in deg."""
+def claim(plan: dict) -> dict:
+    """The recommended plan's one claim (``claim`` in the plan file): the arc
+    it promises, its counts, its trials and perturbations."""
+    return recommended(plan)["claim"]
+
+
+def claim_arc(plan: dict) -> tuple[float, float]:
+    """The arc the plan claims: (start, width) in deg."""
+    arc = claim(plan)["arc"]
+    return float(arc["start"]), float(arc["width"])
+
+
+def carried_sets(plan: dict) -> list[tuple[float, float]]:
+    """The carried sets after the last pin (a propagated bound or a sampled
+    hull; not the claim): (start, width) in deg."""
     return [(float(s["start"]), float(s["width"])) for s in recommended(plan)["final_sets"]]
 
 
@@ -61,9 +74,9 @@ def verified_set(plan: dict) -> tuple[float, float] | None:
     return (float(s["start"]), float(s["width"])) if s else None
 
 
-def claim_kind(plan: dict) -> str:
-    """How the claimed sets were found: ``propagated`` or ``sampled``."""
-    return recommended(plan).get("claim", "propagated")
+def carried_kind(plan: dict) -> str:
+    """How the carried sets were found: ``propagated`` or ``sampled``."""
+    return recommended(plan).get("carried_sets_kind", "propagated")
 
 
 def verdict(plan: dict) -> dict:
@@ -72,18 +85,18 @@ def verdict(plan: dict) -> dict:
 
 
 def trials(plan: dict) -> int:
-    """Held-out trials of the recommended plan."""
-    return int(recommended(plan)["verification"]["trials"])
+    """The claim's trials (held-out; for a support family, the family check's)."""
+    return int(claim(plan)["trials"])
 
 
 def trials_in_set(plan: dict) -> int:
-    """Held-out trials in the best arc of the tolerance."""
-    return int(verdict(plan)["in_tolerance"])
+    """The claim's trials whose finals lie in its arc."""
+    return int(claim(plan)["in_arc"])
 
 
 def width(plan: dict) -> float | None:
-    """The verified width (deg)."""
-    return verdict(plan)["width_deg"]
+    """The claim's width (deg): the narrowest arc holding the required share of its trials."""
+    return claim(plan)["width_deg"]
 
 
 def untruncated(plan: dict) -> dict:
@@ -150,7 +163,6 @@ def numbers(plan: dict) -> dict[str, str]:
     """Every number a page may quote of a stored plan, formatted: key -> text.
     Only the keys that apply to the plan are present."""
     p, h, v = pins(plan), heights(plan), pin_speeds(plan)
-    o = verdict(plan)
     out = {
         "pins": " ".join(p), "n_pins": str(len(p)),
         "n_fixed": str(sum(1 for s in v if s == 0)), "n_moving": str(sum(1 for s in v if s != 0)),
@@ -158,13 +170,14 @@ def numbers(plan: dict) -> dict[str, str]:
         "pins_at": ", ".join(f"{q} at {y:g} mm" for q, y in zip(p, h)),
         "pins_path": " -> ".join(f"{q} at {y:g} mm" for q, y in zip(p, h)),
         "pins_arrow": " -> ".join(p),
-        "claimed_set": ", ".join(_arc(s, w) for s, w in claimed_set(plan)),
-        "n_claimed_sets": str(len(claimed_set(plan))), "claim_kind": claim_kind(plan),
+        "claim": claim(plan)["statement"], "claim_arc": _arc(*claim_arc(plan)),
+        "carried_sets": ", ".join(_arc(s, w) for s, w in carried_sets(plan)),
+        "n_carried_sets": str(len(carried_sets(plan))), "carried_kind": carried_kind(plan),
         "sets_of_tolerance": str(verdict(plan)["sets_within_tolerance"]),
         "trials": str(trials(plan)), "trials_in_set": str(trials_in_set(plan)),
         "in_set": f"{trials_in_set(plan)}/{trials(plan)}",
-        "share": _pct(o["share"]), "share_lower_bound": _pct(o["share_lower_bound"]),
-        "orients": "orients" if o["orients"] else "does not orient",
+        "share": _pct(claim(plan)["share"]), "share_lower_bound": _pct(claim(plan)["share_lower_bound"]),
+        "orients": "orients" if claim(plan)["orients"] else "does not orient",
         "tolerance": f"{tolerance(plan):g}",
         "n_states": str(len(resting_states(plan))),
         "state_thetas": ", ".join(f"{round(t, 1):g}" for t, _ in resting_states(plan)),
@@ -176,7 +189,7 @@ def numbers(plan: dict) -> dict[str, str]:
         out["width"] = f"{width(plan):.1f}"
     if verified_set(plan):
         out["verified_set"] = _arc(*verified_set(plan))
-    iv = o.get("width_interval_deg") or [None, None]
+    iv = claim(plan).get("width_interval_deg") or [None, None]
     if None not in iv:
         out["width_interval"] = f"{iv[0]:.1f}-{iv[1]:.1f}"
     margin = recommended(plan).get("margin")

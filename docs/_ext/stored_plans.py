@@ -145,10 +145,9 @@ REGISTRY: dict[str, Stored] = {
         what="the tutorial's wedge, the default search (with its speed limit)",
         args=("--outline", "wedge.dxf", "--mu-c", "0.2"),
         inputs={"wedge.dxf": _TUTORIAL_DRAWINGS["wedge.dxf"]},
-        pages={"tutorials/own-part.md": ("n_pins", "pins_at", "claimed_set", "in_set", "width", "tolerance",
+        pages={"tutorials/own-part.md": ("n_pins", "pins_at", "claim_arc", "in_set", "width", "tolerance",
                                          "speed_limit"),
-               "explanation/claims.md": ("in_set", "share", "tolerance", "share_lower_bound", "width",
-                                         "width_interval"),
+               "explanation/claims.md": ("claim_arc", "in_set", "share_lower_bound", "width"),
                "reference/glossary.md": ("in_set", "tolerance", "share_lower_bound")},
         quoted={"tutorials/own-part.md": (
             "wedge, plan {pins} (mu_c {friction}, mu_s 0.5): speed limit {speed_limit} mm/s "
@@ -157,7 +156,8 @@ REGISTRY: dict[str, Stored] = {
         what="the tutorial's gusset bracket with holes, the default search",
         args=("--outline", "holed_bracket.dxf", "--mu-c", "0.2"),
         inputs={"holed_bracket.dxf": _TUTORIAL_DRAWINGS["holed_bracket.dxf"]},
-        pages={"tutorials/own-part.md": ("pins", "n_claimed_sets", "claimed_set", "in_set", "width", "tolerance")},
+        pages={"tutorials/own-part.md": ("pins", "n_carried_sets", "carried_sets", "claim_arc", "in_set", "width",
+                                           "tolerance")},
         quoted={"tutorials/own-part.md": ("holed_bracket, plan 1: {pins} (mu_c {friction})",)}),
     "first_plan": Stored(
         what="the paper-feeder tutorial's first plan: the default asymmetric triangle at mu_c 0.2",
@@ -184,7 +184,7 @@ REGISTRY: dict[str, Stored] = {
         pages={"explanation/support-family-claims.md": (
             "fixed_4_sequences", "fixed_4_nominal_within", "fixed_4_broken_by_known_member", "fixed_4_judged",
             "fixed_4_orienting", "n_moving", "prefix_pins", "moving_pins_described", "pins",
-            "family_worst_inside", "in_set", "width", "untruncated_width", "fresh_members", "fresh_outside",
+            "family_worst_inside", "claim", "untruncated_width", "fresh_members", "fresh_outside",
             "epsilon", "beta", "nearest_inset", "nearest_friction", "nearest_tolerance")}),
     "shape_tolerance": Stored(
         what="the default asymmetric triangle's plan certified for a 0.2 mm shape tolerance",
