@@ -179,7 +179,8 @@ class FixedPinSearch:
         self.width_slack = float(search.width_slack_deg)
         nominal = None if bench.family is None else [bench.supports[k] for k in bench.family.representatives]
         self.tree = NominalTree(part, self.pins.heights, self.friction.nominal, bench.pin_radius, search.model,
-                                bench.kernel, float(bench.cfg["pin_halfwidth"]), search.d_min, search.d_max,
+                                bench.step.as_kwargs(), float(bench.verify.perturbation.pin_halfwidth),
+                                search.d_min, search.d_max,
                                 belt=bench.belt, speeds=self.pins.speeds, supports=nominal)
         self.prefix = FixedPlan((), (), 0.0, np.inf)  # the pins every sequence starts with (run)
         # The best results when nothing orients (``best_effort``): the moving-pin stage keeps
@@ -393,7 +394,7 @@ class FixedPinSearch:
         speeds = prefix.speeds or (0.0,) * n
         theta, y_c, jam, _ = replay(bench.part, list(prefix.heights), list(speeds), states[:, 0], states[:, 1],
                                     np.full(len(states), self.friction.nominal), np.zeros((len(states), n)),
-                                    bench.pin_radius, bench.model, bench.kernel["ds_max"], bench.kernel["tol"],
+                                    bench.pin_radius, bench.model, bench.step.ds_max, bench.step.tol,
                                     **bench.belt, support=self.tree.column_support, supports=self.tree.supports)
         if (jam != "").any():
             return None

@@ -81,20 +81,9 @@ class TrialBench:
         self.supports = None if self.family is None else self.family.kernel_supports
         self.kept = PrefixStates()
 
-    # The bench as dicts, for tight/complete.py until it reads the typed settings above.
-    @property
-    def cfg(self) -> dict:
-        """The verification's trials as a flat dict (:meth:`VerifySettings.as_dict`); read ``verify``."""
-        return self.verify.as_dict()
-
-    @property
-    def kernel(self) -> dict:
-        """The kernel's step as rollout keywords; read ``step``."""
-        return self.step.as_kwargs()
-
     @property
     def belt(self) -> dict:
-        """``{"belt_speed", "mu_s"}`` of the dynamic model, ``{}`` quasi-static; read ``belt_speed``, ``mu_s``."""
+        """The dynamic model's keywords ``{"belt_speed", "mu_s"}`` for a rollout, ``{}`` quasi-static."""
         return {} if self.belt_speed is None else {"belt_speed": self.belt_speed, "mu_s": self.mu_s}
 
     def trials(self, n_pins: int) -> list:
