@@ -1,8 +1,9 @@
 """Typed settings all the way down in the planner: no settings parameter is a dict.
 
-The planner's settings are read from a config once, in
-``pipeline/planning/core/settings.py`` (:data:`READER`: ``PlannerSettings``
-and the typed parts beside it), and travel as those objects. So no function
+The planner's settings are read from a config once, in the package
+``pipeline/planning/core/settings/`` (:data:`READER`: ``PlannerSettings``
+and the typed parts beside it, every module of it), and travel as those
+objects. So no function
 of ``pipeline/planning`` takes a parameter whose name says it carries
 settings (:data:`SETTINGS_NAMES`, or a name ending in one of
 :data:`SETTINGS_SUFFIXES`) annotated as a dict (``dict``, ``dict | None``,
@@ -23,7 +24,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 PLANNING = ROOT / "pipeline" / "planning"
-READER = "pipeline/planning/core/settings.py"  # the one place config dicts become typed settings
+READER = "pipeline/planning/core/settings/"  # the one package where config dicts become typed settings
 
 SETTINGS_NAMES = frozenset({"settings", "cfg", "config", "verify", "claims", "search", "planner", "options",
                             "params"})
@@ -105,7 +106,7 @@ def planning_offenders() -> dict[str, str]:
     out = {}
     for path in sorted(PLANNING.rglob("*.py")):
         where = path.relative_to(ROOT).as_posix()
-        if where != READER:
+        if not where.startswith(READER):
             out.update(dict_settings_parameters(path.read_text(), where))
     return out
 
@@ -128,6 +129,17 @@ def fine(settings: "VerifySettings | None" = None, kernel: dict | None = None, l
     found = dict_settings_parameters(src, "f.py")
     assert sorted(found) == ["f.py:K.m:planner", "f.py:K:verify", "f.py:a:settings", "f.py:b:verify",
                              "f.py:c:search_settings", "f.py:d:claims", "f.py:e:cfg", "f.py:f:config"]
+
+
+def test_the_reader_is_the_settings_package():
+    reader = ROOT / READER
+    assert (reader / "__init__.py").is_file(), f"{READER} is not a package"
+    modules = sorted(p.name for p in reader.glob("*.py") if p.name != "__init__.py")
+    assert modules, f"{READER} has no modules"
+    # what the reader skips is the package alone: the planner's other modules are all checked
+    skipped = [p for p in PLANNING.rglob("*.py") if p.relative_to(ROOT).as_posix().startswith(READER)]
+    assert sorted(p.name for p in skipped if p.name != "__init__.py") == modules
+    assert all(p.parent == reader for p in skipped)
 
 
 def test_no_settings_parameter_in_the_planner_is_a_dict():

@@ -1,4 +1,5 @@
-"""Typed plan records (``pipeline.planning.core.types``) and the schema of stored plan
+"""Typed plan records (``pipeline.planning.core.types`` and
+``pipeline.planning.core.plan_records``) and the schema of stored plan
 files: files written by the current code validate and round-trip exactly;
 hand-broken files are refused with the one-line error naming the file."""
 from __future__ import annotations
@@ -16,8 +17,9 @@ from pipeline.errors import PinfeedError
 from pipeline.maps.io import write_json
 from pipeline.parts.part import Part
 from pipeline.planning.paper.planner import Planner, load_maps
-from pipeline.planning.core.types import (SCHEMA_PATH, Plan, PlanFile, Step, TightEntry, Verification,
-                                     load_plan, plan_schema, validate_plan_dict, validate_plan_file)
+from pipeline.planning.core.plan_records import Plan, Step, Verification
+from pipeline.planning.core.types import (SCHEMA_PATH, PlanFile, TightEntry, load_plan, plan_schema,
+                                          validate_plan_dict, validate_plan_file)
 
 VERTICES = "0,0 60,0 15,35"
 

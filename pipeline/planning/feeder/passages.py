@@ -101,7 +101,7 @@ def _chosen_plan(result, plan_index):
 
 def _resting_states(*stored) -> dict:
     """label -> ``(theta_deg, y_c_mm)`` of the first non-empty of ``stored``
-    (label -> :class:`~pipeline.planning.core.types.RestingState` maps or None):
+    (label -> :class:`~pipeline.planning.core.plan_records.RestingState` maps or None):
     ``pinfeed plan --mode tight`` files keep them per friction entry only."""
     found = next((s for s in stored if s), {})
     return {k: (float(s.theta), float(s.y_c)) for k, s in found.items()}

@@ -239,7 +239,7 @@ def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=
 
 
 def stored_speed_limit(plan) -> dict | None:
-    """The speed limit stored with a tight plan (a :class:`~pipeline.planning.core.types.Plan`
+    """The speed limit stored with a tight plan (a :class:`~pipeline.planning.core.plan_records.Plan`
     or its dict; see :func:`attach_speed_limits`), or None."""
     extra = plan.get("speed_limit") if isinstance(plan, dict) else plan.extra.get("speed_limit")
     return extra or None

@@ -5,8 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from pipeline.errors import PinfeedError
+from pipeline.planning.core.plan_records import Plan
 from pipeline.planning.core.settings import Friction
-from pipeline.planning.core.types import Plan, TightEntry, as_plan_file
+from pipeline.planning.core.types import TightEntry, as_plan_file
 
 
 def tight_entry(plan_result, friction=None) -> TightEntry:
