@@ -50,7 +50,7 @@ This file holds no logic: it hands on the names of its modules.
 """
 from __future__ import annotations
 
-from pipeline.planning.core.settings.claim import (RULES, ClaimSettings, check_confidence, check_required,
+from pipeline.planning.core.settings.claim_rules import (RULES, ClaimSettings, check_confidence, check_required,
                                                    check_rule, check_tolerance)
 from pipeline.planning.core.settings.defaults import schema_value
 from pipeline.planning.core.settings.friction import Friction, friction_label, nominal_friction, parse_friction

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 from pipeline.checks import check_time_limit
 from pipeline.config import schema_default
-from pipeline.planning.core.settings.claim import ClaimSettings
+from pipeline.planning.core.settings.claim_rules import ClaimSettings
 from pipeline.planning.core.settings.defaults import schema_value
 from pipeline.planning.core.settings.friction import Friction
 from pipeline.planning.core.settings.stages import SpeedSettings
