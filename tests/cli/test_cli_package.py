@@ -104,7 +104,7 @@ def test_symmetric_part_plan_lists_one_arc_per_carried_set(tmp_path, capsys, mon
         # The claim names one arc in [0, 180) and says its copy is the same set.
         assert "or a copy of it every 180 deg, by symmetry" in claim
         assert plan["claim"]["arc"]["start"] % 180 == pytest.approx(
-            float(re.search(r"in (\d+\.\d)-", claim).group(1)), abs=0.051)
+            float(re.search(r"(\d+\.\d)-\d+\.\d deg", claim).group(1)), abs=0.051)
         shown = re.findall(r"(\d+\.\d)-(\d+\.\d) deg", line.split("not the claim): ", 1)[1].split(";")[0])
         assert line.split(";")[0].endswith("(x2 by symmetry)")
         assert len(shown) == plan["n_final_sets"]  # one arc per set, not its copy 180 deg away
