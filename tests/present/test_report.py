@@ -135,7 +135,7 @@ def test_report_numbers_match_the_verify_json(workflow):
         for t in json.loads((results / "plans" / f"{name}.json").read_text())["tight"]:
             claim = (t["recommended"] or {}).get("claim")
             if claim:
-                cells.append((claim["statement"], [f"{claim['in_arc']}/{claim['trials']} held-out trials in it",
+                cells.append((claim["statement"], [f"{claim['in_arc']}/{claim['trials']} held-out trials",
                                                    f"seed {claim['trials_drawn']['seed']}"]))
     shown = [r[6] for r in side if r[0].startswith("tight")]
     assert len(shown) == len(cells) and cells
