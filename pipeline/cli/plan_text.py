@@ -26,14 +26,23 @@ def _plan_summary(plan, pins=None) -> dict:
     the held-out replay's counts."""
     heights = plan.get("pin_heights_mm") or [pins[p] for p in plan["pins"]]
     claim = plan.get("claim")
-    older = claim if isinstance(claim, str) else None  # files written before claims were records
-    kind = plan.get("carried_sets_kind") or older or ("propagated" if plan.get("mode") == "tight" else "paper bands")
+    kind = carried_kind(plan, plan.get("mode") == "tight")
     return {"pins": list(plan["pins"]), "pin_heights_mm": list(heights),
             "claim": claim if isinstance(claim, dict) else None,
             "carried_sets": {"kind": kind, "n_sets": plan.get("n_final_sets"), "sets": plan["final_sets"],
                              "note": CARRIED_NOTE.get(kind, "not the claim")},
             "selection": _selection_counts(plan),
             "verification": _verification_counts(plan)}
+
+
+def carried_kind(keys: dict, tight: bool = True) -> str:
+    """How a plan's carried sets were found, from its stored keys: ``propagated``
+    or ``sampled`` (``carried_sets_kind``; in files written before claims were
+    records, the string ``claim``), else ``propagated`` for a tight plan and
+    ``paper bands`` for paper mode's."""
+    older = keys.get("claim")
+    return keys.get("carried_sets_kind") or (older if isinstance(older, str) else None) or (
+        "propagated" if tight else "paper bands")
 
 
 CARRIED_NOTE = {
@@ -153,10 +162,10 @@ def _print_claim(plan, order: int, mu_range: bool = False) -> None:
     then the margin in words (``mu_range``: the friction is a range, drawn
     uniformly). A plan file written before claims were recorded prints its
     held-out verdict instead."""
-    from pipeline.planning import Claim, describe_untruncated, margin_text
+    from pipeline.planning import Claim, margin_text
     v = plan.verification
     claim = plan.extra.get("claim")
-    kind = plan.extra.get("carried_sets_kind", claim if isinstance(claim, str) else "propagated")
+    kind = carried_kind(plan.extra)
     if isinstance(claim, dict):
         c = Claim.from_dict(claim)
         print(f"      claim: {c.statement()}")

@@ -191,8 +191,14 @@ def judge_verification(result: dict, tolerance: float, order: int = 1,
     """:func:`judge` on the trials of a ``verify.verify_plan`` result (its
     ``trials_detail``; jammed trials count as failures), with the verified
     width's bootstrap interval."""
-    finals = [t["final_theta"] for t in result["trials_detail"] if not t["reason"].startswith("jammed")]
-    return judge(finals, result["trials"], tolerance, order, required, confidence, interval=True, rule=rule)
+    return judge(verification_finals(result), result["trials"], tolerance, order, required, confidence,
+                 interval=True, rule=rule)
+
+
+def verification_finals(result: dict) -> list:
+    """The final orientations (deg) of the trials of a ``verify.verify_plan``
+    result that did not jam."""
+    return [t["final_theta"] for t in result["trials_detail"] if not t["reason"].startswith("jammed")]
 
 
 def describe_claim(verdict: dict) -> str:

@@ -10,12 +10,15 @@ finals in the printed arc gets the printed numbers.
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from pipeline.planning.claims.confidence import share_lower_bound
-from pipeline.planning.claims.orient import best_arc
+from pipeline.planning.claims.orient import best_arc, max_failures
+from pipeline.planning.core.arcs import in_arc
 from pipeline.planning.core.claim import Claim
-from pipeline.planning.core.settings import TRUNCATE_SIGMA, ClaimSettings, VerifySettings
+from pipeline.planning.core.settings import ClaimSettings, VerifySettings
 
 UNIFORM = "the part (uniform pressure)"
 
@@ -54,28 +57,28 @@ def count_in_arc(finals, arc: tuple, order: int = 1) -> int:
     distinct orientations (period ``360 / order``), its ends widened by
     ``EDGE_DEG`` (many trials can end at exactly the same orientation, on
     the end of the arc that holds them)."""
-    period = 360.0 / order
-    x = np.mod(np.asarray(finals, float) - (arc[0] - EDGE_DEG), period)
-    return int(np.count_nonzero(x <= arc[1] + 2 * EDGE_DEG))
+    return int(np.count_nonzero(in_arc(np.asarray(finals, float), arc[0] - EDGE_DEG, arc[1] + EDGE_DEG,
+                                       tol=EDGE_DEG, period=360.0 / order)))
 
 
-def trials_drawn(verify: VerifySettings, rows: list, seed: int, held_out: bool) -> dict:
-    """How the claim's trials were drawn: held-out or not, the seed, and per
-    resting state the random trials and the box corners (``rows``: the
-    verification's per-state rows)."""
-    random = int(verify.holdout_trials or verify.trials) if held_out else int(verify.trials)
+def trials_drawn(verify: VerifySettings, rows: list) -> dict:
+    """How the claim's trials were drawn: ``verify`` are the settings they
+    were drawn with (``VerifySettings.held_out`` for held-out trials), ``rows``
+    the verification's per-state rows; held-out or not, the seed, and per
+    resting state the random trials and the box corners."""
     per_state = sorted({int(r["trials"]) for r in rows})
-    corners = sorted({max(0, n - random) for n in per_state}) if verify.corners else [0]
-    return {"kind": "held-out" if held_out else "selection", "seed": int(seed), "states": len(rows),
-            "random_per_state": random, "corners_per_state": corners[0] if len(corners) == 1 else corners}
+    corners = sorted({max(0, n - int(verify.trials)) for n in per_state}) if verify.corners else [0]
+    return {"kind": "held-out" if verify.holdout else "selection", "seed": int(verify.seed), "states": len(rows),
+            "random_per_state": int(verify.trials),
+            "corners_per_state": corners[0] if len(corners) == 1 else corners}
 
 
 def perturbations(verify: VerifySettings, mu_c) -> dict:
     """The sizes of the errors each trial draws, and where the normals are cut."""
     p = verify.perturbation
     friction = ({"uniform": [float(mu_c[0]), float(mu_c[1])]} if isinstance(mu_c, (tuple, list))
-                else {"normal_sigma": p.mu_sigma, "cut_at_sigma": TRUNCATE_SIGMA, "floor": 0.0})
-    return {"theta_deg": {"normal_sigma": p.theta_sigma, "cut_at_sigma": TRUNCATE_SIGMA},
+                else {"normal_sigma": p.mu_sigma, "cut_at_sigma": verify.truncate_sigma, "floor": 0.0})
+    return {"theta_deg": {"normal_sigma": p.theta_sigma, "cut_at_sigma": verify.truncate_sigma},
             "y_c_mm": {"uniform_halfwidth": p.y_halfwidth},
             "mu_c": friction, "pin_offset_mm": {"uniform_halfwidth": p.pin_halfwidth},
             "corners": "every corner of the box: theta and mu_c at their cuts, y_c and each pin at their "
@@ -95,12 +98,11 @@ def held_out_claim(verdict: dict, finals, claims: ClaimSettings, order: int, dra
         arc = (round(best_arc(finals, tol, order)[1] % 360.0, 4), tol)
     n = int(verdict["trials"])
     inside = count_in_arc(finals, arc, order)
-    lower = share_lower_bound(inside, n, claims.confidence) if n else 0.0
-    share = inside / n if n else 0.0
-    clears = share >= claims.required and (claims.rule == "point" or lower >= claims.required)
+    share, lower = _share(inside, n, claims.confidence)
+    clears = n > 0 and n - inside <= max_failures(n, claims.required, claims.confidence, claims.rule)
     interval = verdict.get("width_interval_deg")
     return Claim(subject, bool(verdict["orients"] and clears), arc, tol, claims.rule, claims.required,
-                 claims.confidence, inside, n, int(verdict["jammed"]), round(share, 6), round(lower, 6),
+                 claims.confidence, inside, n, int(verdict["jammed"]), share, lower,
                  verdict.get("width_deg"), verdict.get("spread_deg"), drawn, perturbed,
                  tuple(interval) if interval else None, int(order),
                  sets_within_tolerance=verdict.get("sets_within_tolerance"))
@@ -119,7 +121,7 @@ def with_untruncated(claim: Claim, record: dict | None) -> Claim:
               "box_corners": False,
               "note": "random draws from normals that are not cut; the box corners are not replayed here "
                       "(they are among the claim's own trials)"}
-    return _replace(claim, untruncated=beside)
+    return replace(claim, untruncated=beside)
 
 
 def family_claim(claim: Claim, label: str, check: dict, certificate: dict | None = None) -> Claim:
@@ -141,16 +143,18 @@ def family_claim(claim: Claim, label: str, check: dict, certificate: dict | None
                       holds=bool(certificate["holds"]))
     n = int(verdict["trials"])
     inside = int(verdict["in_tolerance"])
-    lower = share_lower_bound(inside, n, claim.confidence) if n else 0.0
-    return _replace(claim, subject=f"every member of the support family {label}", arc=arc, in_arc=inside,
-                    trials=n, jammed=int(verdict.get("jammed", 0)), share=round(inside / n, 6) if n else 0.0,
-                    share_lower_bound=round(lower, 6), orients=bool(verdict["orients"] and family["holds"]),
-                    width_deg=verdict.get("width_deg"), spread_deg=verdict.get("spread_deg"),
-                    width_interval_deg=None, trials_drawn=dict(claim.trials_drawn, kind="family check",
-                                                               members=check.get("members")),
-                    family=family)
+    share, lower = _share(inside, n, claim.confidence)
+    return replace(claim, subject=f"every member of the support family {label}", arc=arc, in_arc=inside,
+                   trials=n, jammed=int(verdict.get("jammed", 0)), share=share,
+                   share_lower_bound=lower, orients=bool(verdict["orients"] and family["holds"]),
+                   width_deg=verdict.get("width_deg"), spread_deg=verdict.get("spread_deg"),
+                   width_interval_deg=None, trials_drawn=dict(claim.trials_drawn, kind="family check",
+                                                              members=check.get("members")),
+                   family=family)
 
 
-def _replace(claim: Claim, **changes) -> Claim:
-    from dataclasses import replace
-    return replace(claim, **changes)
+def _share(inside: int, n: int, confidence: float) -> tuple[float, float]:
+    """``(share, lower bound)`` of ``inside`` of ``n`` trials (to 6 decimals; 0 without trials)."""
+    if not n:
+        return 0.0, 0.0
+    return round(inside / n, 6), round(share_lower_bound(inside, n, confidence), 6)

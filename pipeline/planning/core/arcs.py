@@ -8,11 +8,12 @@ from __future__ import annotations
 import numpy as np
 
 
-def in_arc(x, start, width, tol=1e-9):
-    """True where angle ``x`` lies in the arc ``start + [0, width]``."""
-    if width >= 360.0:
+def in_arc(x, start, width, tol=1e-9, period=360.0):
+    """True where angle ``x`` lies in the arc ``start + [0, width]`` on a circle
+    of ``period`` degrees (``360 / order`` for a part with ``order``-fold symmetry)."""
+    if width >= period:
         return np.ones(np.shape(x), dtype=bool)
-    return (np.asarray(x) - start) % 360.0 <= width + tol
+    return (np.asarray(x) - start) % period <= width + tol
 
 
 def arc_within(inner, outer, tol=1e-6) -> bool:

@@ -67,7 +67,8 @@ class Claim:
 
     KEYS = ("statement", "subject", "orients", "arc", "tolerance_deg", "rule", "required", "confidence",
             "in_arc", "trials", "jammed", "share", "share_lower_bound", "width_deg", "spread_deg",
-            "width_interval_deg", "symmetry_order", "sets_within_tolerance", "trials_drawn", "perturbations", "untruncated", "family")
+            "width_interval_deg", "symmetry_order", "sets_within_tolerance", "trials_drawn", "perturbations",
+            "untruncated", "family")
 
     @classmethod
     def from_dict(cls, d: dict) -> "Claim":
@@ -78,7 +79,8 @@ class Claim:
                    d["required"], d["confidence"], d["in_arc"], d["trials"], d["jammed"], d["share"],
                    d["share_lower_bound"], d.get("width_deg"), d.get("spread_deg"), dict(d["trials_drawn"]),
                    dict(d["perturbations"]), tuple(interval) if interval is not None else None,
-                   int(d.get("symmetry_order", 1)), d.get("sets_within_tolerance"), d.get("untruncated"), d.get("family"), {k: v for k, v in d.items() if k not in cls.KEYS})
+                   int(d.get("symmetry_order", 1)), d.get("sets_within_tolerance"), d.get("untruncated"),
+                   d.get("family"), {k: v for k, v in d.items() if k not in cls.KEYS})
 
     def to_dict(self) -> dict:
         """The stored dict (with its one-line ``statement`` first)."""

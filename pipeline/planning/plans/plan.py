@@ -47,7 +47,7 @@ from pipeline.planning.plans.for_family import certify_for_family, family_checke
 from pipeline.planning.plans.nearest_part import part_nearest_yes
 from pipeline.planning.plans.planner import mechanics_label, planner_belt, planner_for, planner_pin_heights
 from pipeline.planning.tight.store import load_lattice, save_lattice
-from pipeline.planning.claims.orient import describe_claim, judge_verification
+from pipeline.planning.claims.orient import describe_claim, judge_verification, verification_finals
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import TRUNCATE_SIGMA, PlannerSettings
 from pipeline.planning.claims.replay import ReplayMemo
@@ -187,7 +187,7 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
                           mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1), memo=memo)
         verdict = judge_verification(res, claims.tolerance_deg, planner.order, claims.required,
                                      claims.confidence, claims.rule)
-        plan.claim = _held_out_claim(settings, res, verdict, planner.order, held_out.seed, family)
+        plan.claim = _held_out_claim(settings, held_out, res, verdict, planner.order, family)
         plan.verification = {"held_out": True, "seed": held_out.seed,
                              "trials": res["trials"], "successes": res["successes"],
                              "failures": res["failures"], "rows": res["rows"], "model": res["model"],
@@ -203,14 +203,13 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
     beat.finish()
 
 
-def _held_out_claim(settings: PlannerSettings, res: dict, verdict: dict, order: int, seed: int, family=None):
-    """The plan's one claim on its held-out replay ``res`` (``verify_plan``),
-    judged as ``verdict`` (with a support ``family``: on its drawn members,
-    until the family's own check makes it the family's claim)."""
-    finals = [t["final_theta"] for t in res["trials_detail"] if not t["reason"].startswith("jammed")]
-    drawn = trials_drawn(settings.verify, res["rows"], seed, held_out=True)
-    return held_out_claim(verdict, finals, settings.claims, order, drawn,
-                          perturbations(settings.verify, settings.friction.value),
+def _held_out_claim(settings: PlannerSettings, held_out, res: dict, verdict: dict, order: int, family=None):
+    """The plan's one claim on its replay ``res`` (``verify_plan``) of the
+    ``held_out`` trials (``VerifySettings.held_out``), judged as ``verdict``
+    (with a support ``family``: on its drawn members, until the family's own
+    check makes it the family's claim)."""
+    return held_out_claim(verdict, verification_finals(res), settings.claims, order,
+                          trials_drawn(held_out, res["rows"]), perturbations(held_out, settings.friction.value),
                           UNIFORM if family is None else drawn_members(family.label))
 
 
