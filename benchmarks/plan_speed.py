@@ -55,7 +55,7 @@ def main() -> None:
         part = Part.from_vertices(PARTS[name], name=name)
         with tempfile.TemporaryDirectory() as root:
             t0 = time.perf_counter()
-            res = plan_tight_all(part, PlannerSettings.from_config(config), root)[0]
+            res = plan_tight_all(part, PlannerSettings.from_config(config), root)[0].to_dict()
             dt = time.perf_counter() - t0
         times.append(dt)
         rec = res["recommended"]

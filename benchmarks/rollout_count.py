@@ -106,7 +106,7 @@ def main() -> None:
         part = Part.from_vertices(PARTS[name], name=name)
         with tempfile.TemporaryDirectory() as root:
             c0, t0 = os.times(), time.perf_counter()
-            res = plan_tight_all(part, PlannerSettings.from_config(config), root)[0]
+            res = plan_tight_all(part, PlannerSettings.from_config(config), root)[0].to_dict()
             wall, c1 = time.perf_counter() - t0, os.times()
         cpu = (c1.user - c0.user) + (c1.system - c0.system)
         answer = _clean({k: v for k, v in res.items() if k != "lattices"})

@@ -52,7 +52,8 @@ _WHERE = {
                      "SpeedPerturbation SpeedSettings VerifySettings candidate_pins fitted_pins friction_label "
                      "nominal_friction parse_friction",
     "core.claim": "Claim",
-    "core.types": "PlanFile as_plan_file load_plan validate_plan_file",
+    "core.plan_records": "ABSENT Plan RestingState",
+    "core.types": "PlanFile TightEntry as_plan_file load_plan validate_plan_file",
     "core.nearest_axes": "nearest_yes_lines",
     "claims.orient": "check_tolerance describe_claim min_trials narrowest_arc",
     "claims.tails": "describe_untruncated truncation_text untruncated_check",

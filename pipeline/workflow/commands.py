@@ -10,6 +10,7 @@ Each function imports the planner's names it uses when it runs, so that
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 
 from pipeline.errors import PinfeedError
@@ -104,15 +105,17 @@ def named_part(config: dict, name: str | None) -> Part:
     return entry_part(e)
 
 
-def plan_tight_only(part: Part, settings: PlannerSettings, catalog_root, progress=None, deadline=None) -> dict:
-    """A plan file with the tight planner's plans only (``pinfeed plan --mode tight``);
-    ``deadline``: its time limit (default: ``planner.time_limit_s`` from now)."""
-    from pipeline.planning import plan_tight_all, planner_belt
+def plan_tight_only(part: Part, settings: PlannerSettings, catalog_root, progress=None, deadline=None):
+    """The record of a plan file with the tight planner's plans only
+    (``pinfeed plan --mode tight``; a
+    :class:`~pipeline.planning.core.types.PlanFile`); ``deadline``: its time
+    limit (default: ``planner.time_limit_s`` from now)."""
+    from pipeline.planning import PlanFile, plan_tight_all, planner_belt
     belt_speed, mu_s = planner_belt(settings.search, part)
     belt = {} if belt_speed is None else {"belt_speed": belt_speed, "mu_s": mu_s}
-    return {"part": part.to_dict(), "model": settings.search.model, **belt,
-            "tight": plan_tight_all(part, settings, catalog_root, progress=progress, deadline=deadline),
-            **provenance_attrs()}
+    return PlanFile(part.to_dict(), settings.search.model,
+                    tight=tuple(plan_tight_all(part, settings, catalog_root, progress=progress, deadline=deadline)),
+                    extra={**belt, **provenance_attrs()})
 
 
 def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
@@ -120,7 +123,8 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     ``mode`` (``tight``, ``paper`` or ``both``), each verified, the tight ones
     with their speed limit (``speed_limit.attach_speed_limits``). A belt speed
     plans with the tight planner only (a one-line error otherwise). The
-    planner's settings are made here, once, from ``config``.
+    planner's settings are made here, once, from ``config``. The plans are
+    records until the end, where the plan file's dict is made.
 
     With ``planner.time_limit_s`` (``--time-limit``, tight mode only) the
     time runs from here: the planner stops its searches in time
@@ -151,36 +155,37 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
                            "use --mode tight, or leave the time limit out")
     if mode == "tight":
         result = plan_tight_only(part, settings, config["catalog_dir"], progress=progress, deadline=deadline)
-        if not deadline.limited:
-            from pipeline.workflow.plan import with_shape_tolerance
-            return with_shape_tolerance(attach_speed_limits(result, settings), part, settings, progress)
-        return _time_limited_stages(result, settings, deadline)
+        if deadline.limited:
+            return _time_limited_stages(result, part, settings, deadline).to_dict()
+        from pipeline.workflow.plan import with_shape_tolerance
+        return with_shape_tolerance(attach_speed_limits(result, settings, part), part, settings, progress).to_dict()
     from pipeline.workflow.plan import ensure_maps, plan_part
     cat = ensure_maps(config, part)
     result = plan_part(cat, part.id, settings, progress=progress, tight=mode == "both")
     if mode == "paper":
-        result.pop("tight")
-    return attach_speed_limits(result, settings)
+        result = dataclasses.replace(result, tight=None)
+    return attach_speed_limits(result, settings, part).to_dict()
 
 
-def _time_limited_stages(result: dict, settings, deadline) -> dict:
-    """The stages after the tight planner under a time limit: the speed limits
-    while time is left; the shape tolerance's search (a search of its own) not
-    at all. What is skipped joins the first entry's ``unsearched``."""
+def _time_limited_stages(result, part: Part, settings, deadline):
+    """The stages after the tight planner under a time limit, on the plan
+    file's record ``result``: the speed limits while time is left; the shape
+    tolerance's search (a search of its own) not at all. What is skipped
+    joins the first entry's ``unsearched``."""
     from pipeline.planning import attach_speed_limits
     skipped = []
-    if not any(t["plans"] for t in result.get("tight") or ()):
+    if not any(t.plans for t in result.tight or ()):
         pass  # no plan: no speed limit to find
     elif deadline.over():
         skipped.append("the speed limits of the plans: skipped")
     else:
-        attach_speed_limits(result, settings)
+        result = attach_speed_limits(result, settings, part)
     if settings.search.shape_tolerance_mm is not None:
         skipped.append("the shape tolerance's worst-member search: skipped under a time limit")
-    entry = (result.get("tight") or [None])[0]
-    if skipped and entry is not None:
-        entry["unsearched"] = list(entry.get("unsearched") or []) + skipped
-        entry["complete"] = False
+    if skipped and result.tight:
+        entry = result.tight[0]
+        entry = dataclasses.replace(entry, unsearched=list(entry.unsearched or []) + skipped, complete=False)
+        result = dataclasses.replace(result, tight=(entry, *result.tight[1:]))
     return result
 
 

@@ -18,8 +18,9 @@ from pipeline.maps.sweep import ShardJob, write_shard
 from pipeline.parts.part import Part
 from pipeline.parts.support import support_key
 from pipeline.parts.families import config_part_id
-from pipeline.planning import (PlanFile, PlannerSettings, attach_shape_tolerance, attach_speed_limits,
-                               build_planner, load_maps, paper_depth, plan_tight_all, validate_plan_file, verify_plan)
+from pipeline.planning import (Plan, PlanFile, PlannerSettings, RestingState, attach_shape_tolerance,
+                               attach_speed_limits, build_planner, load_maps, paper_depth, plan_tight_all,
+                               validate_plan_file, verify_plan)
 from pipeline.progress import Heartbeat
 from pipeline.provenance import provenance_attrs
 
@@ -38,12 +39,12 @@ def shard_bands(shard, threshold_T, factor_c) -> dict:
 
 
 def plan_part(cat: Catalog, part_id: str, settings: PlannerSettings, keep: int = 5, progress=None,
-              tight: bool = True) -> dict:
+              tight: bool = True) -> PlanFile:
     """Plans for one catalog part (``part_id``: its id or catalog name): the
     paper's adjusted-band planner (``plans``, ``best_static``: fixed pins,
     then moving pins) at the stored friction nearest the planner's, and the
     tight planner (``tight``) at every friction of ``settings.frictions``,
-    each verified by full rollouts."""
+    each verified by full rollouts; the plan file's record."""
     search = settings.search
     part, planner, mu_used, selection = build_planner(cat, part_id, settings)
     depth = paper_depth(search)
@@ -52,20 +53,17 @@ def plan_part(cat: Catalog, part_id: str, settings: PlannerSettings, keep: int =
     static_only = [p for p in plans if p.n_dynamic == 0]
     if planner.dynamic_labels and not static_only:
         static_only = [p for p in planner.search(depth, keep=1) if p.n_dynamic == 0]
-    return {
-        "part": part.to_dict(), "model": search.model, "mu_c": mu_used, "selection": selection,
-        "pins": planner.pins,
-        "pin_speeds": {k: v for k, v in planner.speeds.items() if v != 0.0},
-        "depth": depth, "dynamic_depth": search.dynamic_depth if planner.dynamic_labels else 0,
-        "d_min": search.d_min, "d_max": search.d_max,
-        "coverage": planner.coverage,
-        "best_static": static_only[0].to_dict() if static_only else None,
-        "initial_states": {k: {"theta": s.arc[0], "y_c": s.y_lo} for k, s in states.items()},
-        "plans": [p.to_dict() for p in plans],
-        "found": bool(plans),
-        "tight": plan_tight_all(part, settings, cat.root, keep=keep, progress=progress) if tight else [],
-        **provenance_attrs(),
-    }
+    return PlanFile(
+        part.to_dict(), search.model,
+        tight=tuple(plan_tight_all(part, settings, cat.root, keep=keep, progress=progress)) if tight else (),
+        plans=tuple(Plan.from_dict(p.to_dict()) for p in plans),  # the paper-mode planner writes dicts
+        best_static=Plan.from_dict(static_only[0].to_dict()) if static_only else None,
+        pins=planner.pins, pin_speeds={k: v for k, v in planner.speeds.items() if v != 0.0}, mu_c=mu_used,
+        initial_states={k: RestingState(s.arc[0], s.y_lo) for k, s in states.items()},
+        extra={"selection": selection, "depth": depth,
+               "dynamic_depth": search.dynamic_depth if planner.dynamic_labels else 0,
+               "d_min": search.d_min, "d_max": search.d_max, "coverage": planner.coverage,
+               "found": bool(plans), **provenance_attrs()})
 
 
 def ensure_maps(config, part: Part, family: str = "adhoc") -> Catalog:
@@ -188,18 +186,18 @@ def plan(config: dict, name: str, out, shards=None) -> dict:
         cat = Catalog.of_files(root, shards)
     settings = PlannerSettings.from_config(config)
     result = attach_speed_limits(plan_part(cat, config_part_id(config, name), settings), settings)
-    if settings.search.shape_tolerance_mm is not None:
-        with_shape_tolerance(result, Part.from_dict(result["part"]), settings)
+    result = with_shape_tolerance(result, Part.from_dict(result.part, name=result.name), settings).to_dict()
     write_json(result, out)
     return result
 
 
-def with_shape_tolerance(result: dict, part: Part, settings: PlannerSettings, progress=None) -> dict:
-    """``result`` with its tight entries' ``shape_tolerance`` when the settings
-    give the outline's tolerance (``planner.shape_tolerance_mm``)."""
+def with_shape_tolerance(result: PlanFile, part: Part, settings: PlannerSettings, progress=None) -> PlanFile:
+    """``result`` (a plan file's record) with its tight entries'
+    ``shape_tolerance`` when the settings give the outline's tolerance
+    (``planner.shape_tolerance_mm``)."""
     tol = settings.search.shape_tolerance_mm
-    if tol is not None and result.get("tight"):
-        attach_shape_tolerance(result, part, settings, float(tol), progress)
+    if tol is not None and result.tight:
+        return attach_shape_tolerance(result, part, settings, float(tol), progress)
     return result
 
 

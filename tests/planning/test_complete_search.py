@@ -170,7 +170,7 @@ def test_moving_pins_only_when_fixed_pins_cannot_and_their_plan_holds():
     config["planner"].update(pins="auto", depth=1, tolerance_deg=10.0)
     config["verify"].update(trials=30, rule="point")  # few trials: the point rule
     part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]], name="trapezoid")
-    entry = plan_tight(part, PlannerSettings.from_config(config).at((0.1, 0.3)))
+    entry = plan_tight(part, PlannerSettings.from_config(config).at((0.1, 0.3))).to_dict()
     assert not entry["fixed_pin_search"]["orients"]
     assert entry["fixed_pin_search"]["evidence"].startswith("no fixed-pin sequence of up to 1 pins")
     assert entry["moving_pin_search"]["orients"] and entry["orients"]
@@ -191,7 +191,7 @@ def test_no_plan_recommends_fixed_pins_for_a_sensor():
     config["planner"]["dynamic"].update(speeds=[-2.0, 2.0], depth=1)
     config["verify"].update(trials=30, rule="point")  # few trials: the point rule
     part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]], name="trapezoid")
-    entry = plan_tight(part, PlannerSettings.from_config(config).at(0.15))
+    entry = plan_tight(part, PlannerSettings.from_config(config).at(0.15)).to_dict()
     assert not entry["orients"] and not entry["moving_pin_search"]["orients"]
     assert entry["recommended"]["n_dynamic_pins"] == 0
     assert "nor do up to 1 moving pins" in entry["warning"] and "a sensor must tell them apart" in entry["warning"]
@@ -225,7 +225,7 @@ def _thin_triangle_entry(depth: int, prune: bool, monkeypatch):
     with monkeypatch.context() as patch:
         if not prune:
             patch.setattr(candidates, "moving_room", lambda found, n_prefix, depth, **kw: depth)
-        return plan_module.plan_tight(part, PlannerSettings.from_config(config).at(0.15))
+        return plan_module.plan_tight(part, PlannerSettings.from_config(config).at(0.15)).to_dict()
 
 
 def test_moving_prefixes_that_cannot_beat_a_found_plan_change_nothing(monkeypatch):
@@ -259,7 +259,7 @@ def test_best_fixed_pin_results_name_each_sequence_once():
     config["planner"]["dynamic"].update(depth=0)
     config["verify"].update(trials=30, rule="point")
     part = Part.from_vertices([[0, 0], [60, 0], [45, 50]], name="leaning_triangle")
-    best = plan_tight(part, PlannerSettings.from_config(config).at(0.15))["fixed_pin_search"]["best_effort"]
+    best = plan_tight(part, PlannerSettings.from_config(config).at(0.15)).to_dict()["fixed_pin_search"]["best_effort"]
     assert len(best) == 5 and all(len(b["pins"]) == 3 for b in best[:2])
     assert len({tuple(b["pins"]) for b in best}) == len(best)
 

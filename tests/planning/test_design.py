@@ -67,7 +67,7 @@ def test_the_search_returns_the_smallest_change_that_orients(trapezoid_design):
             xy, area = chamfered(TRAPEZOID, corner, size * original.a)
             entries = plan_tight_all(Part.from_vertices(xy, name="trapezoid"), settings.without_moving_pins(),
                                      catalog)
-            if all(e["orients"] for e in entries):
+            if all(e.orients for e in entries):
                 orienting.append((area, corner, size))
     assert orienting, "the reference grid must hold a change that orients the trapezoid"
     area, corner, size = min(orienting)

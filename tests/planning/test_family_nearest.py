@@ -112,10 +112,13 @@ def test_a_moving_plan_that_holds_is_the_moving_axis_and_the_rest_ask_without_it
     assert [p[0] for p in nearest.rejected_plans(checker, fixed_only=True)] == [("P5",), ("P3", "P4")]
     cert = {"holds": True, "claim": {"epsilon": 0.01, "beta": 0.05, "violations": 0, "members": 299}}
     moving = {"labels": ("P1", "P2v-1"), "heights": (1.0, 2.0), "speeds": (0.0, -1.0), "certificate": cert}
-    axis = nearest.family_moving_axis({"support_family": {"label": "tripods:12"}}, moving)
+    axis = nearest.family_moving_axis("tripods:12", None, moving)
     assert axis["found"] and axis["holds"] and axis["value"] == 1 and axis["plan"] == ["P1", "P2v-1"]
+    assert axis["family"] == "tripods:12"
     assert "holds" in nearest_yes_lines({"axes": [axis]})[1]
-    assert not nearest.family_moving_axis({"moving_pin_search": {"levels": []}})["found"]
+    searched = nearest.family_moving_axis("tripods:12", SimpleNamespace(levels=[]))  # the stage ran, found none
+    assert not searched["found"] and searched["statement"].startswith("searched")
+    assert nearest.family_moving_axis("tripods:12", None)["statement"].startswith("not searched")
 
 
 @pytest.mark.parametrize("tolerance", [10.0, 30.0])

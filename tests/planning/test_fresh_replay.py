@@ -28,7 +28,7 @@ def test_recommended_plan_passes_a_fresh_replay(name, tmp_path):
     config["catalog_dir"] = str(tmp_path / "catalog")
     part = named_part(config, name)
     settings = PlannerSettings.from_config(config)
-    entry = plan_tight(part, settings)
+    entry = plan_tight(part, settings).to_dict()
     rec = entry["recommended"]
     assert rec is not None and entry["orients"], entry["warning"]
     held = rec["verification"]

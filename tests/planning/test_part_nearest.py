@@ -8,6 +8,7 @@ trials (tests/oracle.py) ends in one set of the answered tolerance (+1 deg:
 the two sample the box differently).
 """
 import dataclasses
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -22,6 +23,8 @@ from pipeline.planning import PlannerSettings, nearest_yes_lines
 from pipeline.planning.claims import orient
 from pipeline.planning.plans.nearest_part import (LADDER, MAX_TOLERANCE, loosest_needed, part_moving_axis,
                                                  part_nearest_yes, part_tolerance_axis)
+from pipeline.planning.core.plan_records import Plan
+from pipeline.planning.core.types import TightEntry
 from pipeline.planning.plans.plan import plan_tight
 from pipeline.progress import Deadline
 
@@ -43,7 +46,7 @@ def test_the_tolerance_is_the_smallest_step_whose_arc_holds_the_count(thetas, n_
 
 
 @pytest.fixture(scope="module")
-def no_plan(tmp_path_factory):
+def no_plan_entry(tmp_path_factory):
     config = load_config()
     config["catalog_dir"] = str(tmp_path_factory.mktemp("catalog"))
     config["planner"].update(pins="auto", depth=2, tolerance_deg=6.0, mu_c=0.2, frictions=[])
@@ -51,6 +54,25 @@ def no_plan(tmp_path_factory):
     config["verify"].update(trials=30, rule="point")  # few trials: the point rule
     settings_ = PlannerSettings.from_config(config)
     return plan_tight(TRAPEZOID, settings_.at(0.2)), settings_
+
+
+@pytest.fixture(scope="module")
+def no_plan(no_plan_entry):
+    """The entry as its plan file has it, and the settings."""
+    entry, settings_ = no_plan_entry
+    return entry.to_dict(), settings_
+
+
+def _search_record(time_limit=None, complete=True, complete_to=0, orients=False, unsearched=(), found=()):
+    """A stand-in for a search's record (``tight.records.FixedSearch``): what the nearest "yes" reads."""
+    return SimpleNamespace(time_limit=time_limit, complete=complete, complete_to=complete_to, orients=orients,
+                           unsearched=list(unsearched), plans=[SimpleNamespace(labels=tuple(f)) for f in found])
+
+
+def _entry(recommended=None, rejected=()):
+    """A tight entry with only the plans the moving-pin axis reads."""
+    rec = Plan.from_dict(recommended) if recommended else None
+    return TightEntry(0.2, "0.2", (), recommended=rec, rejected=tuple(Plan.from_dict(r) for r in rejected))
 
 
 def test_a_part_without_a_plan_gets_its_nearest_yes(no_plan):
@@ -113,7 +135,7 @@ def test_a_search_cut_by_its_time_limit_still_answers_from_the_kept_plans(no_pla
     search at looser tolerances, the cut named in ``unsearched`` and only the
     plans replayed listed."""
     full, settings_ = no_plan
-    cut = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=3))
+    cut = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=3)).to_dict()
     assert cut["complete"] is False and not cut["orients"]
     assert cut["fixed_pin_search"]["complete"] is False
     assert any("kept plans only" in u for u in cut["unsearched"])
@@ -142,25 +164,26 @@ def test_moving_pins_the_limit_came_before_are_named_so(no_plan):
     _, settings_ = no_plan
     s = dataclasses.replace(settings_.at(0.2), search=dataclasses.replace(
         settings_.at(0.2).search, dynamic_speeds=(-1.0, 1.0), dynamic_depth=1))
-    cut = plan_tight(TRAPEZOID, s, deadline=_SearchCut(reads=3))
+    cut = plan_tight(TRAPEZOID, s, deadline=_SearchCut(reads=3)).to_dict()
     assert any(u.startswith("moving pins: not reached") for u in cut["unsearched"])
     axis = next(a for a in cut["nearest_yes"]["axes"] if a["axis"] == "moving pins")
     assert not axis["found"] and "time limit ended the search before the moving pins" in axis["statement"]
 
 
-def test_the_kept_plans_answer_needs_no_search(no_plan):
+def test_the_kept_plans_answer_needs_no_search(no_plan_entry):
     """Kept plans only: none of the search's kept plans answers here (the
     complete answer came from the searches at looser tolerances), and it says
     so; given the complete answer's plan as a kept plan, it answers with that
     plan at no looser a tolerance (the same held-out trials)."""
-    full, settings_ = no_plan
+    entry, settings_ = no_plan_entry
+    full = entry.to_dict()
     kept = [(p["pins"], p["pin_heights_mm"], p.get("pin_speeds") or ()) for p in full["plans"]]
     complete = next(a for a in full["nearest_yes"]["axes"] if a["axis"] == "tolerance")
     assert complete["kept_plans_only"] is False and complete["plan"] not in [k[0] for k in kept]
 
     def tolerance(plans):
-        return next(a for a in part_nearest_yes(TRAPEZOID, settings_.at(0.2), full, plans)["axes"]
-                    if a["axis"] == "tolerance")
+        return next(a for a in part_nearest_yes(TRAPEZOID, settings_.at(0.2), entry, _search_record(), None,
+                                                plans)["axes"] if a["axis"] == "tolerance")
 
     none = tolerance(kept)
     assert not none["found"] and none["kept_plans_only"] and "was not run" in none["statement"]
@@ -170,13 +193,14 @@ def test_the_kept_plans_answer_needs_no_search(no_plan):
 
 
 def test_moving_pins_cut_by_the_limit_are_not_called_unconfigured():
-    axis = part_moving_axis({}, cut=True)
+    axis = part_moving_axis(_entry(), None, cut=True)
     assert not axis["found"] and "time limit" in axis["statement"]
-    assert "no pin speeds given" in part_moving_axis({})["statement"]
-    part_way = part_moving_axis({"moving_pin_search": {"orients": False, "complete": False,
-                                                       "unsearched": ["2 moving pin(s) after P1: not reached"]}})
+    assert "no pin speeds given" in part_moving_axis(_entry(), None)["statement"]
+    stage = _search_record(time_limit=5.0, complete=False, unsearched=["2 moving pin(s) after P1: not reached"])
+    part_way = part_moving_axis(_entry(), stage)
     assert not part_way["found"] and part_way["statement"].startswith("searched in part")
     assert "2 moving pin(s) after P1: not reached" in part_way["statement"]
+    assert part_moving_axis(_entry(), _search_record())["statement"].startswith("searched after the fixed pins")
 
 
 def test_searches_that_reuse_rollouts_find_what_they_find_alone(no_plan):
@@ -227,14 +251,13 @@ def test_a_bisection_the_limit_cuts_keeps_its_certified_bound(no_plan, monkeypat
     assert "upper bound" in axis["statement"] and axis["verdict"]["orients"]
 
 
-def test_more_pins_asks_for_a_longer_limit_only_when_the_depth_was_not_searched(no_plan):
-    full, settings_ = no_plan
-    kept = [(p["pins"], p["pin_heights_mm"], ()) for p in full["plans"]][:1]
+def test_more_pins_asks_for_a_longer_limit_only_when_the_depth_was_not_searched(no_plan_entry):
+    entry, settings_ = no_plan_entry
+    kept = [(p.pins, p.pin_heights_mm, ()) for p in entry.plans][:1]
 
     def more(complete_to):
-        entry = dict(full, fixed_pin_search=dict(full["fixed_pin_search"], complete=False,
-                                                 complete_to_pins=complete_to))
-        return next(a for a in part_nearest_yes(TRAPEZOID, settings_.at(0.2), entry, kept)["axes"]
+        cut = _search_record(time_limit=5.0, complete=False, complete_to=complete_to)
+        return next(a for a in part_nearest_yes(TRAPEZOID, settings_.at(0.2), entry, cut, None, kept)["axes"]
                     if a["axis"] == "more pins")["statement"]
 
     assert "--time-limit" in more(1)
@@ -242,9 +265,9 @@ def test_more_pins_asks_for_a_longer_limit_only_when_the_depth_was_not_searched(
 
 
 def test_a_moving_plan_found_but_not_recommended_is_never_called_none():
-    stage = {"orients": True, "found": [["P1", "P2v+1"]], "complete": False}
-    unverified = part_moving_axis({"moving_pin_search": stage, "recommended": {"pins": ["P1"], "pin_speeds": [0.0]}})
+    stage = _search_record(time_limit=5.0, complete=False, orients=True, found=[["P1", "P2v+1"]])
+    fixed_rec = {"pins": ["P1"], "pin_speeds": [0.0], "final_sets": []}
+    unverified = part_moving_axis(_entry(recommended=fixed_rec), stage)
     assert not unverified["found"] and unverified["partial"] and "not verified" in unverified["statement"]
-    failed = part_moving_axis({"moving_pin_search": stage, "recommended": None,
-                               "rejected": [{"pins": ["P1", "P2v+1"]}]})
+    failed = part_moving_axis(_entry(rejected=[{"pins": ["P1", "P2v+1"], "final_sets": []}]), stage)
     assert not failed["found"] and "fails the final verification" in failed["statement"]

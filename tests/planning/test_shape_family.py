@@ -106,11 +106,10 @@ def test_a_tolerance_must_be_a_length(tol):
 
 def test_a_result_without_a_fixed_pin_plan_gets_a_note():
     from pipeline.config import load_config
-    from pipeline.planning import PlannerSettings, attach_shape_tolerance, shape_line
+    from pipeline.planning import PlanFile, PlannerSettings, TightEntry, attach_shape_tolerance, shape_line
     settings = PlannerSettings.from_config(load_config(None))
-    result = {"tight": [{"recommended": None, "mu_c": [0.1, 0.3], "friction": "0.1:0.3"}]}
-    attach_shape_tolerance(result, TRIANGLE, settings, 0.2)
-    entry = result["tight"][0]["shape_tolerance"]
+    result = PlanFile({"name": "triangle"}, tight=(TightEntry((0.1, 0.3), "0.1:0.3", ()),))
+    entry = attach_shape_tolerance(result, TRIANGLE, settings, 0.2).tight[0].shape_tolerance
     assert entry["radius_mm"] is None and "nothing to certify" in shape_line(entry)
     with pytest.raises(PinfeedError, match="--shape-tolerance must be a length"):
         attach_shape_tolerance(result, TRIANGLE, settings, -0.2)
@@ -122,7 +121,7 @@ def test_the_config_gives_the_shape_tolerance_and_the_command_line_overrides_it(
     one-line error; the workflow's plan attaches the check only when it is set;
     the key at its default leaves the config hash alone."""
     from pipeline.config import config_hash, load_config, validate_config
-    from pipeline.planning import PlannerSettings
+    from pipeline.planning import PlanFile, PlannerSettings, TightEntry
     from pipeline.workflow.commands import planner_settings
     from pipeline.workflow.plan import with_shape_tolerance
     config = load_config(None)
@@ -137,8 +136,8 @@ def test_the_config_gives_the_shape_tolerance_and_the_command_line_overrides_it(
             planner_settings(config, shape_tolerance=bad)
     with pytest.raises(Exception):
         validate_config({**config, "planner": {**config["planner"], "shape_tolerance_mm": -1.0}})
-    result = {"tight": [{"recommended": None, "mu_c": [0.1, 0.3], "friction": "0.1:0.3"}]}
-    with_shape_tolerance(result, TRIANGLE, PlannerSettings.from_config(config))
-    assert "shape_tolerance" not in result["tight"][0]
-    with_shape_tolerance(result, TRIANGLE, PlannerSettings.from_config(set_))
-    assert result["tight"][0]["shape_tolerance"]["requested_mm"] == 0.2
+    result = PlanFile({"name": "triangle"}, tight=(TightEntry((0.1, 0.3), "0.1:0.3", ()),))
+    assert "shape_tolerance" not in with_shape_tolerance(result, TRIANGLE, PlannerSettings.from_config(config)
+                                                         ).to_dict()["tight"][0]
+    attached = with_shape_tolerance(result, TRIANGLE, PlannerSettings.from_config(set_))
+    assert attached.to_dict()["tight"][0]["shape_tolerance"]["requested_mm"] == 0.2

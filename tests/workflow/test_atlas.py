@@ -39,7 +39,7 @@ def planned(tmp_path_factory):
     for name, vertices in PARTS.items():
         path = root / "plans" / f"{name}.json"
         part = Part.from_vertices(vertices, name=name, holes=HOLES.get(name, ()))
-        write_json(plan_tight_only(part, PlannerSettings.from_config(config), config["catalog_dir"]), path)
+        write_json(plan_tight_only(part, PlannerSettings.from_config(config), config["catalog_dir"]).to_dict(), path)
         paths.append(path)
     speed = write_json({"part": "right_triangle", "speed_limit_mm_s": 210.0}, root / "speed" / "right_triangle.json")
     layout = write_json({"part": "right_triangle", "belt_speed_mm_s": 168.0, "throughput_per_min": 55.5},

@@ -39,7 +39,7 @@ def stage(tmp_path_factory):
     pc["dynamic"].update(depth=0, speeds=[])
     config["verify"].update(trials=20, rule="point")
     config["support_study"] = {"family": FAMILY, "parts": ["asym_triangle"]}
-    plan_path = write_json(plan_tight_only(TRIANGLE, PlannerSettings.from_config(config), config["catalog_dir"]), root / "plans" / "asym_triangle.json")
+    plan_path = write_json(plan_tight_only(TRIANGLE, PlannerSettings.from_config(config), config["catalog_dir"]).to_dict(), root / "plans" / "asym_triangle.json")
     out, figure = root / "support" / "asym_triangle.json", root / "figures" / "support_maps_asym_triangle.png"
     result = support_part(plan_path, config, out, figure, progress=None)
     return config, plan_path, out, figure, result

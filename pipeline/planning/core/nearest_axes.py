@@ -49,11 +49,9 @@ def unanswered_axis(axis: str, statement: str) -> dict:
     return {"axis": axis, "found": False, "statement": statement}
 
 
-def more_pins_axis(result: dict) -> dict:
-    """The more-pins axis of a part or a family (``result``: its tight entry
-    or plan result, with its ``depth``): not searched; the line says how to
-    run the deeper search."""
-    depth = result.get("depth")
+def more_pins_axis(depth: int | None) -> dict:
+    """The more-pins axis of a part or a family searched to ``depth`` pins:
+    not searched; the line says how to run the deeper search."""
     return unanswered_axis("more pins", f"not searched (a deeper complete search costs more than the rest): "
                                         f"run with --depth {depth + 1 if depth else 'N+1'} or a finer --pins grid")
 

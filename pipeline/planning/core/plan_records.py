@@ -7,6 +7,12 @@ pin did to one branch (:class:`Step`), the replayed trials
 all it does (:class:`Plan`). The file-level records that hold them, and the
 file's schema, are in :mod:`pipeline.planning.core.types`.
 
+The planner builds these records itself (``plans/entry.py``) and the steps
+after the search (family certificate, nearest "yes", speed limits, shape
+tolerance) take them and add to them; a plan is turned into a dict only at
+the edge, to be written or printed. A field a stored dict may lack has the
+default :data:`ABSENT` (falsy), told apart from a stored ``null`` (``None``).
+
 Each record reads a stored dict and writes it back unchanged:
 ``Record.from_dict(d).to_dict() == d`` for every plan the current code
 writes, and ``Record.from_dict(r.to_dict()) == r``. Keys a record does not
@@ -20,6 +26,36 @@ dimensionless, belt speed in mm/s, pin speeds as the ratio v_pin / v_belt.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+
+from pipeline.planning.core.claim import Claim
+
+
+class _Absent:
+    """The value of a record's field whose key the stored dict does not have
+    (``None`` is a stored ``null``). Falsy; one object, also after pickling."""
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return False
+
+    def __repr__(self) -> str:
+        return "ABSENT"
+
+    def __reduce__(self):
+        return "ABSENT"
+
+
+ABSENT = _Absent()
+
+
+def optional_keys(d: dict, keys) -> dict:
+    """``{key: d[key]}`` for ``keys``, :data:`ABSENT` where ``d`` lacks the key: a record's optional fields."""
+    return {k: d.get(k, ABSENT) for k in keys}
+
+
+def present(values: dict) -> dict:
+    """``values`` less the :data:`ABSENT` ones: what a record writes back."""
+    return {k: v for k, v in values.items() if v is not ABSENT}
 
 
 def unmodelled_keys(d: dict, known) -> dict:
@@ -168,7 +204,16 @@ class Verification:
     :class:`VerificationRow` per initial state, the ``model`` replayed with
     (``"dynamic"`` at a belt speed; None in files verified before the model was
     recorded) and, for the dynamic model only, the belt speed (mm/s) and belt
-    friction ``mu_s``."""
+    friction ``mu_s``.
+
+    A tight plan's held-out verification also has: ``held_out`` (True) and
+    its ``seed``; ``orientation``, the verdict of ``orient.judge`` on those
+    trials; ``truncation_sigma``, where the perturbations were cut;
+    ``selection``, the verdict on the trials that chose the plan; with a
+    support family, ``support_family`` (the members drawn) and
+    ``family_check`` (the worst-member check); for the recommended plan,
+    ``untruncated`` (its replay on untruncated normals). :data:`ABSENT` when
+    the stored dict lacks the key."""
     trials: int
     successes: int
     failures: int
@@ -176,16 +221,27 @@ class Verification:
     model: str | None = None
     belt_speed: float | None = None
     mu_s: float | None = None
+    held_out: bool | None = ABSENT
+    seed: int | None = ABSENT
+    orientation: dict | None = ABSENT
+    truncation_sigma: float | None = ABSENT
+    selection: dict | None = ABSENT
+    support_family: dict | None = ABSENT
+    family_check: dict | None = ABSENT
+    untruncated: dict | None = ABSENT
     extra: dict = field(default_factory=dict)
 
-    KEYS = ("trials", "successes", "failures", "rows", "model", "belt_speed", "mu_s")
+    OPTIONAL = ("held_out", "seed", "orientation", "truncation_sigma", "selection", "support_family",
+                "family_check", "untruncated")
+    KEYS = ("trials", "successes", "failures", "rows", "model", "belt_speed", "mu_s", *OPTIONAL)
 
     @classmethod
     def from_dict(cls, d: dict) -> "Verification":
         """The record of a stored dict (as read from the plan file)."""
         return cls(d["trials"], d["successes"], d["failures"],
                    tuple(VerificationRow.from_dict(r) for r in d["rows"]), d.get("model"),
-                   d.get("belt_speed"), d.get("mu_s"), unmodelled_keys(d, cls.KEYS))
+                   d.get("belt_speed"), d.get("mu_s"), **optional_keys(d, cls.OPTIONAL),
+                   extra=unmodelled_keys(d, cls.KEYS))
 
     def to_dict(self) -> dict:
         """The stored dict: the keys and values this record was read from."""
@@ -197,6 +253,7 @@ class Verification:
             out["belt_speed"] = self.belt_speed
         if self.mu_s is not None:
             out["mu_s"] = self.mu_s
+        out.update(present({k: getattr(self, k) for k in self.OPTIONAL}))
         return {**out, **self.extra}
 
     @property
@@ -233,7 +290,16 @@ class Plan:
     ``verification``; a paper-mode plan has none of these keys (``None``
     here), its heights are the file's ``pins`` table. Only ``pins`` and
     ``final_sets`` are required: an older or hand-made plan may lack the rest
-    (``None``; then not written back)."""
+    (``None``; then not written back).
+
+    A verified tight plan also has its one ``claim``
+    (:class:`~pipeline.planning.core.claim.Claim`, ``None`` before it is
+    verified), ``carried_sets_kind`` (how its carried sets were found:
+    ``"propagated"`` or ``"sampled"``) and, once the steps after the search
+    add them, ``speed_limit`` (``pinfeed speed``'s record) and, for a
+    support family, ``family_certificate``. :data:`ABSENT` when the stored
+    dict lacks the key (a file written before claims kept the carried sets'
+    kind as a string ``claim``: it stays in ``extra``)."""
     pins: tuple
     final_sets: tuple
     n_final_sets: int | None = None
@@ -247,11 +313,16 @@ class Plan:
     jump_steps: int | None = None
     initial_sets: dict | None = None
     verification: Verification | None = None
+    carried_sets_kind: str = ABSENT
+    claim: Claim | None = ABSENT
+    speed_limit: dict = ABSENT
+    family_certificate: dict = ABSENT
     extra: dict = field(default_factory=dict)
 
+    OPTIONAL = ("carried_sets_kind", "claim", "speed_limit", "family_certificate")
     KEYS = ("mode", "pins", "pin_heights_mm", "pin_speeds", "n_final_sets", "final_sets", "margin",
             "jump_steps", "sets_after_each_pin", "n_dynamic_pins", "initial_sets", "initial_states",
-            "verification")
+            "verification", *OPTIONAL)
 
     @classmethod
     def from_dict(cls, d: dict) -> "Plan":
@@ -260,12 +331,17 @@ class Plan:
         ver = d.get("verification")
         sets = d.get("initial_sets")
         branches = d.get("initial_states")
+        optional, extra = optional_keys(d, cls.OPTIONAL), unmodelled_keys(d, cls.KEYS)
+        if isinstance(optional["claim"], str):  # an older file: the carried sets' kind
+            extra["claim"], optional["claim"] = optional["claim"], ABSENT
+        elif optional["claim"]:
+            optional["claim"] = Claim.from_dict(optional["claim"])
         return cls(tuple(d["pins"]), tuple(Arc.from_dict(s) for s in d["final_sets"]), d.get("n_final_sets"),
                    d.get("margin"), opt("sets_after_each_pin"), d.get("n_dynamic_pins"),
                    _branches_in(branches) if branches is not None else None, d.get("mode"), opt("pin_heights_mm"),
                    opt("pin_speeds"), d.get("jump_steps"),
                    {k: State.from_dict(v) for k, v in sets.items()} if sets is not None else None,
-                   Verification.from_dict(ver) if ver is not None else None, unmodelled_keys(d, cls.KEYS))
+                   Verification.from_dict(ver) if ver is not None else None, **optional, extra=extra)
 
     def to_dict(self) -> dict:
         """The stored dict: the keys and values this record was read from."""
@@ -291,7 +367,10 @@ class Plan:
             out["initial_states"] = _branches_out(self.branches)
         if self.mode is not None or self.verification is not None:  # a tight plan always has the key
             out["verification"] = self.verification.to_dict() if self.verification else None
-        return {**out, **self.extra}
+        optional = present({k: getattr(self, k) for k in self.OPTIONAL})
+        if optional.get("claim"):
+            optional["claim"] = self.claim.to_dict()
+        return {**out, **optional, **self.extra}
 
     @property
     def final_arcs(self) -> list:

@@ -5,9 +5,14 @@ The file-level records: the tight planner's plans at one friction
 of one plan they hold (:class:`~pipeline.planning.core.plan_records.Plan`
 and its parts) are in :mod:`pipeline.planning.core.plan_records`.
 
-The planners (``search.TightPlan.to_dict``, ``paper.Plan.to_dict``) and the
-writers (``workflow.plan.plan_part``, ``pinfeed plan``) still build plain
-dicts; these records read such a dict and write it back unchanged:
+The tight planner returns a :class:`TightEntry` per friction, and the steps
+after it (family certificate, nearest "yes", speed limits on the
+:class:`PlanFile`, shape tolerance) take the records and add to them; the
+writers (``workflow.plan.plan_part``, ``pinfeed plan``) turn them into
+dicts only at the edge. (The paper-mode planner's ``paper.Plan.to_dict``
+still builds dicts.) A field a stored dict may lack defaults to
+:data:`~pipeline.planning.core.plan_records.ABSENT`. The records read a
+stored dict and write it back unchanged:
 ``Record.from_dict(d).to_dict() == d`` for every plan file the current code
 writes, and ``Record.from_dict(r.to_dict()) == r``. Keys a record does not
 know are kept in its ``extra`` and written back as they were, so a file with
@@ -33,7 +38,7 @@ from pathlib import Path
 
 from pipeline.checks import schema_problem
 from pipeline.errors import PinfeedError
-from pipeline.planning.core.plan_records import Plan, RestingState, unmodelled_keys
+from pipeline.planning.core.plan_records import ABSENT, Plan, RestingState, optional_keys, present, unmodelled_keys
 from pipeline.planning.core.settings import Friction
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "plan.schema.json"
@@ -66,7 +71,18 @@ class TightEntry:
     verified plans best first; ``rejected``: plans that failed verification;
     ``recommended``: the best plan or ``None`` (then ``warning`` says why);
     ``stats``: search statistics (``seconds`` in s, counts otherwise);
-    ``initial_states``: label -> :class:`RestingState`."""
+    ``initial_states``: label -> :class:`RestingState`.
+
+    Written by the tight planner (:data:`ABSENT` in older files):
+    ``tolerance_deg`` and ``required`` (the claim's rule), ``orients``,
+    ``needs_no_pin``, ``pins_used`` (label -> height, mm), the searches'
+    records ``fixed_pin_search`` and ``moving_pin_search``; with a support
+    family ``support_family``, ``family_certificate`` (``None``: no plan
+    holds for it) and ``family_worst_member``; ``nearest_yes`` when nothing
+    orients; under a time limit ``time_limit_s``, ``complete`` and
+    ``unsearched``; ``shape_tolerance`` when it was asked for. These
+    records are written once, by the step that makes them, and read only at
+    the edge (the command line, the report)."""
     mu_c: object
     friction: str
     plans: tuple
@@ -82,11 +98,29 @@ class TightEntry:
     beam: int | None = None
     rejected: tuple | None = None
     stats: dict | None = None
+    tolerance_deg: float = ABSENT
+    required: float = ABSENT
+    orients: bool = ABSENT
+    needs_no_pin: bool = ABSENT
+    pins_used: dict = ABSENT
+    fixed_pin_search: dict = ABSENT
+    moving_pin_search: dict | None = ABSENT
+    support_family: dict = ABSENT
+    family_certificate: dict | None = ABSENT
+    family_worst_member: dict = ABSENT
+    nearest_yes: dict = ABSENT
+    time_limit_s: float = ABSENT
+    complete: bool = ABSENT
+    unsearched: list = ABSENT
+    shape_tolerance: dict = ABSENT
     extra: dict = field(default_factory=dict)
 
+    OPTIONAL = ("tolerance_deg", "required", "orients", "needs_no_pin", "pins_used", "fixed_pin_search",
+                "moving_pin_search", "support_family", "family_certificate", "family_worst_member",
+                "nearest_yes", "time_limit_s", "complete", "unsearched", "shape_tolerance")
     KEYS = ("mu_c", "friction", "belt_speed", "mu_s", "mechanics", "symmetry_order", "depth",
             "complete_depth", "beam", "plans", "rejected", "recommended", "warning", "stats",
-            "initial_states")
+            "initial_states", *OPTIONAL)
     NULLABLE = ("belt_speed", "mu_s", "recommended", "warning")  # always written, maybe null
 
     @property
@@ -104,7 +138,7 @@ class TightEntry:
                    d.get("mu_s"), d.get("mechanics"), d.get("symmetry_order"), d.get("depth"),
                    d.get("complete_depth"), d.get("beam"),
                    tuple(Plan.from_dict(p) for p in rejected) if rejected is not None else None,
-                   d.get("stats"), unmodelled_keys(d, cls.KEYS))
+                   d.get("stats"), **optional_keys(d, cls.OPTIONAL), extra=unmodelled_keys(d, cls.KEYS))
 
     def to_dict(self) -> dict:
         """The stored dict: the keys and values this record was read from."""
@@ -119,6 +153,7 @@ class TightEntry:
                   "initial_states": ({k: v.to_dict() for k, v in self.initial_states.items()}
                                      if self.initial_states is not None else None)}
         out = {k: v for k, v in values.items() if v is not None or k in self.NULLABLE}
+        out.update(present({k: getattr(self, k) for k in self.OPTIONAL}))
         return {**out, **self.extra}
 
     @property

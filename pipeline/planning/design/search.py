@@ -62,19 +62,20 @@ def allowed_candidates(xy: np.ndarray, holes, part: Part, design: DesignSettings
 
 
 def verdict_of(entries: list) -> dict:
-    """What the planner's entries (one per friction) say: ``orients`` at every
-    friction, the recommended pins and the held-out verdict at the first."""
+    """What the planner's entries (one :class:`~pipeline.planning.core.types.TightEntry`
+    per friction) say: ``orients`` at every friction, the recommended pins and
+    the held-out verdict at the first."""
     first = entries[0]
-    rec = first.get("recommended")
-    orients = all(e["orients"] for e in entries)
-    if first.get("needs_no_pin"):
+    rec = first.recommended
+    orients = all(e.orients for e in entries)
+    if first.needs_no_pin:
         text = "no pin is needed"
     elif rec is None:
-        text = f"no plan: {first.get('warning')}"
+        text = f"no plan: {first.warning}"
     else:
-        held = describe_claim(rec["verification"]["orientation"])
-        text = f"{' '.join(rec['pins'])}: {held}" if orients else f"no plan; best {' '.join(rec['pins'])}: {held}"
-    return {"orients": bool(orients), "pins": list(rec["pins"]) if rec else [], "summary": text}
+        held = describe_claim(rec.verification.orientation)
+        text = f"{' '.join(rec.pins)}: {held}" if orients else f"no plan; best {' '.join(rec.pins)}: {held}"
+    return {"orients": bool(orients), "pins": list(rec.pins) if rec else [], "summary": text}
 
 
 def plan_entries(part: Part, settings: PlannerSettings, catalog_root) -> list:
@@ -83,12 +84,14 @@ def plan_entries(part: Part, settings: PlannerSettings, catalog_root) -> list:
         return plan_tight_all(part, settings, catalog_root)
 
 
-def stored_entry(entry: dict) -> dict:
-    """A planner entry as the design file keeps it: the plan and its verdict,
-    without the run's timings and rollout counts (which differ between runs)."""
+def stored_entry(entry) -> dict:
+    """A planner entry (a :class:`~pipeline.planning.core.types.TightEntry`) as
+    the design file keeps it: the plan and its verdict, without the run's
+    timings and rollout counts (which differ between runs)."""
     keep = ("mu_c", "friction", "mechanics", "depth", "tolerance_deg", "required", "orients", "needs_no_pin",
             "recommended", "warning", "initial_states", "symmetry_order", "pins_used")
-    return {k: entry.get(k) for k in keep}
+    stored = entry.to_dict()
+    return {k: stored.get(k) for k in keep}
 
 
 def design_part(outline, holes, name: str, settings: PlannerSettings, design: DesignSettings, catalog_root,

@@ -233,43 +233,45 @@ def family_tolerance_axis(part, family, plans, st, progress=None, kept=()) -> di
                    family)
 
 
-def family_moving_axis(result: dict, moving_yes: dict | None = None) -> dict:
-    """What the search's moving-pin stage found for the family: ``moving_yes``,
-    the recommended moving-pin plan with its check and certificate, when one
-    holds."""
+def family_moving_axis(family_label: str, moving, moving_yes: dict | None = None) -> dict:
+    """What the search's moving-pin stage (``moving``: its record, ``None``
+    when it did not run) found for the family ``family_label``:
+    ``moving_yes``, the recommended moving-pin plan with its check and
+    certificate, when one holds."""
     if moving_yes is not None:
         cert = moving_yes["certificate"]
         return {"axis": "moving pins", "found": True, "holds": bool(cert["holds"]),
                 "value": int(sum(1 for v in moving_yes["speeds"] if v)), "unit": "moving pins",
                 "statement": f"the same family with {sum(1 for v in moving_yes['speeds'] if v)} moving pin(s)",
                 "plan": list(moving_yes["labels"]), "pin_heights_mm": list(moving_yes["heights"]),
-                "pin_speeds": list(moving_yes["speeds"]), "family": result.get("support_family", {}).get("label"),
-                "certificate": cert}
-    stage = result.get("moving_pin_search")
-    if not stage:
+                "pin_speeds": list(moving_yes["speeds"]), "family": family_label, "certificate": cert}
+    if moving is None:
         return unanswered_axis("moving pins", "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
     return unanswered_axis("moving pins", "searched after the fixed pins: no moving-pin plan holds for the "
                                           "family either")
 
 
-def nearest_yes(part, family, checker: FamilyChecker, result: dict, make_family, progress=None,
+def nearest_yes(part, family, checker: FamilyChecker, depth: int | None, moving, make_family, progress=None,
                 moving_yes: dict | None = None) -> dict:
     """Every axis's nearest "yes" for a family no fixed-pin plan holds for (see
-    the module docstring); ``make_family`` turns family text into the planning
-    family (with its extremes). ``moving_yes`` (``labels``, ``heights``,
-    ``speeds``, ``certificate``): the moving-pin plan that holds, when the
-    search found one; the other axes then start from the fixed-pin plans a
-    worst member broke (the answer without a moving pin)."""
+    the module docstring); ``depth``: the search's; ``moving``: the
+    moving-pin search's record (``None``: it did not run); ``make_family``
+    turns family text into the planning family (with its extremes).
+    ``moving_yes`` (``labels``, ``heights``, ``speeds``, ``certificate``):
+    the moving-pin plan that holds, when the search found one; the other
+    axes then start from the fixed-pin plans a worst member broke (the
+    answer without a moving pin)."""
     plans = rejected_plans(checker, fixed_only=moving_yes is not None)
     st = checker.settings
+    moving_axis = family_moving_axis(family.label, moving, moving_yes)
     if not plans:
         nothing = "no plan passed the sampled verification: nothing to loosen"
         return {"plans_tried": [], "axes": [unanswered_axis(a, nothing) for a in ("inset", "friction", "tolerance")]
-                + [family_moving_axis(result, moving_yes), more_pins_axis(result)]}
+                + [moving_axis, more_pins_axis(depth)]}
     kept = kept_members(part, checker.breakers)
     axes = [inset_axis(part, family, plans, st, make_family, progress, kept),
             friction_axis(part, family, plans, st, progress, kept),
             family_tolerance_axis(part, family, plans, st, progress, kept),
-            family_moving_axis(result, moving_yes), more_pins_axis(result)]
+            moving_axis, more_pins_axis(depth)]
     return {"plans_tried": [list(p[0]) for p in plans], "steps": STEPS,
             "assumes": "holding is monotone along each axis (bisection)", "axes": axes}

@@ -26,12 +26,15 @@ member's own centroid, so orientations compare with the drawn part's.
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from pipeline.errors import PinfeedError
 from pipeline.parts.part import Part
 from pipeline.planning.claims.replay import replay
 from pipeline.planning.core.settings import VerifySettings
+from pipeline.planning.core.types import PlanFile, TightEntry
 from pipeline.planning.family.certificate import scenario_claim
 from pipeline.planning.family.member_search import (WorstMember, kernel_steps, outside, probe_inputs,
                                                     search_worst_member)
@@ -220,23 +223,29 @@ def shape_line(result: dict) -> str:
             f"{100 * claim['epsilon']:.2f} % at beta {claim['beta']:g}; the worst-member search is a heuristic)")
 
 
-def attach_shape_tolerance(result: dict, part: Part, settings, tol: float, progress=None) -> dict:
-    """Add ``shape_tolerance`` (:func:`certified_radius`) to every tight entry
-    of a plan result whose recommended plan orients the part (fixed pins:
-    the shape probe replays fixed pins), at that entry's friction; entries
-    without such a plan get a one-line ``note``."""
+def attach_shape_tolerance(result: PlanFile, part: Part, settings, tol: float, progress=None) -> PlanFile:
+    """``result`` (a plan file's record) with ``shape_tolerance``
+    (:func:`certified_radius`) in every tight entry whose recommended plan
+    orients the part (fixed pins: the shape probe replays fixed pins), at
+    that entry's friction; entries without such a plan get a one-line
+    ``note``."""
     if not (np.isfinite(tol) and tol > 0):
         raise PinfeedError(f"--shape-tolerance must be a length > 0 mm, got {tol:g}")
-    for entry in result.get("tight") or ():
-        rec = entry.get("recommended")
-        orients = bool(rec and rec["verification"]["orientation"]["orients"])
-        if not orients or any(rec.get("pin_speeds") or ()):
-            entry["shape_tolerance"] = {"requested_mm": tol, "radius_mm": None, "certificate": None,
-                                        "note": "no fixed-pin plan orients the part: nothing to certify"}
-            continue
-        st = FamilyCheckSettings.from_settings(settings.at(entry["mu_c"]))
-        arc = claimed_arc(rec["verification"]["orientation"], st.claims.tolerance_deg)
-        if progress:
-            progress(f"shape tolerance {tol:g} mm for {' '.join(rec['pins'])} at mu_c {entry['friction']}")
-        entry["shape_tolerance"] = certified_radius(part, rec["pin_heights_mm"], arc, tol, st)
-    return result
+    if not result.tight:
+        return result
+    return replace(result, tight=tuple(_with_shape_tolerance(entry, part, settings, tol, progress)
+                                       for entry in result.tight))
+
+
+def _with_shape_tolerance(entry: TightEntry, part: Part, settings, tol: float, progress=None) -> TightEntry:
+    """One tight entry with its ``shape_tolerance`` (see :func:`attach_shape_tolerance`)."""
+    rec = entry.recommended
+    verdict = rec.verification.orientation if rec is not None else None
+    if not (verdict and verdict["orients"]) or any(rec.pin_speeds or ()):
+        return replace(entry, shape_tolerance={"requested_mm": tol, "radius_mm": None, "certificate": None,
+                                               "note": "no fixed-pin plan orients the part: nothing to certify"})
+    st = FamilyCheckSettings.from_settings(settings.at(entry.mu_c))
+    arc = claimed_arc(verdict, st.claims.tolerance_deg)
+    if progress:
+        progress(f"shape tolerance {tol:g} mm for {' '.join(rec.pins)} at mu_c {entry.friction}")
+    return replace(entry, shape_tolerance=certified_radius(part, list(rec.pin_heights_mm), arc, tol, st))

@@ -3,13 +3,17 @@ candidate, the recommended plan's certificate, and the nearest "yes" when no
 plan holds for the whole family."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 from pipeline.parts.part import Part
 from pipeline.planning.claims.plan_claim import family_claim
 from pipeline.planning.core.settings import PlannerSettings
+from pipeline.planning.core.types import TightEntry
 from pipeline.planning.family.certificate import family_certificate
 from pipeline.planning.family.members import planning_family
 from pipeline.planning.family.nearest import nearest_yes
 from pipeline.planning.family.worst_member import FamilyChecker, FamilyCheckSettings
+from pipeline.planning.tight.records import FixedSearch
 
 
 def family_checker(part: Part, settings: PlannerSettings, family, progress=None) -> FamilyChecker | None:
@@ -41,41 +45,49 @@ def judge_for_family(candidates, checker: FamilyChecker | None) -> None:
                                                     broken_by_worst_member=True)
 
 
-def certify_for_family(result: dict, part: Part, settings: PlannerSettings, family, checker, good) -> None:
-    """The family certificate of the recommended plan (``family_certificate``
-    in ``result`` and in the recommended plan), or, when no plan holds for the
-    family, a warning naming the worst member that broke the best one."""
+def certify_for_family(entry: TightEntry, part: Part, settings: PlannerSettings, family, checker,
+                       moving: FixedSearch | None = None) -> TightEntry:
+    """``entry`` with the family certificate of its recommended plan
+    (``family_certificate`` in the entry and in the recommended plan, whose
+    claim becomes the family's), or, when no plan holds for the family, a
+    warning naming the worst member that broke the best one; then the
+    nearest "yes" (``moving``: the moving-pin search's record, if it ran)."""
     if checker is None:
-        return
-    rec = good[0] if good else None
-    check = rec and rec.verification.get("family_check")
+        return entry
+    rec = entry.recommended
+    check = rec.verification.family_check if rec is not None else None
     moving_yes = None
     if check and check["holds"]:
         cert = family_certificate(part, rec.pin_heights_mm, family, check, checker.settings,
                                   speeds=rec.pin_speeds, progress=checker.progress)
-        result["family_certificate"] = cert
-        result["recommended"]["family_certificate"] = cert
-        rec.claim = family_claim(rec.claim, family.label, check, cert)
-        for entry in [result["recommended"], *result["plans"][:1]]:
-            entry["claim"] = rec.claim.to_dict()
+        claim = family_claim(rec.claim, family.label, check, cert)
+        entry = replace(entry, family_certificate=cert, recommended=replace(rec, claim=claim, family_certificate=cert),
+                        plans=(replace(entry.plans[0], claim=claim), *entry.plans[1:]))
         if not any(rec.pin_speeds or ()):
-            return
+            return entry
         # A moving-pin plan holds: the nearest "yes" without one is still asked for.
         moving_yes = {"labels": rec.pins, "heights": rec.pin_heights_mm, "speeds": rec.pin_speeds or (),
                       "certificate": cert}
     broken = [(key, r) for key, r in checker.results.items() if not r["holds"] and r["worst_member"]]
     if broken and moving_yes is None:
-        (labels, heights), record = max(broken, key=lambda kr: kr[1]["verdict"]["in_tolerance"])
-        worst = record["worst_member"]
-        result["family_certificate"] = None
-        # The evidence, kept whole: the best plan it broke, that plan's set, the member.
-        result["family_worst_member"] = {"plan": list(labels), "pin_heights_mm": list(heights),
-                                         "set_deg": record["set_deg"], **worst}
-        result["warning"] = ((result["warning"] + "; ") if result["warning"] else "") + (
-            f"no plan of up to {result['depth']} pins holds for the whole family {family.label}: "
-            f"{len(broken)} plan(s) that passed the sampled verification are broken by a worst member "
-            f"(e.g. {worst['parameters']}, nominal finals {worst['nominal_finals_deg']} deg, "
-            f"{worst['outside_deg']:.2f} deg outside the set)")
-    result["nearest_yes"] = nearest_yes(part, family, checker, result,
-                                        lambda text: planning_family(part, text, settings), checker.progress,
-                                        moving_yes)
+        entry = _broken_by_worst_member(entry, family, broken)
+    nearest = nearest_yes(part, family, checker, entry.depth, moving,
+                          lambda text: planning_family(part, text, settings), checker.progress, moving_yes)
+    return replace(entry, nearest_yes=nearest)
+
+
+def _broken_by_worst_member(entry: TightEntry, family, broken: list) -> TightEntry:
+    """``entry`` when worst members break the ``broken`` plans: no
+    certificate, the best plan broken with its worst member as evidence, and
+    a warning that says so."""
+    (labels, heights), record = max(broken, key=lambda kr: kr[1]["verdict"]["in_tolerance"])
+    worst = record["worst_member"]
+    warning = ((entry.warning + "; ") if entry.warning else "") + (
+        f"no plan of up to {entry.depth} pins holds for the whole family {family.label}: "
+        f"{len(broken)} plan(s) that passed the sampled verification are broken by a worst member "
+        f"(e.g. {worst['parameters']}, nominal finals {worst['nominal_finals_deg']} deg, "
+        f"{worst['outside_deg']:.2f} deg outside the set)")
+    # The evidence, kept whole: the best plan it broke, that plan's set, the member.
+    return replace(entry, family_certificate=None, warning=warning,
+                   family_worst_member={"plan": list(labels), "pin_heights_mm": list(heights),
+                                        "set_deg": record["set_deg"], **worst})

@@ -33,7 +33,9 @@ import numpy as np
 
 from pipeline.planning.claims import orient
 from pipeline.planning.core.nearest_axes import LADDER, MAX_TOLERANCE, more_pins_axis
+from pipeline.planning.core.types import TightEntry
 from pipeline.planning.tight.judge import TrialBench
+from pipeline.planning.tight.records import FixedSearch
 from pipeline.progress import NO_DEADLINE, Deadline, OutOfTime
 
 
@@ -193,50 +195,53 @@ def part_tolerance_axis(part, settings, plans, pins: dict | None = None, depth: 
                  pin_speeds=[float(v) for v in (speeds or ())], verdict=verdict, **flags)
 
 
-def part_moving_axis(entry: dict, cut: bool = False) -> dict:
-    """What the moving-pin stage found for the part (``cut``: a time limit
+def part_moving_axis(entry: TightEntry, moving: FixedSearch | None, cut: bool = False) -> dict:
+    """What the moving-pin stage (``moving``: its record, ``None`` when it
+    did not run) found for the part of ``entry`` (``cut``: a time limit
     ended the search before that stage)."""
-    stage = entry.get("moving_pin_search")
-    if not stage and cut:
+    if moving is None and cut:
         return _axis("moving pins", False, "not searched: the time limit ended the search before the moving pins",
                      partial=True)
-    rec = entry.get("recommended") or {}
-    if stage and stage.get("orients") and not any(rec.get("pin_speeds") or ()):
-        found = list((stage.get("found") or [[]])[0])
-        if found in [list(r.get("pins") or ()) for r in entry.get("rejected") or ()]:
+    rec = entry.recommended
+    moving_plan = rec is not None and any(rec.pin_speeds or ())
+    if moving is not None and moving.orients and not moving_plan:
+        found = list(moving.plans[0].labels)
+        if found in [list(r.pins) for r in entry.rejected or ()]:
             return _axis("moving pins", False, f"searched: {' '.join(found)} orients on the search's trials "
                                                "but fails the final verification")
         return _axis("moving pins", False, f"found, not verified: {' '.join(found)} orients on the search's "
                                            "trials; the time limit left no time to verify it", partial=True)
-    if stage and stage.get("complete") is False and not stage.get("orients"):
+    if moving is not None and moving.time_limit is not None and not moving.complete and not moving.orients:
         return _axis("moving pins", False, "searched in part: the time limit cut the moving-pin search "
-                                           f"(not searched: {'; '.join(stage.get('unsearched') or [])})",
-                     partial=True)
-    if not stage:
+                                           f"(not searched: {'; '.join(moving.unsearched)})", partial=True)
+    if moving is None:
         return _axis("moving pins", False, "not searched: no pin speeds given (planner.dynamic.speeds, --speeds)")
-    if stage.get("orients") and any(rec.get("pin_speeds") or ()):
-        n = sum(1 for v in rec["pin_speeds"] if v)
+    if moving.orients and moving_plan:
+        n = sum(1 for v in rec.pin_speeds if v)
         return _axis("moving pins", True, f"{n} moving pin(s)", value=n, unit="moving pins",
-                     plan=list(rec["pins"]), verdict=(rec.get("verification") or {}).get("orientation"))
+                     plan=list(rec.pins), verdict=(rec.verification.orientation or None) if rec.verification else None)
     return _axis("moving pins", False, "searched after the fixed pins: no moving-pin plan orients the part either")
 
 
-def sensor_axis(entry: dict) -> dict:
+def sensor_axis(entry: TightEntry) -> dict:
     """A force/torque-sensing pin after the recommended plan, when it ends in a few sets."""
-    rec = entry.get("recommended") or {}
-    verdict = (rec.get("verification") or {}).get("orientation") or {}
+    rec = entry.recommended
+    verdict = (rec.verification.orientation if rec is not None and rec.verification else None) or {}
     sets = verdict.get("sets_within_tolerance")
     if rec and sets and sets > 1:
-        return _axis("sensor", True, f"a force/torque-sensing pin after {' '.join(rec['pins'])} tells its "
+        return _axis("sensor", True, f"a force/torque-sensing pin after {' '.join(rec.pins)} tells its "
                                      f"{sets} sets apart (pinfeed sense)", value=int(sets), unit="sets",
-                     plan=list(rec["pins"]))
+                     plan=list(rec.pins))
     return _axis("sensor", False, "no recommended plan ends in a few sets for a sensor to tell apart")
 
 
-def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = None, progress=None,
-                     deadline: Deadline = NO_DEADLINE, moving_cut: bool = False) -> dict:
+def part_nearest_yes(part, settings, entry: TightEntry, fixed: FixedSearch, moving: FixedSearch | None, plans,
+                     pins: dict | None = None, progress=None, deadline: Deadline = NO_DEADLINE,
+                     moving_cut: bool = False) -> dict:
     """The nearest "yes" on each axis for a part no plan orients (see the
-    module docstring); ``entry``: its tight entry; ``plans``: the kept plans
+    module docstring); ``entry``: its tight entry; ``fixed`` and
+    ``moving``: the fixed-pin and moving-pin searches' records (``moving``
+    ``None`` when that stage did not run); ``plans``: the kept plans
     ``(labels, heights, speeds)``, best first; ``pins``: the fixed pins the
     search chose from (label -> height, mm), searched again at looser
     tolerances when no kept plan answers. ``deadline``: a time limit; one
@@ -244,13 +249,12 @@ def part_nearest_yes(part, settings, entry: dict, plans, pins: dict | None = Non
     plans replayed, and the axis says so (see :func:`part_tolerance_axis`).
     Without ``pins`` only the kept plans are replayed; ``moving_cut``: a
     time limit ended the search before its moving pins."""
-    depth = entry.get("depth")
+    depth = entry.depth
     tolerance = part_tolerance_axis(part, settings, plans, pins, depth, progress, deadline)
-    more = more_pins_axis(entry)
-    searched = entry.get("fixed_pin_search") or {}
-    if searched.get("complete") is False and searched.get("complete_to_pins", 0) < (depth or 0):
+    more = more_pins_axis(depth)
+    if fixed.time_limit is not None and not fixed.complete and fixed.complete_to < (depth or 0):
         # depth N itself was not searched in full
         more = _axis("more pins", False, "not searched: the time limit cut the search before its depth; "
                                          "run with a longer --time-limit first", partial=True)
     return {"plans_tried": [list(p[0]) for p in plans[:tolerance["replayed"]]],
-            "axes": [tolerance, part_moving_axis(entry, moving_cut), sensor_axis(entry), more]}
+            "axes": [tolerance, part_moving_axis(entry, moving, moving_cut), sensor_axis(entry), more]}

@@ -36,16 +36,17 @@ replays with the dynamic model at the same speed.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, replace
 
 from pipeline.parts.part import Part
-from pipeline.planning.core.arcs import format_arcs
+from pipeline.planning.core.types import TightEntry
 from pipeline.planning.tight.records import FixedSearch, orientation_rank, robust_order
 from pipeline.planning.family.members import planning_family
-from pipeline.planning.plans.candidates import (MOVING_NOT_REACHED, MOVING_PREFIXES, add_moving_pins,
-                                                carried_sets, fixed_search)
+from pipeline.planning.plans.candidates import MOVING_NOT_REACHED, add_moving_pins, carried_sets, fixed_search
+from pipeline.planning.plans.entry import entry_record
 from pipeline.planning.plans.for_family import certify_for_family, family_checker, judge_for_family
 from pipeline.planning.plans.nearest_part import part_nearest_yes
-from pipeline.planning.plans.planner import mechanics_label, planner_belt, planner_for, planner_pin_heights
+from pipeline.planning.plans.planner import planner_belt, planner_for, planner_pin_heights
 from pipeline.planning.tight.store import load_lattice, save_lattice
 from pipeline.planning.claims.orient import describe_claim, judge_verification, verification_finals
 from pipeline.planning.core.resting import resting_states
@@ -60,9 +61,10 @@ from pipeline.progress import NO_DEADLINE, Deadline, Heartbeat
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
 def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int | None = None,
-               keep: int = 5, progress=None, family=None, deadline: Deadline = NO_DEADLINE) -> dict:
+               keep: int = 5, progress=None, family=None, deadline: Deadline = NO_DEADLINE) -> TightEntry:
     """Search, verify and rank plans for ``part`` at ``settings.friction`` (a
-    value or a range); returns a JSON-ready dict (``plans`` best first, each
+    value or a range); returns the :class:`~pipeline.planning.core.types.TightEntry`
+    record (``plans`` best first, each
     with its ``verification`` and orientation verdict; ``recommended``;
     ``warning``; ``fixed_pin_search``: what the complete search found, or its
     evidence that no fixed-pin plan orients the part; search statistics).
@@ -102,49 +104,62 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
         unsearched.append("the recommended plan's replay on untruncated normals: skipped")
     else:
         _check_tails(part, settings, planner, good[0] if good else None, states, progress, family)
-    result = _tight_result(settings, depth, keep, planner, candidates, good, states, fixed, moving_search)
-    _add_certificate_or_nearest_yes(result, part, settings, planner, fixed, candidates, good, keep, progress,
-                                    family, checker, deadline, unsearched)
+    entry = entry_record(settings, depth, keep, planner, candidates, good, states, fixed, moving_search)
+    search = SearchRecords(planner, fixed, moving_search, candidates[:keep])
+    entry = _with_certificate_or_nearest_yes(entry, part, settings, search, progress, family, checker, deadline,
+                                             unsearched)
     if deadline.limited:
-        result.update(time_limit_s=deadline.seconds, complete=not unsearched, unsearched=unsearched)
-    return result
+        entry = replace(entry, time_limit_s=deadline.seconds, complete=not unsearched, unsearched=unsearched)
+    return entry
 
 
-def _add_certificate_or_nearest_yes(result: dict, part: Part, settings: PlannerSettings, planner,
-                                    fixed: FixedSearch, candidates, good, keep, progress, family, checker,
-                                    deadline: Deadline, unsearched: list) -> None:
-    """Add to ``result`` what follows the answer: with a support family, the
+@dataclass(frozen=True)
+class SearchRecords:
+    """What the steps after the answer read of the search: the ``planner``
+    (its pins), the fixed-pin and moving-pin searches' records and the best
+    ``kept`` candidates."""
+    planner: object
+    fixed: FixedSearch
+    moving: FixedSearch | None
+    kept: list
+
+
+def _with_certificate_or_nearest_yes(entry: TightEntry, part: Part, settings: PlannerSettings,
+                                     search: SearchRecords, progress, family, checker, deadline: Deadline,
+                                     unsearched: list) -> TightEntry:
+    """``entry`` with what follows the answer: with a support family, the
     family and (without a time limit) the recommended plan's certificate and
     nearest "yes"; without one, when nothing orients, the nearest "yes" of
-    the best ``keep`` candidates (unless a time limit or an incomplete fixed
+    the best kept candidates (unless a time limit or an incomplete fixed
     search rules it out: then only the kept plans are replayed, without
     searches at looser tolerances). What is skipped or cut short joins
     ``unsearched``."""
     if family is not None:
-        result["support_family"] = family.to_dict()
+        entry = replace(entry, support_family=family.to_dict())
         if deadline.limited:  # the certificate and the nearest "yes" are searches of their own
             unsearched.append("the support family's certificate of the recommended plan and its nearest "
                               '"yes": skipped under a time limit')
-        else:
-            certify_for_family(result, part, settings, family, checker, good)
-    elif not result["orients"] and candidates:
-        kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in candidates[:keep]]
-        fixed_pins = {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0}
-        if deadline.over():
-            unsearched.append('the nearest "yes": skipped (no time left)')
-            return
-        # After a cut search the kept plans' held-out replays still answer "which tolerance would
-        # do"; only the searches at looser tolerances (the answer when no kept plan does) are left out.
-        cut = deadline.search_over() or not fixed.complete
-        moving_cut = any(u.startswith(MOVING_NOT_REACHED) for u in unsearched)
-        nearest = part_nearest_yes(part, settings, result, kept, None if cut else fixed_pins, progress, deadline,
-                                   moving_cut)
-        result["nearest_yes"] = nearest
-        tolerance = next(a for a in nearest["axes"] if a["axis"] == "tolerance")
-        if tolerance["kept_plans_only"]:
-            how = "cut by the time limit" if tolerance["searches_cut"] else "not run"
-            unsearched.append(f'the nearest "yes": kept plans only ({tolerance["replayed"]} of {len(kept)} '
-                              f'replayed; the complete searches at looser tolerances {how})')
+            return entry
+        return certify_for_family(entry, part, settings, family, checker, search.moving)
+    if entry.orients or not search.kept:
+        return entry
+    kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in search.kept]
+    fixed_pins = {label: pin.y for label, pin in search.planner.pins.items() if pin.v_pin == 0.0}
+    if deadline.over():
+        unsearched.append('the nearest "yes": skipped (no time left)')
+        return entry
+    # After a cut search the kept plans' held-out replays still answer "which tolerance would
+    # do"; only the searches at looser tolerances (the answer when no kept plan does) are left out.
+    cut = deadline.search_over() or not search.fixed.complete
+    moving_cut = any(u.startswith(MOVING_NOT_REACHED) for u in unsearched)
+    nearest = part_nearest_yes(part, settings, entry, search.fixed, search.moving, kept,
+                               None if cut else fixed_pins, progress, deadline, moving_cut)
+    tolerance = next(a for a in nearest["axes"] if a["axis"] == "tolerance")
+    if tolerance["kept_plans_only"]:
+        how = "cut by the time limit" if tolerance["searches_cut"] else "not run"
+        unsearched.append(f'the nearest "yes": kept plans only ({tolerance["replayed"]} of {len(kept)} '
+                          f'replayed; the complete searches at looser tolerances {how})')
+    return replace(entry, nearest_yes=nearest)
 
 
 
@@ -236,87 +251,12 @@ def _check_tails(part: Part, settings: PlannerSettings, planner, plan, states, p
                  + describe_untruncated(record, TRUNCATE_SIGMA))
 
 
-def _no_plan_warning(depth: int, candidates, good, fixed: FixedSearch, tolerance: float,
-                     moving: FixedSearch | None = None):
-    """Why the recommended plan does not orient the part, or why nothing is
-    recommended (None when a plan orients it)."""
-    if good and good[0].verification["orientation"]["orients"]:
-        return None
-    if fixed.needs_no_pin:
-        return fixed.evidence()
-    why = fixed.evidence()
-    if moving is not None and not moving.complete:
-        why += (f"; nor do the moving-pin sequences searched before the time limit (up to {moving.depth} moving "
-                f"pins after no fixed pin or after the {MOVING_PREFIXES} best fixed-pin results; not searched: "
-                f"{'; '.join(moving.unsearched)})")
-    elif moving is not None:
-        why += (f"; nor do up to {moving.depth} moving pins after no fixed pin or after the "
-                f"{MOVING_PREFIXES} best fixed-pin results")
-    if not candidates and not fixed.complete:
-        return f"{why}; no plan was verified within the time limit"
-    if not candidates:
-        return f"{why}; no allowed pin sequence within depth {depth}"
-    if not good:
-        best = candidates[0]
-        return (f"{why}; no plan passed verification: the best, {' '.join(best.pins)} "
-                f"({format_arcs(best.final_sets)}), failed {best.verification['failures']} of "
-                f"{best.verification['trials']} trials")
-    verdict = good[0].verification["orientation"]
-    if verdict.get("point_rule"):
-        return (f"no plan clears the confidence bound on held-out trials; the best, "
-                f"{' '.join(good[0].pins)}, is a near miss: {describe_claim(verdict)}")
-    return (f"{why}; the recommended plan ends in {verdict['sets_within_tolerance']} "
-            f"sets of at most {tolerance:g} deg: a sensor must tell them apart")
-
-
-def _tight_result(settings: PlannerSettings, depth: int, keep: int, planner, candidates, good, states,
-                  fixed: FixedSearch, moving: FixedSearch | None = None) -> dict:
-    """The JSON-ready tight-planner entry at one friction (the stored format)."""
-    recommended = good[0] if good else None
-    tolerance = settings.claims.tolerance_deg
-    return {
-        "mu_c": settings.friction.to_json(),
-        "friction": settings.friction.label,
-        "belt_speed": planner.belt_speed, "mu_s": planner.mu_s if planner.belt_speed else None,
-        "mechanics": mechanics_label(settings.search.model, planner.belt_speed, planner.mu_s),
-        "symmetry_order": planner.order,
-        "depth": depth, "complete_depth": depth,
-        "beam": settings.search.beam,
-        "tolerance_deg": tolerance, "required": settings.claims.required,
-        "orients": bool(recommended and recommended.verification["orientation"]["orients"])
-        or fixed.needs_no_pin,
-        "needs_no_pin": fixed.needs_no_pin,
-        "plans": [p.to_dict() for p in good[:keep]],
-        "rejected": [p.to_dict() for p in candidates if p not in good][:keep],
-        "recommended": recommended.to_dict() if recommended else None,
-        "warning": _no_plan_warning(depth, candidates, good, fixed, tolerance, moving),
-        "fixed_pin_search": fixed.to_dict(),
-        "moving_pin_search": None if moving is None else {
-            "orients": moving.orients, "depth": moving.depth, "levels": moving.levels,
-            "found": [list(p.labels) for p in moving.plans], "skipped": moving.skipped,
-            "nominal_rollouts": moving.rollouts,
-            "seconds": round(moving.seconds, 2),
-            **({} if moving.time_limit is None else {"complete": moving.complete,
-                                                      "unsearched": list(moving.unsearched)})},
-        "pins_used": {label: pin.y for label, pin in planner.pins.items() if pin.v_pin == 0.0},
-        "stats": {"transitions": planner.stats.transitions,
-                  "rollouts": planner.stats.rollouts + fixed.rollouts + (moving.rollouts if moving else 0),
-                  "nominal_rollouts": fixed.rollouts + (moving.rollouts if moving else 0),
-                  "joint_states": planner.stats.nodes, "seconds": round(fixed.seconds + planner.stats.seconds, 2),
-                  "pruned_branching": planner.stats.pruned_branching,
-                  "unresolved": planner.stats.unresolved,
-                  "per_level": [lv["sequences"] for lv in fixed.levels]},
-        "initial_states": {k: {"theta": t, "y_c": y} for k, (t, y) in states.items()},
-        "lattices": planner.lattices,
-    }
-
-
 # ---------------------------------------------------------------------- every configured friction
 
 
 def plan_tight_all(part: Part, settings: PlannerSettings, catalog_root, keep: int = 5, progress=None,
                    deadline: Deadline | None = None) -> list:
-    """Tight plans at every friction of ``settings.frictions`` (the first is the
+    """Tight plans (a :class:`~pipeline.planning.core.types.TightEntry` each) at every friction of ``settings.frictions`` (the first is the
     recommended one), at the search's belt speed when it is set, for every
     member of its support family when it is set (its extremes found at each
     friction); the planner's rollouts are stored in the catalog (keyed by
@@ -336,12 +276,11 @@ def plan_tight_all(part: Part, settings: PlannerSettings, catalog_root, keep: in
             t0 = time.perf_counter()
             at = settings.at(friction)
             family = planning_family(part, search.support_family or "uniform", at)
-            res = plan_tight(part, at, lattices=lattices, keep=keep,
-                             progress=_labelled(progress, f"mu_c {friction.label}"), family=family,
-                             deadline=deadline)
-            res["stats"]["wall_seconds"] = round(time.perf_counter() - t0, 2)  # search, verification and all
-            res.pop("lattices")
-            out.append(res)
+            entry = plan_tight(part, at, lattices=lattices, keep=keep,
+                               progress=_labelled(progress, f"mu_c {friction.label}"), family=family,
+                               deadline=deadline)
+            wall = round(time.perf_counter() - t0, 2)  # search, verification and all
+            out.append(replace(entry, stats={**entry.stats, "wall_seconds": wall}))
     finally:  # also on Ctrl-C: the rollouts done so far are reused by the next run
         for lattice in lattices.values():
             save_lattice(catalog_root, lattice)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -26,6 +27,7 @@ from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import in_arc
 from pipeline.planning.core.settings import PlannerSettings, SpeedPerturbation, SpeedSettings
+from pipeline.planning.core.types import PlanFile
 from pipeline.progress import SILENT, Heartbeat, Stretch, prefixed
 
 DEFAULT_SPEEDS = SpeedSettings().speeds  # the schema's speed grid, mm/s
@@ -187,7 +189,7 @@ def _speed_limit(frac, grid, required, resolution) -> float:
 
 
 def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=None,
-                      speed: SpeedSettings | None = None, progress=None) -> dict:
+                      speed: SpeedSettings | None = None, progress=None, part: Part | None = None) -> dict:
     """The speed curve and speed limit of a stored tight plan (a plan file's
     ``tight`` entry, see :func:`pick_tight_plan`; ``result`` a
     :class:`~pipeline.planning.core.types.PlanFile` or its dict), with the
@@ -202,6 +204,7 @@ def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=
     success fraction), ``planned_belt_speed`` (``None``: planned
     quasi-static), ``trials``, ``trials_per_speed``, ``seconds`` and ``method``.
     ``progress`` hears about each belt speed tried (:func:`speed_curve`).
+    ``part``: the part in hand (default: made from the file's outline).
     """
     from pipeline.planning.family.certificate import family_assumption
     from pipeline.planning.plans.stored_plan import pick_tight_plan
@@ -213,7 +216,7 @@ def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=
         raise PinfeedError(f"trials must be a whole number >= 1, got {trials!r}")
     result = as_plan_file(result)
     chosen, mu_c, entry = pick_tight_plan(result, plan, mu_text)
-    part = Part.from_dict(result.part, name=result.name)
+    part = part if part is not None else Part.from_dict(result.part, name=result.name)
     perturb = SpeedPerturbation.from_verify(settings.verify.perturbation)
     # A tight-only plan file keeps the resting states per friction entry.
     stored_states = entry.initial_states or result.initial_states or {}
@@ -241,8 +244,7 @@ def stored_plan_speed(result, settings: PlannerSettings, plan: int = 1, mu_text=
 def stored_speed_limit(plan) -> dict | None:
     """The speed limit stored with a tight plan (a :class:`~pipeline.planning.core.plan_records.Plan`
     or its dict; see :func:`attach_speed_limits`), or None."""
-    extra = plan.get("speed_limit") if isinstance(plan, dict) else plan.extra.get("speed_limit")
-    return extra or None
+    return (plan.get("speed_limit") if isinstance(plan, dict) else plan.speed_limit) or None
 
 
 def speed_label(record: dict) -> str:
@@ -250,32 +252,33 @@ def speed_label(record: dict) -> str:
     return f"{record['speed_limit_mm_s']:g} mm/s ({record['trials']} trials per state)"
 
 
-def attach_speed_limits(result: dict, settings: PlannerSettings) -> dict:
-    """Store in the plan dict ``result`` (what ``pinfeed plan`` and the workflow
-    write) the speed limit of the recommended tight plan and of the first tight
+def attach_speed_limits(result: PlanFile, settings: PlannerSettings, part: Part | None = None) -> PlanFile:
+    """``result`` (the record of what ``pinfeed plan`` and the workflow write)
+    with the speed limit of the recommended tight plan and of the first tight
     plan of fixed pins (the one a layout uses) at the first planned friction:
     each such plan gets ``speed_limit``, the :func:`stored_plan_speed` result
     with the speed settings (``settings.speed``, kept under ``settings``), so
     that the report, ``pinfeed speed`` and ``pinfeed layout`` show one figure
     per plan. A plan whose speed limit cannot be computed (a part any grid
-    speed would throw) gets none: the speed stage then says why. Returns
-    ``result`` (changed in place). The belt speeds tried go to the progress
-    report of :func:`pipeline.progress.reporting`, labelled with the friction
-    and the plan's number."""
-    tight = result.get("tight") or []
-    if not tight or not tight[0]["plans"]:
+    speed would throw) gets none: the speed stage then says why. The belt
+    speeds tried go to the progress report of
+    :func:`pipeline.progress.reporting`, labelled with the friction and the
+    plan's number. ``part``: the part in hand (default: made from the file's
+    outline)."""
+    if not result.tight or not result.tight[0].plans:
         return result
-    entry = tight[0]
-    plans = entry["plans"]
-    fixed = [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.get("pin_speeds") or ())]
+    entry = result.tight[0]
+    plans = list(entry.plans)
+    fixed = [k for k, p in enumerate(plans, start=1) if not any(float(v) for v in p.pin_speeds or ())]
     for number in sorted({1, *fixed[:1]}):
         try:
             record = stored_plan_speed(result, settings, plan=number,
-                                       progress=prefixed(f"mu_c {entry['friction']}: plan {number}"))
+                                       progress=prefixed(f"mu_c {entry.friction}: plan {number}"), part=part)
         except PinfeedError:
             continue
         record.pop("seconds", None)  # a timing would make the same plan differ between runs
-        plans[number - 1]["speed_limit"] = dict(record, settings=settings.speed.to_json())
-    if entry.get("recommended") is not None and "speed_limit" in plans[0]:
-        entry["recommended"]["speed_limit"] = plans[0]["speed_limit"]
-    return result
+        plans[number - 1] = replace(plans[number - 1], speed_limit=dict(record, settings=settings.speed.to_json()))
+    recommended = entry.recommended
+    if recommended is not None and plans[0].speed_limit:
+        recommended = replace(recommended, speed_limit=plans[0].speed_limit)
+    return replace(result, tight=(replace(entry, plans=tuple(plans), recommended=recommended), *result.tight[1:]))

@@ -113,13 +113,20 @@ def support_study(part: Part, settings: PlannerSettings, family, uniform_entry: 
         if progress:
             progress(f"planning for every member of {family.label}")
         res = plan_tight(part, settings.without_moving_pins(), family=family, progress=progress)
-        best = res["recommended"]
-        out["family_plan"] = {
-            "orients": res["orients"], "warning": res["warning"],
-            "evidence": res["fixed_pin_search"]["evidence"],
-            "pins": best and list(best["pins"]), "pin_heights_mm": best and best["pin_heights_mm"],
-            "pin_speeds": best and best.get("pin_speeds"),
-            "verification": best and best["verification"], "claim": best and best.get("claim"),
-            "plans": res["plans"],
-            "worst_member": res.get("family_worst_member"), "nearest_yes": res.get("nearest_yes")}
+        out["family_plan"] = _family_plan(res)
     return out
+
+
+def _family_plan(entry) -> dict:
+    """What the support study keeps of the planner's ``entry`` for the family
+    (a :class:`~pipeline.planning.core.types.TightEntry`): the answer, the
+    recommended plan with its verification and claim, the worst member and
+    the nearest "yes"."""
+    best = entry.recommended
+    return {"orients": entry.orients, "warning": entry.warning, "evidence": entry.fixed_pin_search["evidence"],
+            "pins": best and list(best.pins), "pin_heights_mm": best and list(best.pin_heights_mm),
+            "pin_speeds": best and list(best.pin_speeds),
+            "verification": best and best.verification.to_dict(),
+            "claim": best and (best.claim.to_dict() if best.claim else None),
+            "plans": [p.to_dict() for p in entry.plans],
+            "worst_member": entry.family_worst_member or None, "nearest_yes": entry.nearest_yes or None}
