@@ -120,8 +120,8 @@ def print_plan_result(result, part, config, mode):
             print(f"  {shape_line(shape)}")
         nearest = t.extra.get("nearest_yes")
         if nearest:
-            from pipeline.planning import nearest_yes_lines
-            for line in nearest_yes_lines(nearest):
+            from pipeline.planning import SUBJECT_FAMILY, SUBJECT_PART, nearest_yes_lines
+            for line in nearest_yes_lines(nearest, SUBJECT_FAMILY if family else SUBJECT_PART):
                 print(f"  {line}")
         for k, plan in enumerate(t.plans, start=1):
             v = plan.verification

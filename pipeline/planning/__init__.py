@@ -54,7 +54,7 @@ _WHERE = {
     "core.claim": "Claim",
     "core.plan_records": "ABSENT Plan RestingState",
     "core.types": "PlanFile TightEntry as_plan_file load_plan validate_plan_file",
-    "core.nearest_axes": "nearest_yes_lines",
+    "core.nearest_axes": "SUBJECT_FAMILY SUBJECT_PART nearest_yes_lines",
     "claims.orient": "check_tolerance describe_claim min_trials narrowest_arc",
     "claims.tails": "describe_untruncated truncation_text untruncated_check",
     "claims.trials": "VERIFY_DEFAULTS=DEFAULTS PERTURB_DEFAULTS corner_inputs perturbed_batch perturbed_inputs",

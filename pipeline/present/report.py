@@ -14,7 +14,7 @@ from pathlib import Path
 from pipeline import __version__
 from pipeline.config import config_hash
 from pipeline.maps.io import write_text_atomic
-from pipeline.planning import PlannerSettings, format_arcs, nearest_yes_lines
+from pipeline.planning import SUBJECT_FAMILY, SUBJECT_PART, PlannerSettings, format_arcs, nearest_yes_lines
 from pipeline.present.atlas_section import atlas_section
 from pipeline.present.figures.tables import HEADER, verification_rows
 from pipeline.present.layout import speed_limit_text
@@ -183,7 +183,7 @@ def _support_section(res: dict, files: dict, base) -> list[str]:
             p.append(f'<li class="warn">No plan orients the part for every member: '
                      f"{html.escape(fp.get('warning') or fp['evidence'])}</li>")
             if fp.get("nearest_yes"):
-                head, *lines = nearest_yes_lines(fp["nearest_yes"])
+                head, *lines = nearest_yes_lines(fp["nearest_yes"], SUBJECT_FAMILY)  # a family plan's answer
                 p.append(f"<li>{html.escape(head)}<ul>"
                          + "".join(f"<li>{html.escape(line.strip())}</li>" for line in lines) + "</ul></li>")
     p.append("</ul>")
@@ -275,7 +275,8 @@ def _warnings(plans: dict, verifications: dict) -> list[str]:
             if t.get("warning"):
                 items.append(f"{name}, tight planner at mu_c {t['friction']}: {t['warning']}")
             if t.get("nearest_yes"):  # what would make it a "yes", axis by axis
-                head, *lines = nearest_yes_lines(t["nearest_yes"])
+                subject = SUBJECT_FAMILY if t.get("support_family") else SUBJECT_PART
+                head, *lines = nearest_yes_lines(t["nearest_yes"], subject)
                 items += [f"{name}, {head.rstrip(':')}: {line.strip()}" for line in lines]
     for name, ver in verifications.items():
         for check in ver.get("checks", []):

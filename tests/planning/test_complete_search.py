@@ -151,8 +151,8 @@ def test_sampled_claim_splits_outliers_and_holds_in_an_independent_replay():
     plan = sampled_plan(planner, labels, 0.0, VerifySettings(trials=100))
     assert plan.carried == "sampled"
     for label, branches in plan.branches.items():
-        finals = sorted(br[-1].after.start for br in branches)
-        assert all(br[-1].after.width < 20.0 for br in branches), (label, finals)
+        finals = sorted(br[-1].band.start for br in branches)
+        assert all(br[-1].band.width < 20.0 for br in branches), (label, finals)
         assert len(branches) == 1 or min(np.diff(finals)) > CLUSTER_GAP_DEG - 1.0
     states = {k: (float(t), float(y)) for k, (t, y) in zip(planner.initial_states(), part.stable_states())}
     res = verify_plan(part, plan.to_dict(), {k: p.y for k, p in planner.pins.items()}, states, 0.3, 3.0,

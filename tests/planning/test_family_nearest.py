@@ -16,7 +16,7 @@ import pytest
 from pipeline.parts.part import Part
 from pipeline.parts.support import point_support
 from pipeline.parts.support_family import FamilySpec, parse_support_family
-from pipeline.planning.core.nearest_axes import MAX_TOLERANCE, bisect_smallest, nearest_yes_lines
+from pipeline.planning.core.nearest_axes import MAX_TOLERANCE, SUBJECT_FAMILY, bisect_smallest, nearest_yes_lines
 from pipeline.planning.core.settings import ClaimSettings, Perturbation, SearchSettings, VerifySettings
 from pipeline.planning.family import nearest
 from pipeline.planning.family.member_spaces import member_space
@@ -115,7 +115,7 @@ def test_a_moving_plan_that_holds_is_the_moving_axis_and_the_rest_ask_without_it
     axis = nearest.family_moving_axis("tripods:12", None, moving)
     assert axis["found"] and axis["holds"] and axis["value"] == 1 and axis["plan"] == ["P1", "P2v-1"]
     assert axis["family"] == "tripods:12"
-    assert "holds" in nearest_yes_lines({"axes": [axis]})[1]
+    assert "holds" in nearest_yes_lines({"subject": SUBJECT_FAMILY, "axes": [axis]})[1]
     searched = nearest.family_moving_axis("tripods:12", SimpleNamespace(levels=[]))  # the stage ran, found none
     assert not searched["found"] and searched["statement"].startswith("searched")
     assert nearest.family_moving_axis("tripods:12", None)["statement"].startswith("not searched")

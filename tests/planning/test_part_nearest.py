@@ -86,6 +86,7 @@ def test_a_part_without_a_plan_gets_its_nearest_yes(no_plan):
     assert tol["verdict"]["trials"] >= 180  # the held-out trials (fresh seed), not the 30 per state
     assert not axes["moving pins"]["found"] and "not searched" in axes["moving pins"]["statement"]
     assert not axes["more pins"]["found"] and "--depth 3" in axes["more pins"]["statement"]
+    assert result["nearest_yes"]["subject"] == "part"  # the answer says what it is about
     lines = nearest_yes_lines(result["nearest_yes"])
     assert lines[0].startswith("the nearest \"yes\"") and any(f"{tol['value']:g} deg" in x for x in lines)
 

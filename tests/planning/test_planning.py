@@ -139,7 +139,8 @@ def test_planner_finds_the_hand_known_best_plan():
     branches = best.branches
     assert set(branches) == {"state 1", "state 2", "state 3", "state 4"}
     step = branches["state 1"][0][0]
-    assert step.arc == (45.0, 0.0) and step.y_lo == pytest.approx(step.y_hi)
+    assert step.band.pair == (45.0, 0.0) and step.com_interval[0] == pytest.approx(step.com_interval[1])
+    assert step.carried is None  # a paper step carries no state set
 
 
 def test_planner_forbids_jamming_pins_and_keeps_misses():

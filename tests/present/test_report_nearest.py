@@ -39,3 +39,15 @@ def test_a_part_without_a_plan_lists_its_nearest_yes_among_the_warnings():
     assert "tolerance: a tolerance of 30 deg (asked: 6 deg): P14 P2 holds 186 of 186 trials in one set" in text
     assert "sensor: a force/torque-sensing pin after P14 tells its 4 sets apart" in text
     assert "verified by full rollouts" in text
+
+
+def test_a_family_entry_lists_its_answer_as_a_familys():
+    """A family's answer whose axes carry no certificate (and no ``steps``,
+    written before answers said what they are about): the entry's
+    ``support_family`` makes it a family's, not a guess from the axes."""
+    from pipeline.present.report import _warnings
+    nearest = {"axes": [{"axis": "tolerance", "found": False, "statement": "no plan tried holds for the family"}]}
+    plans = {"plate": {"tight": [{"friction": "0.2", "support_family": {"label": "tripods:12"},
+                                  "nearest_yes": nearest}]}}
+    text = "\n".join(_warnings(plans, {}))
+    assert "worst-member search, then fresh members" in text and "full rollouts" not in text

@@ -105,6 +105,13 @@ class State:
     KEYS = ("arc", "y_c", "mu_c")
 
     @classmethod
+    def of_set(cls, state_set) -> "State":
+        """The record of a ``tight.propagate.StateSet`` (read by its fields
+        ``start``, ``width``, ``y_lo``, ``y_hi``, ``mu_lo`` and ``mu_hi``)."""
+        return cls(Arc(state_set.start, state_set.width), (state_set.y_lo, state_set.y_hi),
+                   (state_set.mu_lo, state_set.mu_hi))
+
+    @classmethod
     def from_dict(cls, d: dict) -> "State":
         """The record of a stored dict (as read from the plan file)."""
         return cls(Arc.from_dict(d["arc"]), _pair(d["y_c"]), _pair(d["mu_c"]), unmodelled_keys(d, cls.KEYS))
@@ -133,7 +140,10 @@ class RestingState:
 
 @dataclass(frozen=True)
 class Step:
-    """What one pin did to one branch of one initial state.
+    """What one pin did to one branch of one initial state: the one step
+    record, built by both planners (:meth:`carried_by` in the tight planner,
+    :meth:`reaching` in the paper-mode planner) and read back from a stored
+    plan (:meth:`from_dict`).
 
     ``pin``: its label; ``y_pin``: its height (mm); ``v_pin``: its speed
     ratio (0 for a fixed pin); ``d_range = (lo, hi)``: the offsets ``d`` the
@@ -151,6 +161,22 @@ class Step:
     extra: dict = field(default_factory=dict)
 
     KEYS = ("pin", "y_pin", "v_pin", "d_range", "band", "com_interval", "carried")
+
+    @classmethod
+    def carried_by(cls, pin: str, y_pin: float, v_pin: float, d_range, after) -> "Step":
+        """A tight planner's step: ``after`` is the state set carried after the
+        pin (a ``tight.propagate.StateSet``, read by its fields ``start``,
+        ``width``, ``y_lo``, ``y_hi``, ``mu_lo`` and ``mu_hi``); its arc is the
+        step's band, its centroid heights the step's COM interval."""
+        carried = State.of_set(after)
+        return cls(pin, y_pin, v_pin, tuple(d_range), carried.arc, carried.y_c, carried)
+
+    @classmethod
+    def reaching(cls, pin: str, y_pin: float, v_pin: float, d_range, arc, com_interval) -> "Step":
+        """A paper-mode planner's step: the orientation ``arc`` ``(start, width)``
+        (deg) and the ``com_interval`` ``(lo, hi)`` (mm) it reaches; it carries
+        no state set."""
+        return cls(pin, y_pin, v_pin, tuple(d_range), Arc(arc[0], arc[1]), tuple(com_interval))
 
     @classmethod
     def from_dict(cls, d: dict) -> "Step":

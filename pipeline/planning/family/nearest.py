@@ -42,8 +42,8 @@ import numpy as np
 from pipeline.errors import PinfeedError
 from pipeline.parts.support import material_distance
 from pipeline.parts.support_family import DEFAULT_INSET, FamilySpec, parse_support_family
-from pipeline.planning.core.nearest_axes import (MAX_TOLERANCE, bisect_smallest, ladder_up, more_pins_axis,
-                                                 unanswered_axis)
+from pipeline.planning.core.nearest_axes import (MAX_TOLERANCE, SUBJECT_FAMILY, bisect_smallest, ladder_up,
+                                                 more_pins_axis, unanswered_axis)
 from pipeline.planning.family.certificate import MIN_FRESH_MEMBERS, family_certificate, fresh_finals, fresh_members
 from pipeline.planning.family.member_spaces import member_space
 from pipeline.planning.family.worst_member import FamilyChecker, check_plan_for_family
@@ -266,12 +266,13 @@ def nearest_yes(part, family, checker: FamilyChecker, depth: int | None, moving,
     moving_axis = family_moving_axis(family.label, moving, moving_yes)
     if not plans:
         nothing = "no plan passed the sampled verification: nothing to loosen"
-        return {"plans_tried": [], "axes": [unanswered_axis(a, nothing) for a in ("inset", "friction", "tolerance")]
+        return {"subject": SUBJECT_FAMILY, "plans_tried": [],
+                "axes": [unanswered_axis(a, nothing) for a in ("inset", "friction", "tolerance")]
                 + [moving_axis, more_pins_axis(depth)]}
     kept = kept_members(part, checker.breakers)
     axes = [inset_axis(part, family, plans, st, make_family, progress, kept),
             friction_axis(part, family, plans, st, progress, kept),
             family_tolerance_axis(part, family, plans, st, progress, kept),
             moving_axis, more_pins_axis(depth)]
-    return {"plans_tried": [list(p[0]) for p in plans], "steps": STEPS,
+    return {"subject": SUBJECT_FAMILY, "plans_tried": [list(p[0]) for p in plans], "steps": STEPS,
             "assumes": "holding is monotone along each axis (bisection)", "axes": axes}

@@ -40,23 +40,9 @@ from pipeline.maps.catalog import Catalog, entry_part
 from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import arc_within, in_arc, merge_arcs  # noqa: F401 (merge_arcs: re-exported)
+from pipeline.planning.core.plan_records import Step
 from pipeline.planning.paper.bands import band_lookup, extract_bands
 from pipeline.planning.core.settings import PlannerSettings, candidate_pins
-
-
-@dataclass(frozen=True)
-
-
-class Step:
-    """One pin of a paper plan: its height (mm), d range, and the orientation arc and COM interval reached."""
-    pin: str
-    y_pin: float
-    d_lo: float
-    d_hi: float
-    arc: tuple  # (start, width) of the orientation set reached, degrees
-    y_lo: float
-    y_hi: float
-    v_pin: float = 0.0  # speed ratio v_pin / v_b of a dynamic pin
 
 
 @dataclass(frozen=True)
@@ -97,7 +83,7 @@ class Plan:
     n_sets: int
     final_sets: list  # [(start, width)] merged final arcs
     margin: float
-    branches: dict  # initial-state label -> list of step lists (one per branch)
+    branches: dict  # initial-state label -> list of step lists (plan_records.Step, one list per branch)
     sets_after: tuple = ()  # number of orientation sets after each pin (what each pin adds)
     n_dynamic: int = 0  # how many of the pins (the last ones) move
 
@@ -115,11 +101,7 @@ class Plan:
             "sets_after_each_pin": list(self.sets_after),
             "n_dynamic_pins": self.n_dynamic,
             "initial_states": {
-                label: [[{"pin": st.pin, "y_pin": st.y_pin, "v_pin": st.v_pin,
-                          "d_range": [st.d_lo, st.d_hi],
-                          "band": {"start": st.arc[0], "width": st.arc[1]},
-                          "com_interval": [st.y_lo, st.y_hi]} for st in branch]
-                        for branch in branches]
+                label: [[st.to_dict() for st in branch] for branch in branches]
                 for label, branches in self.branches.items()},
         }
 
@@ -222,7 +204,7 @@ class Planner:
         children, margin, d_lo, d_hi = result
         y_pin, v_pin = self.pins[label], self.speeds[label]
         out = [State(arc, ylo, yhi,
-                     state.history + (Step(label, y_pin, d_lo, d_hi, arc, ylo, yhi, v_pin),))
+                     state.history + (Step.reaching(label, y_pin, v_pin, (d_lo, d_hi), arc, (ylo, yhi)),))
                for arc, ylo, yhi in children]
         return out, margin
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from pipeline.planning.core.arcs import format_arcs
-from pipeline.planning.core.plan_records import Arc, Plan, RestingState, State, Step, Verification
+from pipeline.planning.core.plan_records import Arc, Plan, RestingState, State, Verification
 from pipeline.planning.core.settings import PlannerSettings
 from pipeline.planning.core.types import TightEntry
 from pipeline.planning.claims.orient import describe_claim
@@ -23,28 +23,15 @@ from pipeline.planning.plans.planner import mechanics_label
 from pipeline.planning.tight.records import FixedSearch
 
 
-def _state_record(state) -> State:
-    """A carried :class:`~pipeline.planning.tight.propagate.StateSet` as a :class:`State`."""
-    return State(Arc(state.start, state.width), (state.y_lo, state.y_hi), (state.mu_lo, state.mu_hi))
-
-
-def _step_record(step) -> Step:
-    """One pin of a branch (the search's ``Step``) as the stored :class:`Step`."""
-    after = step.after
-    return Step(step.pin, step.y_pin, step.v_pin, (step.d_lo, step.d_hi), Arc(after.start, after.width),
-                (after.y_lo, after.y_hi), _state_record(after))
-
-
 def plan_record(plan) -> Plan:
     """The record of one verified candidate (a ``TightPlan``): its pins, the
     sets it carries, its held-out verification and its one claim."""
     ver = plan.verification
     return Plan(tuple(plan.pins), tuple(Arc(s, w) for s, w in plan.final_sets), plan.n_sets,
                 plan.margin if math.isfinite(plan.margin) else None, tuple(plan.sets_after), plan.n_dynamic,
-                {label: tuple(tuple(_step_record(st) for st in br) for br in brs)
-                 for label, brs in plan.branches.items()},
+                {label: tuple(tuple(br) for br in brs) for label, brs in plan.branches.items()},
                 "tight", tuple(plan.pin_heights_mm), tuple(plan.pin_speeds), plan.jumps,
-                {k: _state_record(v) for k, v in plan.initial.items()},
+                {k: State.of_set(v) for k, v in plan.initial.items()},
                 Verification.from_dict(ver) if ver is not None else None,
                 carried_sets_kind=plan.carried, claim=plan.claim)
 

@@ -32,7 +32,7 @@ import math
 import numpy as np
 
 from pipeline.planning.claims import orient
-from pipeline.planning.core.nearest_axes import LADDER, MAX_TOLERANCE, more_pins_axis
+from pipeline.planning.core.nearest_axes import LADDER, MAX_TOLERANCE, SUBJECT_PART, more_pins_axis
 from pipeline.planning.core.types import TightEntry
 from pipeline.planning.tight.judge import TrialBench
 from pipeline.planning.tight.records import FixedSearch
@@ -256,5 +256,5 @@ def part_nearest_yes(part, settings, entry: TightEntry, fixed: FixedSearch, movi
         # depth N itself was not searched in full
         more = _axis("more pins", False, "not searched: the time limit cut the search before its depth; "
                                          "run with a longer --time-limit first", partial=True)
-    return {"plans_tried": [list(p[0]) for p in plans[:tolerance["replayed"]]],
+    return {"subject": SUBJECT_PART, "plans_tried": [list(p[0]) for p in plans[:tolerance["replayed"]]],
             "axes": [tolerance, part_moving_axis(entry, moving, moving_cut), sensor_axis(entry), more]}

@@ -19,10 +19,11 @@ import numpy as np
 
 from pipeline.parts.contact import contact_parameter
 from pipeline.planning.core.arcs import merge_arcs, merge_modulo
+from pipeline.planning.core.plan_records import Step
 from pipeline.planning.claims.orient import narrowest_arc
 from pipeline.planning.tight.propagate import friction_interval, snapped_state
 from pipeline.planning.core.resting import resting_states
-from pipeline.planning.tight.search import Step, TightPlan, TightPlanner
+from pipeline.planning.tight.search import TightPlan, TightPlanner
 from pipeline.planning.claims.replay import replay
 from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.settings import VerifySettings
@@ -78,9 +79,10 @@ def sampled_plan(planner: TightPlanner, labels, margin: float, verify: VerifySet
                 arc = narrowest_arc(theta_k[members], members.size) or (0.0, 360.0)
                 after = snapped_state(arc[0], arc[1], float(y_k[members].min()), float(y_k[members].max()),
                                       mu_lo, mu_hi)
-                steps.append(Step(pin.label, pin.y, pin.v_pin, float(d.min()), float(d.max()), after))
+                steps.append(Step.carried_by(pin.label, pin.y, pin.v_pin, (float(d.min()), float(d.max())),
+                                               after))
             branches[label].append(steps)
-            finals.append(steps[-1].after.arc)
+            finals.append(steps[-1].band.pair)
     plan = TightPlan(tuple(labels), tuple(p.y for p in pins), tuple(p.v_pin for p in pins),
                      merge_arcs(finals), len(merge_modulo(finals, planner.order)), float(margin), 0,
                      branches, dict(starts), ())

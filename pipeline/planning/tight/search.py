@@ -32,6 +32,7 @@ from pipeline.parts.contact import contact_parameter
 from pipeline.parts.part import Part
 from pipeline.planning.core.arcs import merge_arcs, merge_modulo
 from pipeline.planning.core.claim import Claim
+from pipeline.planning.core.plan_records import Step
 from pipeline.planning.core.settings import KernelSettings, as_kernel_settings
 from pipeline.planning.tight.propagate import (UNRESOLVED, OutcomeLattice, StateSet, Tolerances, Uncertainty,
                         initial_state_sets, propagate)
@@ -45,25 +46,6 @@ class Pin:
     v_pin: float = 0.0
 
 
-@dataclass(frozen=True)
-class Step:
-    """What one pin did to one branch: the d range met and the set carried after it."""
-    pin: str
-    y_pin: float
-    v_pin: float
-    d_lo: float
-    d_hi: float
-    after: StateSet
-
-    def to_dict(self) -> dict:
-        """The step as a JSON-ready dict (the stored plan format)."""
-        return {"pin": self.pin, "y_pin": self.y_pin, "v_pin": self.v_pin,
-                "d_range": [self.d_lo, self.d_hi],
-                "band": {"start": self.after.start, "width": self.after.width},
-                "com_interval": [self.after.y_lo, self.after.y_hi],
-                "carried": self.after.to_dict()}
-
-
 @dataclass
 class TightPlan:
     """A pin sequence with the sets it carries for every initial state."""
@@ -74,7 +56,7 @@ class TightPlan:
     n_sets: int  # counted modulo the part's rotational symmetry
     margin: float
     jumps: int  # steps whose box straddled a jump
-    branches: dict  # initial-state label -> list of branches (each a list of Step)
+    branches: dict  # initial-state label -> list of branches (each a list of plan_records.Step)
     initial: dict  # initial-state label -> StateSet
     sets_after: tuple = ()
     verification: dict | None = None  # filled in by verify
@@ -100,7 +82,7 @@ class TightPlan:
 
     def predicted_sets(self, label: str) -> list:
         """Final arcs predicted for one initial state."""
-        return merge_arcs([br[-1].after.arc if br else self.initial[label].arc
+        return merge_arcs([br[-1].band.pair if br else self.initial[label].arc
                            for br in self.branches[label]])
 
     def to_dict(self) -> dict:
@@ -300,8 +282,8 @@ class SequenceFollower:
                 kids, m, d_lo, d_hi, jump = res
                 margin, jumps = min(margin, m), jumps + int(jump)
                 for kid in kids:
-                    children.setdefault(kid, history + (Step(label, pin.y, pin.v_pin, d_lo, d_hi,
-                                                             kid),))
+                    step = Step.carried_by(label, pin.y, pin.v_pin, (d_lo, d_hi), kid)
+                    children.setdefault(kid, history + (step,))
             if len(children) > planner.max_branches:
                 planner.stats.pruned_branching += 1
                 return None
