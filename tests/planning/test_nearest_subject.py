@@ -22,7 +22,8 @@ def test_a_family_answer_without_certificates_reads_as_a_family():
     axis has a certificate and there is no ``steps`` key, so a guess from
     the keys would call it a part's."""
     checker = SimpleNamespace(results={}, settings=None)
-    answer = nearest.nearest_yes(None, None, checker, {"depth": 2}, None)
+    family = SimpleNamespace(label="tripods:12")
+    answer = nearest.nearest_yes(None, family, checker, 2, None, None)
     assert answer["subject"] == SUBJECT_FAMILY
     assert not any("certificate" in a for a in answer["axes"]) and "steps" not in answer
     assert nearest_yes_lines(answer)[0] == FAMILY_HEAD
