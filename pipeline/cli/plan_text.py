@@ -101,24 +101,24 @@ def print_plan_result(result, part, config, mode):
         st = t.stats
         print(f"tight planner, friction {t.friction}: {st['rollouts']} new rollouts in "
               f"{st['seconds']:.0f} s, stored under {config['catalog_dir']}/refine/{part.id}/")
-        family = t.extra.get("support_family")
+        family = t.support_family
         if family:
             print(f"  for every member of the support family {family['label']} ({len(family['members'])} "
                   f"supports; nominal paths under {', '.join(family['extremes'])})")
-        search = t.extra.get("fixed_pin_search")
+        search = t.fixed_pin_search
         if search:
             print(f"  {search['evidence']}")
-        cert = t.extra.get("family_certificate")
+        cert = t.family_certificate
         if cert:
             from pipeline.planning import family_certificate_line
             print(f"  {family_certificate_line(cert)}")
         if t.warning:
             print(f"  WARNING: {t.warning}")
-        shape = t.extra.get("shape_tolerance")
+        shape = t.shape_tolerance
         if shape:
             from pipeline.planning import shape_line
             print(f"  {shape_line(shape)}")
-        nearest = t.extra.get("nearest_yes")
+        nearest = t.nearest_yes
         if nearest:
             from pipeline.planning import SUBJECT_FAMILY, SUBJECT_PART, nearest_yes_lines
             for line in nearest_yes_lines(nearest, SUBJECT_FAMILY if family else SUBJECT_PART):
@@ -162,12 +162,11 @@ def _print_claim(plan, order: int, mu_range: bool = False) -> None:
     then the margin in words (``mu_range``: the friction is a range, drawn
     uniformly). A plan file written before claims were recorded prints its
     held-out verdict instead."""
-    from pipeline.planning import Claim, margin_text
+    from pipeline.planning import margin_text
     v = plan.verification
-    claim = plan.extra.get("claim")
-    kind = carried_kind(plan.extra)
-    if isinstance(claim, dict):
-        c = Claim.from_dict(claim)
+    c = plan.claim
+    kind = plan.carried_sets_kind or carried_kind(plan.extra)
+    if c:
         print(f"      claim: {c.statement()}")
         print(f"      its trials: {c.trials_text()}")
         if c.untruncated:
@@ -178,7 +177,7 @@ def _print_claim(plan, order: int, mu_range: bool = False) -> None:
                   + (f"; width {u['width_deg']:.1f} deg" if u.get("width_deg") is not None else ""))
     else:
         _print_verdict(plan, mu_range)
-    sel = v.extra.get("selection") if v else None
+    sel = v.selection if v else None
     if sel:
         print(f"      beside it: the selection trials (chose the plan; no claim): {sel['in_tolerance']}/"
               f"{sel['trials']} in one set" + (f", width {sel['width_deg']:.1f} deg"
@@ -193,21 +192,21 @@ def _print_verdict(plan, mu_range: bool = False) -> None:
     """A plan file without a claim record: its held-out verdict, as written then."""
     from pipeline.planning import describe_claim, describe_untruncated, truncation_text
     v = plan.verification
-    o = v.extra.get("orientation") if v else None
+    o = v.orientation if v else None
     if o and "share_lower_bound" in o:
-        where = "held-out trials" if v.extra.get("held_out") else "trials"
-        sigma = v.extra.get("truncation_sigma")
+        where = "held-out trials" if v.held_out else "trials"
+        sigma = v.truncation_sigma or None
         drawn = "" if sigma is None else f" ({truncation_text(sigma, mu_range)})"
         print(f"      {where}: {describe_claim(o)}{drawn}")
-        if v.extra.get("untruncated"):
-            print(f"      {describe_untruncated(v.extra['untruncated'], sigma)}")
+        if v.untruncated:
+            print(f"      {describe_untruncated(v.untruncated, sigma)}")
     else:
         print(f"      {_orientation_text(v)}")
 
 
 def _orientation_text(v) -> str:
     """Verified width next to the claim: how many trials ended in one set within the tolerance."""
-    o = v.extra.get("orientation") if v else None
+    o = v.orientation if v else None
     if not o:
         return f"verified {v.successes}/{v.trials} trials in the claimed sets" if v else "not verified"
     width = "n/a" if o["width_deg"] is None else f"{o['width_deg']:.1f} deg"

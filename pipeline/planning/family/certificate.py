@@ -222,8 +222,7 @@ def plan_family_label(source) -> str | None:
     of its ``tight`` entries."""
     entries = source.get("tight") if isinstance(source, dict) else getattr(source, "tight", None)
     for entry in (entries if entries is not None else [source]):
-        extra = entry if isinstance(entry, dict) else getattr(entry, "extra", {})
-        family = (extra or {}).get("support_family")
+        family = entry.get("support_family") if isinstance(entry, dict) else getattr(entry, "support_family", None)
         if family:
             return family["label"] if isinstance(family, dict) else str(family)
     return None
