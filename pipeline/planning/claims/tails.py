@@ -29,7 +29,7 @@ def normal_quantities(mu_c) -> list[str]:
 def untruncated_check(part, plan: dict, pins: dict, initial_states: dict, mu_c, pin_radius: float,
                       model: str, settings: VerifySettings, trials_per_state: int, claims: ClaimSettings,
                       order: int = 1, **replay) -> dict:
-    """Replay ``plan`` (a plan's ``to_dict()``) on untruncated trials and judge it.
+    """Replay ``plan`` (a plan record or a stored plan dict) on untruncated trials and judge it.
 
     Parameters
     ----------

@@ -18,6 +18,7 @@ from pipeline.parts.part import Part
 from pipeline.planning.claims.replay import ReplayMemo, replay
 from pipeline.planning.claims.trials import state_start, trial_inputs
 from pipeline.planning.core.arcs import in_arc, merge_arcs
+from pipeline.planning.core.plan_records import Plan
 from pipeline.planning.core.settings import KernelSettings, VerifySettings, as_kernel_settings, as_verify_settings
 from pipeline.progress import SILENT, Stretch
 
@@ -32,17 +33,36 @@ def _arc(step):
     return (step["band"]["start"], step["band"]["width"])
 
 
-def predicted_sets(plan: dict, label: str):
-    """The final orientation sets a stored plan predicts for one initial state."""
-    return merge_arcs([_arc(branch[-1]) for branch in plan["initial_states"][label] if branch])
+def _branch_arcs(plan, label: str) -> list:
+    """The orientation arcs ``(start, width)`` after each pin of every branch
+    of one initial state: of a :class:`~pipeline.planning.core.plan_records.Plan`
+    record (the planner's) or of a stored plan dict (as read from a file)."""
+    if isinstance(plan, Plan):
+        return [[step.band.pair for step in branch] for branch in plan.branches[label]]
+    return [[_arc(step) for step in branch] for branch in plan["initial_states"][label]]
 
 
-def _expects_contact(plan: dict, label: str, k: int, start_arc) -> bool:
+def _start_arc(plan, label: str):
+    """The orientation arc the plan carries from one initial state (``None``
+    when it keeps none: paper mode's plans, hand-made ones)."""
+    first = (plan.initial_sets or {}).get(label) if isinstance(plan, Plan) else \
+        plan.get("initial_sets", {}).get(label)
+    if not first:
+        return None
+    return first.arc.pair if isinstance(plan, Plan) else (first["arc"]["start"], first["arc"]["width"])
+
+
+def predicted_sets(plan, label: str):
+    """The final orientation sets a plan (a record or a stored dict) predicts for one initial state."""
+    return merge_arcs([branch[-1] for branch in _branch_arcs(plan, label) if branch])
+
+
+def _expects_contact(branches: list, k: int, start_arc) -> bool:
     # A step whose orientation set differs from the one before it needed the pin to touch.
-    for branch in plan["initial_states"][label]:
+    for branch in branches:
         if k < len(branch):
-            before = _arc(branch[k - 1]) if k > 0 else start_arc
-            if tuple(_arc(branch[k])) != tuple(before):
+            before = branch[k - 1] if k > 0 else start_arc
+            if tuple(branch[k]) != tuple(before):
                 return True
     return False
 
@@ -57,13 +77,14 @@ def _failure(jammed: str, theta_f: float, finals, missed, expected) -> str | Non
     return "missed a pin" if any(m and e for m, e in zip(missed, expected)) else "other band"
 
 
-def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, pin_radius: float,
+def verify_plan(part: Part, plan, pins: dict, initial_states: dict, mu_c, pin_radius: float,
                 model: str = "minpower", settings: VerifySettings | None = None,
                 speeds: dict | None = None, kernel: KernelSettings | None = None,
                 belt_speed: float | None = None, mu_s: float = 0.5, family=None,
                 stretch: Stretch = SILENT, memo: ReplayMemo | None = None) -> dict:
-    """Run the trials of ``settings`` (``None``: the schema's) for a stored
-    plan (``to_dict()`` of a plan), each rollout at the kernel step
+    """Run the trials of ``settings`` (``None``: the schema's) for a plan (a
+    :class:`~pipeline.planning.core.plan_records.Plan` record, as the
+    planner verifies its candidates, or a stored plan's dict), each rollout at the kernel step
     ``kernel`` (``None``: the kernel's defaults). Flat dicts of either, which
     callers not yet switched still pass, are read with ``as_verify_settings``
     and ``as_kernel_settings``.
@@ -89,7 +110,7 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     how far the trials have got, each initial state an equal share."""
     speeds = speeds or {}
     settings, kernel = as_verify_settings(settings), as_kernel_settings(kernel)
-    labels = list(plan["pins"])
+    labels = list(plan.pins if isinstance(plan, Plan) else plan["pins"])
     heights = [float(pins[p]) for p in labels]
     vs = [float(speeds.get(p, 0.0)) for p in labels]
     rows, trials = [], []
@@ -105,12 +126,12 @@ def verify_plan(part: Part, plan: dict, pins: dict, initial_states: dict, mu_c, 
     return _verification_record(labels, settings, mu_c, model, belt_speed, mu_s, family, rows, trials)
 
 
-def _judge_state(plan: dict, label: str, state, n_pins: int, start, outcome, family) -> tuple:
+def _judge_state(plan, label: str, state, n_pins: int, start, outcome, family) -> tuple:
     """Judge the replayed trials of one initial state against the sets the plan predicts.
 
     Parameters
     ----------
-    plan : the stored plan.
+    plan : the plan (a record or a stored dict).
     label, state : the initial state's label and its ``(theta, y_c)`` (or planner state).
     n_pins : the plan's pins.
     start : the trials' inputs ``(theta, y_c, mu, support)``.
@@ -127,9 +148,9 @@ def _judge_state(plan: dict, label: str, state, n_pins: int, start, outcome, fam
     tf, yf, jam, missed = outcome
     theta0, _ = state_start(state)
     finals = predicted_sets(plan, label)
-    first = plan.get("initial_sets", {}).get(label)
-    start_arc = (first["arc"]["start"], first["arc"]["width"]) if first else (theta0, 0.0)
-    expected = [_expects_contact(plan, label, k, start_arc) for k in range(n_pins)]
+    start_arc = _start_arc(plan, label) or (theta0, 0.0)
+    branches = _branch_arcs(plan, label)
+    expected = [_expects_contact(branches, k, start_arc) for k in range(n_pins)]
     counts = {"state": label, "trials": 0, "successes": 0, "failures": 0, "reasons": {}}
     trials = []
     for j in range(tf.size):

@@ -43,7 +43,7 @@ from pipeline.planning.core.types import TightEntry
 from pipeline.planning.tight.records import FixedSearch, orientation_rank, robust_order
 from pipeline.planning.family.members import planning_family
 from pipeline.planning.plans.candidates import MOVING_NOT_REACHED, add_moving_pins, carried_sets, fixed_search
-from pipeline.planning.plans.entry import entry_record
+from pipeline.planning.plans.entry import entry_record, plan_record
 from pipeline.planning.plans.for_family import certify_for_family, family_checker, judge_for_family
 from pipeline.planning.plans.nearest_part import part_nearest_yes
 from pipeline.planning.plans.planner import planner_belt, planner_for, planner_pin_heights
@@ -196,7 +196,7 @@ def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidate
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
     beat = Heartbeat("verifying the chosen plans on held-out trials", len(candidates), "plan", progress).start()
     for k, (plan, selection) in enumerate(zip(candidates, selections)):
-        res = verify_plan(part, plan.to_dict(), planner_pin_heights(planner), states, settings.friction.value,
+        res = verify_plan(part, plan_record(plan), planner_pin_heights(planner), states, settings.friction.value,
                           search.pin_radius, search.model, held_out, speeds=speeds,
                           kernel=search.kernel_step, belt_speed=planner.belt_speed,
                           mu_s=planner.mu_s, family=family, stretch=beat.stretch(k, k + 1), memo=memo)
@@ -239,7 +239,7 @@ def _check_tails(part: Part, settings: PlannerSettings, planner, plan, states, p
     search = settings.search
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}
     per_state = max(row["trials"] for row in plan.verification["rows"])
-    record = untruncated_check(part, plan.to_dict(), planner_pin_heights(planner), states,
+    record = untruncated_check(part, plan_record(plan), planner_pin_heights(planner), states,
                                settings.friction.value, search.pin_radius, search.model, settings.verify,
                                per_state, settings.claims, planner.order, speeds=speeds,
                                kernel=search.kernel_step, belt_speed=planner.belt_speed,
