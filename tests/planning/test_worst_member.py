@@ -148,7 +148,11 @@ def test_the_old_family_plan_is_broken_by_the_widest_tripod():
     assert _outside(finals, start, width).max() > 0.5
     # the sampled members alone did not break it: the verification on them orients the part
     from pipeline.planning.family.worst_member import verify_members
-    assert verify_members(TRIANGLE, heights, family, st)["orients"]
+    sampled = verify_members(TRIANGLE, heights, family, st)
+    assert sampled["orients"]
+    # The count in the arc the plan claims (an arc of the tolerance's width about the set) is the
+    # best arc's count: that arc holds the set, and no arc of that width holds more.
+    assert sampled["in_claimed_arc"] == sampled["in_tolerance"] <= sampled["trials"]
 
 
 # --------------------------------------------------------------------------- bad input

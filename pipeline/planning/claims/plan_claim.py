@@ -142,7 +142,9 @@ def family_claim(claim: Claim, label: str, check: dict, certificate: dict | None
                       epsilon=certificate["claim"]["epsilon"], beta=certificate["claim"]["beta"],
                       holds=bool(certificate["holds"]))
     n = int(verdict["trials"])
-    inside = int(verdict["in_tolerance"])
+    # The count in the claimed arc itself; a check stored before it was kept counts the best arc
+    # of the tolerance, the same number (an arc of that width around the set holds no more).
+    inside = int(verdict["in_claimed_arc"] if verdict.get("in_claimed_arc") is not None else verdict["in_tolerance"])
     share, lower = _share(inside, n, claim.confidence)
     return replace(claim, subject=f"every member of the support family {label}", arc=arc, in_arc=inside,
                    trials=n, jammed=int(verdict.get("jammed", 0)), share=share,

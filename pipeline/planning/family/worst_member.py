@@ -23,7 +23,7 @@ import numpy as np
 
 from pipeline.parts.support_family import SupportFamily
 from pipeline.planning.claims import orient
-from pipeline.planning.claims.plan_claim import claimed_arc
+from pipeline.planning.claims.plan_claim import claimed_arc, count_in_arc
 from pipeline.planning.claims.replay import replay, replay_shared
 from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.resting import resting_states
@@ -83,7 +83,9 @@ class FamilyCheckSettings:
 def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings, speeds=(),
                    progress=None, what: str = "verification on the family's members") -> dict:
     """The verification's trials of a plan (``verify.trial_inputs``) on ``family``,
-    judged; ``progress`` hears how far the trials have got (stage ``what``)."""
+    judged (``orient.judge``), with ``in_claimed_arc``: how many end in the
+    arc the plan would claim (``claimed_arc``; ``None`` without a set).
+    ``progress`` hears how far the trials have got (stage ``what``)."""
     inputs = trial_inputs(resting_states(part), st.mu_c, len(heights), st.verify.as_dict(), family)
     th, yc, mu, offs, sup = (np.concatenate([r[k] for r in inputs]) for k in range(5))
     search, claims = st.search, st.claims
@@ -91,8 +93,11 @@ def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings
         tf, _, jam, _ = replay(part, list(heights), list(speeds) or [0.0] * len(heights), th, yc, mu, offs,
                                search.pin_radius, search.model, **kernel_steps(search.kernel_settings),
                                support=sup, supports=family.kernel_supports, stretch=beat.stretch(0, th.size))
-    return orient.judge(tf[jam == ""], th.size, claims.tolerance_deg, part.symmetry_order(), claims.required,
-                        claims.confidence, rule=claims.rule)
+    finals = tf[jam == ""]
+    verdict = orient.judge(finals, th.size, claims.tolerance_deg, part.symmetry_order(), claims.required,
+                           claims.confidence, rule=claims.rule)
+    arc = claimed_arc(verdict, claims.tolerance_deg)
+    return {**verdict, "in_claimed_arc": None if arc is None else count_in_arc(finals, arc, part.symmetry_order())}
 
 
 def known_member(probe: PlanProbe, members, arc: tuple, period: float, params=()) -> WorstMember | None:
