@@ -60,14 +60,18 @@ from pipeline.progress import NO_DEADLINE, Deadline, Heartbeat
 
 
 MAX_FAILURE = 0.01  # a recommended plan fails at most this fraction of its trials
+
+
 def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int | None = None,
                keep: int = 5, progress=None, family=None, deadline: Deadline = NO_DEADLINE) -> TightEntry:
     """Search, verify and rank plans for ``part`` at ``settings.friction`` (a
-    value or a range); returns the :class:`~pipeline.planning.core.types.TightEntry`
-    record (``plans`` best first, each
-    with its ``verification`` and orientation verdict; ``recommended``;
-    ``warning``; ``fixed_pin_search``: what the complete search found, or its
-    evidence that no fixed-pin plan orients the part; search statistics).
+    value or a range); returns the answer as a
+    :class:`~pipeline.planning.core.types.TightEntry` record (``plans``: the
+    verified :class:`~pipeline.planning.core.plan_records.Plan` records, best
+    first, each with its ``verification`` and its one ``claim``;
+    ``recommended``; ``warning``; ``fixed_pin_search``: what the complete
+    search found, or its evidence that no fixed-pin plan orients the part;
+    search statistics), built by :func:`~pipeline.planning.plans.entry.entry_record`.
 
     Fixed pins first, by the complete search (``complete.FixedPinSearch``);
     only when no fixed-pin sequence of up to ``depth`` pins (default: the
