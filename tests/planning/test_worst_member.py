@@ -153,6 +153,27 @@ def test_the_old_family_plan_is_broken_by_the_widest_tripod():
     # The count in the arc the plan claims (an arc of the tolerance's width about the set) is the
     # best arc's count: that arc holds the set, and no arc of that width holds more.
     assert sampled["in_claimed_arc"] == sampled["in_tolerance"] <= sampled["trials"]
+    assert sampled["claimed_arc_deg"][1] == pytest.approx(10.0)
+
+
+def test_a_family_claim_that_fails_names_an_arc_of_the_tolerance():
+    """One pin leaves the triangle in several sets for the family: the set
+    its trials need is far wider than the tolerance, so the claim names the
+    arc of the tolerance that holds the most trials, and counts those (the
+    same count the verdict's best arc has), never the wide set."""
+    from pipeline.planning.claims.plan_claim import family_claim, held_out_claim
+    from pipeline.planning.family.worst_member import verify_members
+    family = parse_support_family("tripods:12", TRIANGLE)
+    st = _settings((0.1, 0.3), 10.0, 60, budget=10)
+    verdict = verify_members(TRIANGLE, (15.0,), family, st)
+    assert not verdict["orients"] and verdict["set"]["width"] > 10.0
+    assert verdict["claimed_arc_deg"][1] == pytest.approx(10.0)
+    assert verdict["in_claimed_arc"] == verdict["in_tolerance"] < verdict["trials"]
+    base = held_out_claim(verdict, [], st.claims, 1, {}, {})
+    claim = family_claim(base, family.label, {"verdict": verdict, "holds": False, "members": 12,
+                                             "set_deg": [0.0, verdict["set"]["width"]]})
+    assert claim.arc == tuple(verdict["claimed_arc_deg"]) and claim.in_arc == verdict["in_tolerance"]
+    assert not claim.orients and "NOT" in claim.statement()
 
 
 # --------------------------------------------------------------------------- bad input

@@ -127,11 +127,13 @@ def with_untruncated(claim: Claim, record: dict | None) -> Claim:
 def family_claim(claim: Claim, label: str, check: dict, certificate: dict | None = None) -> Claim:
     """The claim of a plan for the support family ``label``: the family
     check's set (the arc its worst members and fresh members are checked
-    against), its counts over the drawn members and the worst members that
-    joined them, and its spread (every such trial, the worst member's
-    included), not the drawn members' own width."""
+    against; when no arc of the tolerance holds the required share, the one
+    that holds the most, as for one part), its counts over the drawn members
+    and the worst members that joined them, and its spread (every such
+    trial, the worst member's included), not the drawn members' own width."""
     verdict = check["verdict"]
-    arc = tuple(check["set_deg"]) if check.get("set_deg") else claim.arc
+    named = verdict.get("claimed_arc_deg")  # a check stored before it was kept: the set it checked
+    arc = tuple(named) if named else tuple(check["set_deg"]) if check.get("set_deg") else claim.arc
     family = {"label": label, "members": check.get("members"), "holds": bool(check.get("holds")),
               "worst_member_outside_deg": (check.get("worst_member") or {}).get("outside_deg"),
               "worst_member_search": "a heuristic: evidence about the family's edge, not a proof"}
@@ -142,9 +144,9 @@ def family_claim(claim: Claim, label: str, check: dict, certificate: dict | None
                       epsilon=certificate["claim"]["epsilon"], beta=certificate["claim"]["beta"],
                       holds=bool(certificate["holds"]))
     n = int(verdict["trials"])
-    # The count in the claimed arc itself; a check stored before it was kept counts the best arc
-    # of the tolerance, the same number (an arc of that width around the set holds no more).
-    inside = int(verdict["in_claimed_arc"] if verdict.get("in_claimed_arc") is not None else verdict["in_tolerance"])
+    # The count in the named arc itself; a check stored before it was kept counts the best arc
+    # of the tolerance, the same number when the set fits the tolerance.
+    inside = int(verdict["in_claimed_arc"] if named else verdict["in_tolerance"])
     share, lower = _share(inside, n, claim.confidence)
     return replace(claim, subject=f"every member of the support family {label}", arc=arc, in_arc=inside,
                    trials=n, jammed=int(verdict.get("jammed", 0)), share=share,

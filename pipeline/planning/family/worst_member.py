@@ -83,9 +83,10 @@ class FamilyCheckSettings:
 def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings, speeds=(),
                    progress=None, what: str = "verification on the family's members") -> dict:
     """The verification's trials of a plan (``verify.trial_inputs``) on ``family``,
-    judged (``orient.judge``), with ``in_claimed_arc``: how many end in the
-    arc the plan would claim (``claimed_arc``; ``None`` without a set).
-    ``progress`` hears how far the trials have got (stage ``what``)."""
+    judged (``orient.judge``), with the arc a claim on them names
+    (``claimed_arc_deg``, see :func:`family_claim_arc`) and how many of the
+    trials end in it (``in_claimed_arc``). ``progress`` hears how far the
+    trials have got (stage ``what``)."""
     inputs = trial_inputs(resting_states(part), st.mu_c, len(heights), st.verify.as_dict(), family)
     th, yc, mu, offs, sup = (np.concatenate([r[k] for r in inputs]) for k in range(5))
     search, claims = st.search, st.claims
@@ -96,8 +97,23 @@ def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings
     finals = tf[jam == ""]
     verdict = orient.judge(finals, th.size, claims.tolerance_deg, part.symmetry_order(), claims.required,
                            claims.confidence, rule=claims.rule)
-    arc = claimed_arc(verdict, claims.tolerance_deg)
-    return {**verdict, "in_claimed_arc": None if arc is None else count_in_arc(finals, arc, part.symmetry_order())}
+    arc = family_claim_arc(verdict, finals, claims.tolerance_deg, part.symmetry_order())
+    return {**verdict, "claimed_arc_deg": None if arc is None else list(arc),
+            "in_claimed_arc": None if arc is None else count_in_arc(finals, arc, part.symmetry_order())}
+
+
+def family_claim_arc(verdict: dict, finals, tolerance: float, order: int = 1) -> tuple | None:
+    """The arc a family claim names, as the check stores its set (start modulo
+    the period ``360 / order`` and width, deg, to 3 decimals): the plan's
+    claimed arc (``claimed_arc``), or, when no arc of the tolerance holds the
+    required share (the verified set is wider), the arc of the tolerance
+    that holds the most ``finals``; ``None`` without a final."""
+    arc = claimed_arc(verdict, tolerance)
+    if arc is None or arc[1] > tolerance + 1e-9:
+        if not len(finals):
+            return None
+        arc = (orient.best_arc(finals, tolerance, order)[1], tolerance)
+    return round(arc[0] % (360.0 / order), 3), round(arc[1], 3)
 
 
 def known_member(probe: PlanProbe, members, arc: tuple, period: float, params=()) -> WorstMember | None:
