@@ -97,23 +97,28 @@ def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings
     finals = tf[jam == ""]
     verdict = orient.judge(finals, th.size, claims.tolerance_deg, part.symmetry_order(), claims.required,
                            claims.confidence, rule=claims.rule)
-    arc = family_claim_arc(verdict, finals, claims.tolerance_deg, part.symmetry_order())
-    return {**verdict, "claimed_arc_deg": None if arc is None else list(arc),
-            "in_claimed_arc": None if arc is None else count_in_arc(finals, arc, part.symmetry_order())}
+    order = part.symmetry_order()
+    arc = family_claim_arc(verdict, finals, claims.tolerance_deg, order)
+    if arc is None:
+        return {**verdict, "claimed_arc_deg": None, "in_claimed_arc": None}
+    # Counted in the arc itself; stored, like the check's set, to 3 decimals (many trials end at
+    # exactly the same orientation, on the end of the arc: a rounded end could leave them out).
+    return {**verdict, "claimed_arc_deg": [round(arc[0] % (360.0 / order), 3), round(arc[1], 3)],
+            "in_claimed_arc": count_in_arc(finals, arc, order)}
 
 
 def family_claim_arc(verdict: dict, finals, tolerance: float, order: int = 1) -> tuple | None:
-    """The arc a family claim names, as the check stores its set (start modulo
-    the period ``360 / order`` and width, deg, to 3 decimals): the plan's
+    """The arc ``(start, width)`` (deg) a family claim names: the plan's
     claimed arc (``claimed_arc``), or, when no arc of the tolerance holds the
     required share (the verified set is wider), the arc of the tolerance
-    that holds the most ``finals``; ``None`` without a final."""
+    that holds the most ``finals`` (modulo ``360 / order``); ``None``
+    without a final."""
     arc = claimed_arc(verdict, tolerance)
     if arc is None or arc[1] > tolerance + 1e-9:
         if not len(finals):
             return None
         arc = (orient.best_arc(finals, tolerance, order)[1], tolerance)
-    return round(arc[0] % (360.0 / order), 3), round(arc[1], 3)
+    return arc
 
 
 def known_member(probe: PlanProbe, members, arc: tuple, period: float, params=()) -> WorstMember | None:
