@@ -1,5 +1,4 @@
-"""The plans the performance page's planning-time table states are the
-recorded plans of the ten benchmark parts.
+"""The plans the performance page's tables state are the recorded ones.
 
 The table under "Planning time of new parts" (``docs/performance/index.md``,
 the run of 2026-11-28) gives, per part, the recommended plan, its verdict
@@ -8,7 +7,10 @@ times are measurements; its plans are not: they must be the plans
 ``benchmarks/plan_record.py record --benchmark-parts also`` recorded
 (``benchmarks/records/plans_typed_record.json.gz``, the same settings as
 ``benchmarks/plan_speed.py``). A plan, width or count typed into the table
-that the record does not hold fails here.
+that the record does not hold fails here. So does an answer or a nearest
+"yes" of the corpus table ("Real parts planned under a time limit") that
+its run's record (``benchmarks/records/real_parts_limit50_2026-11-28.json``)
+does not hold.
 """
 from __future__ import annotations
 
@@ -70,3 +72,37 @@ def test_a_row_states_the_recorded_plan(part):
     assert (m.group(1) == "orients") == bool(verdict["orients"])
     assert float(m.group(2)) == pytest.approx(verdict["width_deg"], abs=0.05)
     assert (int(m.group(3)), int(m.group(4))) == (verdict["in_tolerance"], verdict["trials"])
+
+
+# --------------------------------------------------------------------------- the corpus under a time limit
+
+CORPUS_HEADING = "### Real parts planned under a time limit"
+CORPUS_RECORD = ROOT / "benchmarks" / "records" / "real_parts_limit50_2026-11-28.json"
+
+
+def _corpus_rows() -> dict:
+    """file name -> (answer, nearest yes): the table under the corpus heading."""
+    text = PAGE.read_text()
+    section = text[text.index(CORPUS_HEADING):]
+    rows, started = {}, False
+    for line in section.splitlines()[1:]:
+        if line.startswith("| part |"):
+            started = True
+            continue
+        if started and not line.startswith("|"):
+            break
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if started and not line.startswith("|---") and cells[0] != "default triangle":
+            rows[cells[0]] = (cells[6], cells[7])
+    return rows
+
+
+def test_the_corpus_table_states_the_recorded_answers():
+    """Each part's answer and nearest "yes" in the corpus table are those the
+    run recorded (``benchmarks/real_parts.py``'s record of that day)."""
+    record = json.loads(CORPUS_RECORD.read_text())
+    recorded = {Path(r["file"]).name: (r["plan"]["answer"], r["plan"]["nearest_yes"] or "")
+                for r in record["rows"]}
+    rows = _corpus_rows()
+    assert len(rows) == len(recorded) >= 20
+    assert rows == recorded
