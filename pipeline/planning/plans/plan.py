@@ -109,7 +109,7 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     else:
         _check_tails(part, settings, planner, good[0] if good else None, states, progress, family)
     entry = entry_record(settings, depth, keep, planner, candidates, good, states, fixed, moving_search)
-    search = SearchRecords(planner, fixed, moving_search, candidates[:keep])
+    search = SearchRecords(fixed, moving_search, candidates[:keep])
     entry = _with_certificate_or_nearest_yes(entry, part, settings, search, progress, family, checker, deadline,
                                              unsearched)
     if deadline.limited:
@@ -119,10 +119,8 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
 
 @dataclass(frozen=True)
 class SearchRecords:
-    """What the steps after the answer read of the search: the ``planner``
-    (its pins), the fixed-pin and moving-pin searches' records and the best
-    ``kept`` candidates."""
-    planner: object
+    """What the steps after the answer read of the search: the fixed-pin and
+    moving-pin searches' records and the best ``kept`` candidates."""
     fixed: FixedSearch
     moving: FixedSearch | None
     kept: list
@@ -148,7 +146,6 @@ def _with_certificate_or_nearest_yes(entry: TightEntry, part: Part, settings: Pl
     if entry.orients or not search.kept:
         return entry
     kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in search.kept]
-    fixed_pins = {label: pin.y for label, pin in search.planner.pins.items() if pin.v_pin == 0.0}
     if deadline.over():
         unsearched.append('the nearest "yes": skipped (no time left)')
         return entry
@@ -157,15 +154,13 @@ def _with_certificate_or_nearest_yes(entry: TightEntry, part: Part, settings: Pl
     cut = deadline.search_over() or not search.fixed.complete
     moving_cut = any(u.startswith(MOVING_NOT_REACHED) for u in unsearched)
     nearest = part_nearest_yes(part, settings, entry, search.fixed, search.moving, kept,
-                               None if cut else fixed_pins, progress, deadline, moving_cut)
+                               None if cut else dict(entry.pins_used), progress, deadline, moving_cut)
     tolerance = next(a for a in nearest["axes"] if a["axis"] == "tolerance")
     if tolerance["kept_plans_only"]:
         how = "cut by the time limit" if tolerance["searches_cut"] else "not run"
         unsearched.append(f'the nearest "yes": kept plans only ({tolerance["replayed"]} of {len(kept)} '
                           f'replayed; the complete searches at looser tolerances {how})')
     return replace(entry, nearest_yes=nearest)
-
-
 
 
 def _rank(plan) -> tuple:
@@ -260,7 +255,8 @@ def _check_tails(part: Part, settings: PlannerSettings, planner, plan, states, p
 
 def plan_tight_all(part: Part, settings: PlannerSettings, catalog_root, keep: int = 5, progress=None,
                    deadline: Deadline | None = None) -> list:
-    """Tight plans (a :class:`~pipeline.planning.core.types.TightEntry` each) at every friction of ``settings.frictions`` (the first is the
+    """Tight plans (a :class:`~pipeline.planning.core.types.TightEntry` each)
+    at every friction of ``settings.frictions`` (the first is the
     recommended one), at the search's belt speed when it is set, for every
     member of its support family when it is set (its extremes found at each
     friction); the planner's rollouts are stored in the catalog (keyed by
