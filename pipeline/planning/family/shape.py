@@ -40,7 +40,7 @@ from pipeline.planning.family.member_search import (WorstMember, kernel_steps, o
                                                     search_worst_member)
 from pipeline.planning.family.member_spaces import MemberSpace
 from pipeline.planning.claims.plan_claim import claimed_arc
-from pipeline.planning.family.worst_member import FamilyCheckSettings
+from pipeline.planning.family.worst_member import FamilyCheckSettings, stored_set
 
 FRESH_MEMBERS = 300
 STEPS = 5
@@ -171,7 +171,7 @@ def shape_certificate(part: Part, heights, arc: tuple, tol: float, st, members: 
         leaving += bool(np.any(jam) or np.any(outside(tf[~jam], arc, period) > 0.0))
     claim = scenario_claim(leaving, members, confidence)
     return {"family": f"shape:tol:{tol:g}", "tolerance_mm": tol, "space": space.describe(),
-            "set_deg": [round(arc[0] % period, 3), round(arc[1], 3)],
+            "set_deg": stored_set(arc, period),
             "holds": bool(not worst.breaks and leaving == 0),
             "worst_member": _worst_dict(worst), "claim": claim}
 

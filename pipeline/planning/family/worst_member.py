@@ -103,8 +103,14 @@ def verify_members(part, heights, family: SupportFamily, st: FamilyCheckSettings
         return {**verdict, "claimed_arc_deg": None, "in_claimed_arc": None}
     # Counted in the arc itself; stored, like the check's set, to 3 decimals (many trials end at
     # exactly the same orientation, on the end of the arc: a rounded end could leave them out).
-    return {**verdict, "claimed_arc_deg": [round(arc[0] % (360.0 / order), 3), round(arc[1], 3)],
+    return {**verdict, "claimed_arc_deg": stored_set(arc, 360.0 / order),
             "in_claimed_arc": count_in_arc(finals, arc, order)}
+
+
+def stored_set(arc: tuple, period: float) -> list:
+    """A set ``(start, width)`` (deg) as the checks store it: ``[start, width]``,
+    the start modulo ``period``, both to 3 decimals."""
+    return [round(arc[0] % period, 3), round(arc[1], 3)]
 
 
 def family_claim_arc(verdict: dict, finals, tolerance: float, order: int = 1) -> tuple | None:
@@ -165,7 +171,7 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
         if worst is None:
             beat = Heartbeat(f"{what}: search {k + 1}", st.budget, "member evaluation", progress)
             worst = search_worst_member(probe, space, arc, period, st.budget, st.seed + k, beat=beat)
-        rounds.append({"set_deg": [round(arc[0] % period, 3), round(arc[1], 3)], **worst.to_dict()})
+        rounds.append({"set_deg": stored_set(arc, period), **worst.to_dict()})
         if not worst.breaks:
             break
         extra = dataclasses.replace(worst.support, label=f"worst member {k + 1}")
@@ -178,7 +184,7 @@ def check_plan_for_family(part, heights, family: SupportFamily, st: FamilyCheckS
     return {"holds": holds, "space": space.describe(), "budget": st.budget,
             "members": len(joined.members), "trials": verdict["trials"],
             "verdict": verdict, "sampled_verdict": {k: sampled.get(k) for k in ("orients", "in_tolerance", "trials")},
-            "set_deg": None if arc is None else [round(arc[0] % period, 3), round(arc[1], 3)],
+            "set_deg": None if arc is None else stored_set(arc, period),
             "worst_member": None if worst is None else worst.to_dict(), "rounds": rounds,
             "_family": joined, "_worst": worst}
 
