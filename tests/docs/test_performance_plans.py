@@ -27,21 +27,23 @@ RECORD = ROOT / "benchmarks" / "records" / "plans_typed_record.json.gz"
 HEADING = "### Planning time of new parts"
 
 
-def _table_rows() -> dict:
-    """part -> (recommended plan, verified, sequences per level): the first table under the heading."""
+def _table(heading: str) -> list:
+    """The cells of each row of the first table under ``heading`` (its header and rule left out)."""
     text = PAGE.read_text()
-    section = text[text.index(HEADING):]
-    rows, started = {}, False
-    for line in section.splitlines()[1:]:
+    rows, started = [], False
+    for line in text[text.index(heading):].splitlines()[1:]:
         if line.startswith("| part |"):
             started = True
-            continue
-        if started and not line.startswith("|"):
+        elif started and not line.startswith("|"):
             break
-        if started and not line.startswith("|---"):
-            cells = [c.strip() for c in line.strip("|").split("|")]
-            rows[cells[0]] = (cells[4], cells[5], cells[6])
+        elif started and not line.startswith("|---"):
+            rows.append([c.strip() for c in line.strip("|").split("|")])
     return rows
+
+
+def _table_rows() -> dict:
+    """part -> (recommended plan, verified, sequences per level): the planning-time table."""
+    return {cells[0]: (cells[4], cells[5], cells[6]) for cells in _table(HEADING)}
 
 
 def _record() -> dict:
@@ -81,20 +83,8 @@ CORPUS_RECORD = ROOT / "benchmarks" / "records" / "real_parts_limit50_2026-11-28
 
 
 def _corpus_rows() -> dict:
-    """file name -> (answer, nearest yes): the table under the corpus heading."""
-    text = PAGE.read_text()
-    section = text[text.index(CORPUS_HEADING):]
-    rows, started = {}, False
-    for line in section.splitlines()[1:]:
-        if line.startswith("| part |"):
-            started = True
-            continue
-        if started and not line.startswith("|"):
-            break
-        cells = [c.strip() for c in line.strip("|").split("|")]
-        if started and not line.startswith("|---") and cells[0] != "default triangle":
-            rows[cells[0]] = (cells[6], cells[7])
-    return rows
+    """file name -> (answer, nearest yes): the corpus table, the triangle's reference row left out."""
+    return {cells[0]: (cells[6], cells[7]) for cells in _table(CORPUS_HEADING) if cells[0] != "default triangle"}
 
 
 def test_the_corpus_table_states_the_recorded_answers():
