@@ -64,11 +64,14 @@ def _pin_search(part, settings: PlannerSettings, planner, moving: bool, family=N
 
 
 def fixed_search(part, settings: PlannerSettings, planner, depth, keep, progress, family=None,
-                  checker=None, deadline: Deadline = NO_DEADLINE) -> FixedSearch:
-    """The complete fixed-pin search with the planner's pins and the settings."""
+                  checker=None, deadline: Deadline = NO_DEADLINE) -> tuple:
+    """``(record, search)``: the complete fixed-pin search with the planner's
+    pins and the settings, run (its :class:`FixedSearch` record), and the
+    search itself, whose rollouts later searches of the same part and pins
+    reuse (:meth:`FixedPinSearch.reuse_rollouts`)."""
     search = _pin_search(part, settings, planner, moving=False, family=family, checker=checker)
     return search.run(depth, candidates=settings.search.candidates, keep=keep, progress=progress,
-                      deadline=deadline)
+                      deadline=deadline), search
 
 
 def _moving_planner(part, settings: PlannerSettings, planner):

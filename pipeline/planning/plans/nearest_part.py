@@ -62,7 +62,7 @@ def loosest_needed(finals, jammed, n_trials: int, order: int, required: float, c
 
 
 def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, progress=None,
-                       deadline: Deadline = NO_DEADLINE) -> tuple | None:
+                       deadline: Deadline = NO_DEADLINE, reuse=None) -> tuple | None:
     """``(tolerance, plan, exact)``: the smallest tolerance on the ``LADDER`` up to
     ``MAX_TOLERANCE`` at which the complete fixed-pin search over ``pins``
     (label -> height, mm) finds a plan of up to ``depth`` pins, certified on
@@ -71,6 +71,12 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
     Exact bisection: on the same trials, a sequence that orients within ``t``
     orients within any looser tolerance, and its nominal finals pass the
     looser filter too, so "some plan orients" is monotone in ``t``.
+
+    The searches reuse the rollouts of ``reuse`` (the planner's own
+    fixed-pin search, say) when it shares them
+    (:meth:`~pipeline.planning.tight.complete.FixedPinSearch.shares_rollouts_with`),
+    else those of the first: an outcome depends on its key only, so each
+    finds what it would alone.
 
     Under a time limit (``deadline``) a search it cuts short gives no
     answer at its tolerance (over part searches the bisection would give a
@@ -82,15 +88,17 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
 
     from pipeline.planning.tight.complete import FixedPinSearch
 
-    searches = []  # the first search's rollouts serve the later ones (tolerance changes no outcome)
+    donor = reuse  # whose rollouts serve the searches (tolerance changes no outcome)
 
     def found(t):
+        nonlocal donor
         claims = dataclasses.replace(settings.claims, tolerance_deg=float(t))
         search = FixedPinSearch(part, pins, settings.friction, claims, settings.verify, settings.search)
-        if searches:
-            search.reuse_rollouts(searches[0])
+        if donor is not None and search.shares_rollouts_with(donor):
+            search.reuse_rollouts(donor)
+        else:
+            donor = search
         search.evidence = False
-        searches.append(search)
         result = search.run(depth, candidates=candidates, keep=1, progress=_at(progress, t), deadline=deadline)
         if not result.complete:
             raise OutOfTime(f"the search at {t:g} deg was not finished")
@@ -146,7 +154,7 @@ def _kept_tolerance(part, settings, plans, deadline: Deadline) -> tuple:
 
 
 def part_tolerance_axis(part, settings, plans, pins: dict | None = None, depth: int | None = None,
-                        progress=None, deadline: Deadline = NO_DEADLINE) -> dict:
+                        progress=None, deadline: Deadline = NO_DEADLINE, reuse=None) -> dict:
     """The smallest tolerance at which one of ``plans`` (``(labels, heights,
     speeds)``) orients ``part`` on held-out trials; when none does within
     ``MAX_TOLERANCE`` and ``pins`` are given, the smallest at which the
@@ -157,7 +165,9 @@ def part_tolerance_axis(part, settings, plans, pins: dict | None = None, depth: 
     time limit (``deadline``) the kept plans are replayed while it lasts,
     and a bisection it cuts gives no tolerance: the axis then answers from
     the kept plans replayed and says so (``kept_plans_only``, ``replayed``;
-    ``searches_cut`` when the limit cut the searches at looser tolerances)."""
+    ``searches_cut`` when the limit cut the searches at looser tolerances).
+    ``reuse``: a search whose rollouts the searches may share
+    (:func:`searched_tolerance`)."""
     claims = settings.claims
     best, tried = _kept_tolerance(part, settings, plans, deadline)
     cut = tried < len(plans)  # the limit passed before every kept plan was replayed
@@ -165,7 +175,7 @@ def part_tolerance_axis(part, settings, plans, pins: dict | None = None, depth: 
     if best is None and pins is not None and not cut:
         try:
             searched = searched_tolerance(part, settings, pins, depth or settings.search.depth,
-                                          settings.search.candidates, progress, deadline)
+                                          settings.search.candidates, progress, deadline, reuse)
         except OutOfTime:
             searches_cut = True
         else:
@@ -237,7 +247,7 @@ def sensor_axis(entry: TightEntry) -> dict:
 
 def part_nearest_yes(part, settings, entry: TightEntry, fixed: FixedSearch, moving: FixedSearch | None, plans,
                      pins: dict | None = None, progress=None, deadline: Deadline = NO_DEADLINE,
-                     moving_cut: bool = False) -> dict:
+                     moving_cut: bool = False, reuse=None) -> dict:
     """The nearest "yes" on each axis for a part no plan orients (see the
     module docstring); ``entry``: its tight entry; ``fixed`` and
     ``moving``: the fixed-pin and moving-pin searches' records (``moving``
@@ -248,9 +258,11 @@ def part_nearest_yes(part, settings, entry: TightEntry, fixed: FixedSearch, movi
     that passes before the tolerance answer is whole leaves it to the kept
     plans replayed, and the axis says so (see :func:`part_tolerance_axis`).
     Without ``pins`` only the kept plans are replayed; ``moving_cut``: a
-    time limit ended the search before its moving pins."""
+    time limit ended the search before its moving pins; ``reuse``: the
+    planner's fixed-pin search, whose rollouts the searches at looser
+    tolerances share (:func:`searched_tolerance`)."""
     depth = entry.depth
-    tolerance = part_tolerance_axis(part, settings, plans, pins, depth, progress, deadline)
+    tolerance = part_tolerance_axis(part, settings, plans, pins, depth, progress, deadline, reuse)
     more = more_pins_axis(depth)
     if fixed.time_limit is not None and not fixed.complete and fixed.complete_to < (depth or 0):
         # depth N itself was not searched in full

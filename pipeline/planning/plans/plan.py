@@ -90,7 +90,7 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     family = None if family is None or family.is_uniform else family
     planner = planner_for(part, settings, lattices)
     checker = family_checker(part, settings, family, progress)
-    fixed = fixed_search(part, settings, planner, depth, keep, progress, family, checker, deadline)
+    fixed, rollouts = fixed_search(part, settings, planner, depth, keep, progress, family, checker, deadline)
     unsearched = list(fixed.unsearched)
     # No pin is the plan with the fewest pins: then nothing is certified or recommended.
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
@@ -109,7 +109,7 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     else:
         _check_tails(part, settings, planner, good[0] if good else None, states, progress, family)
     entry = entry_record(settings, depth, keep, planner, candidates, good, states, fixed, moving_search)
-    search = SearchRecords(fixed, moving_search, candidates[:keep])
+    search = SearchRecords(fixed, moving_search, candidates[:keep], rollouts)
     entry = _with_certificate_or_nearest_yes(entry, part, settings, search, progress, family, checker, deadline,
                                              unsearched)
     if deadline.limited:
@@ -120,10 +120,13 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
 @dataclass(frozen=True)
 class SearchRecords:
     """What the steps after the answer read of the search: the fixed-pin and
-    moving-pin searches' records and the best ``kept`` candidates."""
+    moving-pin searches' records, the best ``kept`` candidates and the
+    fixed-pin search itself (``rollouts``), whose rollouts the nearest
+    "yes"'s searches at looser tolerances reuse."""
     fixed: FixedSearch
     moving: FixedSearch | None
     kept: list
+    rollouts: object = None
 
 
 def _with_certificate_or_nearest_yes(entry: TightEntry, part: Part, settings: PlannerSettings,
@@ -154,7 +157,8 @@ def _with_certificate_or_nearest_yes(entry: TightEntry, part: Part, settings: Pl
     cut = deadline.search_over() or not search.fixed.complete
     moving_cut = any(u.startswith(MOVING_NOT_REACHED) for u in unsearched)
     nearest = part_nearest_yes(part, settings, entry, search.fixed, search.moving, kept,
-                               None if cut else dict(entry.pins_used), progress, deadline, moving_cut)
+                               None if cut else dict(entry.pins_used), progress, deadline, moving_cut,
+                               search.rollouts)
     tolerance = next(a for a in nearest["axes"] if a["axis"] == "tolerance")
     if tolerance["kept_plans_only"]:
         how = "cut by the time limit" if tolerance["searches_cut"] else "not run"

@@ -13,7 +13,9 @@ placement tolerance, and end within ``T + SLACK_DEG`` of each other; and it
 never returns a plan with more pins than such a sequence. It does so by
 trying every sequence, level by level:
 
-1. enumerate all sequences of the level by nominal rollouts;
+1. enumerate all sequences of the level by nominal rollouts (on the deepest
+   level a sequence stops once its finals spread over ``T + SLACK_DEG``:
+   it could not be kept in step 2; see :mod:`~pipeline.planning.tight.enumerate`);
 2. keep those whose nominal finals span at most ``T + SLACK_DEG`` (modulo the
    part's symmetry), narrowest first;
 3. replay a small subset of the verification trials (``PROBE``: six random
@@ -95,7 +97,7 @@ from pipeline.parts.part import Part
 from pipeline.planning.tight.enumerate import Level, NominalTree
 from pipeline.planning.tight.judge import Certifier, FamilyCheck, TrialBench, stack
 from pipeline.planning.tight.records import CandidatePins, FixedPlan, FixedSearch, robust_order
-from pipeline.planning.tight.screen import LevelScreen
+from pipeline.planning.tight.screen import SLACK_DEG, LevelScreen
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
 from pipeline.planning.claims.replay import replay
 from pipeline.progress import NO_DEADLINE, Deadline, Heartbeat, duration_text
@@ -197,6 +199,21 @@ class FixedPinSearch:
         self.tree = other.tree
         self.bench.kept = other.bench.kept
 
+    def shares_rollouts_with(self, other: "FixedPinSearch") -> bool:
+        """Whether ``other``'s rollouts are this search's own
+        (:meth:`reuse_rollouts`): the same part, pins (heights and speeds, in
+        order), friction, trials, supports and rollout settings; the
+        tolerance, the claim and the evidence may differ. Only searches under
+        uniform pressure (no support family) are compared."""
+        a, b, mine, theirs = self.tree, other.tree, self.bench, other.bench
+        return (a.part is b.part and np.array_equal(a.heights, b.heights) and np.array_equal(a.speeds, b.speeds)
+                and (a.mu_c, a.pin_radius, a.model, a.kernel, a.pin_halfwidth) == (b.mu_c, b.pin_radius, b.model,
+                                                                                  b.kernel, b.pin_halfwidth)
+                and a.supports == b.supports == [None] and mine.family is theirs.family is None
+                and mine.verify == theirs.verify
+                and mine.mu_c == theirs.mu_c and (mine.pin_radius, mine.model, mine.step, mine.belt)
+                == (theirs.pin_radius, theirs.model, theirs.step, theirs.belt))
+
     @property
     def member_check(self) -> FamilyCheck | None:
         """With a family: the check of a plan against the family's worst member
@@ -256,7 +273,8 @@ class FixedPinSearch:
         level without a plan joins ``levels``. Returns the deepest level
         enumerated in full (the root when none was)."""
         last = root if root is not None else self.tree.root()
-        for level in self.tree.levels(depth, root, self._level_heralds(progress, deadline), deadline):
+        span = (self.bench.tolerance + SLACK_DEG, self.bench.order)  # the deepest level's nominal span stop
+        for level in self.tree.levels(depth, root, self._level_heralds(progress, deadline), deadline, span):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
             if level.cut:  # the time limit ended the enumeration: screen what it enumerated, if time is left
                 record = self._cut_level(result, level, n_pins, candidates, keep, progress, deadline,
@@ -341,7 +359,9 @@ class FixedPinSearch:
     def _level_summary(self, n_pins: int, record: dict) -> str:
         """A searched level's last progress line: its sequences, how many were
         within the tolerance nominally, replayed in full and orienting."""
-        return (f"{self._name(n_pins)}: {record['sequences']} sequences, "
+        spread = (f" ({record['spread_out']} spread over {self.bench.tolerance + SLACK_DEG:g} deg before every "
+                  "state was rolled out)" if record.get("spread_out") else "")
+        return (f"{self._name(n_pins)}: {record['sequences']} sequences{spread}, "
                 f"{record['nominal_within']} within {self.bench.tolerance:g} deg nominally, "
                 f"{record['judged']} replayed in full, {record['orienting']} orient the part")
 
@@ -356,7 +376,7 @@ class FixedPinSearch:
                 result.unsearched.append(f"the fewest-set sequences of {len(levels) - k} level(s) "
                                          "(the evidence when nothing orients): not judged")
                 break
-            runners_up.extend(screen.several_sets(min(candidates, EVIDENCE_PER_LEVEL), progress))
+            runners_up.extend(screen.several_sets(min(candidates, EVIDENCE_PER_LEVEL), progress, self.tree.complete))
         result.best_effort = self.ranked(_distinct(runners_up))[:keep]
 
     def _not_reached(self, result: FixedSearch, last: Level, depth: int) -> None:

@@ -22,11 +22,21 @@ jams (or runs out of steps) or passes a touched centroid within
 ``pin_halfwidth`` is dropped by the rules below whatever its other columns
 do, so its remaining columns are not rolled out; a candidate that survives
 has had every column rolled out, from the same rounded keys, so its finals,
-heights and margin are exactly those of one batch of every column. (The
-nominal span is *not* used to stop early: a level's sequences, counted in
-the search's record, are all those the rules below keep, and the evidence
-ranks all of them by their clusters of finals, so every surviving candidate
-needs all its columns.)
+heights and margin are exactly those of one batch of every column.
+
+The deepest level of a search is never extended, so there the nominal span
+may stop a candidate early (``levels(..., span=...)``): once the columns
+rolled out already spread its finals over the span limit (the screen's
+``tolerance + SLACK_DEG``), its other columns are not rolled out (spans only
+grow as points are added). Such a candidate is *spread out*: it is kept in
+the level with its unrolled columns marked (``Level.unrolled``: they hold
+the parent's pose), since a jam in one of them is not known; it is never
+within the span limit, so the screen never sees it, and the evidence (which
+ranks the level's sequences by their clusters of finals) rolls out the
+columns of those that might rank among its fewest-cluster sequences
+(:meth:`NominalTree.complete`), so it picks exactly the sequences a full
+enumeration would. Every candidate within the limit has had every column
+rolled out, from the same rounded keys, exactly as at once.
 
 A sequence is dropped (with all its extensions) when, on its nominal path:
 
@@ -58,6 +68,7 @@ import numpy as np
 from kernels.rollout import JAMMED, MISS, TRUNCATED
 
 from pipeline.parts.part import Part
+from pipeline.planning.claims import orient
 from pipeline.planning.claims.replay import rollouts_by_speed
 from pipeline.progress import BATCH_SECONDS, NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
 
@@ -83,21 +94,45 @@ class Level:
     ``inf`` if nothing was touched); ``cut``: ``None`` for a whole level,
     else ``(candidate sequences rolled out, candidate sequences of the
     level)`` when a time limit ended its enumeration early (its sequences are
-    then those of the parents done)."""
+    then those of the parents done).
+
+    Spread-out sequences (the deepest level only, see the module's
+    docstring): ``unrolled`` marks ``(n, states)`` the columns not rolled
+    out (``None``: every column was), which hold the parent's pose, with
+    ``margin`` over the columns rolled out only; ``touched`` says per
+    sequence whether its last pin touched a state in a column rolled out;
+    ``dropped`` marks the sequences whose columns, rolled out later
+    (:meth:`NominalTree.complete`), broke a rule (``None``: none)."""
     seq: np.ndarray
     theta: np.ndarray
     y: np.ndarray
     margin: np.ndarray
     cut: tuple | None = None
+    unrolled: np.ndarray | None = None
+    touched: np.ndarray | None = None
+    dropped: np.ndarray | None = None
 
     def rows(self, lo: int, hi: int) -> "Level":
         """The sequences ``lo`` to ``hi`` of the level."""
-        return Level(self.seq[lo:hi], self.theta[lo:hi], self.y[lo:hi], self.margin[lo:hi])
+        return Level(*(None if x is None else x[lo:hi] for x in (self.seq, self.theta, self.y, self.margin)),
+                     None, *(None if x is None else x[lo:hi] for x in (self.unrolled, self.touched, self.dropped)))
 
     @property
     def size(self) -> int:
         """Number of sequences in the level."""
         return int(self.seq.shape[0])
+
+    @property
+    def spread_out(self) -> np.ndarray:
+        """``(n,)``: the sequences with columns not rolled out (still unknown)."""
+        if self.unrolled is None:
+            return np.zeros(self.size, bool)
+        return self.unrolled.any(axis=1)
+
+    @property
+    def alive(self) -> np.ndarray:
+        """``(n,)``: the sequences not dropped once their columns were rolled out."""
+        return np.ones(self.size, bool) if self.dropped is None else ~self.dropped
 
 
 class NominalTree:
@@ -148,7 +183,8 @@ class NominalTree:
         return Level(np.zeros((1, 0), dtype=np.int16), states[None, :, 0].copy(),
                      states[None, :, 1].copy(), np.full(1, np.inf))
 
-    def levels(self, depth: int, root: Level | None = None, heartbeat=None, deadline: Deadline = NO_DEADLINE):
+    def levels(self, depth: int, root: Level | None = None, heartbeat=None, deadline: Deadline = NO_DEADLINE,
+               span: tuple | None = None):
         """Yield the levels of lengths 1 to ``depth`` after ``root`` (default
         :meth:`root`) in turn (lazily, so a search may stop early).
 
@@ -161,10 +197,12 @@ class NominalTree:
         does stops once it has used ``ENUMERATION_SHARE`` of the search time
         left when it started (the rest is for screening what it enumerated;
         :func:`finishes_in_time`), and a level it cuts short is the last
-        (``Level.cut``)."""
+        (``Level.cut``). ``span``: ``(limit_deg, symmetry order)``: the
+        deepest level stops a candidate once its finals spread over the limit
+        (see the module's docstring); ``None``: every column of every level."""
         heartbeat = heartbeat or (lambda length, n: Heartbeat("", n))
         level = self.root() if root is None else root
-        for _ in range(depth):
+        for k in range(depth):
             if deadline.search_over():
                 return
             n = level.size * self.heights.size
@@ -172,7 +210,7 @@ class NominalTree:
             if deadline.limited:
                 stop_at = deadline.elapsed() + ENUMERATION_SHARE * max(0.0, deadline.left() - deadline.reserve)
             with heartbeat(level.seq.shape[1] + 1, n) as beat:
-                level = self.extend(level, beat.stretch(0, n), deadline, stop_at)
+                level = self.extend(level, beat.stretch(0, n), deadline, stop_at, span if k == depth - 1 else None)
                 if level.cut:
                     beat.finish(level.cut[0], "the time limit ended the enumeration here")
             yield level
@@ -180,7 +218,7 @@ class NominalTree:
                 return
 
     def extend(self, level: Level, stretch: Stretch = SILENT, deadline: Deadline = NO_DEADLINE,
-               stop_at: float | None = None) -> Level:
+               stop_at: float | None = None, span: tuple | None = None) -> Level:
         """Every surviving sequence of ``level`` followed by every candidate pin
         (in chunks of parents, so memory stays bounded on long levels);
         ``stretch`` is told the share of parents done. Under a time limit
@@ -189,25 +227,26 @@ class NominalTree:
         ``stop_at`` seconds of the deadline have passed and the rest would
         not end before the search is over (:func:`finishes_in_time`): the
         level returned is then ``cut``. (An outcome depends on its rounded pose only, so the
-        sequences enumerated are the same in any chunks.)"""
+        sequences enumerated are the same in any chunks.) ``span``: as for
+        :meth:`levels`, for this level."""
         per_parent = max(1, self.heights.size * level.theta.shape[1])
         step = max(1, MAX_PAIRS // per_parent)
         if deadline.limited:
-            return self._extend_timed(level, step, stretch, deadline, stop_at)
+            return self._extend_timed(level, step, stretch, deadline, stop_at, span)
         if level.size <= step:
-            return self._extend(level, stretch)
+            return self._extend(level, stretch, span)
         parts = [self._extend(level.rows(i, i + step),
-                              stretch.part(i / level.size, min(i + step, level.size) / level.size))
+                              stretch.part(i / level.size, min(i + step, level.size) / level.size), span)
                  for i in range(0, level.size, step)]
         return _joined(parts)
 
     def _extend_timed(self, level: Level, step: int, stretch: Stretch, deadline: Deadline,
-                      stop_at: float | None = None) -> Level:
+                      stop_at: float | None = None, span: tuple | None = None) -> Level:
         """:meth:`extend` under a time limit: chunks of parents sized by the pace
         of the ones before (up to ``step``), the deadline (and ``stop_at``)
         read between them."""
         if level.size == 0:
-            return self._extend(level, stretch)
+            return self._extend(level, stretch, span)
         parts, done, size = [], 0, min(step, FIRST_PARENTS)
         started = deadline.elapsed() if stop_at is not None else 0.0
 
@@ -223,7 +262,7 @@ class NominalTree:
         while done < level.size and not (parts and stop()):
             hi = min(level.size, done + size)
             t0 = time.monotonic()
-            parts.append(self._extend(level.rows(done, hi), stretch.part(done / level.size, hi / level.size)))
+            parts.append(self._extend(level.rows(done, hi), stretch.part(done / level.size, hi / level.size), span))
             took = max(time.monotonic() - t0, 1e-6)
             size = max(1, min(step, int((hi - done) * min(8.0, max(0.125, BATCH_SECONDS / took)))))
             done = hi
@@ -232,26 +271,39 @@ class NominalTree:
             out.cut = (done * self.heights.size, level.size * self.heights.size)
         return out
 
-    def _extend(self, level: Level, stretch: Stretch = SILENT) -> Level:
+    def _extend(self, level: Level, stretch: Stretch = SILENT, span: tuple | None = None) -> Level:
         n_pins, n = self.heights.size, level.size
         theta = np.repeat(level.theta, n_pins, axis=0)
         y_c = np.repeat(level.y, n_pins, axis=0)
         y_pin = np.tile(self.heights, n)[:, None]
         v_pin = np.broadcast_to(np.tile(self.speeds, n)[:, None], theta.shape)
-        status, theta_f, dy = self._columns(theta, y_pin - y_c, v_pin, stretch)
-        touched = status != MISS
-        d_abs = np.abs(y_pin - y_c) / self.part.a
-        bad = ((status == JAMMED) | (status == TRUNCATED)).any(axis=1)
-        bad |= (touched & (np.abs(y_pin - y_c) < self.pin_halfwidth)).any(axis=1)
-        bad |= ~touched.any(axis=1)
-        step_margin = np.where(touched, np.minimum(d_abs - self.d_min, self.d_max - d_abs), np.inf).min(axis=1)
-        keep = ~bad
+        status, theta_f, dy, unrolled = self._columns(theta, y_pin - y_c, v_pin, stretch, span)
         seq = np.concatenate([np.repeat(level.seq, n_pins, axis=0),
                               np.tile(np.arange(n_pins, dtype=np.int16), n)[:, None]], axis=1)
+        keep, step_margin, touched = self._rules(status, y_pin - y_c, unrolled)
         margin = np.minimum(np.repeat(level.margin, n_pins), step_margin)
-        return Level(seq[keep], theta_f[keep], (y_c + dy)[keep], margin[keep])
+        out = Level(seq[keep], theta_f[keep], (y_c + dy)[keep], margin[keep])
+        if unrolled is not None:
+            out.unrolled, out.touched = unrolled[keep], touched[keep]
+        return out
 
-    def _columns(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT):
+    def _rules(self, status, dy_pin, unrolled=None):
+        """The rules of the module's docstring on rollouts' ``status`` and pin
+        offsets ``dy_pin`` (mm; columns marked in ``unrolled`` were not
+        rolled out and read ``MISS``): ``(kept, step margin, touched)`` per
+        row. A row with columns not rolled out is kept unless a rolled
+        column breaks a rule (whether its last pin touches a state at all is
+        known once every column is)."""
+        touched = status != MISS
+        d_abs = np.abs(dy_pin) / self.part.a
+        bad = ((status == JAMMED) | (status == TRUNCATED)).any(axis=1)
+        bad |= (touched & (np.abs(dy_pin) < self.pin_halfwidth)).any(axis=1)
+        complete = np.ones(status.shape[0], bool) if unrolled is None else ~unrolled.any(axis=1)
+        bad |= ~touched.any(axis=1) & complete
+        step_margin = np.where(touched, np.minimum(d_abs - self.d_min, self.d_max - d_abs), np.inf).min(axis=1)
+        return ~bad, step_margin, touched.any(axis=1)
+
+    def _columns(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT, span: tuple | None = None):
         """:meth:`_rollouts` of every (candidate sequence, column) pair, one
         column at a time: a candidate whose rollout in one column jams (or runs
         out of steps) or passes a centroid it touches within ``pin_halfwidth``
@@ -260,12 +312,24 @@ class NominalTree:
         ``JAMMED``: the candidate is dropped all the same, and every surviving
         candidate has all its columns rolled out, exactly as at once. The
         columns go in the order of the share of candidates each dropped so far
-        (any order gives the same survivors)."""
+        (any order gives the same survivors).
+
+        With ``span`` (``(limit_deg, order)``), a candidate whose columns
+        rolled out so far span more than the limit stops too: its other
+        columns keep the pose they started from, read ``MISS`` and are marked
+        in the fourth array returned (``unrolled``; ``None`` without
+        ``span``). Which candidates stop then depends on the order of the
+        columns, so they go in their own order: the level is the same
+        whatever was rolled out before."""
         n, cols = theta.shape
         status = np.full(theta.shape, JAMMED, dtype=np.int8)
         theta_f, dy = theta.astype(float, copy=True), np.zeros(theta.shape)
+        unrolled = None if span is None else np.zeros(theta.shape, bool)
         alive = np.arange(n)
-        for k, c in enumerate(np.argsort(-self._column_drops / np.maximum(self._column_tries, 1), kind="stable")):
+        order = np.argsort(-self._column_drops / np.maximum(self._column_tries, 1), kind="stable")
+        if span is not None:  # which rows stop depends on the order: a fixed one keeps it free of history
+            order = np.arange(cols)
+        for k, c in enumerate(order):
             if alive.size == 0:
                 break
             st, tf, d = self._rollouts(theta[alive, c:c + 1], dy_pin[alive, c:c + 1], v_pin[alive, c:c + 1],
@@ -276,7 +340,43 @@ class NominalTree:
             self._column_tries[c] += alive.size
             self._column_drops[c] += int(drop.sum())
             alive = alive[~drop]
-        return status, theta_f, dy
+            if span is not None and 0 < k < cols - 1 and alive.size:
+                wide = orient.row_spans(theta_f[np.ix_(alive, order[:k + 1])], span[1]) > span[0]
+                stop, rest = alive[wide], order[k + 1:]
+                status[np.ix_(stop, rest)] = MISS
+                unrolled[np.ix_(stop, rest)] = True
+                alive = alive[~wide]
+        return status, theta_f, dy, unrolled
+
+    def complete(self, level: Level, rows) -> None:
+        """Roll out the columns of ``level``'s spread-out ``rows`` that were not
+        (from the parent's pose they hold, with the sequence's last pin), in
+        place: their finals, heights and margin become those of a full
+        enumeration, and a row whose columns break a rule is marked in
+        ``level.dropped`` (so the level's live sequences are exactly those a
+        full enumeration keeps)."""
+        rows = np.unique(np.asarray(rows, dtype=int))
+        if level.unrolled is None or rows.size == 0:
+            return
+        at, c = np.nonzero(level.unrolled[rows])
+        r = rows[at]
+        pin = level.seq[r, -1].astype(int)
+        dy_pin = self.heights[pin] - level.y[r, c]
+        st, tf, d = self._rollouts(level.theta[r, c][None, :], dy_pin[None, :], self.speeds[pin][None, :],
+                                   columns=c)
+        status = np.full((rows.size, level.theta.shape[1]), MISS, dtype=np.int8)
+        offsets = np.zeros(status.shape)
+        status[at, c], offsets[at, c] = st[0], dy_pin
+        # the rows' earlier columns touched or not: the no-touch rule is applied below, over all columns
+        keep, step_margin, touched = self._rules(status, offsets, unrolled=np.ones(status.shape, bool))
+        level.theta[r, c], level.y[r, c] = tf[0], level.y[r, c] + d[0]
+        level.margin[rows] = np.minimum(level.margin[rows], step_margin)
+        level.touched[rows] |= touched
+        broken = ~keep | ~level.touched[rows]
+        level.unrolled[rows] = False
+        if level.dropped is None:
+            level.dropped = np.zeros(level.size, bool)
+        level.dropped[rows] |= broken
 
     def _rollouts(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT, columns=None):
         """``(status, theta_f, dy)`` arrays shaped like ``theta`` for the pin offsets
@@ -371,4 +471,9 @@ def _joined(parts) -> Level:
     """The levels ``parts`` (sequences of one length) as one level, in order."""
     if len(parts) == 1:
         return parts[0]
-    return Level(*(np.concatenate([getattr(p, k) for p in parts]) for k in ("seq", "theta", "y", "margin")))
+    out = Level(*(np.concatenate([getattr(p, k) for p in parts]) for k in ("seq", "theta", "y", "margin")))
+    if any(p.unrolled is not None for p in parts):
+        out.unrolled = np.concatenate([np.zeros(p.theta.shape, bool) if p.unrolled is None else p.unrolled
+                                       for p in parts])
+        out.touched = np.concatenate([np.ones(p.size, bool) if p.touched is None else p.touched for p in parts])
+    return out

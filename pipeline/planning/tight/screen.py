@@ -10,6 +10,7 @@ import numpy as np
 
 from pipeline.planning.claims import orient
 from pipeline.planning.tight.enumerate import Level
+from pipeline.planning.tight.fewest import fewest_sets
 from pipeline.planning.tight.judge import MAX_ROWS, Certifier, TrialBench, stack
 from pipeline.planning.tight.records import CandidatePins, FixedPlan
 from pipeline.progress import NO_DEADLINE, Deadline, Heartbeat
@@ -114,7 +115,10 @@ class LevelScreen:
         if allowed < 0:  # no plan of this length can be claimed, however it ends
             record["too_few_trials"] = n_total
         span = orient.row_spans(level.theta, bench.order)
-        within = np.flatnonzero(span <= bench.tolerance + SLACK_DEG)
+        spread_out = level.spread_out  # (deepest level) their finals spread over the limit: never within
+        if spread_out.any():
+            record["spread_out"] = int(spread_out.sum())
+        within = np.flatnonzero((span <= bench.tolerance + SLACK_DEG) & ~spread_out)
         within = within[np.lexsort((-level.margin[within], span[within]))]
         record["nominal_within"] = int(within.size)
         if within.size == 0:
@@ -360,21 +364,25 @@ class LevelScreen:
             record["broken_by_known_member"] = record.get("broken_by_known_member", 0) + int(broken.sum())
         return alive[~broken]
 
-    def several_sets(self, candidates: int, progress=None) -> list:
+    def several_sets(self, candidates: int, progress=None, complete=None) -> list:
         """The level's sequences whose nominal finals fall into the fewest
         clusters (gaps over the tolerance), judged in full (telling
-        ``progress``): the evidence when nothing orients."""
+        ``progress``): the evidence when nothing orients
+        (:func:`~pipeline.planning.tight.fewest.fewest_sets`; ``complete``
+        rolls out the spread-out sequences that might be among them)."""
         level, bench = self.level, self.bench
         if level.size == 0:
             return []
-        period = 360.0 / bench.order
-        x = np.sort(np.mod(level.theta, period), axis=1)
-        gaps = np.diff(np.concatenate([x, x[:, :1] + period], axis=1), axis=1)
-        clusters = np.maximum(1, (gaps > bench.tolerance).sum(axis=1))
-        spread = period - gaps.max(axis=1)
-        best = np.lexsort((-level.margin, spread, clusters))[:candidates]
+        beat = Heartbeat(f"{self.name}: rolling out the spread-out sequences that may have the fewest sets",
+                         int(level.spread_out.sum()) if complete else 0, "sequence", progress)
+        best = fewest_sets(level, bench.tolerance, bench.order, candidates, complete, beat.tick)
+        if beat.last is not None:
+            beat.finish(beat.done, "the others cannot be among the fewest-set sequences")
+        if best.size == 0:
+            return []
+        spread = orient.row_spans(level.theta[best], bench.order)
         inputs = bench.trials(self.n_pins)
         with Heartbeat(f"{self.name}: judging the fewest-set sequences for the evidence", best.size,
                        "sequence", progress) as beat:
             verdicts = bench.judge(*self.sequences(best), stack(inputs), stretch=beat.stretch(0, best.size))
-            return [self.plan(i, spread[i], v) for i, v in zip(best, verdicts)]
+            return [self.plan(i, s, v) for i, s, v in zip(best, spread, verdicts)]
