@@ -15,7 +15,7 @@ as it was; a vertex pushed to rest ends where the vertex sits behind the
 centroid whatever the offset was). Because an outcome is a function of its
 rounded key (pose, offset, speed, support) alone, the tree keeps the
 outcomes it has rolled out and reuses them in later columns, chunks and
-levels (up to ``MAX_OUTCOMES``).
+levels (up to ``outcomes.MAX_OUTCOMES``).
 
 Fewer rollouts, the same levels. A candidate whose rollout in one column
 jams (or runs out of steps) or passes a touched centroid within
@@ -70,12 +70,12 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
 from pipeline.planning.claims.replay import rollouts_by_speed
+from pipeline.planning.tight.outcomes import Outcomes
 from pipeline.progress import BATCH_SECONDS, NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
 
 QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout
 MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
 FIRST_PARENTS = 64  # parents of the first batch of a level under a time limit (it sets the pace)
-MAX_OUTCOMES = 8_000_000  # nominal outcomes kept for reuse (about 200 MB)
 # Under a time limit a level's enumeration that will not end before the search
 # time does stops after this share of the search time left when it started;
 # the rest screens the sequences it enumerated.
@@ -168,7 +168,7 @@ class NominalTree:
         n_states = self.part.stable_states().shape[0]
         self.column_support = np.repeat(np.arange(len(self.supports)), n_states)
         self.rollouts = 0
-        self._outcomes = _Outcomes()
+        self._outcomes = Outcomes()
         self._column_tries = np.zeros(self.column_support.size, dtype=np.int64)
         self._column_drops = np.zeros(self.column_support.size, dtype=np.int64)
 
@@ -385,7 +385,7 @@ class NominalTree:
         columns of ``theta`` are the tree's columns ``columns`` (default all).
         An outcome is a function of its key alone, so the outcomes of keys
         rolled out before (by any level, chunk or column of this tree) are
-        reused (``_Outcomes``)."""
+        reused (:class:`~pipeline.planning.tight.outcomes.Outcomes`)."""
         a = self.part.a
         speed_index = np.searchsorted(np.unique(self.speeds), v_pin)
         col_support = self.column_support if columns is None else self.column_support[columns]
@@ -420,51 +420,6 @@ def finishes_in_time(now: float, started: float, done: int, total: int, search_e
     in time with room to screen it is never cut)."""
     pace = (now - started) / max(done, 1)
     return now + pace * (total - done) <= search_end - SCREEN_SHARE * (search_end - started)
-
-
-class _Outcomes:
-    """The nominal rollouts' outcomes ``(status, theta_f, dy)`` by key (a
-    rounded pose, pin offset, speed and support: a rollout starts from the
-    rounded pose itself, so its outcome is a function of the key alone), up
-    to ``MAX_OUTCOMES`` keys; later keys are rolled out without being kept."""
-
-    def __init__(self):
-        self.codes = np.zeros(0, dtype=np.int64)
-        self.status = np.zeros(0, dtype=np.int8)
-        self.theta_f, self.dy = np.zeros(0), np.zeros(0)
-
-    @staticmethod
-    def _codes(keys):
-        """One int64 per key row, or ``None`` where a key is out of range."""
-        t, d, v, s = keys.T
-        if keys.size and (t.min() < 0 or t.max() >= 1 << 14 or np.abs(d).max() >= 1 << 30 or v.max() >= 1 << 8
-                          or s.max() >= 1 << 8 or v.min() < 0 or s.min() < 0):
-            return None
-        return (((t << 31) + (d + (1 << 30))) << 16) + (v << 8) + s
-
-    def lookup(self, keys):
-        """``(status, theta_f, dy, known)`` arrays over the key rows ``keys``."""
-        n = keys.shape[0]
-        status, theta_f, dy = np.zeros(n, dtype=np.int8), np.zeros(n), np.zeros(n)
-        known = np.zeros(n, bool)
-        codes = self._codes(keys)
-        if codes is None or self.codes.size == 0:
-            return status, theta_f, dy, known
-        at = np.minimum(np.searchsorted(self.codes, codes), self.codes.size - 1)
-        known = self.codes[at] == codes
-        status[known], theta_f[known], dy[known] = self.status[at[known]], self.theta_f[at[known]], self.dy[at[known]]
-        return status, theta_f, dy, known
-
-    def add(self, keys, status, theta_f, dy) -> None:
-        """Keep the outcomes of the (new) key rows ``keys``, while there is room."""
-        codes = self._codes(keys)
-        if codes is None or self.codes.size + codes.size > MAX_OUTCOMES:
-            return
-        order = np.argsort(np.concatenate([self.codes, codes]), kind="stable")
-        self.codes = np.concatenate([self.codes, codes])[order]
-        self.status = np.concatenate([self.status, np.asarray(status, dtype=np.int8)])[order]
-        self.theta_f = np.concatenate([self.theta_f, theta_f])[order]
-        self.dy = np.concatenate([self.dy, dy])[order]
 
 
 def _joined(parts) -> Level:
