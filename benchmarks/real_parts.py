@@ -132,7 +132,8 @@ def answer(doc: dict) -> tuple[str, str | None]:
         else:
             text = f"orients with {len(pins)} fixed pin{'s' if len(pins) != 1 else ''}"
     elif rec:
-        text = f"sensor: {len(rec['pins'])} pins end in {rec['n_final_sets']} sets"
+        sets = rec["carried_sets"]["n_sets"] if "carried_sets" in rec else rec["n_final_sets"]  # older JSON
+        text = f"sensor: {len(rec['pins'])} pins end in {sets} sets"
     else:
         text = "no plan"
     near = doc.get("nearest_yes")
