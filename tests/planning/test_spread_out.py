@@ -62,7 +62,8 @@ def test_the_deepest_level_keeps_what_a_full_enumeration_finds(name):
     # the evidence: the fewest-cluster rows of the full level, by a plain sort
     for k in (1, 4, 12):
         want = [tuple(full.seq[i]) for i in _brute_fewest(full, order, k)]
-        assert [tuple(lazy.seq[i]) for i in fewest_sets(lazy, TOLERANCE, order, k, tree.complete)] == want
+        rows, cut = fewest_sets(lazy, TOLERANCE, order, k, tree.complete)
+        assert not cut and [tuple(lazy.seq[i]) for i in rows] == want
     # every column rolled out: the full level itself
     tree.complete(lazy, np.flatnonzero(lazy.spread_out))
     alive = lazy.alive
@@ -117,3 +118,17 @@ def test_the_deepest_level_is_the_same_whatever_was_rolled_out_before():
         pass
     for k in ("seq", "theta", "y", "margin", "unrolled"):
         np.testing.assert_array_equal(getattr(level, k), getattr(fresh, k))
+
+
+def test_a_stopped_roll_out_ranks_the_sequences_rolled_out_in_full_and_says_so():
+    part = PARTS["t_bracket"]()
+    pins = _pins(part, 9)
+    order = part.symmetry_order()
+    tree, lazy = _levels(part, pins, (LIMIT, order))
+    before = lazy.spread_out.copy()
+    rows, cut = fewest_sets(lazy, TOLERANCE, order, 4, tree.complete, stop=lambda: True)
+    assert cut and np.array_equal(lazy.spread_out, before)  # nothing more was rolled out
+    assert not before[rows].any()  # the best of those rolled out in full (maybe none)
+    exact = np.flatnonzero(~before)
+    assert rows.size == min(4, exact.size)
+    assert fewest_sets(lazy, TOLERANCE, order, 0, tree.complete)[0].size == 0

@@ -376,7 +376,12 @@ class FixedPinSearch:
                 result.unsearched.append(f"the fewest-set sequences of {len(levels) - k} level(s) "
                                          "(the evidence when nothing orients): not judged")
                 break
-            runners_up.extend(screen.several_sets(min(candidates, EVIDENCE_PER_LEVEL), progress, self.tree.complete))
+            runners_up.extend(screen.several_sets(min(candidates, EVIDENCE_PER_LEVEL), progress, self.tree.complete,
+                                                  deadline.search_over))
+            if screen.evidence_cut:
+                result.unsearched.append(f"the fewest-set sequences of {screen.name}: ranked among the sequences "
+                                         "rolled out in full only (the time limit ended the roll-out of the "
+                                         "spread-out ones)")
         result.best_effort = self.ranked(_distinct(runners_up))[:keep]
 
     def _not_reached(self, result: FixedSearch, last: Level, depth: int) -> None:

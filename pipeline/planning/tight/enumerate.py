@@ -70,6 +70,7 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
 from pipeline.planning.claims.replay import rollouts_by_speed
+from pipeline.planning.tight.fewest import ROUNDING
 from pipeline.planning.tight.outcomes import Outcomes
 from pipeline.progress import BATCH_SECONDS, NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
 
@@ -341,7 +342,8 @@ class NominalTree:
             self._column_drops[c] += int(drop.sum())
             alive = alive[~drop]
             if span is not None and 0 < k < cols - 1 and alive.size:
-                wide = orient.row_spans(theta_f[np.ix_(alive, order[:k + 1])], span[1]) > span[0]
+                # ROUNDING: a row within the limit is never stopped by rounding in its partial span
+                wide = orient.row_spans(theta_f[np.ix_(alive, order[:k + 1])], span[1]) > span[0] + ROUNDING
                 stop, rest = alive[wide], order[k + 1:]
                 status[np.ix_(stop, rest)] = MISS
                 unrolled[np.ix_(stop, rest)] = True

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 ROUNDING = 1e-9  # deg: the bounds give this much away, so rounding in the gaps never makes them unsound
-COMPLETE_BATCH = 1024  # spread-out sequences rolled out at once, lowest bound first
+COMPLETE_BATCH = 1024  # spread-out sequences rolled out in the first batch (then twice as many each time)
 
 
 def cluster_keys(theta: np.ndarray, tolerance: float, order: int):
@@ -57,31 +57,40 @@ def cluster_bounds(theta: np.ndarray, unrolled: np.ndarray, tolerance: float, or
     return clusters, spread
 
 
-def fewest_sets(level, tolerance: float, order: int, k: int, complete=None, tick=None) -> np.ndarray:
-    """The rows of ``level`` (an ``enumerate.Level``) of its ``k`` best ranked
-    sequences (see the module's docstring), best first. Spread-out rows that
-    might rank among them are rolled out first by ``complete(level, rows)``
-    (``NominalTree.complete``), lowest bound first, in batches, until none
-    might: rows it drops (``level.dropped``) are not ranked. ``tick(n)`` hears
-    how many rows were rolled out so far."""
-    rolled = 0
+def fewest_sets(level, tolerance: float, order: int, k: int, complete=None, tick=None, stop=None) -> tuple:
+    """``(rows, cut)``: the rows of ``level`` (an ``enumerate.Level``) of its
+    ``k`` best ranked sequences (see the module's docstring), best first.
+    Spread-out rows that might rank among them are rolled out first by
+    ``complete(level, rows)`` (``NominalTree.complete``, which clears their
+    ``unrolled``), lowest bound first, in batches that double, until none
+    might: rows it drops (``level.dropped``) are not ranked. ``tick(n)``
+    hears how many rows were rolled out so far; once ``stop()`` is true no
+    further batch starts, and the rows are the best of those rolled out in
+    full (``cut`` True: not necessarily a full enumeration's)."""
+    pending = np.flatnonzero(level.alive & level.spread_out) if complete is not None else np.zeros(0, int)
+    if pending.size:  # a pending row's bounds do not change until it is rolled out
+        lb_c, lb_s = cluster_bounds(level.theta[pending], level.unrolled[pending], tolerance, order)
+        by_bound = np.lexsort((lb_s, lb_c))
+        pending, lb_c, lb_s = pending[by_bound], lb_c[by_bound], lb_s[by_bound]
+    rolled, batch = 0, COMPLETE_BATCH
     while True:
         exact = np.flatnonzero(level.alive & ~level.spread_out)
         clusters, spread = cluster_keys(level.theta[exact], tolerance, order)
         ranked = exact[np.lexsort((-level.margin[exact], spread, clusters))] if exact.size else exact
-        pending = np.flatnonzero(level.alive & level.spread_out)
-        if pending.size == 0 or complete is None:
-            return ranked[:k]
-        lb_c, lb_s = cluster_bounds(level.theta[pending], level.unrolled[pending], tolerance, order)
+        if k <= 0:
+            return ranked[:0], False
+        if rolled >= pending.size:
+            return ranked[:k], False
         if ranked.size >= k:
             at = np.searchsorted(exact, ranked[k - 1])
             c_k, s_k = clusters[at], spread[at]
-            might = (lb_c < c_k) | ((lb_c == c_k) & (lb_s <= s_k))
-            pending, lb_c, lb_s = pending[might], lb_c[might], lb_s[might]
-            if pending.size == 0:
-                return ranked[:k]
-        batch = pending[np.lexsort((lb_s, lb_c))[:COMPLETE_BATCH]]
-        complete(level, batch)
-        rolled += batch.size
+            c, s = lb_c[rolled], lb_s[rolled]  # the lowest bound of the rows still pending
+            if c > c_k or (c == c_k and s > s_k):
+                return ranked[:k], False
+        if stop is not None and stop():
+            return ranked[:k], True
+        complete(level, pending[rolled:rolled + batch])
+        rolled = min(pending.size, rolled + batch)
+        batch *= 2
         if tick is not None:
             tick(rolled)

@@ -78,6 +78,7 @@ class LevelScreen:
         self.unverified = []  # orienting on the selection trials, left uncertified by a time limit
         self.learn = learn
         self.fail_counts = None  # per trial of the full set: the judged sequences it failed (learn)
+        self.evidence_cut = False  # the time limit ended the roll-out of its spread-out sequences
 
     @property
     def family_checked(self) -> bool:
@@ -364,20 +365,24 @@ class LevelScreen:
             record["broken_by_known_member"] = record.get("broken_by_known_member", 0) + int(broken.sum())
         return alive[~broken]
 
-    def several_sets(self, candidates: int, progress=None, complete=None) -> list:
+    def several_sets(self, candidates: int, progress=None, complete=None, stop=None) -> list:
         """The level's sequences whose nominal finals fall into the fewest
         clusters (gaps over the tolerance), judged in full (telling
         ``progress``): the evidence when nothing orients
         (:func:`~pipeline.planning.tight.fewest.fewest_sets`; ``complete``
-        rolls out the spread-out sequences that might be among them)."""
+        rolls out the spread-out sequences that might be among them until
+        ``stop()``; ``evidence_cut`` then says the ranking is over the
+        sequences rolled out in full only)."""
         level, bench = self.level, self.bench
         if level.size == 0:
             return []
         beat = Heartbeat(f"{self.name}: rolling out the spread-out sequences that may have the fewest sets",
                          int(level.spread_out.sum()) if complete else 0, "sequence", progress)
-        best = fewest_sets(level, bench.tolerance, bench.order, candidates, complete, beat.tick)
+        best, self.evidence_cut = fewest_sets(level, bench.tolerance, bench.order, candidates, complete, beat.tick,
+                                              stop)
         if beat.last is not None:
-            beat.finish(beat.done, "the others cannot be among the fewest-set sequences")
+            beat.finish(beat.done, "the time limit ended it here" if self.evidence_cut
+                        else "the others cannot be among the fewest-set sequences")
         if best.size == 0:
             return []
         spread = orient.row_spans(level.theta[best], bench.order)
