@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 
 ROUNDING = 1e-9  # deg: the bounds give this much away, so rounding in the gaps never makes them unsound
-COMPLETE_BATCH = 1024  # spread-out sequences rolled out in the first batch (then twice as many each time)
+COMPLETE_BATCH = 1024  # spread-out sequences rolled out in the first batch (then twice as many each time ...)
+MAX_BATCH = 16_384  # ... up to this many: a batch may roll out rows the one before has already ruled out
 
 
 def cluster_keys(theta: np.ndarray, tolerance: float, order: int):
@@ -62,7 +63,8 @@ def fewest_sets(level, tolerance: float, order: int, k: int, complete=None, tick
     ``k`` best ranked sequences (see the module's docstring), best first.
     Spread-out rows that might rank among them are rolled out first by
     ``complete(level, rows)`` (``NominalTree.complete``, which clears their
-    ``unrolled``), lowest bound first, in batches that double, until none
+    ``unrolled``), lowest bound first, in batches that double up to
+    ``MAX_BATCH``, until none
     might: rows it drops (``level.dropped``) are not ranked. ``tick(n)``
     hears how many rows were rolled out so far; once ``stop()`` is true no
     further batch starts, and the rows are the best of those rolled out in
@@ -91,6 +93,6 @@ def fewest_sets(level, tolerance: float, order: int, k: int, complete=None, tick
             return ranked[:k], True
         complete(level, pending[rolled:rolled + batch])
         rolled = min(pending.size, rolled + batch)
-        batch *= 2
+        batch = min(2 * batch, MAX_BATCH)
         if tick is not None:
             tick(rolled)
