@@ -104,20 +104,26 @@ def test_the_cluster_bound_is_met_when_the_hidden_finals_close_the_cheapest_gaps
     assert cluster_keys(filled, 10.0, 1)[0][0] == 2
 
 
-def test_the_deepest_level_is_the_same_whatever_was_rolled_out_before():
-    """Which sequences stop depends on the order of the states; it is fixed,
-    so a tree that has searched at another tolerance gives the same level."""
+def test_what_was_rolled_out_before_changes_no_sequence_within_the_limit_nor_the_evidence():
+    """The states go in the order of their drops so far, so which sequences
+    stop depends on what the tree rolled out before; the sequences within the
+    limit and the fewest-set sequences do not."""
     part = PARTS["l_bracket"]()
     pins = _pins(part, 9)
     order = part.symmetry_order()
-    _, fresh = _levels(part, pins, (LIMIT, order))
+    fresh_tree, fresh = _levels(part, pins, (LIMIT, order))
     tree = NominalTree(part, pins, 0.2, 3.0)
     for _ in tree.levels(3, span=(46.0, order)):
         pass
     for level in tree.levels(3, span=(LIMIT, order)):
         pass
-    for k in ("seq", "theta", "y", "margin", "unrolled"):
-        np.testing.assert_array_equal(getattr(level, k), getattr(fresh, k))
+    for lv in (fresh, level):
+        lv.within = (orient.row_spans(lv.theta, order) <= LIMIT) & ~lv.spread_out
+    for k in ("seq", "theta", "y", "margin"):
+        np.testing.assert_array_equal(getattr(level, k)[level.within], getattr(fresh, k)[fresh.within])
+    rows, _ = fewest_sets(level, TOLERANCE, order, 4, tree.complete)
+    want, _ = fewest_sets(fresh, TOLERANCE, order, 4, fresh_tree.complete)
+    assert [tuple(level.seq[i]) for i in rows] == [tuple(fresh.seq[i]) for i in want]
 
 
 def test_a_stopped_roll_out_ranks_the_sequences_rolled_out_in_full_and_says_so():

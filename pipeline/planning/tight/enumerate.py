@@ -319,17 +319,20 @@ class NominalTree:
         rolled out so far span more than the limit stops too: its other
         columns keep the pose they started from, read ``MISS`` and are marked
         in the fourth array returned (``unrolled``; ``None`` without
-        ``span``). Which candidates stop then depends on the order of the
-        columns, so they go in their own order: the level is the same
-        whatever was rolled out before."""
+        ``span``). Which candidates stop (and so the level's count of
+        sequences) then depends on the order of the columns, which follows
+        what the tree rolled out before; the candidates within the limit and
+        the evidence do not (any order). The drop order pays twice here: a
+        candidate dropped is not rolled out again for the evidence, and the
+        columns that tell candidates apart come first (the heart cam's
+        evidence rolled out 64,512 stopped sequences with it, 326,656 in the
+        states' own order)."""
         n, cols = theta.shape
         status = np.full(theta.shape, JAMMED, dtype=np.int8)
         theta_f, dy = theta.astype(float, copy=True), np.zeros(theta.shape)
         unrolled = None if span is None else np.zeros(theta.shape, bool)
         alive = np.arange(n)
         order = np.argsort(-self._column_drops / np.maximum(self._column_tries, 1), kind="stable")
-        if span is not None:  # which rows stop depends on the order: a fixed one keeps it free of history
-            order = np.arange(cols)
         for k, c in enumerate(order):
             if alive.size == 0:
                 break
