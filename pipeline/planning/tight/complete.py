@@ -206,13 +206,12 @@ class FixedPinSearch:
         tolerance, the claim and the evidence may differ. Only searches under
         uniform pressure (no support family) are compared."""
         a, b, mine, theirs = self.tree, other.tree, self.bench, other.bench
+        # the tree's friction, pin radius, model, kernel and pin tolerance come from the bench's settings
         return (a.part is b.part and np.array_equal(a.heights, b.heights) and np.array_equal(a.speeds, b.speeds)
-                and (a.mu_c, a.pin_radius, a.model, a.kernel, a.pin_halfwidth) == (b.mu_c, b.pin_radius, b.model,
-                                                                                  b.kernel, b.pin_halfwidth)
+                and (a.d_min, a.d_max) == (b.d_min, b.d_max)
                 and a.supports == b.supports == [None] and mine.family is theirs.family is None
-                and mine.verify == theirs.verify
-                and mine.mu_c == theirs.mu_c and (mine.pin_radius, mine.model, mine.step, mine.belt)
-                == (theirs.pin_radius, theirs.model, theirs.step, theirs.belt))
+                and (mine.mu_c, mine.pin_radius, mine.model, mine.step, mine.belt, mine.verify)
+                == (theirs.mu_c, theirs.pin_radius, theirs.model, theirs.step, theirs.belt, theirs.verify))
 
     @property
     def member_check(self) -> FamilyCheck | None:

@@ -115,8 +115,8 @@ class Level:
 
     def rows(self, lo: int, hi: int) -> "Level":
         """The sequences ``lo`` to ``hi`` of the level."""
-        return Level(*(None if x is None else x[lo:hi] for x in (self.seq, self.theta, self.y, self.margin)),
-                     None, *(None if x is None else x[lo:hi] for x in (self.unrolled, self.touched, self.dropped)))
+        return Level(self.seq[lo:hi], self.theta[lo:hi], self.y[lo:hi], self.margin[lo:hi], None,
+                     *(None if x is None else x[lo:hi] for x in (self.unrolled, self.touched, self.dropped)))
 
     @property
     def size(self) -> int:
@@ -281,26 +281,26 @@ class NominalTree:
         status, theta_f, dy, unrolled = self._columns(theta, y_pin - y_c, v_pin, stretch, span)
         seq = np.concatenate([np.repeat(level.seq, n_pins, axis=0),
                               np.tile(np.arange(n_pins, dtype=np.int16), n)[:, None]], axis=1)
-        keep, step_margin, touched = self._rules(status, y_pin - y_c, unrolled)
+        keep, step_margin, touched = self._rules(status, y_pin - y_c, None if unrolled is None
+                                                 else ~unrolled.any(axis=1))
         margin = np.minimum(np.repeat(level.margin, n_pins), step_margin)
         out = Level(seq[keep], theta_f[keep], (y_c + dy)[keep], margin[keep])
         if unrolled is not None:
             out.unrolled, out.touched = unrolled[keep], touched[keep]
         return out
 
-    def _rules(self, status, dy_pin, unrolled=None):
+    def _rules(self, status, dy_pin, whole=None):
         """The rules of the module's docstring on rollouts' ``status`` and pin
-        offsets ``dy_pin`` (mm; columns marked in ``unrolled`` were not
-        rolled out and read ``MISS``): ``(kept, step margin, touched)`` per
-        row. A row with columns not rolled out is kept unless a rolled
-        column breaks a rule (whether its last pin touches a state at all is
-        known once every column is)."""
+        offsets ``dy_pin`` (mm; a column not rolled out reads ``MISS``):
+        ``(kept, step margin, touched)`` per row. Whether a row's last pin
+        touches a state at all is known only for the rows ``whole`` marks
+        (every column rolled out; ``None``: all rows), so only they are
+        dropped for touching none."""
         touched = status != MISS
         d_abs = np.abs(dy_pin) / self.part.a
         bad = ((status == JAMMED) | (status == TRUNCATED)).any(axis=1)
         bad |= (touched & (np.abs(dy_pin) < self.pin_halfwidth)).any(axis=1)
-        complete = np.ones(status.shape[0], bool) if unrolled is None else ~unrolled.any(axis=1)
-        bad |= ~touched.any(axis=1) & complete
+        bad |= ~touched.any(axis=1) & (True if whole is None else whole)
         step_margin = np.where(touched, np.minimum(d_abs - self.d_min, self.d_max - d_abs), np.inf).min(axis=1)
         return ~bad, step_margin, touched.any(axis=1)
 
@@ -332,7 +332,7 @@ class NominalTree:
         theta_f, dy = theta.astype(float, copy=True), np.zeros(theta.shape)
         unrolled = None if span is None else np.zeros(theta.shape, bool)
         alive = np.arange(n)
-        order = np.argsort(-self._column_drops / np.maximum(self._column_tries, 1), kind="stable")
+        order = self._drop_order()
         for k, c in enumerate(order):
             if alive.size == 0:
                 break
@@ -353,6 +353,10 @@ class NominalTree:
                 alive = alive[~wide]
         return status, theta_f, dy, unrolled
 
+    def _drop_order(self) -> np.ndarray:
+        """The columns in the order of the share of candidates each has dropped so far."""
+        return np.argsort(-self._column_drops / np.maximum(self._column_tries, 1), kind="stable")
+
     def complete(self, level: Level, rows) -> None:
         """Roll out the columns of ``level``'s spread-out ``rows`` that were not
         (from the parent's pose they hold, with the sequence's last pin), in
@@ -372,8 +376,8 @@ class NominalTree:
         status = np.full((rows.size, level.theta.shape[1]), MISS, dtype=np.int8)
         offsets = np.zeros(status.shape)
         status[at, c], offsets[at, c] = st[0], dy_pin
-        # the rows' earlier columns touched or not: the no-touch rule is applied below, over all columns
-        keep, step_margin, touched = self._rules(status, offsets, unrolled=np.ones(status.shape, bool))
+        # only these columns are in ``status``: the no-touch rule is applied below, over all of them
+        keep, step_margin, touched = self._rules(status, offsets, whole=np.zeros(rows.size, bool))
         level.theta[r, c], level.y[r, c] = tf[0], level.y[r, c] + d[0]
         level.margin[rows] = np.minimum(level.margin[rows], step_margin)
         level.touched[rows] |= touched
