@@ -138,3 +138,28 @@ def test_a_stopped_roll_out_ranks_the_sequences_rolled_out_in_full_and_says_so()
     exact = np.flatnonzero(~before)
     assert rows.size == min(4, exact.size)
     assert fewest_sets(lazy, TOLERANCE, order, 0, tree.complete)[0].size == 0
+
+
+def test_the_deepest_level_is_the_same_in_any_chunks(monkeypatch):
+    """Which sequences stop depends on the order of the states, fixed for the
+    whole deepest level, so the chunks a time limit cuts it into change no
+    row."""
+    from pipeline.planning.tight import enumerate as enumerate_module
+    from pipeline.progress import Deadline
+    part = PARTS["t_bracket"]()
+    pins = _pins(part, 9)
+    span = (LIMIT, part.symmetry_order())
+
+    def deepest(deadline=None):
+        tree = NominalTree(part, pins, 0.2, 3.0)
+        two = tree.extend(tree.extend(tree.root()))
+        tree._column_tries[:], tree._column_drops[:] = 0, 0  # no drops yet: the first chunk will reorder them
+        return tree.extend(two, span=span) if deadline is None else tree.extend(two, deadline=deadline, span=span)
+
+    want = deepest()
+    monkeypatch.setattr(enumerate_module, "FIRST_PARENTS", 2)  # chunks of 2 parents, then at most 16
+    monkeypatch.setattr(enumerate_module, "BATCH_SECONDS", 1e-9)  # ... each as small as the pace allows
+    got = deepest(Deadline(3600.0))
+    assert got.cut is None
+    for k in ("seq", "theta", "y", "margin", "unrolled"):
+        np.testing.assert_array_equal(getattr(got, k), getattr(want, k))

@@ -229,7 +229,10 @@ class NominalTree:
         not end before the search is over (:func:`finishes_in_time`): the
         level returned is then ``cut``. (An outcome depends on its rounded pose only, so the
         sequences enumerated are the same in any chunks.) ``span``: as for
-        :meth:`levels`, for this level."""
+        :meth:`levels`, for this level; its columns then go in one order for
+        the whole level (see :meth:`_columns`)."""
+        if span is not None:
+            span = (*span[:2], self._drop_order())
         per_parent = max(1, self.heights.size * level.theta.shape[1])
         step = max(1, MAX_PAIRS // per_parent)
         if deadline.limited:
@@ -315,14 +318,16 @@ class NominalTree:
         columns go in the order of the share of candidates each dropped so far
         (any order gives the same survivors).
 
-        With ``span`` (``(limit_deg, order)``), a candidate whose columns
-        rolled out so far span more than the limit stops too: its other
-        columns keep the pose they started from, read ``MISS`` and are marked
-        in the fourth array returned (``unrolled``; ``None`` without
+        With ``span`` (``(limit_deg, order, columns)``), a candidate whose
+        columns rolled out so far span more than the limit stops too: its
+        other columns keep the pose they started from, read ``MISS`` and are
+        marked in the fourth array returned (``unrolled``; ``None`` without
         ``span``). Which candidates stop (and so the level's count of
-        sequences) then depends on the order of the columns, which follows
-        what the tree rolled out before; the candidates within the limit and
-        the evidence do not (any order). The drop order pays twice here: a
+        sequences) then depends on the order of the columns, so the columns
+        go in the one order ``columns`` for every chunk of the level (the drop
+        order when the level began: how a time limit chunks the level then
+        changes nothing; what the tree rolled out before may); the
+        candidates within the limit and the evidence do not depend on it. The drop order pays twice here: a
         candidate dropped is not rolled out again for the evidence, and the
         columns that tell candidates apart come first (the heart cam's
         evidence rolled out 64,512 stopped sequences with it, 326,656 in the
@@ -332,7 +337,7 @@ class NominalTree:
         theta_f, dy = theta.astype(float, copy=True), np.zeros(theta.shape)
         unrolled = None if span is None else np.zeros(theta.shape, bool)
         alive = np.arange(n)
-        order = self._drop_order()
+        order = self._drop_order() if span is None else span[2]
         for k, c in enumerate(order):
             if alive.size == 0:
                 break
