@@ -178,8 +178,33 @@ def pin_step(part, pin_y, v_pin, theta, y_c, mu, pin_radius, model, kw, support,
         of ``simulate.rollout_points``'s results.
     """
     d = contact_parameter(pin_y, y_c, part.a)
-    return rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model if "belt_speed" not in kw else "dynamic",
-                             kw, support, supports, stretch)
+    model = model if "belt_speed" not in kw else "dynamic"
+    theta, d, mu, v_pin = np.broadcast_arrays(*(np.asarray(x, float) for x in (theta, d, mu, v_pin)))
+    first, inverse = distinct_rows(theta, d, mu, v_pin, support)
+    if first is None:
+        return rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw, support, supports, stretch)
+    # Rows that meet the pin in the same state (the corners of a perturbation
+    # box share their first pins' offsets) are rolled out once.
+    res = rollouts_by_speed(part, theta[first], d[first], mu[first], v_pin[first], pin_radius, model, kw,
+                            None if support is None else np.asarray(support)[first], supports, stretch)
+    return {key: arr[inverse] for key, arr in res.items()}
+
+
+def distinct_rows(theta, d, mu, v_pin, support) -> tuple:
+    """The rows whose rollout inputs (orientation, contact parameter, friction,
+    pin speed, support) differ, bit for bit: ``(first, inverse)``, the first
+    row of each distinct input and each row's index among them, or
+    ``(None, None)`` when every row is distinct. A rollout depends on its
+    inputs only, so one rollout per distinct input gives every row's result."""
+    theta = np.asarray(theta, float)
+    n = theta.size
+    columns = [theta, d, mu, v_pin, np.zeros(n) if support is None else support]
+    key = np.column_stack([np.broadcast_to(np.asarray(c, float), (n,)) for c in columns])
+    _, first, inverse = np.unique(np.ascontiguousarray(key).view(np.int64), axis=0, return_index=True,
+                                  return_inverse=True)
+    if first.size == n:
+        return None, None
+    return first, inverse.ravel()
 
 
 def replay_shared(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
