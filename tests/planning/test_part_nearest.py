@@ -159,6 +159,39 @@ def test_a_search_cut_by_its_time_limit_still_answers_from_the_kept_plans(no_pla
     assert not axis["found"] and "was not run" in axis["statement"]
 
 
+class _NoTimeLeft(_SearchCut):
+    """:class:`_SearchCut` whose time runs out (``over``) once ``expired`` is set."""
+    expired = False
+
+    def over(self) -> bool:
+        return self.expired
+
+
+def test_with_no_time_left_the_nearest_yes_still_gives_the_axes_that_need_no_rollout(no_plan, monkeypatch):
+    """The limit has passed when the nearest "yes" begins: its sensor and
+    moving-pin axes (read from the search, no rollout) answer as with time
+    left, the tolerance axis replays nothing and says so, and ``unsearched``
+    names what was left out."""
+    from pipeline.planning.plans import plan as plan_module
+    _, settings_ = no_plan
+    with_time = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=3)).to_dict()
+    deadline, original = _NoTimeLeft(reads=3), plan_module._with_certificate_or_nearest_yes
+
+    def expire(*args, **kwargs):
+        deadline.expired = True
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(plan_module, "_with_certificate_or_nearest_yes", expire)
+    cut = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=deadline).to_dict()
+    assert deadline.expired and [p["pins"] for p in cut["plans"]] == [p["pins"] for p in with_time["plans"]]
+    axes = {a["axis"]: a for a in cut["nearest_yes"]["axes"]}
+    before = {a["axis"]: a for a in with_time["nearest_yes"]["axes"]}
+    assert axes["sensor"] == before["sensor"] and axes["moving pins"] == before["moving pins"]
+    assert axes["tolerance"]["replayed"] == 0 and "no time was left" in axes["tolerance"]["statement"]
+    assert cut["nearest_yes"]["plans_tried"] == []
+    assert any(u.startswith('the nearest "yes": only the axes that need no rollout') for u in cut["unsearched"])
+
+
 def test_moving_pins_the_limit_came_before_are_named_so(no_plan):
     """With moving pins configured, a limit that ends the search before them
     says so on the moving-pin axis (never "no pin speeds given")."""

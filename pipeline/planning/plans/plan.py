@@ -22,9 +22,10 @@ are carried and verified one by one while the limit lasts, and the moving
 pins and the untruncated replay are skipped when there is no time left for
 them; the nearest "yes" runs its searches under the same limit, and after
 a cut search, or when the limit cuts its own searches, answers from the
-kept plans' held-out replays only, and says so; the family certificate (a
-search of its own) is
-skipped under a limit. The entry then says so (``time_limit_s``,
+kept plans' held-out replays only, and says so (with no time left at all,
+only its axes that need no rollout answer: a sensor after the recommended
+plan, what the moving-pin stage found); the family certificate (a search
+of its own) is skipped under a limit. The entry then says so (``time_limit_s``,
 ``complete``, ``unsearched``).
 
 With ``planner.belt_speed`` (mm/s) set, the planner plans with the dynamic
@@ -149,9 +150,9 @@ def _with_certificate_or_nearest_yes(entry: TightEntry, part: Part, settings: Pl
     if entry.orients or not search.kept:
         return entry
     kept = [(p.pins, p.pin_heights_mm, p.pin_speeds or ()) for p in search.kept]
-    if deadline.over():
-        unsearched.append('the nearest "yes": skipped (no time left)')
-        return entry
+    # With no time left the axes that need no rollout (a sensor after the recommended plan, what
+    # the moving-pin stage found) still answer; the kept plans are then not replayed.
+    over = deadline.over()
     # After a cut search the kept plans' held-out replays still answer "which tolerance would
     # do"; only the searches at looser tolerances (the answer when no kept plan does) are left out.
     cut = deadline.search_over() or not search.fixed.complete
@@ -160,7 +161,10 @@ def _with_certificate_or_nearest_yes(entry: TightEntry, part: Part, settings: Pl
                                None if cut else dict(entry.pins_used), progress, deadline, moving_cut,
                                search.rollouts)
     tolerance = next(a for a in nearest["axes"] if a["axis"] == "tolerance")
-    if tolerance["kept_plans_only"]:
+    if over:
+        unsearched.append('the nearest "yes": only the axes that need no rollout (no time was left to replay '
+                          'the kept plans or search at looser tolerances)')
+    elif tolerance["kept_plans_only"]:
         how = "cut by the time limit" if tolerance["searches_cut"] else "not run"
         unsearched.append(f'the nearest "yes": kept plans only ({tolerance["replayed"]} of {len(kept)} '
                           f'replayed; the complete searches at looser tolerances {how})')
