@@ -5,7 +5,7 @@ the run of 2026-11-28) gives, per part, the recommended plan, its verdict
 (width and the held-out trials in one set) and the sequences per level. Its
 times are measurements; its plans are not: they must be the plans
 ``benchmarks/plan_record.py record --benchmark-parts also`` recorded
-(``benchmarks/records/plans_spread_out.json.gz``, the same settings as
+(``benchmarks/records/plans_corner_sharing.json.gz``, the same settings as
 ``benchmarks/plan_speed.py``). A plan, width or count typed into the table
 that the record does not hold fails here. So does an answer or a nearest
 "yes" of the corpus table ("Real parts planned under a time limit") that
@@ -23,7 +23,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "performance" / "index.md"
-RECORD = ROOT / "benchmarks" / "records" / "plans_spread_out.json.gz"
+RECORD = ROOT / "benchmarks" / "records" / "plans_corner_sharing.json.gz"
 HEADING = "### Planning time of new parts"
 
 
