@@ -67,8 +67,8 @@ def test_corners_share_their_first_pins_and_give_each_trial_its_own_numbers(name
                     "minpower") for i in range(th.size)]
     for k, name_ in enumerate(("theta_f", "y_c", "jam", "missed")):
         assert np.array_equal(shared[k], np.concatenate([a[k] for a in alone])), name_
-    # Before pin k + 1 the corners differ in start (theta, y_c, friction: 8)
-    # and the first k offsets: at most 8 * 2**(k + 1) distinct per state.
+    # The inputs at pin k + 1 differ in the start (theta, y_c, friction: 8)
+    # and the first k + 1 offsets: at most 8 * 2**(k + 1) distinct per state.
     states = len(resting_states(part))
     assert rolled <= states * sum(8 * 2 ** (k + 1) for k in range(n_pins)) < th.size * n_pins
 

@@ -159,7 +159,9 @@ def kernel_kw(ds_max, tol, belt_speed, mu_s) -> dict:
 
 def pin_step(part, pin_y, v_pin, theta, y_c, mu, pin_radius, model, kw, support, supports, stretch) -> dict:
     """One pin (placed at ``pin_y`` mm, speed ``v_pin``) for every row: the
-    rollouts' results (``rollouts_by_speed``).
+    rollouts' results (``rollouts_by_speed``). Rows whose rollout inputs are
+    the same, bit for bit (:func:`distinct_rows`), are rolled out once and
+    share the result, so ``stretch`` hears the share of distinct rows done.
 
     Parameters
     ----------

@@ -138,8 +138,9 @@ def _with_certificate_or_nearest_yes(entry: TightEntry, part: Part, settings: Pl
     nearest "yes"; without one, when nothing orients, the nearest "yes" of
     the best kept candidates (unless a time limit or an incomplete fixed
     search rules it out: then only the kept plans are replayed, without
-    searches at looser tolerances). What is skipped or cut short joins
-    ``unsearched``."""
+    searches at looser tolerances; with no time left, none is replayed and
+    only the axes that need no rollout answer). What is skipped or cut short
+    joins ``unsearched``."""
     if family is not None:
         entry = replace(entry, support_family=family.to_dict())
         if deadline.limited:  # the certificate and the nearest "yes" are searches of their own
