@@ -182,14 +182,13 @@ def pin_step(part, pin_y, v_pin, theta, y_c, mu, pin_radius, model, kw, support,
     d = contact_parameter(pin_y, y_c, part.a)
     model = model if "belt_speed" not in kw else "dynamic"
     theta, d, mu, v_pin = np.broadcast_arrays(*(np.asarray(x, float) for x in (theta, d, mu, v_pin)))
-    first, inverse = distinct_rows(theta, d, mu, v_pin, support)
-    if first is None:
-        return rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw, support, supports, stretch)
     # Rows that meet the pin in the same state (the corners of a perturbation
     # box share their first pins' offsets) are rolled out once.
-    res = rollouts_by_speed(part, theta[first], d[first], mu[first], v_pin[first], pin_radius, model, kw,
-                            None if support is None else np.asarray(support)[first], supports, stretch)
-    return {key: arr[inverse] for key, arr in res.items()}
+    first, inverse = distinct_rows(theta, d, mu, v_pin, support)
+    rows = slice(None) if first is None else first
+    res = rollouts_by_speed(part, theta[rows], d[rows], mu[rows], v_pin[rows], pin_radius, model, kw,
+                            None if support is None else np.asarray(support)[rows], supports, stretch)
+    return res if inverse is None else {key: arr[inverse] for key, arr in res.items()}
 
 
 def distinct_rows(theta, d, mu, v_pin, support) -> tuple:
