@@ -33,7 +33,7 @@ it), so a wing can change inside without touching its callers.
 
 Each name is imported from its wing when it is first asked for (PEP 562),
 so a caller that needs the arcs does not pay for the planner, its Numba
-kernels and scipy.stats; ``_WHERE`` says where each name lives.
+kernels and scipy; ``_WHERE`` says where each name lives.
 
 Wings import downwards only (core < claims < tight < family < plans <
 feeder, and design beside feeder, on plans; paper uses the core alone). The package imports maps, parts, ``config`` and the

@@ -91,6 +91,16 @@ def test_a_part_without_a_plan_gets_its_nearest_yes(no_plan):
     assert lines[0].startswith("the nearest \"yes\"") and any(f"{tol['value']:g} deg" in x for x in lines)
 
 
+def test_the_answer_is_its_plans_own_tolerance(no_plan):
+    """The searched answer is the narrowest tolerance its plan's held-out
+    trials allow: replayed afresh as a kept plan, it answers the same."""
+    result, settings_ = no_plan
+    tol = next(a for a in result["nearest_yes"]["axes"] if a["axis"] == "tolerance")
+    fresh = part_tolerance_axis(TRAPEZOID, settings_.at(0.2), [(tol["plan"], tol["pin_heights_mm"], ())])
+    searched = {k: v for k, v in tol["verdict"].items() if k != "width_interval_deg"}  # kept plans give none
+    assert fresh["value"] == tol["value"] and fresh["verdict"] == searched
+
+
 def test_half_a_degree_tighter_the_complete_search_finds_no_plan(no_plan):
     import dataclasses
     from pipeline.planning.tight.complete import FixedPinSearch
@@ -275,8 +285,9 @@ def test_searches_that_reuse_rollouts_find_what_they_find_alone(no_plan):
 
 def test_a_bisection_the_limit_cuts_keeps_its_certified_bound(no_plan, monkeypatch):
     """When the limit cuts the bisection after its first search (at the widest
-    tolerance) found a plan, the answer is that plan's tolerance, said to be
-    an upper bound, not nothing."""
+    tolerance) found a plan, the answer is that plan's own tolerance (the
+    narrowest its held-out trials allow: the same as replaying it afresh as a
+    kept plan), said to be an upper bound, not nothing."""
     from pipeline.planning.tight import complete
     full, settings_ = no_plan
     real_run, calls = complete.FixedPinSearch.run, []
@@ -291,8 +302,12 @@ def test_a_bisection_the_limit_cuts_keeps_its_certified_bound(no_plan, monkeypat
     monkeypatch.setattr(complete.FixedPinSearch, "run", run)
     axis = part_tolerance_axis(TRAPEZOID, settings_.at(0.2), [], dict(full["pins_used"]), 2)
     assert calls[0] == MAX_TOLERANCE and len(calls) == 2
-    assert axis["found"] and axis["value"] == MAX_TOLERANCE and axis["searches_cut"]
-    assert not axis["kept_plans_only"] and "at most 45 deg" in axis["statement"]
+    monkeypatch.setattr(complete.FixedPinSearch, "run", real_run)
+    fresh = part_tolerance_axis(TRAPEZOID, settings_.at(0.2), [(axis["plan"], axis["pin_heights_mm"], ())])
+    assert fresh["found"] and fresh["kept_plans_only"]
+    assert axis["found"] and axis["value"] == fresh["value"] < MAX_TOLERANCE and axis["searches_cut"]
+    assert {k: v for k, v in axis["verdict"].items() if k != "width_interval_deg"} == fresh["verdict"]
+    assert not axis["kept_plans_only"] and f"at most {axis['value']:g} deg" in axis["statement"]
     assert "upper bound" in axis["statement"] and axis["verdict"]["orients"]
 
 

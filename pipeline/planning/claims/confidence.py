@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.stats import beta
+from scipy.special import betaincinv  # beta.ppf's own function, without scipy.stats' import time
 
 from pipeline.config import schema_default
 from pipeline.errors import PinfeedError
@@ -55,7 +55,7 @@ def share_lower_bound(k, n, confidence: float = DEFAULT_CONFIDENCE) -> float:
     c = check_confidence(confidence)
     if k == 0:
         return 0.0
-    return float(beta.ppf(1.0 - c, k, n - k + 1))
+    return float(betaincinv(k, n - k + 1, 1.0 - c))
 
 
 def share_upper_bound(k, n, confidence: float = DEFAULT_CONFIDENCE) -> float:
@@ -65,7 +65,7 @@ def share_upper_bound(k, n, confidence: float = DEFAULT_CONFIDENCE) -> float:
     c = check_confidence(confidence)
     if k == n:
         return 1.0
-    return float(beta.ppf(c, k + 1, n - k))
+    return float(betaincinv(k + 1, n - k, c))
 
 
 def narrowest_width(theta, k: int, period: float) -> float:

@@ -13,7 +13,9 @@ fits the tolerance, the engineer asks what would. For one part the axes are:
   that tolerance is the claim's own judgement of the same finals. When no
   kept plan gets there (they end in several sets far apart), the complete
   fixed-pin search runs again at looser tolerances, by bisection, and its
-  plan (certified on held-out trials) is the answer;
+  plan (certified on held-out trials) is the answer, at the narrowest
+  tolerance its held-out trials allow (which may be tighter than the
+  tolerance of the search that found it);
 * **moving pins**: what the search's moving-pin stage found (it runs when
   pin speeds are configured and fixed pins do not orient the part);
 * **a sensor**: when the recommended plan ends in a few sets within the
@@ -27,6 +29,7 @@ plan with fewer pins, which this does not look for.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -70,7 +73,9 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
 
     Exact bisection: on the same trials, a sequence that orients within ``t``
     orients within any looser tolerance, and its nominal finals pass the
-    looser filter too, so "some plan orients" is monotone in ``t``.
+    looser filter too, so "some plan orients" is monotone in ``t``. A plan
+    found answers at its own tolerance (:func:`_own_tolerance`), where the
+    upper end moves: never looser than the plain bisection's answer.
 
     The searches reuse the rollouts of ``reuse`` (the planner's own
     fixed-pin search, say) when it shares them
@@ -84,8 +89,6 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
     later one ends the bisection with the loosest tolerance it certified, an
     upper bound (``exact`` False). Its searches keep no evidence (only their
     plans are read)."""
-    import dataclasses
-
     from pipeline.planning.tight.complete import FixedPinSearch
 
     donor = reuse  # whose rollouts serve the searches (tolerance changes no outcome)
@@ -102,24 +105,44 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
         result = search.run(depth, candidates=candidates, keep=1, progress=_at(progress, t), deadline=deadline)
         if not result.complete:
             raise OutOfTime(f"the search at {t:g} deg was not finished")
-        return result.plans[0] if result.plans else None
+        return _own_tolerance(result.plans[0], search.bench, settings.claims) if result.plans else None
 
     lo = math.floor(settings.claims.tolerance_deg / LADDER) * LADDER  # does not orient (the question)
-    hi = MAX_TOLERANCE
-    best = found(hi)
-    if best is None:
+    first = found(MAX_TOLERANCE)
+    if first is None:
         return None
+    hi, best = first
     while hi - lo > LADDER + 1e-9:
         mid = math.floor((lo + hi) / 2 / LADDER) * LADDER
         try:
-            plan = found(mid)
+            got = found(mid)
         except OutOfTime:
             return hi, best, False  # certified at hi; tighter ones not decided
-        if plan is None:
+        if got is None:
             lo = mid
         else:
-            hi, best = mid, plan
+            hi, best = got
     return hi, best, True
+
+
+def _own_tolerance(plan, bench: TrialBench, claims) -> tuple:
+    """``(tolerance, plan)``: the smallest tolerance on the ``LADDER`` at which
+    ``plan``, certified by a search on ``bench``, orients the part on its
+    held-out trials (:func:`loosest_needed`; never looser than the search's),
+    and the plan with its held-out verdict at that tolerance. The
+    certification replayed those trials, so the bench has their states and
+    this rolls out nothing."""
+    rows = bench.held_out(len(plan.heights))
+    speeds = plan.speeds or (0.0,) * len(plan.heights)
+    tf, jam = bench.replay(np.atleast_2d(np.asarray(plan.heights, float)), np.atleast_2d(np.asarray(speeds, float)),
+                           rows)
+    searched = float(plan.verdict["tolerance_deg"])
+    tol = loosest_needed(tf[0], jam[0], rows[0].size, bench.order, claims.required, claims.confidence, claims.rule)
+    if tol is None or tol >= searched:
+        return searched, plan
+    verdict = orient.judge(tf[0][~jam[0]], rows[0].size, tol, bench.order, claims.required, claims.confidence,
+                           interval=True, rule=claims.rule)
+    return tol, dataclasses.replace(plan, verdict=verdict)
 
 
 def _at(progress, tolerance):
