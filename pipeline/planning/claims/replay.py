@@ -53,6 +53,8 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     missed = np.zeros((n, n_pins), bool)
     alive = np.ones(n, bool)
     kw = kernel_kw(ds_max, tol, belt_speed, mu_s)
+    if memo is not None and not memo.serves(part, pin_radius, model, kw, supports):
+        memo = None  # kept for other rollout settings: its states are not this replay's
     if memo is not None:
         trial, node = memo.trial_ids(theta, y_c, mu, offsets, support), np.zeros(n, dtype=np.int64)
     for k in range(n_pins):
@@ -71,10 +73,8 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
                             pin_radius, model, kw, None if support is None else support[idx], supports,
                             stretch.part(k / n_pins, (k + 1) / n_pins))
             st = res["status"]
-            stuck = (st == JAMMED) | (st == TRUNCATED)
-            for j in np.flatnonzero(stuck):
-                jam[idx[j]] = f"jammed ({JAM_REASONS[res['jam_reason'][j]] or 'truncated'})"
-            alive[idx[stuck]] = False
+            jam[idx] = jam_reasons(res)
+            alive[idx[(st == JAMMED) | (st == TRUNCATED)]] = False
             missed[idx, k] = st == MISS
             theta[idx] = res["theta_f"]
             y_c[idx] = y_c[idx] + res["dy"]
@@ -85,22 +85,55 @@ def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_rad
     return theta % 360.0, y_c, jam, missed
 
 
+def jam_reasons(res: dict) -> np.ndarray:
+    """Why each rollout of ``res`` (``simulate.rollout_points``'s results)
+    stopped its trial: ``jammed (REASON)`` (``jammed (truncated)`` for a
+    rollout out of steps or travel), ``""`` when it did not."""
+    st = res["status"]
+    out = np.full(st.size, "", dtype=object)
+    for j in np.flatnonzero((st == JAMMED) | (st == TRUNCATED)):
+        out[j] = f"jammed ({JAM_REASONS[res['jam_reason'][j]] or 'truncated'})"
+    return out
+
+
 class ReplayMemo:
-    """Each trial's state after a prefix of pins, for :func:`replay` calls with
-    one part and one set of rollout settings (the chosen plans verified on
-    the same held-out trials share their first pins): ``(theta, y_c, jam
-    reason, missed the last pin)`` by (prefix, trial), up to ``max_kept``
-    states. A prefix is numbered from the empty one (0) by (prefix, pin
-    height, pin speed); a trial by its values (start, friction, pin offsets,
-    support). A state depends on the prefix and the trial only, and each
-    rollout on its own inputs only, so a replay with a memo gives the
-    numbers it gives without."""
+    """Each trial's state after a prefix of pins, for replays with one part
+    and one set of rollout settings: ``(theta, y_c, jam reason, missed the
+    last pin)`` by (prefix, trial), up to ``max_kept`` states. The searches'
+    trial benches (``tight.judge.TrialBench``) keep theirs in one, and the
+    final verification and the nearest "yes" read it: the held-out trials
+    that certified a plan are not rolled out again.
+
+    A prefix is numbered from the empty one (0) by (prefix, pin height, pin
+    speed); a trial by its values (start, friction, pin offsets, support). A
+    state depends on the prefix, the trial and the rollout settings only,
+    and each rollout on its own inputs only, so a replay with a memo gives
+    the numbers it gives without. The memo serves the part and rollout
+    settings of its first replay alone (:meth:`serves`)."""
 
     def __init__(self, max_kept: int = 1_000_000):
         self.max_kept = int(max_kept)
         self.prefixes, self.trials, self.at, self.reasons = {}, {}, {}, {"": 0}
         self.theta, self.y_c = np.zeros(256), np.zeros(256)
         self.reason, self.missed = np.zeros(256, dtype=np.int32), np.zeros(256, bool)
+        self.rollout = None  # (part, supports, settings) of the first replay
+
+    def serves(self, part: Part, pin_radius, model, kw: dict, supports) -> bool:
+        """Whether replays of ``part`` with these rollout settings (pin radius,
+        model, :func:`kernel_kw`, the supports ``support`` indexes) may use
+        the memo: those of its first replay (the part and each support the
+        same objects), which this call records when it is the first."""
+        model = "dynamic" if "belt_speed" in kw else str(model)
+        settings = (float(pin_radius), model, tuple(sorted((k, v if v is None else float(v)) for k, v in kw.items())))
+        supports = None if supports is None else tuple(supports)
+        if self.rollout is None:
+            self.rollout = (part, supports, settings)
+            return True
+        kept_part, kept_supports, kept_settings = self.rollout
+        same_supports = (kept_supports is None and supports is None) or (
+            kept_supports is not None and supports is not None and len(kept_supports) == len(supports)
+            and all(a is b for a, b in zip(kept_supports, supports)))
+        return kept_part is part and kept_settings == settings and same_supports
 
     def trial_ids(self, theta, y_c, mu, offsets, support) -> np.ndarray:
         """The number of each trial (by its values)."""

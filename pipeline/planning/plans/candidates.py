@@ -21,12 +21,14 @@ MOVING_NOT_REACHED = "moving pins: not reached"  # how a time limit that came fi
 
 def add_moving_pins(part: Part, settings: PlannerSettings, planner, fixed: FixedSearch, chosen, keep, progress,
                      family, checker, deadline: Deadline, candidates: list, selections: list,
-                     unsearched: list) -> tuple:
+                     unsearched: list, memo: ReplayMemo | None = None) -> tuple:
     """When fixed pins neither orient the part nor are unneeded: the moving
     pins' search after the ``chosen`` fixed-pin results (if the settings
     allow moving pins and the search time lasts; else ``unsearched`` says
     so). Its plans' carried sets join ``candidates`` and their selection
-    verdicts ``selections``; what it left out joins ``unsearched``.
+    verdicts ``selections``; what it left out joins ``unsearched``. Its
+    trials' states join ``memo`` (the fixed-pin search's, whose states after
+    the fixed prefixes it reads).
 
     Returns
     -------
@@ -42,7 +44,8 @@ def add_moving_pins(part: Part, settings: PlannerSettings, planner, fixed: Fixed
         unsearched.append(f"{MOVING_NOT_REACHED} (up to {settings.search.dynamic_depth} moving pin(s) after "
                           f"no fixed pin and after the {MOVING_PREFIXES} best fixed-pin results)")
         return planner, None
-    moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker, deadline)
+    moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker, deadline,
+                                   memo)
     unsearched += moving_search.unsearched
     carried = carried_sets(moving, moving_search.plans, settings.verify, family, progress, deadline, unsearched)
     candidates += carried
@@ -82,7 +85,7 @@ def _moving_planner(part, settings: PlannerSettings, planner):
 
 
 def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progress, family=None,
-                   checker=None, deadline: Deadline = NO_DEADLINE) -> FixedSearch:
+                   checker=None, deadline: Deadline = NO_DEADLINE, memo: ReplayMemo | None = None) -> FixedSearch:
     """Up to ``search.dynamic_depth`` moving pins after no fixed pin and after
     each of the ``MOVING_PREFIXES`` best fixed-pin results, by the same
     enumeration, screen and judgement as the fixed pins; the orienting plans,
@@ -98,6 +101,8 @@ def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progre
     if progress:
         progress(f"mu_c {settings.friction.label}: fixed pins do not orient the part: adding moving pins")
     search = _pin_search(part, settings, moving, moving=True, family=family, checker=checker)
+    if memo is not None:
+        search.bench.kept = memo
     depth = settings.search.dynamic_depth
     total = FixedSearch([], [], depth, settings.claims.tolerance_deg, settings.claims.required,
                         time_limit=deadline.seconds)

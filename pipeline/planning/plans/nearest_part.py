@@ -152,12 +152,16 @@ def _at(progress, tolerance):
     return lambda line: progress(f"nearest yes, tolerance {tolerance:g} deg: {line}")
 
 
-def _kept_tolerance(part, settings, plans, deadline: Deadline) -> tuple:
+def _kept_tolerance(part, settings, plans, deadline: Deadline, reuse=None) -> tuple:
     """``(best, replayed)``: the kept ``plans`` replayed on held-out trials
     while ``deadline`` lasts; ``best`` is ``(tolerance, labels, heights,
     speeds, verdict)`` of the one with the smallest tolerance (None if none
-    orients within ``MAX_TOLERANCE``), ``replayed`` how many were replayed."""
+    orients within ``MAX_TOLERANCE``), ``replayed`` how many were replayed.
+    The replays read the trial states of ``reuse`` (the planner's search,
+    whose memo the final verification filled with these replays)."""
     bench = TrialBench(part, settings.friction, settings.claims, settings.verify, settings.search)
+    if reuse is not None:
+        bench.kept = reuse.bench.kept
     claims = settings.claims
     best, tried = None, 0
     for labels, heights, speeds in plans:
@@ -192,7 +196,7 @@ def part_tolerance_axis(part, settings, plans, pins: dict | None = None, depth: 
     ``reuse``: a search whose rollouts the searches may share
     (:func:`searched_tolerance`)."""
     claims = settings.claims
-    best, tried = _kept_tolerance(part, settings, plans, deadline)
+    best, tried = _kept_tolerance(part, settings, plans, deadline, reuse)
     cut = tried < len(plans)  # the limit passed before every kept plan was replayed
     searches_cut, bound = False, False
     if best is None and pins is not None and not cut:

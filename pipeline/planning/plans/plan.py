@@ -98,9 +98,11 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     candidates = carried_sets(planner, chosen, settings.verify, family, progress, deadline, unsearched)
     selections = [p.selection or p.verdict for p in chosen[:len(candidates)]]
     planner, moving_search = add_moving_pins(part, settings, planner, fixed, chosen, keep, progress, family,
-                                              checker, deadline, candidates, selections, unsearched)
+                                              checker, deadline, candidates, selections, unsearched,
+                                              rollouts.bench.kept)
     states = resting_states(part)
-    _verify_candidates(part, settings, planner, candidates, states, progress, family, selections)
+    _verify_candidates(part, settings, planner, candidates, states, progress, family, selections,
+                       rollouts.bench.kept)
     judge_for_family(candidates, checker)
     candidates = robust_order(candidates, _rank, lambda p: p.verification["orientation"].get("width_deg"),
                               lambda p: p.margin, settings.search.width_slack_deg)
@@ -189,16 +191,18 @@ def _acceptable(plan) -> bool:
 
 
 def _verify_candidates(part: Part, settings: PlannerSettings, planner, candidates, states, progress,
-                       family=None, selections=None) -> None:
+                       family=None, selections=None, memo: ReplayMemo | None = None) -> None:
     """Replay each candidate by perturbed full rollouts on the held-out trials
     (``verify_plan`` with ``VerifySettings.held_out``) and attach the summary as
     ``plan.verification``, with the orientation verdict (``orient.judge``: one
     set within the tolerance, with confidence?) as ``orientation`` and the
     verdict on the trials that chose it (``selections``, in order) as
     ``selection``. The candidates' replays share the states after their
-    common first pins (``verify.ReplayMemo``: same numbers, fewer rollouts)."""
+    common first pins (a :class:`ReplayMemo`: same numbers, fewer rollouts);
+    ``memo``, the searches' own, also has the held-out trials that certified
+    their plans."""
     held_out = settings.verify.held_out()
-    memo = ReplayMemo()
+    memo = ReplayMemo() if memo is None else memo
     claims, search = settings.claims, settings.search
     selections = list(selections or []) + [None] * len(candidates)
     speeds = {label: pin.v_pin for label, pin in planner.pins.items() if pin.v_pin}

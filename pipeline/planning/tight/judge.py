@@ -25,11 +25,11 @@ from typing import Protocol
 
 import numpy as np
 
-from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAMMED, TRUNCATED
+from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, MISS
 
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
-from pipeline.planning.claims.replay import kernel_kw, pin_step
+from pipeline.planning.claims.replay import ReplayMemo, jam_reasons, kernel_kw, pin_step
 from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
@@ -79,7 +79,7 @@ class TrialBench:
         self.states = resting_states(part)
         self.family = None if family is None or family.is_uniform else family
         self.supports = None if self.family is None else self.family.kernel_supports
-        self.kept = PrefixStates()
+        self.kept = ReplayMemo(MAX_KEPT)  # states after each prefix (shared, see ReplayMemo)
 
     @property
     def belt(self) -> dict:
@@ -119,9 +119,12 @@ class TrialBench:
         sequences ``heights``, ``speeds`` on ``rows`` (``stretch`` is told how
         far the replay has got), as ``replay.replay_shared`` gives them:
         sequences that share their first pins share those rollouts, and so do
-        the calls of this bench (:class:`PrefixStates`: the probe, the screen,
-        the cascade and the full judgement replay subsets of one level's
-        trials, in blocks whose sequences share prefixes with earlier blocks).
+        the calls of this bench and of the replays that share its ``kept``
+        (a :class:`~pipeline.planning.claims.replay.ReplayMemo`): the probe,
+        the screen, the cascade and the full judgement replay subsets of one
+        level's trials, in blocks whose sequences share prefixes with earlier
+        blocks, and the final verification replays the held-out trials that
+        certified a plan.
         A trial's state after a prefix depends on the trial and the prefix
         only, and each rollout is independent of its batch, so the numbers are
         those of one ``replay_shared`` call."""
@@ -129,9 +132,9 @@ class TrialBench:
         heights, speeds = np.atleast_2d(np.asarray(heights, float)), np.atleast_2d(np.asarray(speeds, float))
         n_plans, n_pins = heights.shape
         n = np.size(th0)
-        kept = self.kept
-        trial = kept.trial_ids(rows)
         kw = kernel_kw(self.step.ds_max, self.step.tol, self.belt_speed, self.mu_s)
+        kept = self.kept if self.kept.serves(self.part, self.pin_radius, self.model, kw, self.supports) else None
+        trial = None if kept is None else kept.trial_ids(th0, yc0, mu, offsets, sup)
         node, key = np.zeros(n_plans, int), np.zeros(1, dtype=np.int64)  # distinct prefixes; their keys
         th, yc = np.asarray(th0, float)[None, :].copy(), np.asarray(yc0, float)[None, :].copy()
         jam = np.zeros((1, n), bool)
@@ -141,13 +144,14 @@ class TrialBench:
             node = node.ravel()
             parent = nodes[:, 0].astype(int)
             th, yc, jam = th[parent], yc[parent], jam[parent]
-            key = np.array([kept.node(key[p], h, v) for p, h, v in zip(parent.tolist(), nodes[:, 1].tolist(),
-                                                                           nodes[:, 2].tolist())], dtype=np.int64)
             rows_, cols = np.nonzero(~jam)
-            at = kept.lookup(key[rows_], trial[cols])
-            old = at >= 0
-            th[rows_[old], cols[old]], yc[rows_[old], cols[old]], jam[rows_[old], cols[old]] = kept.get(at[old])
-            rows_, cols = rows_[~old], cols[~old]
+            if kept is not None:
+                key = kept.nodes(key[parent], nodes[:, 1], nodes[:, 2])
+                at = kept.lookup(key[rows_], trial[cols])
+                old = at >= 0
+                th[rows_[old], cols[old]], yc[rows_[old], cols[old]], reason, _ = kept.get(at[old])
+                jam[rows_[old], cols[old]] = reason != ""
+                rows_, cols = rows_[~old], cols[~old]
             if rows_.size:
                 res = pin_step(self.part, nodes[rows_, 1] + offsets[cols, k], nodes[rows_, 2], th[rows_, cols],
                                 yc[rows_, cols], mu[cols], self.pin_radius, self.model, kw,
@@ -155,9 +159,11 @@ class TrialBench:
                                 stretch.part(k / n_pins, (k + 1) / n_pins))
                 th[rows_, cols] = res["theta_f"]
                 yc[rows_, cols] = yc[rows_, cols] + res["dy"]
-                st = res["status"]
-                jam[rows_, cols] = (st == JAMMED) | (st == TRUNCATED)
-                kept.add(key[rows_], trial[cols], th[rows_, cols], yc[rows_, cols], jam[rows_, cols])
+                reason = jam_reasons(res)
+                jam[rows_, cols] = reason != ""
+                if kept is not None:
+                    kept.add(key[rows_], trial[cols], th[rows_, cols], yc[rows_, cols], reason,
+                             res["status"] == MISS)
         return th[node] % 360.0, jam[node]
 
     def failures(self, heights, speeds, rows, stretch: Stretch = SILENT) -> np.ndarray:
@@ -198,56 +204,6 @@ class TrialBench:
             _, start = orient.best_arc(finals[k][~jammed[k]], self.tolerance, self.order)
             out[k] = jammed[k] | (np.mod(finals[k] - start, period) > self.tolerance + 1e-9)
         return out
-
-
-class PrefixStates:
-    """Each trial's state ``(theta, y_c, jammed)`` after a prefix of pins, kept
-    for later replays on the same bench (up to ``MAX_KEPT`` states; later ones
-    are rolled out without being kept).
-
-    A prefix is a node: the empty prefix is 0 and each (node, pin height,
-    pin speed) gets the next number; a trial is numbered by its values (its
-    start, friction, pin offsets and support), so the same trial in two sets
-    of rows (the probe's rows are among the screen's, the screen's among the
-    full trials) is one trial."""
-
-    def __init__(self):
-        self.nodes, self.trials, self.at = {}, {}, {}
-        self.theta, self.y_c, self.jammed = np.zeros(1024), np.zeros(1024), np.zeros(1024, bool)
-
-    def node(self, parent: int, height: float, speed: float) -> int:
-        """The number of the prefix ``parent`` followed by a pin at ``height``, ``speed``."""
-        return self.nodes.setdefault((int(parent), float(height), float(speed)), len(self.nodes) + 1)
-
-    def trial_ids(self, rows) -> np.ndarray:
-        """The number of each trial of ``rows``."""
-        th, yc, mu, offsets, sup = rows
-        n = np.size(th)
-        values = np.column_stack([np.asarray(th, float), np.asarray(yc, float), np.asarray(mu, float),
-                                  np.asarray(offsets, float).reshape(n, -1),
-                                  np.zeros(n) if sup is None else np.asarray(sup, float)])
-        return np.array([self.trials.setdefault(v.tobytes(), len(self.trials)) for v in values], dtype=np.int64)
-
-    def lookup(self, nodes, trials) -> np.ndarray:
-        """Where the state of each (node, trial) pair is kept (-1: not kept)."""
-        get = self.at.get
-        return np.array([get(c, -1) for c in ((nodes << 32) | trials).tolist()], dtype=np.int64)
-
-    def get(self, at) -> tuple:
-        """``(theta, y_c, jammed)`` kept at ``at``."""
-        return self.theta[at], self.y_c[at], self.jammed[at]
-
-    def add(self, nodes, trials, theta, y_c, jammed) -> None:
-        """Keep the states of the (node, trial) pairs, while there is room."""
-        start = len(self.at)
-        if start + nodes.size > MAX_KEPT:
-            return
-        while self.theta.size < start + nodes.size:
-            self.theta, self.y_c = np.concatenate([self.theta, self.theta]), np.concatenate([self.y_c, self.y_c])
-            self.jammed = np.concatenate([self.jammed, self.jammed])
-        self.theta[start:start + nodes.size], self.y_c[start:start + nodes.size] = theta, y_c
-        self.jammed[start:start + nodes.size] = jammed
-        self.at.update(zip(((nodes << 32) | trials).tolist(), range(start, start + nodes.size)))
 
 
 class FamilyCheck(Protocol):
