@@ -142,17 +142,12 @@ def _solve_take(tol):
     return max(_DEC_TAKE, _TAKE_PER_TOL * tol)
 
 
-@jit
 def _prepare(xy):
     """Normalise a solid part's vertex list for rollouts (``_prepare_loops``
     with one loop)."""
-    starts = np.empty(2, dtype=np.int64)
-    starts[0] = 0
-    starts[1] = xy.shape[0]
-    return _prepare_loops(xy, starts)
+    return _prepare_loops(xy, np.array([0, xy.shape[0]], dtype=np.int64))
 
 
-@jit
 def _prepare_loops(xy, starts):
     """Normalise a part with holes for rollouts.
 
@@ -173,16 +168,27 @@ def _prepare_loops(xy, starts):
     (``geometry._keyhole``), with the tabulated integrals of
     ``support_table`` when the material has ``TABLE_MIN_EDGES`` edges or
     more.
+
+    A Python function over Numba kernels (``_prepared_loops``, then
+    ``support_table._with_table``, whose cells are computed in parallel).
     """
+    verts, area, a, quad, m_max, convex, n_material = _prepared_loops(xy, starts)
+    if n_material >= TABLE_MIN_EDGES:
+        quad = _with_table(quad)
+    return verts, area, a, quad, m_max, convex
+
+
+@jit
+def _prepared_loops(xy, starts):
+    """``_prepare_loops`` without the support table, and the number of
+    material edges (outline, holes and their bridges)."""
     loops, area, a = _normalise_loops(xy, starts)
     n = starts[1] - starts[0]
     verts = loops[:n] / a
     material = _keyhole(loops, starts) / a
     area = area / (a * a)
     quad = _fan_quadrature(material)
-    if material.shape[0] >= TABLE_MIN_EDGES:
-        quad = _with_table(quad)
-    return verts, area, a, quad, _max_moment(material, area), _is_convex(verts)
+    return verts, area, a, quad, _max_moment(material, area), _is_convex(verts), material.shape[0]
 
 
 @jit

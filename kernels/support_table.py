@@ -69,8 +69,9 @@ Offsets below are rows from the table's first row::
 import math
 
 import numpy as np
+from numba import prange
 
-from ._numba import jit
+from ._numba import jit, jit_parallel
 from .edge_integrals import _edge_support, _support_sum, _table_sizes
 
 _R_INNER = 1.25  # units of a: the outline lies within the unit disc
@@ -379,8 +380,38 @@ def _near_edges(quad, f, n, candidates, n_cand, x0, y0, h, near):
     return m
 
 
+@jit_parallel
+def _top_cells(quad, f, n, every, n_every, r_grid, n_grid, skip_inside):
+    """Near edges and far values of every top-level cell of one grid, the
+    cells in parallel (each on its own; the costly part of a table: the far
+    sum at each Chebyshev point runs over every edge).
+
+    Returns
+    -------
+    (near, count, vals)
+        Per cell ``i n_grid + j``: its near edges (``near[c, :count[c]]``,
+        ``_near_edges``) and ``_far_values`` (``vals[c]``); a cell inside
+        ``skip_inside`` has count -1.
+    """
+    h = 2.0 * r_grid / n_grid
+    d1 = _DEGREE + 1
+    n_cells = n_grid * n_grid
+    near = np.empty((n_cells, max(n, 1)), dtype=np.int64)
+    count = np.full(n_cells, -1, dtype=np.int64)
+    vals = np.empty((n_cells, d1, d1))
+    for c in prange(n_cells):
+        x0, y0 = -r_grid + (c // n_grid) * h, -r_grid + (c % n_grid) * h
+        if (skip_inside > 0.0 and x0 >= -skip_inside and x0 + h <= skip_inside
+                and y0 >= -skip_inside and y0 + h <= skip_inside):
+            continue
+        m = _near_edges(quad, f, n, every, n_every, x0, y0, h, near[c])
+        count[c] = m
+        vals[c] = _far_values(quad, f, n, (x0, y0, h), near[c], m)
+    return near, count, vals
+
+
 @jit
-def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nears):
+def _grid_cells(quad, f, n, twin, r_grid, n_grid, top, cells, coefs, nears):
     """Fit every cell of one grid, splitting a cell with more than
     ``_SPLIT_NEAR`` near edges into four (down to ``_MAX_SPLIT`` times);
     append to the lists ``cells`` (index rows: a leaf's block, near count and
@@ -389,7 +420,10 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nea
 
     A child's far part is its parent's polynomial plus the few edges near
     the parent but not near it (``_child_far_values``), so splitting costs the
-    parent's near edges per point, not all of them."""
+    parent's near edges per point, not all of them. ``top`` is
+    ``_top_cells`` of the grid (its top-level cells' near edges and far
+    values, computed in parallel); the order of the cells, and so the
+    table, is the serial one."""
     h = 2.0 * r_grid / n_grid
     rows_per_cell = (_DEGREE + 1) * (_DEGREE + 1) // 3
     every = np.empty(n, dtype=np.int64)
@@ -399,6 +433,7 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nea
             every[n_every] = e
             n_every += 1
     first = len(cells)
+    top_near, top_count, top_vals = top
     # Split cells kept while their children are fitted: block, geometry, near list.
     parents = [np.empty((1, 3))]
     parents.pop()
@@ -413,15 +448,16 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nea
         for j in range(n_grid):
             cells.append((-1.0, 0.0, 0.0))
             x0, y0 = -r_grid + i * h, -r_grid + j * h
-            if not (skip_inside > 0.0 and x0 >= -skip_inside and x0 + h <= skip_inside
-                    and y0 >= -skip_inside and y0 + h <= skip_inside):
+            if top_count[i * n_grid + j] >= 0:
                 stack.append((first + i * n_grid + j, x0, y0, h, 0, -1))
     near = np.empty(n, dtype=np.int64)
     while len(stack) > 0:
         row, x0, y0, w, depth, par = stack.pop()
         if par < 0:
-            m = _near_edges(quad, f, n, every, n_every, x0, y0, w, near)
-            vals = _far_values(quad, f, n, (x0, y0, w), near, m)
+            top = row - first
+            m = top_count[top]
+            near[:m] = top_near[top, :m]
+            vals = top_vals[top]
         else:
             pn = parent_near[par]
             m = _near_edges(quad, f, n, pn, pn.shape[0], x0, y0, w, near)
@@ -445,24 +481,38 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, skip_inside, cells, coefs, nea
         cells[row] = (float(len(coefs) - 1), float(m), float(len(nears) - 1))
 
 
-@jit
 def _with_table(quad):
     """``quad`` with the support table of its material appended (module notes).
 
     Returns a new array; ``_has_table`` is then true and ``support._power``
-    reads the table instead of summing every edge.
+    reads the table instead of summing every edge. A Python function: the
+    top-level cells of both grids are computed by ``_top_cells`` over the
+    cores (called from Python, as a parallel kernel called from a cached
+    serial one can crash when loaded from Numba's cache, numba issue 8578),
+    then ``_table_from`` builds the table serially.
     """
     f, n = _table_sizes(quad)
     twin = _twin_edges(quad)
+    every = np.flatnonzero(~twin).astype(np.int64)
+    inner = _top_cells(quad, f, n, every, every.size, _R_INNER, _N_INNER, 0.0)
+    outer = _top_cells(quad, f, n, every, every.size, _R_OUTER, _N_OUTER, _R_INNER)
+    return _table_from(quad, twin, inner, outer)
+
+
+@jit
+def _table_from(quad, twin, inner, outer):
+    """The table of ``_with_table`` from the top-level cells of the inner and
+    outer grids (``_top_cells``)."""
+    f, n = _table_sizes(quad)
     cells = [(0.0, 0.0, 0.0)]
     cells.pop()
     coefs = [np.empty((1, 3))]
     coefs.pop()
     nears = [np.empty(1, dtype=np.int64)]
     nears.pop()
-    _grid_cells(quad, f, n, twin, _R_INNER, _N_INNER, 0.0, cells, coefs, nears)
+    _grid_cells(quad, f, n, twin, _R_INNER, _N_INNER, inner, cells, coefs, nears)
     outer_first = len(cells)
-    _grid_cells(quad, f, n, twin, _R_OUTER, _N_OUTER, _R_INNER, cells, coefs, nears)
+    _grid_cells(quad, f, n, twin, _R_OUTER, _N_OUTER, outer, cells, coefs, nears)
     mom_re, mom_im = _moments(quad, _ORDER + 2)
     m1 = _ORDER + 3
     rows_per_cell = (_DEGREE + 1) * (_DEGREE + 1) // 3

@@ -20,8 +20,9 @@ from kernels.batch import _rollout_grid
 from kernels.edge_integrals import _support_sum, _table_sizes
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, _prepare, _prepare_loops
 from kernels.support import _R_FAR, _point_sums, _point_table, _power
-from kernels.support_table import (TABLE_MIN_EDGES, _has_table, _moment_power, _near_edge_terms,
-                                   _table_support, _with_table)
+from kernels.support_table import (_N_INNER, _N_OUTER, _R_INNER, _R_OUTER, TABLE_MIN_EDGES, _far_values,
+                                   _has_table, _moment_power, _near_edge_terms, _near_edges, _table_support,
+                                   _top_cells, _twin_edges, _with_table)
 from pipeline.parts.part import Part, _stack
 
 
@@ -79,6 +80,31 @@ def test_parts_with_many_edges_carry_a_table_and_small_ones_do_not():
     below = _prepare(_circle(0.0, 0.0, 10.0, TABLE_MIN_EDGES - 1))[3]
     at = _prepare(_circle(0.0, 0.0, 10.0, TABLE_MIN_EDGES))[3]
     assert not _has_table(below) and _has_table(at)
+
+
+@pytest.mark.parametrize("grid", [(_R_INNER, _N_INNER, 0.0), (_R_OUTER, _N_OUTER, _R_INNER)])
+def test_the_top_cells_built_in_parallel_are_those_built_one_by_one(grid):
+    """The table's costly part, each top-level cell's near edges and far
+    values, runs over the cells in parallel: every cell's numbers are, bit
+    for bit, those of the cell computed alone (no scratch is shared)."""
+    _, _, _, raw = _plate_quads()
+    f, n = _table_sizes(raw)
+    r_grid, n_grid, skip = grid
+    every = np.flatnonzero(~_twin_edges(raw)).astype(np.int64)
+    near, count, vals = _top_cells(raw, f, n, every, every.size, r_grid, n_grid, skip)
+    h = 2.0 * r_grid / n_grid
+    one = np.empty(n, dtype=np.int64)
+    skipped = 0
+    for c in range(n_grid * n_grid):
+        x0, y0 = -r_grid + (c // n_grid) * h, -r_grid + (c % n_grid) * h
+        if skip and -skip <= x0 and x0 + h <= skip and -skip <= y0 and y0 + h <= skip:
+            assert count[c] == -1
+            skipped += 1
+            continue
+        m = _near_edges(raw, f, n, every, every.size, x0, y0, h, one)
+        assert count[c] == m and np.array_equal(near[c, :m], one[:m])
+        assert vals[c].tobytes() == _far_values(raw, f, n, (x0, y0, h), one, m).tobytes()
+    assert skipped == (4 if skip else 0)  # the outer grid leaves out its 2 x 2 cells inside the inner square
 
 
 @pytest.mark.parametrize("half_width", [1.2, 3.0, 7.9])
