@@ -488,7 +488,7 @@ def _with_table(quad):
     reads the table instead of summing every edge. A Python function: the
     top-level cells of both grids are computed by ``_top_cells`` over the
     cores (called from Python, as a parallel kernel called from a cached
-    serial one can crash when loaded from Numba's cache, numba issue 8578),
+    serial one can crash when loaded from Numba's cache, a known Numba bug),
     then ``_table_from`` builds the table serially.
     """
     f, n = _table_sizes(quad)
