@@ -454,10 +454,10 @@ def _grid_cells(quad, f, n, twin, r_grid, n_grid, top, cells, coefs, nears):
     while len(stack) > 0:
         row, x0, y0, w, depth, par = stack.pop()
         if par < 0:
-            top = row - first
-            m = top_count[top]
-            near[:m] = top_near[top, :m]
-            vals = top_vals[top]
+            k_top = row - first
+            m = top_count[k_top]
+            near[:m] = top_near[k_top, :m]
+            vals = top_vals[k_top]
         else:
             pn = parent_near[par]
             m = _near_edges(quad, f, n, pn, pn.shape[0], x0, y0, w, near)

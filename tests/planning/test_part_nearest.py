@@ -101,6 +101,35 @@ def test_the_answer_is_its_plans_own_tolerance(no_plan):
     assert fresh["value"] == tol["value"] and fresh["verdict"] == searched
 
 
+class _Bench:
+    """A trial bench whose held-out replay gives the finals ``finals`` (none jammed)."""
+    order = 1
+
+    def __init__(self, finals):
+        self.finals = np.asarray(finals, float)
+
+    def held_out(self, n_pins):
+        return (self.finals,)
+
+    def replay(self, heights, speeds, rows):
+        return self.finals[None, :], np.zeros((1, self.finals.size), bool)
+
+
+@pytest.mark.parametrize("spread, expected", [(0.2, 6.5), (20.0, 20.0)])
+def test_a_found_plan_answers_at_its_own_tolerance_above_the_asked_one(spread, expected):
+    """A plan a search certified at 45 deg answers at the narrowest tolerance
+    its held-out trials allow, never at or below the asked one (here 6 deg:
+    held-out trials easier than those that rejected it give the next step)."""
+    from pipeline.planning.plans.nearest_part import _own_tolerance
+    finals = np.linspace(100.0, 100.0 + spread, 200)
+    claims = SimpleNamespace(required=0.99, confidence=0.95, rule="point")
+    plan = SimpleNamespace(heights=(5.0, 9.0), speeds=(), verdict={"tolerance_deg": 45.0})
+    plan = dataclasses.make_dataclass("P", ["heights", "speeds", "verdict"])(**vars(plan))
+    tol, answered = _own_tolerance(plan, _Bench(finals), claims, 6.0)
+    assert tol == expected and answered.verdict["tolerance_deg"] == expected and answered.verdict["orients"]
+    assert most_in_arc(finals, tol, 1) >= 0.99 * finals.size
+
+
 def test_half_a_degree_tighter_the_complete_search_finds_no_plan(no_plan):
     import dataclasses
     from pipeline.planning.tight.complete import FixedPinSearch

@@ -17,6 +17,7 @@ from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.planning import PlannerSettings
 from pipeline.planning.claims.replay import ReplayMemo, kernel_kw, replay
+from pipeline.planning.tight.judge import TrialBench
 from pipeline.planning.plans import nearest_part
 from pipeline.planning.plans import plan as plan_module
 from pipeline.planning.plans.plan import plan_tight
@@ -119,3 +120,41 @@ def test_a_replay_with_a_memo_of_other_settings_gives_its_own_numbers():
     again = replay(TRAPEZOID, heights, speeds, theta, y_c, mu, offsets, 3.0, "minpower", memo=memo)
     for a, b in zip(again, first):
         assert np.array_equal(a, b)
+
+
+def test_a_bench_memo_gives_replay_its_misses_and_jams(tmp_path, monkeypatch):
+    """States the trial bench kept (a pin that misses the part, another that
+    meets it) serve ``replay`` whole: its finals, heights, jam reasons and
+    misses are those of a replay on its own, with no rollout."""
+    s = _settings(tmp_path, 10.0)
+    bench = TrialBench(TRAPEZOID, s.friction, s.claims, s.verify, s.search)
+    rows = bench.held_out(3)
+    heights, speeds = np.array([[14.0, 400.0, 6.0]]), np.zeros((1, 3))  # the second pin is far above the part
+    bench.replay(heights, speeds, rows)
+    th, yc, mu, offsets, sup = rows
+    args = (TRAPEZOID, heights[0], speeds[0], th, yc, mu, offsets, bench.pin_radius, bench.model,
+            bench.step.ds_max, bench.step.tol)
+    alone = replay(*args)
+    counted = []
+    real_rollouts = simulate.rollout_points
+
+    def counting(part, theta, *a, **k):
+        counted.append(np.size(theta))
+        return real_rollouts(part, theta, *a, **k)
+
+    monkeypatch.setattr(simulate, "rollout_points", counting)
+    shared = replay(*args, memo=bench.kept)
+    assert sum(counted) == 0
+    assert alone[3][:, 1].all() and not alone[3][:, 0].all()  # every trial misses pin 2, not every one pin 1
+    for a, b in zip(alone, shared):
+        assert np.array_equal(a, b)
+
+
+def test_a_full_memo_keeps_what_fits():
+    memo = ReplayMemo(max_kept=5)
+    memo.serves(TRAPEZOID, 3.0, "minpower", kernel_kw(0.05, 1e-6, None, 0.5), None)
+    nodes, trials = np.ones(8, dtype=np.int64), np.arange(8, dtype=np.int64)
+    memo.add(nodes, trials, np.arange(8.0), np.zeros(8), np.array([""] * 8, dtype=object), np.zeros(8, bool))
+    assert len(memo.at) == 5 and memo.half_full
+    assert (memo.lookup(nodes, trials) >= 0).tolist() == [True] * 5 + [False] * 3
+    assert memo.get(memo.lookup(nodes[:5], trials[:5]))[0].tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]

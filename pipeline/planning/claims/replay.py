@@ -118,6 +118,12 @@ class ReplayMemo:
         self.reason, self.missed = np.zeros(256, dtype=np.int32), np.zeros(256, bool)
         self.rollout = None  # (part, supports, settings) of the first replay
 
+    @property
+    def half_full(self) -> bool:
+        """True once half of ``max_kept`` is used (a later stage then does
+        better with a memo of its own)."""
+        return 2 * len(self.at) >= self.max_kept
+
     def serves(self, part: Part, pin_radius, model, kw: dict, supports) -> bool:
         """Whether replays of ``part`` with these rollout settings (pin radius,
         model, :func:`kernel_kw`, the supports ``support`` indexes) may use
@@ -160,10 +166,14 @@ class ReplayMemo:
         return self.theta[at], self.y_c[at], names[self.reason[at]], self.missed[at]
 
     def add(self, nodes, trials, theta, y_c, reasons, missed) -> None:
-        """Keep these states, while there is room."""
+        """Keep these states, as many as there is room for (the first ones)."""
         start, n = len(self.at), np.size(nodes)
         if start + n > self.max_kept:
-            return
+            n = max(0, self.max_kept - start)
+            if n == 0:
+                return
+            nodes, trials, theta, y_c, reasons, missed = (np.asarray(x)[:n] for x in (nodes, trials, theta, y_c,
+                                                                                      reasons, missed))
         while self.theta.size < start + n:
             self.theta, self.y_c = np.concatenate([self.theta, self.theta]), np.concatenate([self.y_c, self.y_c])
             self.reason, self.missed = np.concatenate([self.reason, self.reason]), np.concatenate([self.missed,

@@ -28,7 +28,7 @@ def add_moving_pins(part: Part, settings: PlannerSettings, planner, fixed: Fixed
     so). Its plans' carried sets join ``candidates`` and their selection
     verdicts ``selections``; what it left out joins ``unsearched``. Its
     trials' states join ``memo`` (the fixed-pin search's, whose states after
-    the fixed prefixes it reads).
+    the fixed prefixes it reads) while that is less than half full.
 
     Returns
     -------
@@ -101,7 +101,7 @@ def _moving_search(part, settings: PlannerSettings, moving, chosen, keep, progre
     if progress:
         progress(f"mu_c {settings.friction.label}: fixed pins do not orient the part: adding moving pins")
     search = _pin_search(part, settings, moving, moving=True, family=family, checker=checker)
-    if memo is not None:
+    if memo is not None and not memo.half_full:  # else its own memo, with room for its trials
         search.bench.kept = memo
     depth = settings.search.dynamic_depth
     total = FixedSearch([], [], depth, settings.claims.tolerance_deg, settings.claims.required,

@@ -105,7 +105,7 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
         result = search.run(depth, candidates=candidates, keep=1, progress=_at(progress, t), deadline=deadline)
         if not result.complete:
             raise OutOfTime(f"the search at {t:g} deg was not finished")
-        return _own_tolerance(result.plans[0], search.bench, settings.claims) if result.plans else None
+        return _own_tolerance(result.plans[0], search.bench, settings.claims, lo) if result.plans else None
 
     lo = math.floor(settings.claims.tolerance_deg / LADDER) * LADDER  # does not orient (the question)
     first = found(MAX_TOLERANCE)
@@ -125,19 +125,23 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
     return hi, best, True
 
 
-def _own_tolerance(plan, bench: TrialBench, claims) -> tuple:
-    """``(tolerance, plan)``: the smallest tolerance on the ``LADDER`` at which
-    ``plan``, certified by a search on ``bench``, orients the part on its
-    held-out trials (:func:`loosest_needed`; never looser than the search's),
-    and the plan with its held-out verdict at that tolerance. The
-    certification replayed those trials, so the bench has their states and
-    this rolls out nothing."""
+def _own_tolerance(plan, bench: TrialBench, claims, asked: float) -> tuple:
+    """``(tolerance, plan)``: the smallest tolerance on the ``LADDER`` above
+    ``asked`` (the question's, which no search answered) at which ``plan``,
+    certified by a search on ``bench``, orients the part on its held-out
+    trials (:func:`loosest_needed`; never looser than the search's), and the
+    plan with its held-out verdict at that tolerance. The certification
+    replayed those trials, so the bench has their states and this rolls out
+    nothing."""
     rows = bench.held_out(len(plan.heights))
     speeds = plan.speeds or (0.0,) * len(plan.heights)
     tf, jam = bench.replay(np.atleast_2d(np.asarray(plan.heights, float)), np.atleast_2d(np.asarray(speeds, float)),
                            rows)
     searched = float(plan.verdict["tolerance_deg"])
     tol = loosest_needed(tf[0], jam[0], rows[0].size, bench.order, claims.required, claims.confidence, claims.rule)
+    if tol is not None:
+        # held-out trials easier than the ones that rejected it at the asked tolerance: the next step
+        tol = max(tol, asked + LADDER)
     if tol is None or tol >= searched:
         return searched, plan
     verdict = orient.judge(tf[0][~jam[0]], rows[0].size, tol, bench.order, claims.required, claims.confidence,
