@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pipeline.maps import simulate
+from rollout_counter import count_rollouts
+
 from pipeline.parts.outlines import read_outline
 from pipeline.parts.part import Part
 from pipeline.parts.support import rim_support, tripod_support
@@ -43,24 +44,12 @@ def _heights(part, n_pins):
     return list(np.linspace(0.25, 0.8, n_pins) * top)
 
 
-def _counting(monkeypatch):
-    counted = []
-    original = simulate.rollout_points
-
-    def counted_rollouts(part, theta, *args, **kwargs):
-        counted.append(np.size(theta))
-        return original(part, theta, *args, **kwargs)
-
-    monkeypatch.setattr(simulate, "rollout_points", counted_rollouts)
-    return counted
-
-
 @pytest.mark.parametrize("name", sorted(PARTS))
 def test_corners_share_their_first_pins_and_give_each_trial_its_own_numbers(name, monkeypatch):
     part, n_pins = PARTS[name](), 3
     th, yc, mu, offs = _corners(part, n_pins)
     heights = _heights(part, n_pins)
-    counted = _counting(monkeypatch)
+    counted = count_rollouts(monkeypatch)
     shared = replay(part, heights, [0.0] * n_pins, th, yc, mu, offs, 3.0, "minpower")
     rolled = sum(counted)
     alone = [replay(part, heights, [0.0] * n_pins, th[i:i + 1], yc[i:i + 1], mu[i:i + 1], offs[i:i + 1], 3.0,
@@ -81,7 +70,7 @@ def test_rows_on_different_supports_or_speeds_are_not_shared(monkeypatch):
     offs = np.zeros((n, 1))
     supports = [tripod_support(part), rim_support(part)]
     support = np.array([0, 0, 1, 1, 0, 1])
-    counted = _counting(monkeypatch)
+    counted = count_rollouts(monkeypatch)
     out = replay(part, [0.5 * y_c], [[0.0]] * 3 + [[0.5]] * 3, th, yc, mu, offs, 3.0, "minpower",
                  support=support, supports=supports)
     # distinct (speed, support): (0, 0), (0, 1), (0.5, 0), (0.5, 1)

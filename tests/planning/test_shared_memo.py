@@ -12,8 +12,9 @@ kept for other rollout settings is never read.
 import numpy as np
 import pytest
 
+from rollout_counter import count_rollouts
+
 from pipeline.config import load_config
-from pipeline.maps import simulate
 from pipeline.parts.part import Part
 from pipeline.planning import PlannerSettings
 from pipeline.planning.claims.replay import ReplayMemo, kernel_kw, replay
@@ -46,12 +47,7 @@ def _planned(tmp_path, tolerance, shared: bool, monkeypatch) -> tuple:
     """The plan's dict and the rows rolled out by its verification and by the
     nearest "yes"'s replays of the kept plans (``shared`` False: each with a
     memo of its own, as before the memo was shared)."""
-    rows, counted = [], {"verification": 0, "kept plans": 0}
-    real_rollouts = simulate.rollout_points
-
-    def counting(part, theta, *args, **kwargs):
-        rows.append(np.size(theta))
-        return real_rollouts(part, theta, *args, **kwargs)
+    counted = {"verification": 0, "kept plans": 0}
 
     def measured(step, fn, drop):
         def wrapper(*args, **kwargs):
@@ -64,7 +60,7 @@ def _planned(tmp_path, tolerance, shared: bool, monkeypatch) -> tuple:
             return out
         return wrapper
 
-    monkeypatch.setattr(simulate, "rollout_points", counting)
+    rows = count_rollouts(monkeypatch)
     monkeypatch.setattr(plan_module, "_verify_candidates", measured("verification", plan_module._verify_candidates, 8))
     monkeypatch.setattr(nearest_part, "_kept_tolerance", measured("kept plans", nearest_part._kept_tolerance, 4))
     entry = plan_tight(TRAPEZOID, _settings(tmp_path, tolerance))
@@ -135,14 +131,7 @@ def test_a_bench_memo_gives_replay_its_misses_and_jams(tmp_path, monkeypatch):
     args = (TRAPEZOID, heights[0], speeds[0], th, yc, mu, offsets, bench.pin_radius, bench.model,
             bench.step.ds_max, bench.step.tol)
     alone = replay(*args)
-    counted = []
-    real_rollouts = simulate.rollout_points
-
-    def counting(part, theta, *a, **k):
-        counted.append(np.size(theta))
-        return real_rollouts(part, theta, *a, **k)
-
-    monkeypatch.setattr(simulate, "rollout_points", counting)
+    counted = count_rollouts(monkeypatch)
     shared = replay(*args, memo=bench.kept)
     assert sum(counted) == 0
     assert alone[3][:, 1].all() and not alone[3][:, 0].all()  # every trial misses pin 2, not every one pin 1
