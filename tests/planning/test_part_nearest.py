@@ -231,6 +231,34 @@ def test_with_no_time_left_the_nearest_yes_still_gives_the_axes_that_need_no_rol
     assert any(u.startswith('the nearest "yes": only the axes that need no rollout') for u in cut["unsearched"])
 
 
+def test_a_limit_passing_as_the_chosen_plans_are_carried_keeps_the_first(no_plan, monkeypatch):
+    """The limit passes as the carried sets of the chosen plans begin: the
+    first (the best the search kept) is still carried and verified, with
+    the numbers it has with time left, and the others are named as skipped
+    (dropping them all would leave no plan where the search had one)."""
+    from pipeline.planning.plans import plan as plan_module
+    _, settings_ = no_plan
+    with_time = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=3)).to_dict()
+    deadline, original = _NoTimeLeft(reads=3), plan_module.carried_sets
+
+    def expire(*args, **kwargs):
+        deadline.expired = True
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(plan_module, "carried_sets", expire)
+    cut = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=deadline).to_dict()
+    kept = cut["plans"] + cut["rejected"]
+    before = {tuple(p["pins"]): p for p in with_time["plans"] + with_time["rejected"]}
+    assert deadline.expired and len(kept) == 1 and len(before) > 1
+    plan = kept[0]
+    same = before[tuple(plan["pins"])]["verification"]
+    assert plan["verification"] == {k: v for k, v in same.items() if k != "untruncated"}  # skipped: no time
+    skipped = [u for u in cut["unsearched"] if u.startswith("carried sets and held-out verification")]
+    assert len(skipped) == 1 and skipped[0].startswith(f"carried sets and held-out verification of "
+                                                       f"{len(before) - 1} chosen plan(s): skipped")
+    assert " ".join(plan["pins"]) not in skipped[0].split(": skipped")[1]
+
+
 def test_moving_pins_the_limit_came_before_are_named_so(no_plan):
     """With moving pins configured, a limit that ends the search before them
     says so on the moving-pin axis (never "no pin speeds given")."""

@@ -217,3 +217,94 @@ def test_a_cut_enumeration_with_time_left_screens_what_it_enumerated(monkeypatch
 ])
 def test_a_level_that_ends_in_time_is_never_cut_for_its_share(now, done, search_end, goes_on):
     assert enumerate_module.finishes_in_time(now, 0.0, done, 80, search_end) is goes_on
+
+
+def test_a_probe_cut_by_its_share_judges_the_sequences_it_probed(monkeypatch):
+    """A level whose first screen the limit cuts (here after its first chunk
+    of one sequence, the narrowest nominally) goes on with the sequences it
+    probed: the plan found there has the complete search's verdict, and the
+    level says how far the first screen got and that only those were judged."""
+    from pipeline.planning.tight import screen as screen_module
+    monkeypatch.setattr(screen_module, "PROBE_CHUNK", 1)
+    monkeypatch.setattr(screen_module, "PROBE_SHARE", 1e-9)  # past its share after the first chunk ...
+    monkeypatch.setattr(screen_module, "finishes_in_time", lambda *args, **kw: False)  # ... and slow
+    result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
+    level = result.levels[-1]
+    assert level["pins"] == 2 and level["nominal_within"] == 2 and level["probed"] == 1
+    assert "the first screen reached 1 of the 2 sequences" in level["unsearched"]
+    assert "only those screened and judged" in level["unsearched"]
+    assert not result.complete and result.complete_to == 1
+    assert len(result.plans) == 1
+    best = result.plans[0]
+    got = [list(best.labels), best.verdict["in_tolerance"], best.verdict["trials"], round(best.verdict["width_deg"], 4)]
+    assert got in BEFORE[10.0]["plans"]
+
+
+def test_a_probe_cut_with_no_search_time_left_judges_none(monkeypatch):
+    """With the search time over when the probe stops, nothing is judged and
+    the level says so."""
+    from pipeline.planning.tight import screen as screen_module
+    monkeypatch.setattr(screen_module, "PROBE_CHUNK", 1)
+    probing = {"started": False}
+    original = screen_module.LevelScreen._probe
+
+    def probe(self, *args, **kw):
+        probing["started"] = True  # the search time ends once the first screen runs
+        return original(self, *args, **kw)
+
+    monkeypatch.setattr(screen_module.LevelScreen, "_probe", probe)
+    monkeypatch.setattr(Deadline, "search_over", lambda self: probing["started"])
+    result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
+    level = result.levels[-1]
+    assert level["pins"] == 2 and level["probed"] == 1 and level["judged"] == 0
+    assert level["unsearched"].endswith("none judged") and not result.plans
+
+
+@pytest.mark.parametrize("now, done, search_end, goes_on", [
+    (10.0, 10, 40.0, True),    # within its share (0.3) of the 40 s
+    (15.0, 95, 40.0, True),    # past its share, but the other 5 end at 15.8 s, leaving over half of the 40 s to judge
+    (15.0, 60, 40.0, False),   # the other 40 end at 25 s, leaving under half: it stops and the level judges
+                               # what it probed
+])
+def test_a_probe_that_ends_in_time_with_room_to_judge_is_never_cut(now, done, search_end, goes_on):
+    from pipeline.planning.tight.screen import probe_goes_on
+    assert probe_goes_on(now, 0.0, done, 100, search_end) is goes_on
+
+
+class _OverOnceCertifying(Deadline):
+    """A time limit with search time throughout that passes as soon as the
+    first held-out replay of the certification starts."""
+
+    def __init__(self):
+        super().__init__(3600.0)
+        self.passed = False
+
+    def search_over(self) -> bool:
+        return False
+
+    def over(self) -> bool:
+        return self.passed
+
+
+def test_the_limit_passing_during_certification_certifies_the_best_first(monkeypatch):
+    """The two orienting sequences of the 2-pin level are certified one at a
+    time, best first on the selection trials, under a limit: when the limit
+    passes after the first, it is the plan (with the complete search's
+    verdict) and the other is an unverified candidate, named as such."""
+    from pipeline.planning.tight.judge import TrialBench
+    deadline, judge = _OverOnceCertifying(), TrialBench.judge
+
+    def certifying(self, heights, speeds, rows, interval=False, stretch=None, **kw):
+        if interval:  # the certification's held-out replay
+            deadline.passed = True
+        return judge(self, heights, speeds, rows, interval, **({"stretch": stretch} if stretch else {}))
+
+    monkeypatch.setattr(TrialBench, "judge", certifying)
+    result = _search(10.0).run(2, candidates=3, deadline=deadline)
+    level = result.levels[-1]
+    assert level["orienting"] == 2 and level["certified"] == 1 and level["unverified"] == 1
+    assert "not replayed on held-out trials (unverified)" in level["unsearched"] and not result.complete
+    best = result.plans[0]
+    assert len(result.plans) == 1 and [list(best.labels), best.verdict["in_tolerance"], best.verdict["trials"],
+                                       round(best.verdict["width_deg"], 4)] == BEFORE[10.0]["plans"][0]
+    assert [list(p.labels) for p in result.unverified] == [BEFORE[10.0]["plans"][1][0]]

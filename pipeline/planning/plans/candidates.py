@@ -144,13 +144,15 @@ def carried_sets(planner, chosen, verify, family, progress, deadline: Deadline =
     ``progress`` how many are done (and, between the propagation's rollout
     batches, that it is still at it). Once ``deadline`` has passed no further
     plan is started (each one started is then verified): the plans left are
-    named in ``unsearched``. Sampled carried sets of plans that share their
-    first pins share those rollouts (``verify.ReplayMemo``)."""
+    named in ``unsearched``. The first (the best the search certified) is
+    always done, past the limit too: dropping it would turn a plan the
+    search certified into no plan at all. Sampled carried sets of plans
+    that share their first pins share those rollouts (``verify.ReplayMemo``)."""
     out, memo = [], ReplayMemo()
     with Heartbeat("carried sets of the chosen plans", len(chosen), "plan", progress) as beat:
         try:
             for p in chosen:
-                if deadline.over():
+                if out and deadline.over():
                     left = chosen[len(out):]
                     beat.finish(len(out), "the time limit has passed")
                     if unsearched is not None:

@@ -426,14 +426,16 @@ class NominalTree:
         return status[inverse].reshape(shape), theta_f[inverse].reshape(shape), dy[inverse].reshape(shape)
 
 
-def finishes_in_time(now: float, started: float, done: int, total: int, search_end: float) -> bool:
+def finishes_in_time(now: float, started: float, done: int, total: int, search_end: float,
+                     leave: float = SCREEN_SHARE) -> bool:
     """Whether a level's enumeration, begun at ``started`` with ``done`` of its
-    ``total`` parents done at ``now``, ends at that pace with ``SCREEN_SHARE``
-    of its time to ``search_end`` (seconds on the deadline's clock) left for
-    its screen: then it goes on past its share of the time (a level that ends
-    in time with room to screen it is never cut)."""
+    ``total`` parents done at ``now``, ends at that pace with ``leave``
+    (``SCREEN_SHARE``) of its time to ``search_end`` (seconds on the
+    deadline's clock) left for its screen: then it goes on past its share of
+    the time (a level that ends in time with room to screen it is never
+    cut). The probe of a level's screen asks the same of its sequences."""
     pace = (now - started) / max(done, 1)
-    return now + pace * (total - done) <= search_end - SCREEN_SHARE * (search_end - started)
+    return now + pace * (total - done) <= search_end - leave * (search_end - started)
 
 
 def _joined(parts) -> Level:

@@ -33,7 +33,7 @@ from pipeline.planning.claims.replay import ReplayMemo, jam_reasons, kernel_kw, 
 from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
-from pipeline.progress import SILENT, Heartbeat, Stretch
+from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
 
 MAX_ROWS = 150_000  # trials replayed in one batch
 MAX_KEPT = 2_000_000  # trial states after a prefix kept for reuse (about 250 MB at most)
@@ -277,24 +277,39 @@ class Certifier:
             return np.zeros(np.atleast_2d(heights).shape[0], bool)
         return self.member_check.prescreen(heights, speeds, self.bench.tolerance, screened, allowed)
 
-    def certify(self, found: list, heights, speeds, n_pins: int, beat: Heartbeat) -> list:
-        """The plans of ``found`` (whose pins are the rows of ``heights`` and
-        ``speeds``) whose verdict on the held-out trials orients the part; each
-        plan's ``verdict`` becomes its held-out verdict (with the width's
-        bootstrap interval) and ``selection`` keeps the verdict on the trials
-        that chose it. ``beat`` hears how far it got."""
+    def certify(self, found: list, heights, speeds, n_pins: int, beat: Heartbeat,
+                deadline: Deadline = NO_DEADLINE) -> tuple[list, list]:
+        """``(certified, untried)``: the plans of ``found`` (whose pins are the
+        rows of ``heights`` and ``speeds``) whose verdict on the held-out
+        trials orients the part, and those the time limit left unreplayed.
+        Each certified plan's ``verdict`` becomes its held-out verdict (with
+        the width's bootstrap interval) and ``selection`` keeps the verdict on
+        the trials that chose it. ``beat`` hears how far it got.
+
+        Under a time limit (``deadline``) the plans are replayed one at a
+        time, best first on the selection trials, until the limit has passed:
+        the best one is certified first, and the ones left are ``untried``
+        (never plans: unverified candidates)."""
         if not found:
-            return []
+            return [], []
         rows = self.bench.held_out(n_pins)
-        out = []
+        order = list(range(len(found)))
         step = max(1, MAX_ROWS // rows[0].size)
+        if deadline.limited:
+            order.sort(key=lambda k: found[k].rank_key())
+            step = 1
+        out = []
         with beat:
-            for start in range(0, len(found), step):
-                stop = min(len(found), start + step)
-                verdicts = self.bench.judge(heights[start:stop], speeds[start:stop], rows, interval=True,
-                                            stretch=beat.stretch(start, stop))
-                for plan, held in zip(found[start:start + step], verdicts):
+            for start in range(0, len(order), step):
+                if start and deadline.over():
+                    beat.finish(start, "the time limit has passed: the others are not replayed")
+                    return out, [found[k] for k in order[start:]]
+                pick = np.asarray(order[start:start + step])
+                verdicts = self.bench.judge(heights[pick], speeds[pick], rows, interval=True,
+                                            stretch=beat.stretch(start, start + pick.size))
+                for k, held in zip(pick, verdicts):
+                    plan = found[k]
                     plan.selection, plan.verdict = plan.verdict, held
                     if held["orients"]:
                         out.append(plan)
-        return out
+        return out, []

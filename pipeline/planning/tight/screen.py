@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pipeline.planning.claims import orient
-from pipeline.planning.tight.enumerate import Level
+from pipeline.planning.tight.enumerate import Level, finishes_in_time
 from pipeline.planning.tight.fewest import fewest_sets
 from pipeline.planning.tight.judge import MAX_ROWS, Certifier, TrialBench, stack
 from pipeline.planning.tight.records import CandidatePins, FixedPlan
@@ -26,7 +26,14 @@ SCREEN = (12, 8)  # random trials and corners per resting state in the screen
 CASCADE = ((48, 64), (150, 384))
 SCREEN_BLOCK = 96  # candidates screened at once
 HARD_TRIALS = 64  # trials that failed most often in a level's judged sequences, tried first (moving pins)
-PROBE_CHUNK = 1024  # candidates probed at once under a time limit (the clock is read between chunks)
+PROBE_CHUNK = 256  # candidates probed at once under a time limit (the clock is read between chunks)
+# Under a time limit the probe may use this share of the search time left when
+# it starts, and goes on past it only if at its pace it ends leaving
+# JUDGE_SHARE of that time to screen and judge what it probed: else the level
+# goes on with the sequences probed (a probe that ate the search time would
+# leave none judged, and no plan, where one was within reach).
+PROBE_SHARE = 0.3
+JUDGE_SHARE = 0.5
 
 
 @dataclass(eq=False)
@@ -128,40 +135,71 @@ class LevelScreen:
         # first) and already rejects the hopeless ones.
         with Heartbeat(f"{self.name}: first screen", within.size, "sequence", progress) as beat:
             probe_fails = self._probe(within, bench.screen_rows(inputs, *PROBE), beat, deadline)
-        if probe_fails.size < within.size:  # the time limit ended the first screen
-            record["complete"] = False
-            record["unsearched"] = (f"{self.name}: the first screen reached {probe_fails.size:,} of the "
-                                    f"{within.size:,} sequences within the tolerance nominally; none judged")
+        within, probe_cut = self._probed(within, probe_fails, record, deadline)
+        if within is None:
             return [], [], record
         order = within[probe_fails <= allowed][np.argsort(probe_fails[probe_fails <= allowed], kind="stable")]
         record["screened_out"] = int(within.size - order.size)
         with Heartbeat(f"{self.name}: screening and judging", order.size, "sequence", progress) as beat:
             found, found_idx, judged = self._screen_and_judge(order, inputs, allowed, span, candidates,
                                                               record, beat, deadline)
+        if probe_cut:
+            record["unsearched"] = "; ".join(filter(None, [f"{probe_cut}, only those screened and judged",
+                                                           record.get("unsearched")]))
         record["judged"], record["orienting"] = len(judged), len(found)
-        if found and deadline.over():  # no time left to certify them: candidates, not plans
-            self.unverified = found
+        return self._certify(found, found_idx, record, progress, deadline), judged, record
+
+    def _certify(self, found, found_idx, record, progress, deadline: Deadline) -> list:
+        """The plans of ``found`` (level rows ``found_idx``) that orient on
+        held-out trials, replayed while ``deadline`` lasts (none once it has
+        passed); the ones left unreplayed become ``unverified`` candidates,
+        and ``record`` counts both and says what was left."""
+        untried = found
+        certified = []
+        if found and not deadline.over():
+            certified, untried = self.certifier.certify(
+                found, *self.sequences(np.asarray(found_idx, dtype=int)), self.n_pins,
+                Heartbeat(f"{self.name}: held-out trials", len(found), "sequence", progress), deadline)
+            record["held_out"], record["certified"] = len(found) - len(untried), len(certified)
+        if untried:  # no time left to certify them: candidates, not plans
+            self.unverified = untried
             record["complete"] = False
-            record["unverified"] = len(found)
+            record["unverified"] = len(untried)
             record["unsearched"] = "; ".join(filter(None, [
-                record.get("unsearched"), f"{self.name}: the {len(found)} sequence(s) orienting on the selection "
-                                          f"trials not replayed on held-out trials (unverified)"]))
-            return [], judged, record
-        certified = self.certifier.certify(
-            found, *self.sequences(np.asarray(found_idx, dtype=int)), self.n_pins,
-            Heartbeat(f"{self.name}: held-out trials", len(found), "sequence", progress))
-        record["held_out"], record["certified"] = len(found), len(certified)
-        return certified, judged, record
+                record.get("unsearched"), f"{self.name}: the {len(untried)} sequence(s) orienting on the "
+                                          f"selection trials not replayed on held-out trials (unverified)"]))
+        return certified
+
+    def _probed(self, within, probe_fails, record, deadline: Deadline) -> tuple:
+        """``(rows, cut)``: the level's rows ``within`` that the probe reached
+        (``probe_fails`` has one count per row probed) and, when the time
+        limit ended it early, what it left for ``record["unsearched"]``
+        (``None`` when it probed them all). ``rows`` is None when none can be
+        judged (none probed, or no search time left): ``record`` then says so."""
+        if probe_fails.size == within.size:
+            return within, None
+        cut = (f"{self.name}: the first screen reached {probe_fails.size:,} of the {within.size:,} "
+               f"sequences within the tolerance nominally")
+        record["complete"] = False
+        record["probed"] = int(probe_fails.size)
+        if probe_fails.size == 0 or deadline.search_over():
+            record["unsearched"] = f"{cut}; none judged"
+            return None, cut
+        return within[:probe_fails.size], cut
 
     def _probe(self, within, rows, beat, deadline: Deadline) -> np.ndarray:
         """Failures of the level's rows ``within`` on the probe's ``rows``, all at
         once; under a time limit in chunks of ``PROBE_CHUNK``, stopping between
-        them once the search is over (fewer failures than ``within`` then)."""
+        them once the search is over or once the probe has used its share of
+        the search time (:func:`probe_goes_on`); fewer failures than
+        ``within`` then."""
         if not deadline.limited:
             return self.bench.failures(*self.sequences(within), rows, beat.stretch(0, within.size))
         out = []
+        started, search_end = deadline.elapsed(), deadline.elapsed() + max(0.0, deadline.left() - deadline.reserve)
         for start in range(0, within.size, PROBE_CHUNK):
-            if start and deadline.search_over():
+            if start and (deadline.search_over()
+                          or not probe_goes_on(deadline.elapsed(), started, start, within.size, search_end)):
                 beat.finish(start, "the time limit ended the first screen here")
                 break
             chunk = within[start:start + PROBE_CHUNK]
@@ -391,3 +429,16 @@ class LevelScreen:
                        "sequence", progress) as beat:
             verdicts = bench.judge(*self.sequences(best), stack(inputs), stretch=beat.stretch(0, best.size))
             return [self.plan(i, s, v) for i, s, v in zip(best, spread, verdicts)]
+
+
+def probe_goes_on(now: float, started: float, done: int, total: int, search_end: float) -> bool:
+    """Whether the probe of a level, begun at ``started`` with ``done`` of its
+    ``total`` sequences probed at ``now`` (seconds on the deadline's clock),
+    probes on: within ``PROBE_SHARE`` of the search time it had, or past it
+    when at its pace it ends leaving ``JUDGE_SHARE`` of that time to
+    ``search_end`` for screening and judging (a probe that ends in time with
+    room to judge is never cut)."""
+    if now - started < PROBE_SHARE * (search_end - started):
+        return True
+    return finishes_in_time(now, started, done, total, search_end, leave=JUDGE_SHARE)
+
