@@ -9,7 +9,7 @@ times are measurements; its plans are not: they must be the plans
 ``benchmarks/plan_speed.py``). A plan, width or count typed into the table
 that the record does not hold fails here. So does an answer or a nearest
 "yes" of the corpus table ("Real parts planned under a time limit") that
-its run's record (``benchmarks/records/real_parts_limit50_spread_out_2026-11-28.json``)
+its run's record (``benchmarks/records/real_parts_limit50_probe_budget_2026-11-28.json``)
 does not hold.
 """
 from __future__ import annotations
@@ -79,7 +79,7 @@ def test_a_row_states_the_recorded_plan(part):
 # --------------------------------------------------------------------------- the corpus under a time limit
 
 CORPUS_HEADING = "### Real parts planned under a time limit"
-CORPUS_RECORD = ROOT / "benchmarks" / "records" / "real_parts_limit50_spread_out_2026-11-28.json"
+CORPUS_RECORD = ROOT / "benchmarks" / "records" / "real_parts_limit50_probe_budget_2026-11-28.json"
 
 
 def _corpus_rows() -> dict:

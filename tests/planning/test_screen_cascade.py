@@ -106,6 +106,38 @@ def test_hard_trials_learned_from_judged_sequences_change_no_plan(tolerance):
     assert learned.best_effort == [] and (plain.plans or plain.best_effort)
 
 
+def test_the_hardest_trials_first_change_no_count_and_replay_less(monkeypatch):
+    """The hard trials in two steps (the ``HARD_FIRST`` hardest, then all
+    ``HARD_TRIALS``) reject exactly what all of them at once reject: the same
+    plans, verdicts and every level count, with fewer sequence-trial pairs
+    replayed (rolled out, or read from the bench's memo)."""
+    from pipeline.planning.tight.judge import TrialBench
+    part = Part.from_vertices([[0, 0], [50, 0], [10, 30]], name="sharp_triangle")
+    top = max(y for _, y in part.stable_states()) * 1.8
+    pins = {f"Q{k}": float(y) for k, y in enumerate(np.linspace(0.05 * part.a, top, 9), start=1)}
+    replay = TrialBench.replay
+
+    def search(hard_first):
+        monkeypatch.setattr(screen, "HARD_FIRST", hard_first)
+        pairs = []
+
+        def counted(self, heights, speeds, rows, *args, **kwargs):
+            pairs.append(np.atleast_2d(heights).shape[0] * np.size(rows[0]))
+            return replay(self, heights, speeds, rows, *args, **kwargs)
+
+        monkeypatch.setattr(TrialBench, "replay", counted)
+        # a strict claim (at most one failure allowed): few of the hardest trials already reject
+        s = FixedPinSearch(part, pins, MU, ClaimSettings(5.0, 0.999, rule="point"), VERIFY, SEARCH)
+        s.evidence = False
+        return s.run(3, candidates=1, keep=5), sum(pairs)
+
+    (staged, staged_pairs), (at_once, at_once_pairs) = search(16), search(screen.HARD_TRIALS)
+    assert [p.labels for p in staged.plans] == [p.labels for p in at_once.plans]
+    assert staged.levels == at_once.levels
+    assert sum(lv.get("hard_trials_out", 0) for lv in staged.levels) > 0  # the hard trials were used
+    assert staged_pairs < at_once_pairs
+
+
 def test_the_failing_trials_are_those_outside_the_best_arc():
     part = Part.from_vertices([[0, 0], [70, 0], [50, 25], [10, 25]])
     bench = _bench(part)

@@ -70,12 +70,16 @@ judged. A level's enumeration stops earlier, once it has used
 ``enumerate.ENUMERATION_SHARE`` of the search time left when it began: the
 sequences it enumerated are then screened and judged like a whole level's,
 so a plan of that many pins may still be found (it has the fewest pins: the
-levels before are complete). It is then complete only up to the last level it finished: the
+levels before are complete). A level's first screen likewise stops once it
+has used ``screen.PROBE_SHARE`` of the search time left when it began
+(unless it ends leaving ``screen.JUDGE_SHARE`` of it), and the level goes on
+with the sequences it probed. It is then complete only up to the last level it finished: the
 result says so (``complete``, ``unsearched``: the level cut short and how
 far it got, the levels not reached, the evidence not judged), and its "no"
 covers the sequences searched only. Orienting sequences found before the
-stop are still certified on held-out trials while the limit lasts; those it
-leaves no time for are ``unverified`` candidates, never plans.
+stop are still certified on held-out trials, one at a time and best first,
+while the limit lasts; those it leaves no time for are ``unverified``
+candidates, never plans.
 
 Who does what. :class:`FixedPinSearch` drives the levels (steps 1 and 6, the
 ranking and the evidence); a :class:`~pipeline.planning.tight.screen.LevelScreen`
