@@ -8,6 +8,7 @@ trials (tests/oracle.py) ends in one set of the answered tolerance (+1 deg:
 the two sample the box differently).
 """
 import dataclasses
+import math
 from types import SimpleNamespace
 
 import numpy as np
@@ -139,6 +140,33 @@ def test_half_a_degree_tighter_the_complete_search_finds_no_plan(no_plan):
     claims = dataclasses.replace(s.claims, tolerance_deg=tol["value"] - 0.5)
     pins = {k: v for k, v in result["pins_used"].items()}
     assert not FixedPinSearch(TRAPEZOID, pins, s.friction, claims, s.verify, s.search).run(2, keep=1).plans
+
+
+def test_the_first_step_below_the_plan_found_answers_as_the_plain_bisection(no_plan, monkeypatch):
+    """Searching half a step below the widest search's plan first, then
+    bisecting, gives the plain bisection's answer (the same tolerance and
+    plan) and the planner's."""
+    from pipeline.planning.plans import nearest_part
+    result, settings_ = no_plan
+    pins = dict(result["pins_used"])
+    tried = []
+    at = nearest_part._at
+
+    def noted(progress, tolerance):
+        tried.append(tolerance)
+        return at(progress, tolerance)
+
+    monkeypatch.setattr(nearest_part, "_at", noted)
+    stepped = nearest_part.searched_tolerance(TRAPEZOID, settings_.at(0.2), pins, 2, 12)
+    first_tries = list(tried)
+    tried.clear()
+    monkeypatch.setattr(nearest_part, "_next_tolerance",
+                        lambda lo, hi, tries: math.floor((lo + hi) / 2 / LADDER) * LADDER)
+    plain = nearest_part.searched_tolerance(TRAPEZOID, settings_.at(0.2), pins, 2, 12)
+    assert stepped[0] == plain[0] and stepped[1].labels == plain[1].labels and stepped[2] and plain[2]
+    assert first_tries[0] == MAX_TOLERANCE and len(first_tries) > 1 and len(tried) > 1
+    tol_first = next(a for a in result["nearest_yes"]["axes"] if a["axis"] == "tolerance")
+    assert stepped[0] == tol_first["value"]
 
 
 def test_the_answer_holds_in_an_independent_replay(no_plan):

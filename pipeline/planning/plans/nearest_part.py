@@ -46,6 +46,9 @@ def _axis(axis: str, found: bool, statement: str, **extra) -> dict:
     return {"axis": axis, "found": found, "holds": found, "statement": statement, **extra}
 
 
+STEPS_BELOW = 3  # searches half a step below the plan found before the bisection (see _next_tolerance)
+
+
 def loosest_needed(finals, jammed, n_trials: int, order: int, required: float, confidence: float,
                    rule: str) -> float | None:
     """The smallest tolerance (deg, on the ``LADDER``) whose claim the finals
@@ -75,20 +78,16 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
     orients within any looser tolerance, and its nominal finals pass the
     looser filter too, so "some plan orients" is monotone in ``t``. A plan
     found answers at its own tolerance (:func:`_own_tolerance`), where the
-    upper end moves: never looser than the plain bisection's answer.
-
-    The searches reuse the rollouts of ``reuse`` (the planner's own
-    fixed-pin search, say) when it shares them
-    (:meth:`~pipeline.planning.tight.complete.FixedPinSearch.shares_rollouts_with`),
-    else those of the first: an outcome depends on its key only, so each
-    finds what it would alone.
-
-    Under a time limit (``deadline``) a search it cuts short gives no
-    answer at its tolerance (over part searches the bisection would give a
-    wrong one): the first raises :class:`~pipeline.progress.OutOfTime`; a
-    later one ends the bisection with the loosest tolerance it certified, an
-    upper bound (``exact`` False). Its searches keep no evidence (only their
-    plans are read)."""
+    upper end moves: never looser than the plain bisection's answer. The
+    first steps are half a step below it (:func:`_next_tolerance`). The
+    searches reuse the rollouts of ``reuse`` (the planner's own search, say)
+    when it shares them (``FixedPinSearch.shares_rollouts_with``), else
+    those of the first: an outcome depends on its key only, so each finds
+    what it would alone. Under a time limit (``deadline``) a search it cuts
+    short gives no answer at its tolerance (over part searches the bisection
+    would give a wrong one): the first raises :class:`~pipeline.progress.OutOfTime`;
+    a later one ends the bisection with the loosest tolerance it certified,
+    an upper bound (``exact`` False). Its searches keep no evidence."""
     from pipeline.planning.tight.complete import FixedPinSearch
 
     donor = reuse  # whose rollouts serve the searches (tolerance changes no outcome)
@@ -112,8 +111,10 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
     if first is None:
         return None
     hi, best = first
+    tries = 0
     while hi - lo > LADDER + 1e-9:
-        mid = math.floor((lo + hi) / 2 / LADDER) * LADDER
+        mid = _next_tolerance(lo, hi, tries)
+        tries += 1
         try:
             got = found(mid)
         except OutOfTime:
@@ -123,6 +124,19 @@ def searched_tolerance(part, settings, pins: dict, depth: int, candidates: int, 
         else:
             hi, best = got
     return hi, best, True
+
+
+def _next_tolerance(lo: float, hi: float, tries: int) -> float:
+    """The tolerance to search next between ``lo`` (no plan) and ``hi`` (the
+    plan found last), ``tries`` searches after the widest: half a step below
+    ``hi`` for the first ``STEPS_BELOW``, then the middle, on the ``LADDER``.
+
+    A plan found is often the answer, or close: a "no" half a step below it
+    settles the question in one search, and a "yes" moves ``hi`` to the new
+    plan's own tolerance. The searches just short of the answer, where near
+    misses are screened deep, are the dear ones; the plain bisection made
+    four of them on a 20 mm triangle, where this makes one."""
+    return hi - LADDER if tries < STEPS_BELOW else math.floor((lo + hi) / 2 / LADDER) * LADDER
 
 
 def _own_tolerance(plan, bench: TrialBench, claims, asked: float) -> tuple:
