@@ -102,7 +102,11 @@ def record(out: Path, atlas_plans: Path | None, benchmark_parts: str | None = No
     if atlas_plans is not None:
         for path in sorted(Path(atlas_plans).glob("*.json")):
             plans[f"atlas/{path.stem}"] = stable(json.loads(path.read_text()))
-    out.write_text(json.dumps(plans, indent=1, sort_keys=True) + "\n")
+    text = json.dumps(plans, indent=1, sort_keys=True) + "\n"
+    if out.suffix == ".gz":  # as ``compare`` reads it
+        out.write_bytes(gzip.compress(text.encode(), mtime=0))
+    else:
+        out.write_text(text)
     print(f"recorded {len(plans)} plan files in {out}", file=sys.stderr)
 
 
