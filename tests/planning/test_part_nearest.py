@@ -164,7 +164,8 @@ def test_the_first_step_below_the_plan_found_answers_as_the_plain_bisection(no_p
                         lambda lo, hi, tries: math.floor((lo + hi) / 2 / LADDER) * LADDER)
     plain = nearest_part.searched_tolerance(TRAPEZOID, settings_.at(0.2), pins, 2, 12)
     assert stepped[0] == plain[0] and stepped[1].labels == plain[1].labels and stepped[2] and plain[2]
-    assert first_tries[0] == MAX_TOLERANCE and len(first_tries) > 1 and len(tried) > 1
+    assert first_tries[0] == MAX_TOLERANCE and 1 < len(first_tries) < len(tried)  # fewer searches
+    assert first_tries[1] == stepped[0] - LADDER  # half a step below the answer: its "no" settles it
     tol_first = next(a for a in result["nearest_yes"]["axes"] if a["axis"] == "tolerance")
     assert stepped[0] == tol_first["value"]
 
@@ -259,15 +260,12 @@ def test_with_no_time_left_the_nearest_yes_still_gives_the_axes_that_need_no_rol
     assert any(u.startswith('the nearest "yes": only the axes that need no rollout') for u in cut["unsearched"])
 
 
-def test_a_limit_passing_as_the_chosen_plans_are_carried_keeps_the_first(no_plan, monkeypatch):
-    """The limit passes as the carried sets of the chosen plans begin: the
-    first (the best the search kept) is still carried and verified, with
-    the numbers it has with time left, and the others are named as skipped
-    (dropping them all would leave no plan where the search had one)."""
+def _carried_as_the_limit_passes(settings_, monkeypatch) -> tuple:
+    """The trapezoid planned with time left (``with_time``) and with the limit
+    passing as the carried sets of the chosen plans begin (``cut``)."""
     from pipeline.planning.plans import plan as plan_module
-    _, settings_ = no_plan
-    with_time = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=3)).to_dict()
-    deadline, original = _NoTimeLeft(reads=3), plan_module.carried_sets
+    with_time = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=_SearchCut(reads=10 ** 6)).to_dict()
+    deadline, original = _NoTimeLeft(reads=10 ** 6), plan_module.carried_sets
 
     def expire(*args, **kwargs):
         deadline.expired = True
@@ -275,16 +273,43 @@ def test_a_limit_passing_as_the_chosen_plans_are_carried_keeps_the_first(no_plan
 
     monkeypatch.setattr(plan_module, "carried_sets", expire)
     cut = plan_tight(TRAPEZOID, settings_.at(0.2), deadline=deadline).to_dict()
+    assert deadline.expired
+    skipped = [u for u in cut["unsearched"] if u.startswith("carried sets and held-out verification")]
+    return with_time, cut, skipped
+
+
+def test_a_limit_passing_as_certified_plans_are_carried_keeps_the_first(monkeypatch):
+    """At 40 deg the search certifies plans for the trapezoid. When the limit
+    passes as their carried sets begin, the first (the search's best) is
+    still carried and verified, with the numbers it has with time left, and
+    the others are named as skipped (dropping them all would leave no plan
+    where the search certified one)."""
+    config = load_config()
+    config["planner"].update(pins="auto", depth=2, tolerance_deg=40.0, mu_c=0.2, frictions=[])
+    config["planner"]["dynamic"].update(depth=0, speeds=[])
+    config["verify"].update(trials=30, rule="point")
+    with_time, cut, skipped = _carried_as_the_limit_passes(PlannerSettings.from_config(config), monkeypatch)
     kept = cut["plans"] + cut["rejected"]
     before = {tuple(p["pins"]): p for p in with_time["plans"] + with_time["rejected"]}
-    assert deadline.expired and len(kept) == 1 and len(before) > 1
+    assert with_time["orients"] and cut["orients"] and len(kept) == 1 and len(before) > 1
     plan = kept[0]
     same = before[tuple(plan["pins"])]["verification"]
     assert plan["verification"] == {k: v for k, v in same.items() if k != "untruncated"}  # skipped: no time
-    skipped = [u for u in cut["unsearched"] if u.startswith("carried sets and held-out verification")]
     assert len(skipped) == 1 and skipped[0].startswith(f"carried sets and held-out verification of "
                                                        f"{len(before) - 1} chosen plan(s): skipped")
     assert " ".join(plan["pins"]) not in skipped[0].split(": skipped")[1]
+
+
+def test_a_limit_passing_as_uncertified_plans_are_carried_keeps_none(no_plan, monkeypatch):
+    """Where nothing orients, the chosen plans are the search's best efforts,
+    never certified: past the limit none is carried (each would need its own
+    held-out replays), and all are named as skipped."""
+    _, settings_ = no_plan
+    with_time, cut, skipped = _carried_as_the_limit_passes(settings_, monkeypatch)
+    n_kept = len(with_time["plans"] + with_time["rejected"])
+    assert not cut["plans"] and not cut["rejected"] and n_kept > 0
+    assert skipped == [s for s in skipped if s.startswith(f"carried sets and held-out verification of {n_kept} ")]
+    assert len(skipped) == 1
 
 
 def test_moving_pins_the_limit_came_before_are_named_so(no_plan):

@@ -238,6 +238,10 @@ def test_a_probe_cut_by_its_share_judges_the_sequences_it_probed(monkeypatch):
     best = result.plans[0]
     got = [list(best.labels), best.verdict["in_tolerance"], best.verdict["trials"], round(best.verdict["width_deg"], 4)]
     assert got in BEFORE[10.0]["plans"]
+    # the one probed is the narrowest nominally (the screen's first), not the other
+    whole = _search(10.0).run(2, candidates=3).plans
+    assert len(whole) == 2 and best.nominal_span == min(p.nominal_span for p in whole)
+    assert best.nominal_span < max(p.nominal_span for p in whole)
 
 
 def test_a_probe_cut_with_no_search_time_left_judges_none(monkeypatch):
@@ -291,6 +295,7 @@ def test_the_limit_passing_during_certification_certifies_the_best_first(monkeyp
     time, best first on the selection trials, under a limit: when the limit
     passes after the first, it is the plan (with the complete search's
     verdict) and the other is an unverified candidate, named as such."""
+    from pipeline.planning.tight import screen as screen_module
     from pipeline.planning.tight.judge import TrialBench
     deadline, judge = _OverOnceCertifying(), TrialBench.judge
 
@@ -300,6 +305,14 @@ def test_the_limit_passing_during_certification_certifies_the_best_first(monkeyp
         return judge(self, heights, speeds, rows, interval, **({"stretch": stretch} if stretch else {}))
 
     monkeypatch.setattr(TrialBench, "judge", certifying)
+    # the screen finds them in the reverse of their rank: the certification must rank them itself
+    screen_and_judge = screen_module.LevelScreen._screen_and_judge
+
+    def reversed_found(self, *args, **kwargs):
+        found, found_idx, judged = screen_and_judge(self, *args, **kwargs)
+        return found[::-1], found_idx[::-1], judged
+
+    monkeypatch.setattr(screen_module.LevelScreen, "_screen_and_judge", reversed_found)
     result = _search(10.0).run(2, candidates=3, deadline=deadline)
     level = result.levels[-1]
     assert level["orienting"] == 2 and level["certified"] == 1 and level["unverified"] == 1

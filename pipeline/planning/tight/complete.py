@@ -303,6 +303,7 @@ class FixedPinSearch:
         ``levels`` (for the evidence); ``whose`` ends its progress line."""
         screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier, self._name(n_pins),
                              learn=not self.evidence)
+        screen.rank = self.ranked
         found, judged, record = screen.search(candidates, progress, deadline)
         if progress:
             progress(self._level_summary(n_pins, record) + whose)

@@ -287,28 +287,23 @@ class Certifier:
         the trials that chose it. ``beat`` hears how far it got.
 
         Under a time limit (``deadline``) the plans are replayed one at a
-        time, best first on the selection trials, until the limit has passed:
-        the best one is certified first, and the ones left are ``untried``
-        (never plans: unverified candidates)."""
+        time, in the order given (the caller's ranking, best first), until
+        the limit has passed: the ones left are ``untried`` (never plans:
+        unverified candidates)."""
         if not found:
             return [], []
         rows = self.bench.held_out(n_pins)
-        order = list(range(len(found)))
-        step = max(1, MAX_ROWS // rows[0].size)
-        if deadline.limited:
-            order.sort(key=lambda k: found[k].rank_key())
-            step = 1
+        step = 1 if deadline.limited else max(1, MAX_ROWS // rows[0].size)
         out = []
         with beat:
-            for start in range(0, len(order), step):
+            for start in range(0, len(found), step):
                 if start and deadline.over():
                     beat.finish(start, "the time limit has passed: the others are not replayed")
-                    return out, [found[k] for k in order[start:]]
-                pick = np.asarray(order[start:start + step])
-                verdicts = self.bench.judge(heights[pick], speeds[pick], rows, interval=True,
-                                            stretch=beat.stretch(start, start + pick.size))
-                for k, held in zip(pick, verdicts):
-                    plan = found[k]
+                    return out, found[start:]
+                stop = min(len(found), start + step)
+                verdicts = self.bench.judge(heights[start:stop], speeds[start:stop], rows, interval=True,
+                                            stretch=beat.stretch(start, stop))
+                for plan, held in zip(found[start:stop], verdicts):
                     plan.selection, plan.verdict = plan.verdict, held
                     if held["orients"]:
                         out.append(plan)

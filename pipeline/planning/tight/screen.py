@@ -85,6 +85,7 @@ class LevelScreen:
         self.bench, self.certifier, self.name = bench, certifier, name
         self.unverified = []  # orienting on the selection trials, left uncertified by a time limit
         self.learn = learn
+        self.rank = lambda plans: sorted(plans, key=FixedPlan.rank_key)  # best first; the search sets its own
         self.fail_counts = None  # per trial of the full set: the judged sequences it failed (learn)
         self.evidence_cut = False  # the time limit ended the roll-out of its spread-out sequences
 
@@ -109,10 +110,12 @@ class LevelScreen:
         """``(orienting plans, every judged plan, the level's counts)``; each
         stage tells ``progress`` how far it has got. Once ``deadline``'s
         search is over the level stops between chunks of the first screen or
-        between blocks of the screen (``complete`` False and ``unsearched`` in
-        its counts say how far it got); orienting sequences are certified
-        unless the limit itself has passed (then they are kept in
-        ``unverified``)."""
+        between blocks of the screen, and the first screen stops early once it
+        has used its share of the search time (:func:`probe_goes_on`; the
+        level goes on with the sequences it probed); ``complete`` False and
+        ``unsearched`` in its counts say how far it got. Orienting sequences
+        are certified, best first, until the limit itself has passed (the
+        rest are kept in ``unverified``)."""
         level, bench = self.level, self.bench
         record = {"sequences": level.size, "nominal_within": 0, "screened_out": 0, "judged": 0,
                   "orienting": 0, "not_screened": 0, "held_out": 0, "certified": 0}
@@ -158,6 +161,10 @@ class LevelScreen:
         untried = found
         certified = []
         if found and not deadline.over():
+            if deadline.limited:  # one at a time until the limit: the best (as the search ranks) first
+                at = {id(plan): idx for plan, idx in zip(found, found_idx)}
+                found = self.rank(found)
+                found_idx = [at[id(plan)] for plan in found]
             certified, untried = self.certifier.certify(
                 found, *self.sequences(np.asarray(found_idx, dtype=int)), self.n_pins,
                 Heartbeat(f"{self.name}: held-out trials", len(found), "sequence", progress), deadline)
