@@ -300,16 +300,21 @@ def test_a_limit_passing_as_certified_plans_are_carried_keeps_the_first(monkeypa
     assert " ".join(plan["pins"]) not in skipped[0].split(": skipped")[1]
 
 
-def test_a_limit_passing_as_uncertified_plans_are_carried_keeps_none(no_plan, monkeypatch):
-    """Where nothing orients, the chosen plans are the search's best efforts,
-    never certified: past the limit none is carried (each would need its own
-    held-out replays), and all are named as skipped."""
+def test_a_limit_passing_as_best_efforts_are_carried_keeps_the_first(no_plan, monkeypatch):
+    """Where nothing orients, the chosen plans are the search's best efforts:
+    past the limit the first is still carried and verified on its held-out
+    trials, with the numbers it has with time left (an answer, not "no
+    plan"), and the others are named as skipped."""
     _, settings_ = no_plan
     with_time, cut, skipped = _carried_as_the_limit_passes(settings_, monkeypatch)
-    n_kept = len(with_time["plans"] + with_time["rejected"])
-    assert not cut["plans"] and not cut["rejected"] and n_kept > 0
-    assert skipped == [s for s in skipped if s.startswith(f"carried sets and held-out verification of {n_kept} ")]
-    assert len(skipped) == 1
+    kept = cut["plans"] + cut["rejected"]
+    before = {tuple(p["pins"]): p for p in with_time["plans"] + with_time["rejected"]}
+    assert not with_time["orients"] and len(kept) == 1 and len(before) > 1
+    plan = kept[0]
+    same = before[tuple(plan["pins"])]["verification"]
+    assert plan["verification"] == {k: v for k, v in same.items() if k != "untruncated"}
+    assert len(skipped) == 1 and skipped[0].startswith(f"carried sets and held-out verification of "
+                                                       f"{len(before) - 1} chosen plan(s): skipped")
 
 
 def test_moving_pins_the_limit_came_before_are_named_so(no_plan):

@@ -47,8 +47,7 @@ def add_moving_pins(part: Part, settings: PlannerSettings, planner, fixed: Fixed
     moving_search = _moving_search(part, settings, moving, chosen, keep, progress, family, checker, deadline,
                                    memo)
     unsearched += moving_search.unsearched
-    carried = carried_sets(moving, moving_search.plans, settings.verify, family, progress, deadline, unsearched,
-                           certified=True)
+    carried = carried_sets(moving, moving_search.plans, settings.verify, family, progress, deadline, unsearched)
     candidates += carried
     selections += [p.selection or p.verdict for p in moving_search.plans[:len(carried)]]
     return moving, moving_search
@@ -140,22 +139,22 @@ def moving_room(found: list, n_prefix: int, depth: int, fewer: bool = False) -> 
 
 
 def carried_sets(planner, chosen, verify, family, progress, deadline: Deadline = NO_DEADLINE,
-             unsearched: list | None = None, certified: bool = False) -> list:
+             unsearched: list | None = None) -> list:
     """The carried sets of each chosen plan (``certify.carried_plan``), telling
     ``progress`` how many are done (and, between the propagation's rollout
     batches, that it is still at it). Once ``deadline`` has passed no further
     plan is started (each one started is then verified): the plans left are
-    named in ``unsearched``. When the search ``certified`` the plans, the
-    first (its best) is always done, past the limit too: dropping it would
-    turn a plan the search certified into no plan at all (its verification
-    then reads the held-out states its certification left). Sampled carried
-    sets of plans that share their first pins share those rollouts
-    (``verify.ReplayMemo``)."""
+    named in ``unsearched``. The first (the search's best) is always done,
+    past the limit too: dropping it would leave no answer at all where the
+    search had one (a certified plan's verification reads the held-out
+    states its certification left; a best effort's replays its held-out
+    trials). Sampled carried sets of plans that share their first pins
+    share those rollouts (``verify.ReplayMemo``)."""
     out, memo = [], ReplayMemo()
     with Heartbeat("carried sets of the chosen plans", len(chosen), "plan", progress) as beat:
         try:
             for p in chosen:
-                if (out or not certified) and deadline.over():
+                if out and deadline.over():
                     left = chosen[len(out):]
                     beat.finish(len(out), "the time limit has passed")
                     if unsearched is not None:

@@ -95,8 +95,7 @@ def plan_tight(part: Part, settings: PlannerSettings, lattices=None, depth: int 
     unsearched = list(fixed.unsearched)
     # No pin is the plan with the fewest pins: then nothing is certified or recommended.
     chosen = [] if fixed.needs_no_pin else fixed.plans or fixed.best_effort
-    candidates = carried_sets(planner, chosen, settings.verify, family, progress, deadline, unsearched,
-                              certified=bool(fixed.plans))
+    candidates = carried_sets(planner, chosen, settings.verify, family, progress, deadline, unsearched)
     selections = [p.selection or p.verdict for p in chosen[:len(candidates)]]
     planner, moving_search = add_moving_pins(part, settings, planner, fixed, chosen, keep, progress, family,
                                               checker, deadline, candidates, selections, unsearched,
