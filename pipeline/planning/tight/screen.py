@@ -28,13 +28,8 @@ SCREEN_BLOCK = 96  # candidates screened at once
 HARD_TRIALS = 64  # trials that failed most often in a level's judged sequences, tried first (moving pins)
 HARD_FIRST = 16  # ... the hardest of them first: a subset rejects exactly (see CASCADE), at a quarter of the cost
 PROBE_CHUNK = 256  # candidates probed at once under a time limit (the clock is read between chunks)
-# Under a time limit the probe may use this share of the search time left when
-# it starts, and goes on past it only if at its pace it ends leaving
-# JUDGE_SHARE of that time to screen and judge what it probed: else the level
-# goes on with the sequences probed (a probe that ate the search time would
-# leave none judged, and no plan, where one was within reach).
-PROBE_SHARE = 0.3
-JUDGE_SHARE = 0.5
+PROBE_SHARE = 0.3  # of the search time left, the most a probe uses under a limit (see probe_goes_on) ...
+JUDGE_SHARE = 0.5  # ... unless it ends leaving this share to screen and judge what it probed
 
 
 @dataclass(eq=False)
@@ -155,9 +150,8 @@ class LevelScreen:
 
     def _certify(self, found, found_idx, record, progress, deadline: Deadline) -> list:
         """The plans of ``found`` (level rows ``found_idx``) that orient on
-        held-out trials, replayed while ``deadline`` lasts (none once it has
-        passed); the ones left unreplayed become ``unverified`` candidates,
-        and ``record`` counts both and says what was left."""
+        held-out trials, replayed while ``deadline`` lasts; the ones left
+        become ``unverified`` candidates, named in ``record``."""
         untried = found
         certified = []
         if found and not deadline.over():
@@ -179,11 +173,9 @@ class LevelScreen:
         return certified
 
     def _probed(self, within, probe_fails, record, deadline: Deadline) -> tuple:
-        """``(rows, cut)``: the level's rows ``within`` that the probe reached
-        (``probe_fails`` has one count per row probed) and, when the time
-        limit ended it early, what it left for ``record["unsearched"]``
-        (``None`` when it probed them all). ``rows`` is None when none can be
-        judged (none probed, or no search time left): ``record`` then says so."""
+        """``(rows, cut)``: the rows of ``within`` the probe reached (one count
+        each in ``probe_fails``) and, when the limit ended it early, what it
+        left (else ``None``); ``rows`` is None when none can be judged."""
         if probe_fails.size == within.size:
             return within, None
         cut = (f"{self.name}: the first screen reached {probe_fails.size:,} of the {within.size:,} "
@@ -198,9 +190,8 @@ class LevelScreen:
     def _probe(self, within, rows, beat, deadline: Deadline) -> np.ndarray:
         """Failures of the level's rows ``within`` on the probe's ``rows``, all at
         once; under a time limit in chunks of ``PROBE_CHUNK``, stopping between
-        them once the search is over or once the probe has used its share of
-        the search time (:func:`probe_goes_on`); fewer failures than
-        ``within`` then."""
+        them (fewer failures than ``within`` then) once the search is over or
+        :func:`probe_goes_on` says so."""
         if not deadline.limited:
             return self.bench.failures(*self.sequences(within), rows, beat.stretch(0, within.size))
         out = []
@@ -370,8 +361,7 @@ class LevelScreen:
         """``alive`` without the sequences that fail more than ``allowed`` of the
         ``HARD_TRIALS`` trials of ``full`` that failed most often in the
         sequences judged so far (``learn`` only; exact, as the ``CASCADE``),
-        the ``HARD_FIRST`` hardest of them first (a near miss fails the same
-        few trials as the sequences judged before it, so most go there);
+        the ``HARD_FIRST`` hardest first (a near miss fails the same few);
         counted in ``record``."""
         counts = self.fail_counts
         if not self.learn or counts is None or alive.size == 0 or np.count_nonzero(counts) <= allowed:
@@ -448,12 +438,12 @@ class LevelScreen:
 
 
 def probe_goes_on(now: float, started: float, done: int, total: int, search_end: float) -> bool:
-    """Whether the probe of a level, begun at ``started`` with ``done`` of its
+    """Whether a level's probe, begun at ``started`` with ``done`` of its
     ``total`` sequences probed at ``now`` (seconds on the deadline's clock),
-    probes on: within ``PROBE_SHARE`` of the search time it had, or past it
-    when at its pace it ends leaving ``JUDGE_SHARE`` of that time to
-    ``search_end`` for screening and judging (a probe that ends in time with
-    room to judge is never cut)."""
+    goes on: within ``PROBE_SHARE`` of its time to ``search_end``, or past it
+    if at its pace it ends leaving ``JUDGE_SHARE`` of that time to judge.
+    A probe that would use up the search time leaves none judged, and no
+    plan where one was within reach: the level then judges what it probed."""
     if now - started < PROBE_SHARE * (search_end - started):
         return True
     return finishes_in_time(now, started, done, total, search_end, leave=JUDGE_SHARE)
