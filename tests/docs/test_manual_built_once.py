@@ -33,6 +33,8 @@ def built_docs():
 # One module, three kinds of test: reading the manual (its own group), sharing
 # the module's fixture (the module's group), and neither (spread).
 TESTS_PY = '''
+import time
+
 import pytest
 
 @pytest.fixture(scope="module")
@@ -49,7 +51,7 @@ def test_reads_the_run(workflow_run, i):
 
 @pytest.mark.parametrize("i", range(12))
 def test_other(i):
-    pass
+    time.sleep(0.2)  # long enough that one worker cannot take them all while the other starts its group
 '''
 
 
