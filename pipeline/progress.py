@@ -292,6 +292,10 @@ class Deadline:
         """Seconds left before the limit (``inf`` without one; negative once past it)."""
         return math.inf if self.seconds is None else self.seconds - self.elapsed()
 
+    def search_left(self) -> float:
+        """Seconds of search time left: :meth:`left` less the reserve, never negative."""
+        return math.inf if self.seconds is None else max(0.0, self.left() - self.reserve)
+
     def search_over(self) -> bool:
         """True when a search should stop: less than the reserve for verification is left."""
         return self.seconds is not None and self.left() <= self.reserve

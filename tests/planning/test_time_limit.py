@@ -76,11 +76,14 @@ def test_the_deadline_keeps_a_reserve_for_verification_and_no_limit_never_ends()
     deadline = Deadline(10.0, clock=clock)  # made at t = 1
     assert deadline.limited and deadline.reserve == pytest.approx(2.0)
     assert not deadline.search_over()  # t = 2: 9 s left
+    assert deadline.search_left() == pytest.approx(6.0)  # t = 3: 8 s left, less the 2 s reserve
     clock.now = 8.5  # the next read is t = 9.5: 1.5 s left, inside the reserve
     assert deadline.search_over() and not deadline.over()
+    assert deadline.search_left() == 0.0  # inside the reserve: none, never negative
     clock.now = 11.0
     assert deadline.over()
     assert not NO_DEADLINE.limited and not NO_DEADLINE.search_over() and not NO_DEADLINE.over()
+    assert NO_DEADLINE.search_left() == float("inf")
     assert Deadline(3600.0).reserve == 60.0  # at most a minute is kept back
 
 

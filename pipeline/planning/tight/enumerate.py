@@ -209,7 +209,7 @@ class NominalTree:
             n = level.size * self.heights.size
             stop_at = None
             if deadline.limited:
-                stop_at = deadline.elapsed() + ENUMERATION_SHARE * max(0.0, deadline.left() - deadline.reserve)
+                stop_at = deadline.elapsed() + ENUMERATION_SHARE * deadline.search_left()
             with heartbeat(level.seq.shape[1] + 1, n) as beat:
                 level = self.extend(level, beat.stretch(0, n), deadline, stop_at, span if k == depth - 1 else None)
                 if level.cut:

@@ -195,7 +195,8 @@ class LevelScreen:
         if not deadline.limited:
             return self.bench.failures(*self.sequences(within), rows, beat.stretch(0, within.size))
         out = []
-        started, search_end = deadline.elapsed(), deadline.elapsed() + max(0.0, deadline.left() - deadline.reserve)
+        started = deadline.elapsed()
+        search_end = started + deadline.search_left()
         for start in range(0, within.size, PROBE_CHUNK):
             if start and (deadline.search_over()
                           or not probe_goes_on(deadline.elapsed(), started, start, within.size, search_end)):
@@ -368,28 +369,22 @@ class LevelScreen:
             return alive
         order = np.lexsort((np.arange(counts.size), -counts))
         n_hard = min(HARD_TRIALS, np.count_nonzero(counts))
-        out = 0
-        for size in sorted({min(HARD_FIRST, n_hard), n_hard}):
-            if alive.size == 0 or size <= allowed:
-                continue  # no sequence can fail more than allowed of so few trials
-            hard = order[:size]
-            fails = self.bench.failures(*self.sequences(alive), tuple(np.asarray(x)[hard] for x in full))
-            out += int((fails > allowed).sum())
-            alive = alive[fails <= allowed]
-        record["screened_out"] += out
-        record["hard_trials_out"] = record.get("hard_trials_out", 0) + out
-        return alive
+        subsets = [tuple(np.asarray(x)[order[:size]] for x in full)
+                   for size in sorted({min(HARD_FIRST, n_hard), n_hard}) if size > allowed]
+        record.setdefault("hard_trials_out", 0)
+        return self._cascade(alive, subsets, allowed, record, "hard_trials_out")
 
-    def _cascade(self, alive, cascade, allowed: int, record):
+    def _cascade(self, alive, cascade, allowed: int, record, counter: str = "cascade_out"):
         """``alive`` without the sequences that fail more than ``allowed`` trials
         of one of the growing subsets ``cascade`` (rows; see ``CASCADE``), in
-        turn; the rejected ones are counted as screened out in ``record``."""
+        turn; the rejected ones are counted as screened out and under
+        ``counter`` in ``record``."""
         for rows in cascade:
             if alive.size == 0:
                 break
             fails = self.bench.failures(*self.sequences(alive), rows)
             record["screened_out"] += int((fails > allowed).sum())
-            record["cascade_out"] = record.get("cascade_out", 0) + int((fails > allowed).sum())
+            record[counter] = record.get(counter, 0) + int((fails > allowed).sum())
             alive = alive[fails <= allowed]
         return alive
 
