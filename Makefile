@@ -20,7 +20,11 @@ $(STAMP): pyproject.toml
 # pipeline/workflow/runner.py prints it).
 # After a killed run it removes Snakemake's stale lock and temporary files
 # when no other run is alive (pipeline/workflow/runner.py), saying so in one line.
+# First compiles the kernels once after an install or an edit of kernels/
+# (pipeline/maps/warm.py; silent when they are cached), so that the jobs, and
+# the first drawing planned after, load them instead.
 run: $(STAMP)
+	@$(BIN)/python -m pipeline.maps.warm
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pipeline.workflow run --cores all --rerun-incomplete
 
 # The support-family study (rules/support.smk, config key support_study): not

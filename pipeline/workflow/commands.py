@@ -127,7 +127,8 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     records until the end, where the plan file's dict is made.
 
     With ``planner.time_limit_s`` (``--time-limit``, tight mode only) the
-    time runs from here: the planner stops its searches in time
+    time runs from here, the kernels' compile on a first run included
+    (:func:`pipeline.maps.warm.warm_kernels`): the planner stops its searches in time
     (:func:`pipeline.planning.plan_tight_all`), the speed limits are found
     only while time is left and the shape tolerance's search is skipped; each
     entry's ``unsearched`` says what was left out."""
@@ -153,6 +154,8 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     if deadline.limited and mode != "tight":
         raise PinfeedError("--time-limit (planner.time_limit_s) bounds the tight planner's search; "
                            "use --mode tight, or leave the time limit out")
+    from pipeline.maps.warm import warm_kernels
+    warm_kernels(progress)  # a first run compiles here (and says so), not within the first level's pace
     if mode == "tight":
         result = plan_tight_only(part, settings, config["catalog_dir"], progress=progress, deadline=deadline)
         if deadline.limited:

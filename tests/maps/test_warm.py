@@ -1,0 +1,60 @@
+"""The kernels' warm-up (``pipeline.maps.warm``): it says so when it takes
+long (compiling), and a plan after it compiles nothing more, so the first
+level's pace is the planner's own and a real drawing planned after ``make
+run`` does not spend its time limit compiling."""
+import importlib
+import math
+import pkgutil
+
+from numba.core.registry import CPUDispatcher
+
+import kernels
+from cli_runs import run_cli, small_config_file
+from pipeline.maps.warm import NOTICE, warm_kernels
+
+
+def _overloads() -> dict:
+    """Compiled signatures per CPU kernel (``module.name`` -> count)."""
+    out = {}
+    for info in pkgutil.iter_modules(kernels.__path__):
+        if info.name == "cuda":  # the GPU kernels: not run on a CPU
+            continue
+        module = importlib.import_module(f"kernels.{info.name}")
+        for name, obj in vars(module).items():
+            if isinstance(obj, CPUDispatcher):
+                out[f"{info.name}.{name}"] = len(obj.overloads)
+    return out
+
+
+def _ring(cx, cy, r, n, clockwise=False):
+    sign = -1.0 if clockwise else 1.0
+    return " ".join(f"{cx + r * math.cos(sign * 2 * math.pi * k / n):.4f},"
+                    f"{cy + r * math.sin(sign * 2 * math.pi * k / n):.4f}" for k in range(n))
+
+
+def test_notice_comes_only_when_the_warm_up_takes_long():
+    lines = []
+    warm_kernels(lines.append, notice_after=600.0)  # cached by now (or compiled): well under 600 s
+    assert lines == []
+    warm_kernels(lines.append, notice_after=0.0)
+    assert lines == [NOTICE]
+
+
+def test_plans_after_the_warm_up_compile_no_kernel(tmp_path, capsys, monkeypatch):
+    """A holed part of 40 + 12 vertices (its support table) with a moving pin,
+    and a plain quadrilateral: every kernel they run was compiled (or loaded)
+    by the warm-up, with the same signature."""
+    monkeypatch.chdir(tmp_path)
+    config = small_config_file(tmp_path)
+    warm_kernels()
+    before = _overloads()
+    holed = ["--vertices", _ring(0, 0, 20, 40), "--hole", _ring(5, 0, 4, 12, clockwise=True), "--name", "disc",
+             "--speeds=1", "--dynamic-depth", "1"]
+    plain = ["--vertices", "0,0 40,0 40,20 10,25", "--name", "quad", "--dynamic-depth", "0"]
+    for part in (holed, plain):
+        code, _, err = run_cli(capsys, ["plan", "--config", str(config), *part, "--depth", "1", "--pins=5,15",
+                                        "--mu-c", "0.2", "--catalog", str(tmp_path / "cat"),
+                                        "--out", str(tmp_path / "plan.json")])
+        assert code == 0, err
+    after = _overloads()
+    assert {k: (before.get(k, 0), n) for k, n in after.items() if n > before.get(k, 0)} == {}
