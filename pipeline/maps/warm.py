@@ -8,9 +8,9 @@ on tiny inputs, so that this cost is paid in one known place:
 
 * ``pinfeed plan`` calls it before its search. A search's first level then
   measures its real pace (the estimates of the levels after it use it), and
-  when compiling takes a while a progress line says what is happening. Under
-  ``--time-limit`` the compile counts in the limit like any other work: the
-  limit is the user's wall time.
+  when compiling takes a while a progress line says what is happening. A
+  ``--time-limit`` counts from after it (see
+  ``pipeline.workflow.commands._warm_up``).
 * ``make run`` runs ``python -m pipeline.maps.warm`` first, so the workflow's
   jobs and the first plan of a drawing after it load the kernels instead of
   compiling them. The workflow's default parts are triangles: without this

@@ -127,8 +127,8 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     records until the end, where the plan file's dict is made.
 
     With ``planner.time_limit_s`` (``--time-limit``, tight mode only) the
-    time runs from here, the kernels' compile on a first run included
-    (:func:`pipeline.maps.warm.warm_kernels`): the planner stops its searches in time
+    time runs from here, after the kernels are compiled or loaded
+    (:func:`_warm_up`): the planner stops its searches in time
     (:func:`pipeline.planning.plan_tight_all`), the speed limits are found
     only while time is left and the shape tolerance's search is skipped; each
     entry's ``unsearched`` says what was left out."""
@@ -150,12 +150,11 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
         parse_support_family(family, part)  # a bad family: a one-line error before any work
     from pipeline.planning import attach_speed_limits
     from pipeline.progress import Deadline
-    deadline = Deadline(settings.search.time_limit_s)
-    if deadline.limited and mode != "tight":
+    if settings.search.time_limit_s is not None and mode != "tight":
         raise PinfeedError("--time-limit (planner.time_limit_s) bounds the tight planner's search; "
                            "use --mode tight, or leave the time limit out")
-    from pipeline.maps.warm import warm_kernels
-    warm_kernels(progress)  # a first run compiles here (and says so), not within the first level's pace
+    _warm_up(progress, settings.search.time_limit_s)
+    deadline = Deadline(settings.search.time_limit_s)
     if mode == "tight":
         result = plan_tight_only(part, settings, config["catalog_dir"], progress=progress, deadline=deadline)
         if deadline.limited:
@@ -168,6 +167,20 @@ def plan_command(part: Part, config: dict, mode: str, progress=None) -> dict:
     if mode == "paper":
         result = dataclasses.replace(result, tight=None)
     return attach_speed_limits(result, settings, part).to_dict()
+
+
+def _warm_up(progress, time_limit_s) -> None:
+    """Compile (or load from the cache) the kernels before the search
+    (:func:`pipeline.maps.warm.warm_kernels`), so a first run's compile is
+    not taken for the pace of the search's first level. The compile is done
+    once after an install and takes longer than most time limits, so a time
+    limit runs from after it (a first run would otherwise search nothing);
+    ``progress`` is told so when it compiled."""
+    from pipeline.maps.warm import NOTICE_AFTER, warm_kernels
+    took = warm_kernels(progress)
+    if progress is not None and took > NOTICE_AFTER:
+        progress(f"kernels compiled in {took:.0f} s"
+                 + ("; the time limit counts from now" if time_limit_s is not None else ""))
 
 
 def _time_limited_stages(result, part: Part, settings, deadline):

@@ -3,6 +3,7 @@ long (compiling), and a plan after it compiles nothing more, so the first
 level's pace is the planner's own and a real drawing planned after ``make
 run`` does not spend its time limit compiling."""
 import importlib
+import json
 import math
 import pkgutil
 
@@ -58,3 +59,27 @@ def test_plans_after_the_warm_up_compile_no_kernel(tmp_path, capsys, monkeypatch
         assert code == 0, err
     after = _overloads()
     assert {k: (before.get(k, 0), n) for k, n in after.items() if n > before.get(k, 0)} == {}
+
+
+def test_a_time_limit_counts_from_after_the_compile(tmp_path, capsys, monkeypatch):
+    """A first run's compile (here a warm-up made to take 3 s) does not eat a
+    2 s limit: the quadrilateral's one-pin search is still complete, and the
+    progress says the compile took place."""
+    import time
+
+    import pipeline.maps.warm as warm
+
+    def slow_warm_up(progress=None, every=False, notice_after=warm.NOTICE_AFTER):
+        time.sleep(3.0)
+        return 3.0
+
+    monkeypatch.chdir(tmp_path)
+    warm_kernels()  # the real kernels, before the clock matters
+    monkeypatch.setattr(warm, "warm_kernels", slow_warm_up)
+    code, out, err = run_cli(capsys, ["plan", "--config", str(small_config_file(tmp_path)), "--vertices",
+                                      "0,0 40,0 40,20 10,25", "--name", "quad", "--depth", "1", "--pins=5,15",
+                                      "--mu-c", "0.2", "--dynamic-depth", "0", "--time-limit", "2",
+                                      "--catalog", str(tmp_path / "cat"), "--json"])
+    assert code == 0, err
+    assert "kernels compiled in 3 s; the time limit counts from now" in err
+    assert json.loads(out)["complete"] is True
