@@ -1,7 +1,7 @@
 """Compile the kernels before the work that needs them.
 
 Numba compiles a kernel the first time it runs after an install or an edit
-of ``kernels/`` (about a minute in all on a 2-core machine) and keeps the
+of ``kernels/`` (a minute or two on a 2-core machine) and keeps the
 machine code in its cache (see ``kernels/_numba.py``); a later process loads
 it in about a second. :func:`warm_kernels` runs every kernel a plan uses once,
 on tiny inputs, so that this cost is paid in one known place:
@@ -34,7 +34,7 @@ from pipeline.maps.simulate import compute_map, dynamic_rollout, rollout, rollou
 from pipeline.parts.part import Part
 
 NOTICE_AFTER = 2.0  # seconds: loading cached kernels takes less; compiling them takes more
-NOTICE = ("compiling the kernels: once after an install or an update of pinfeed, about a minute on "
+NOTICE = ("compiling the kernels: once after an install or an update of pinfeed, a minute or two on "
           "2 cores (later runs load them from the cache)")
 
 
