@@ -324,3 +324,29 @@ def test_the_limit_passing_during_certification_certifies_the_best_first(monkeyp
     assert len(result.plans) == 1 and [list(best.labels), best.verdict["in_tolerance"], best.verdict["trials"],
                                        round(best.verdict["width_deg"], 4)] == BEFORE[10.0]["plans"][0]
     assert [list(p.labels) for p in result.unverified] == [BEFORE[10.0]["plans"][1][0]]
+
+
+def test_the_search_time_ending_inside_a_block_leaves_its_other_survivors_unjudged(monkeypatch):
+    """Under a limit a block judges no further chunk once the search time is
+    over (what is left is the reserve for verifying): with one sequence a
+    chunk, the 2-pin level judges its first survivor only, keeps its plan
+    with the complete search's verdict, and names the other as not judged."""
+    from pipeline.planning.tight import screen as screen_module
+    monkeypatch.setattr(screen_module, "MAX_ROWS", 1)  # one sequence per chunk of the judging
+    calls = {"judge": 0}
+    judge = screen_module.LevelScreen._judge
+
+    def counted(self, *args, **kwargs):
+        calls["judge"] += 1
+        return judge(self, *args, **kwargs)
+
+    monkeypatch.setattr(screen_module.LevelScreen, "_judge", counted)
+    monkeypatch.setattr(Deadline, "search_over", lambda self: calls["judge"] > 0)  # over once one is judged
+    result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
+    level = result.levels[-1]
+    assert level["pins"] == 2 and level["judged"] == 1 and level["not_judged"] == 1
+    assert "2 fixed pin(s): 1 of the 2 sequences that passed the first screen not screened or judged" \
+        in level["unsearched"]
+    assert not result.complete and calls["judge"] == 1
+    assert [[list(p.labels), p.verdict["in_tolerance"], p.verdict["trials"], round(p.verdict["width_deg"], 4)]
+            for p in result.plans] in ([plan] for plan in BEFORE[10.0]["plans"])

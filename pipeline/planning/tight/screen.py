@@ -225,22 +225,27 @@ class LevelScreen:
         with the first block where one holds (``_check_family``): each check
         is a worst-member search, dearer than a wider ranking is worth.
 
-        Once ``deadline``'s search is over no further block starts: the
-        blocks left are counted as not screened, ``complete`` is False and
-        ``unsearched`` says how many were left."""
+        Once ``deadline``'s search is over no further block starts, and a
+        block judges no further chunk after its first (the reserve is for
+        verifying): the sequences left are counted as not screened or not
+        judged, ``complete`` is False and ``unsearched`` says how many."""
         stages = self._screen_stages(inputs)
         got = _Screened()
-        done = 0
+        done = unjudged = 0
         timed_out = False
         while done < order.size and not got.enough(candidates, self.family_checked):
             if deadline.search_over():
                 timed_out = True
                 break
             block = order[done:done + SCREEN_BLOCK]
-            self._screen_block(block, done, stages, allowed, span, candidates, record, beat, got)
+            unjudged = self._screen_block(block, done, stages, allowed, span, candidates, record, beat, got,
+                                          deadline)
             done += block.size
             beat.tick(done)
-        self._close_screen(order.size, done, timed_out, got, record, beat)
+            if unjudged:
+                timed_out = True
+                break
+        self._close_screen(order.size, done, timed_out, got, record, beat, unjudged)
         return got.found, got.found_idx, got.judged
 
     def _screen_stages(self, inputs) -> tuple:
@@ -256,14 +261,15 @@ class LevelScreen:
         return screen, full, cascade, share
 
     def _screen_block(self, block, done: int, stages: tuple, allowed: int, span, candidates: int, record, beat,
-                      got: "_Screened") -> None:
+                      got: "_Screened", deadline: Deadline = NO_DEADLINE) -> int:
         """Screen one ``block`` of level rows (the ``done`` rows before it
         already screened) on the screen rows of ``stages``
         (:meth:`_screen_stages`) and judge its survivors in full, in chunks,
         into ``got``; stop once ``got`` has enough (see
-        :meth:`_screen_and_judge`). With a family check
+        :meth:`_screen_and_judge`), or after the first chunk once
+        ``deadline``'s search is over. With a family check
         (:attr:`family_checked`) the block's orienting plans are checked at
-        its end, else as they are judged."""
+        its end, else as they are judged. Returns the survivors left unjudged."""
         screen, full, cascade, share = stages
         family_checked = self.family_checked
         fails = self.bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
@@ -271,7 +277,11 @@ class LevelScreen:
         record["screened_out"] += int(block.size - alive.size)
         judging = beat.stretch(done + share * block.size, done + block.size)
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
+        unjudged = 0
         for start in range(0, alive.size, step):
+            if start and deadline.search_over():
+                unjudged = int(alive.size - start)
+                break
             # members kept from this block's earlier plans already count
             chunk = self._drop_known_broken(alive[start:start + step], screen, allowed, record)
             if len(got.judged) >= candidates:  # the first ones are judged in full, for the evidence
@@ -289,19 +299,24 @@ class LevelScreen:
                 break
         if family_checked:
             self._check_family(got.pending, got.found, got.found_idx, record, screen, allowed)
+        return unjudged
 
-    def _close_screen(self, n_order: int, done: int, timed_out: bool, got: "_Screened", record, beat) -> None:
+    def _close_screen(self, n_order: int, done: int, timed_out: bool, got: "_Screened", record, beat,
+                      unjudged: int = 0) -> None:
         """Record how the screen of ``n_order`` sequences ended after ``done``
         of them: the ones not screened, and, when the time limit ended it
-        (``timed_out``), that the level is not complete and what it left
-        unsearched; ``beat`` says why it stopped early."""
+        (``timed_out``; ``unjudged`` of the last block's survivors left),
+        that the level is not complete and what it left unsearched; ``beat``
+        says why it stopped early."""
         record["not_screened"] = int(n_order - done)  # left once enough orienting plans were found
         if timed_out:
-            beat.finish(done, f"the time limit ended the screen here: the other {n_order - done} are not "
-                              "screened")
+            left = n_order - done + unjudged
+            beat.finish(done, f"the time limit ended the screen here: the other {left} are not screened or judged")
             record["complete"] = False
-            record["unsearched"] = (f"{self.name}: {n_order - done:,} of the {n_order:,} sequences that "
-                                    f"passed the first screen not screened or judged"
+            if unjudged:
+                record["not_judged"] = unjudged
+            record["unsearched"] = (f"{self.name}: {left:,} of the {n_order:,} sequences that passed the first "
+                                    f"screen not screened or judged"
                                     + (f" (the plans found are ranked among the {len(got.judged)} judged)"
                                        if got.found else ""))
         elif done < n_order:
