@@ -350,3 +350,34 @@ def test_the_search_time_ending_inside_a_block_leaves_its_other_survivors_unjudg
     assert not result.complete and calls["judge"] == 1
     assert [[list(p.labels), p.verdict["in_tolerance"], p.verdict["trials"], round(p.verdict["width_deg"], 4)]
             for p in result.plans] in ([plan] for plan in BEFORE[10.0]["plans"])
+
+
+@pytest.mark.parametrize("step, left, per_sequence, size", [
+    (12, float("inf"), 0.5, 12),  # no limit: the whole chunk
+    (12, 100.0, 0.5, 12),         # room for all
+    (12, 2.0, 0.5, 4),            # room for four
+    (12, 0.1, 0.5, 1),            # room for none: one, so a block started judges
+    (12, 2.0, 0.0, 12),           # no pace measured: the whole chunk
+])
+def test_a_chunk_is_cut_to_what_ends_in_the_search_time_left(step, left, per_sequence, size):
+    from pipeline.planning.tight.screen import fitting
+    assert fitting(step, left, per_sequence) == size
+
+
+def test_with_little_search_time_left_the_judging_goes_one_sequence_at_a_time(monkeypatch):
+    """With almost no search time left (but not none), the 2-pin level
+    judges its two survivors one chunk of one each, and finds the complete
+    search's plans and verdicts."""
+    from pipeline.planning.tight import screen as screen_module
+    sizes = []
+    judge = screen_module.LevelScreen._judge
+
+    def sized(self, chunk, *args, **kwargs):
+        sizes.append(len(chunk))
+        return judge(self, chunk, *args, **kwargs)
+
+    monkeypatch.setattr(screen_module.LevelScreen, "_judge", sized)
+    monkeypatch.setattr(Deadline, "search_left", lambda self: 1e-9)
+    result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
+    assert sizes == [1, 1]
+    assert _answer(result)["plans"] == BEFORE[10.0]["plans"]

@@ -4,6 +4,7 @@ them and certified (steps 2 to 5 of :mod:`pipeline.planning.tight.complete`).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -267,23 +268,29 @@ class LevelScreen:
         (:meth:`_screen_stages`) and judge its survivors in full, in chunks,
         into ``got``; stop once ``got`` has enough (see
         :meth:`_screen_and_judge`), or after the first chunk once
-        ``deadline``'s search is over. With a family check
-        (:attr:`family_checked`) the block's orienting plans are checked at
-        its end, else as they are judged. Returns the survivors left unjudged."""
+        ``deadline``'s search is over; under a limit a chunk is cut to what
+        ends within the search time left at the screen's pace (at least one
+        sequence). With a family check (:attr:`family_checked`) the block's
+        orienting plans are checked at its end, else as they are judged.
+        Returns the survivors left unjudged."""
         screen, full, cascade, share = stages
         family_checked = self.family_checked
+        started = deadline.elapsed()
         fails = self.bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
+        per_sequence = (deadline.elapsed() - started) / (block.size * screen[0].size) * full[0].size
         alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
         record["screened_out"] += int(block.size - alive.size)
         judging = beat.stretch(done + share * block.size, done + block.size)
         step = max(1, min(candidates, MAX_ROWS // full[0].size))
-        unjudged = 0
-        for start in range(0, alive.size, step):
+        start = unjudged = 0
+        while start < alive.size:
             if start and deadline.search_over():
                 unjudged = int(alive.size - start)
                 break
+            size = fitting(step, deadline.search_left(), per_sequence)
             # members kept from this block's earlier plans already count
-            chunk = self._drop_known_broken(alive[start:start + step], screen, allowed, record)
+            chunk = self._drop_known_broken(alive[start:start + size], screen, allowed, record)
+            start += size
             if len(got.judged) >= candidates:  # the first ones are judged in full, for the evidence
                 size = chunk.size
                 chunk = self._hard_trials(chunk, full, allowed, record)
@@ -292,7 +299,7 @@ class LevelScreen:
             if chunk.size == 0:
                 continue
             self._judge(chunk, full, span, got.judged, got.pending,
-                        judging.part(start / alive.size, (start + chunk.size) / alive.size))
+                        judging.part((start - size) / alive.size, (start - size + chunk.size) / alive.size))
             if not family_checked:
                 self._check_family(got.pending, got.found, got.found_idx, record)
             if got.enough(candidates, family_checked):
@@ -458,3 +465,12 @@ def probe_goes_on(now: float, started: float, done: int, total: int, search_end:
         return True
     return finishes_in_time(now, started, done, total, search_end, leave=JUDGE_SHARE)
 
+
+
+def fitting(step: int, seconds_left: float, per_sequence: float) -> int:
+    """The sequences of a chunk to judge: ``step``, or under a time limit as
+    many as end within ``seconds_left`` at ``per_sequence`` seconds each
+    (at least one, so a block started always judges)."""
+    if not math.isfinite(seconds_left) or per_sequence <= 0.0:
+        return step
+    return max(1, min(step, int(seconds_left / per_sequence)))
