@@ -192,6 +192,7 @@ class FixedPinSearch:
         # The best results when nothing orients (``best_effort``): the moving-pin stage keeps
         # only the plans, so it turns this off (and its screens learn their hardest trials).
         self.evidence = True
+        self.judge_pace = None  # seconds per sequence and pin of the last full judgement, from level to level
 
     def reuse_rollouts(self, other: "FixedPinSearch") -> None:
         """Take the nominal outcomes and the trials' states after each prefix
@@ -303,8 +304,9 @@ class FixedPinSearch:
         ``levels`` (for the evidence); ``whose`` ends its progress line."""
         screen = LevelScreen(level, n_pins, self.prefix, self.pins, self.bench, self.certifier, self._name(n_pins),
                              learn=not self.evidence)
-        screen.rank = self.ranked
+        screen.rank, screen.judge_pace = self.ranked, self.judge_pace
         found, judged, record = screen.search(candidates, progress, deadline)
+        self.judge_pace = screen.judge_pace
         if progress:
             progress(self._level_summary(n_pins, record) + whose)
         runners_up.extend(judged)

@@ -5,6 +5,7 @@ them and certified (steps 2 to 5 of :mod:`pipeline.planning.tight.complete`).
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -84,6 +85,7 @@ class LevelScreen:
         self.rank = lambda plans: sorted(plans, key=FixedPlan.rank_key)  # best first; the search sets its own
         self.fail_counts = None  # per trial of the full set: the judged sequences it failed (learn)
         self.evidence_cut = False  # the time limit ended the roll-out of its spread-out sequences
+        self.judge_pace = None  # seconds per sequence and pin of the last full judgement (this level's or before)
 
     @property
     def family_checked(self) -> bool:
@@ -275,9 +277,11 @@ class LevelScreen:
         Returns the survivors left unjudged."""
         screen, full, cascade, share = stages
         family_checked = self.family_checked
-        started = deadline.elapsed()
+        started = time.monotonic()
         fails = self.bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
-        per_sequence = (deadline.elapsed() - started) / (block.size * screen[0].size) * full[0].size
+        # a full judgement's pace: the last one measured, else the screen's (which shares more rollouts)
+        per_sequence = max((self.judge_pace or 0.0) * self.n_pins,
+                           (time.monotonic() - started) / (block.size * screen[0].size) * full[0].size)
         alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
         record["screened_out"] += int(block.size - alive.size)
         judging = beat.stretch(done + share * block.size, done + block.size)
@@ -332,7 +336,8 @@ class LevelScreen:
     def _judge(self, chunk, rows, span, judged, pending, stretch) -> None:
         """Judge the level's rows ``chunk`` on all the trials ``rows``: each
         plan joins ``judged``, and ``(row, plan)`` joins ``pending`` when it
-        orients (its family check still to come)."""
+        orients (its family check still to come); times it (``judge_pace``)."""
+        started = time.monotonic()
         finals, jammed = self.bench.replay(*self.sequences(chunk), rows, stretch)
         if self.learn:
             failed = self.bench.failing(finals, jammed).sum(axis=0)
@@ -342,6 +347,7 @@ class LevelScreen:
             judged.append(plan)
             if verdict["orients"]:
                 pending.append((idx, plan))
+        self.judge_pace = (time.monotonic() - started) / (chunk.size * self.n_pins)
 
     def _check_family(self, pending, found, found_idx, record, screen=None, allowed: int = 0) -> None:
         """Move the plans of ``pending`` (``(row, plan)``, orienting on the
