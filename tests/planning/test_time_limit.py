@@ -13,6 +13,7 @@ from pipeline.parts.part import Part
 from pipeline.planning.core.settings import ClaimSettings, SearchSettings, VerifySettings
 from pipeline.planning.tight.complete import FixedPinSearch, level_estimate
 from pipeline.planning.tight import enumerate as enumerate_module
+from pipeline.planning.tight import pacing
 from pipeline.planning.tight.enumerate import NominalTree
 from pipeline.progress import NO_DEADLINE, Deadline, duration_text
 
@@ -227,10 +228,9 @@ def test_a_probe_cut_by_its_share_judges_the_sequences_it_probed(monkeypatch):
     of one sequence, the narrowest nominally) goes on with the sequences it
     probed: the plan found there has the complete search's verdict, and the
     level says how far the first screen got and that only those were judged."""
-    from pipeline.planning.tight import screen as screen_module
-    monkeypatch.setattr(screen_module, "PROBE_CHUNK", 1)
-    monkeypatch.setattr(screen_module, "PROBE_SHARE", 1e-9)  # past its share after the first chunk ...
-    monkeypatch.setattr(screen_module, "finishes_in_time", lambda *args, **kw: False)  # ... and slow
+    monkeypatch.setattr(pacing, "PROBE_CHUNK", 1)
+    monkeypatch.setattr(pacing, "PROBE_SHARE", 1e-9)  # past its share after the first chunk ...
+    monkeypatch.setattr(pacing, "finishes_in_time", lambda *args, **kw: False)  # ... and slow
     result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
     level = result.levels[-1]
     assert level["pins"] == 2 and level["nominal_within"] == 2 and level["probed"] == 1
@@ -251,7 +251,7 @@ def test_a_probe_cut_with_no_search_time_left_judges_none(monkeypatch):
     """With the search time over when the probe stops, nothing is judged and
     the level says so."""
     from pipeline.planning.tight import screen as screen_module
-    monkeypatch.setattr(screen_module, "PROBE_CHUNK", 1)
+    monkeypatch.setattr(pacing, "PROBE_CHUNK", 1)
     probing = {"started": False}
     original = screen_module.LevelScreen._probe
 
@@ -274,8 +274,7 @@ def test_a_probe_cut_with_no_search_time_left_judges_none(monkeypatch):
                                # what it probed
 ])
 def test_a_probe_that_ends_in_time_with_room_to_judge_is_never_cut(now, done, search_end, goes_on):
-    from pipeline.planning.tight.screen import probe_goes_on
-    assert probe_goes_on(now, 0.0, done, 100, search_end) is goes_on
+    assert pacing.probe_goes_on(now, 0.0, done, 100, search_end) is goes_on
 
 
 class _OverOnceCertifying(Deadline):
@@ -360,8 +359,7 @@ def test_the_search_time_ending_inside_a_block_leaves_its_other_survivors_unjudg
     (12, 2.0, 0.0, 12),           # no pace measured: the whole chunk
 ])
 def test_a_chunk_is_cut_to_what_ends_in_the_search_time_left(step, left, per_sequence, size):
-    from pipeline.planning.tight.screen import fitting
-    assert fitting(step, left, per_sequence) == size
+    assert pacing.fitting(step, left, per_sequence) == size
 
 
 def test_with_little_search_time_left_the_judging_goes_one_sequence_at_a_time(monkeypatch):

@@ -71,8 +71,8 @@ judged. A level's enumeration stops earlier, once it has used
 sequences it enumerated are then screened and judged like a whole level's,
 so a plan of that many pins may still be found (it has the fewest pins: the
 levels before are complete). A level's first screen likewise stops once it
-has used ``screen.PROBE_SHARE`` of the search time left when it began
-(unless it ends leaving ``screen.JUDGE_SHARE`` of it), and the level goes on
+has used ``pacing.PROBE_SHARE`` of the search time left when it began
+(unless it ends leaving ``pacing.JUDGE_SHARE`` of it), and the level goes on
 with the sequences it probed. It is then complete only up to the last level it finished: the
 result says so (``complete``, ``unsearched``: the level cut short and how
 far it got, the levels not reached, the evidence not judged), and its "no"

@@ -4,14 +4,14 @@ them and certified (steps 2 to 5 of :mod:`pipeline.planning.tight.complete`).
 """
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from pipeline.planning.claims import orient
-from pipeline.planning.tight.enumerate import Level, finishes_in_time
+from pipeline.planning.tight import pacing
+from pipeline.planning.tight.enumerate import Level
 from pipeline.planning.tight.fewest import fewest_sets
 from pipeline.planning.tight.judge import MAX_ROWS, Certifier, TrialBench, stack
 from pipeline.planning.tight.records import CandidatePins, FixedPlan
@@ -29,9 +29,6 @@ CASCADE = ((48, 64), (150, 384))
 SCREEN_BLOCK = 96  # candidates screened at once
 HARD_TRIALS = 64  # trials that failed most often in a level's judged sequences, tried first (moving pins)
 HARD_FIRST = 16  # ... the hardest of them first: a subset rejects exactly (see CASCADE), at a quarter of the cost
-PROBE_CHUNK = 256  # candidates probed at once under a time limit (the clock is read between chunks)
-PROBE_SHARE = 0.3  # of the search time left, the most a probe uses under a limit (see probe_goes_on) ...
-JUDGE_SHARE = 0.5  # ... unless it ends leaving this share to screen and judge what it probed
 
 
 @dataclass(eq=False)
@@ -109,7 +106,7 @@ class LevelScreen:
         stage tells ``progress`` how far it has got. Once ``deadline``'s
         search is over the level stops between chunks of the first screen or
         between blocks of the screen, and the first screen stops early once it
-        has used its share of the search time (:func:`probe_goes_on`; the
+        has used its share of the search time (:func:`~pipeline.planning.tight.pacing.probe_goes_on`; the
         level goes on with the sequences it probed); ``complete`` False and
         ``unsearched`` in its counts say how far it got. Orienting sequences
         are certified, best first, until the limit itself has passed (the
@@ -192,20 +189,21 @@ class LevelScreen:
 
     def _probe(self, within, rows, beat, deadline: Deadline) -> np.ndarray:
         """Failures of the level's rows ``within`` on the probe's ``rows``, all at
-        once; under a time limit in chunks of ``PROBE_CHUNK``, stopping between
+        once; under a time limit in chunks of ``pacing.PROBE_CHUNK``, stopping between
         them (fewer failures than ``within`` then) once the search is over or
-        :func:`probe_goes_on` says so."""
+        :func:`~pipeline.planning.tight.pacing.probe_goes_on` says so."""
         if not deadline.limited:
             return self.bench.failures(*self.sequences(within), rows, beat.stretch(0, within.size))
         out = []
         started = deadline.elapsed()
         search_end = started + deadline.search_left()
-        for start in range(0, within.size, PROBE_CHUNK):
+        for start in range(0, within.size, pacing.PROBE_CHUNK):
             if start and (deadline.search_over()
-                          or not probe_goes_on(deadline.elapsed(), started, start, within.size, search_end)):
+                          or not pacing.probe_goes_on(deadline.elapsed(), started, start, within.size,
+                                                      search_end)):
                 beat.finish(start, "the time limit ended the first screen here")
                 break
-            chunk = within[start:start + PROBE_CHUNK]
+            chunk = within[start:start + pacing.PROBE_CHUNK]
             out.append(self.bench.failures(*self.sequences(chunk), rows, beat.stretch(start, start + chunk.size)))
         return np.concatenate(out) if out else np.zeros(0, dtype=int)
 
@@ -291,7 +289,7 @@ class LevelScreen:
             if start and deadline.search_over():
                 unjudged = int(alive.size - start)
                 break
-            size = fitting(step, deadline.search_left(), per_sequence)
+            size = pacing.fitting(step, deadline.search_left(), per_sequence)
             # members kept from this block's earlier plans already count
             chunk = self._drop_known_broken(alive[start:start + size], screen, allowed, record)
             start += size
@@ -459,24 +457,3 @@ class LevelScreen:
             verdicts = bench.judge(*self.sequences(best), stack(inputs), stretch=beat.stretch(0, best.size))
             return [self.plan(i, s, v) for i, s, v in zip(best, spread, verdicts)]
 
-
-def probe_goes_on(now: float, started: float, done: int, total: int, search_end: float) -> bool:
-    """Whether a level's probe, begun at ``started`` with ``done`` of its
-    ``total`` sequences probed at ``now`` (seconds on the deadline's clock),
-    goes on: within ``PROBE_SHARE`` of its time to ``search_end``, or past it
-    if at its pace it ends leaving ``JUDGE_SHARE`` of that time to judge.
-    A probe that would use up the search time leaves none judged, and no
-    plan where one was within reach: the level then judges what it probed."""
-    if now - started < PROBE_SHARE * (search_end - started):
-        return True
-    return finishes_in_time(now, started, done, total, search_end, leave=JUDGE_SHARE)
-
-
-
-def fitting(step: int, seconds_left: float, per_sequence: float) -> int:
-    """The sequences of a chunk to judge: ``step``, or under a time limit as
-    many as end within ``seconds_left`` at ``per_sequence`` seconds each
-    (at least one, so a block started always judges)."""
-    if not math.isfinite(seconds_left) or per_sequence <= 0.0:
-        return step
-    return max(1, min(step, int(seconds_left / per_sequence)))
