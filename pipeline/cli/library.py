@@ -68,6 +68,7 @@ def cmd_library(args) -> None:
     import os
     import sys
 
+    from pipeline.maps.warm import warm_kernels
     from pipeline.workflow.runner import run
     snakefile = Path(__file__).resolve().parents[2] / "Snakefile"
     if not snakefile.is_file():
@@ -79,6 +80,8 @@ def cmd_library(args) -> None:
              "--rerun-incomplete", "--keep-going"]
     if args.dry_run:
         snake.append("--dry-run")
+    else:  # compiled once here, not by each job at once (a first run after an install)
+        warm_kernels(lambda line: print(f"pinfeed: {line}", flush=True))
     code = run([*snake, "library"])
     if code:
         raise SystemExit(code)

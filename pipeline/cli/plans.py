@@ -193,7 +193,7 @@ def add_plan_commands(sub) -> None:
                    help="return within about S seconds (plus the step running then) with the best verified "
                         "answer so far, marked not complete, with what was left unsearched (default: the "
                         "config's planner.time_limit_s; none = the complete search); counted from after the kernels "
-                        "are compiled, which the first run after an install does first)")
+                        "are compiled, which the first run after an install does first")
     p.add_argument("--out", default=None, help="store the plan JSON here (default: RESULTS/plans/NAME.json, "
                    "where speed, layout and animate look; a part the workflow plans is stored only "
                    "with --out)")

@@ -69,6 +69,7 @@ def warm_kernels(progress=None, every: bool = False, notice_after: float = NOTIC
     finally:
         if timer is not None:
             timer.cancel()
+            timer.join()  # a notice already on its way is printed before this returns
     return time.perf_counter() - t0
 
 

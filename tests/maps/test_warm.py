@@ -6,12 +6,17 @@ import importlib
 import json
 import math
 import pkgutil
+import subprocess
+import sys
+from pathlib import Path
 
 from numba.core.registry import CPUDispatcher
 
 import kernels
 from cli_runs import run_cli, small_config_file
 from pipeline.maps.warm import NOTICE, warm_kernels
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _overloads() -> dict:
@@ -41,24 +46,32 @@ def test_notice_comes_only_when_the_warm_up_takes_long():
     assert lines == [NOTICE]
 
 
-def test_plans_after_the_warm_up_compile_no_kernel(tmp_path, capsys, monkeypatch):
+def test_plans_after_the_warm_up_compile_no_kernel(tmp_path):
     """A holed part of 40 + 12 vertices (its support table) with a moving pin,
     and a plain quadrilateral: every kernel they run was compiled (or loaded)
-    by the warm-up, with the same signature."""
-    monkeypatch.chdir(tmp_path)
+    by the warm-up, with the same signature. In a process of its own: in
+    this one, earlier tests have loaded kernels the warm-up might miss."""
     config = small_config_file(tmp_path)
-    warm_kernels()
-    before = _overloads()
     holed = ["--vertices", _ring(0, 0, 20, 40), "--hole", _ring(5, 0, 4, 12, clockwise=True), "--name", "disc",
              "--speeds=1", "--dynamic-depth", "1"]
     plain = ["--vertices", "0,0 40,0 40,20 10,25", "--name", "quad", "--dynamic-depth", "0"]
-    for part in (holed, plain):
-        code, _, err = run_cli(capsys, ["plan", "--config", str(config), *part, "--depth", "1", "--pins=5,15",
-                                        "--mu-c", "0.2", "--catalog", str(tmp_path / "cat"),
-                                        "--out", str(tmp_path / "plan.json")])
-        assert code == 0, err
-    after = _overloads()
-    assert {k: (before.get(k, 0), n) for k, n in after.items() if n > before.get(k, 0)} == {}
+    runs = [["plan", "--config", str(config), *part, "--depth", "1", "--pins=5,15", "--mu-c", "0.2",
+             "--catalog", str(tmp_path / "cat"), "--out", str(tmp_path / "plan.json")] for part in (holed, plain)]
+    script = (f"import json, sys; sys.path[:0] = {[str(ROOT), str(ROOT / 'tests'), str(ROOT / 'tests' / 'maps')]!r}\n"
+              "from pipeline.cli import main\n"
+              "from pipeline.maps.warm import warm_kernels\n"
+              "from test_warm import _overloads\n"
+              "warm_kernels()\n"
+              "before = _overloads()\n"
+              f"codes = [main(argv) for argv in {runs!r}]\n"
+              "after = _overloads()\n"
+              "print(json.dumps([codes, {k: (before.get(k, 0), n) for k, n in after.items() "
+              "if n > before.get(k, 0)}]))\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path,
+                          check=False)
+    assert done.returncode == 0, done.stderr[-2000:]
+    codes, new = json.loads(done.stdout.strip().splitlines()[-1])
+    assert codes == [0, 0] and new == {}
 
 
 def test_a_time_limit_counts_from_after_the_compile(tmp_path, capsys, monkeypatch):

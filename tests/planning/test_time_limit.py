@@ -343,7 +343,7 @@ def test_the_search_time_ending_inside_a_block_leaves_its_other_survivors_unjudg
     monkeypatch.setattr(Deadline, "search_over", lambda self: calls["judge"] > 0)  # over once one is judged
     result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
     level = result.levels[-1]
-    assert level["pins"] == 2 and level["judged"] == 1 and level["not_judged"] == 1
+    assert level["pins"] == 2 and level["judged"] == 1 and level["not_judged"] == 1 and _counts_add_up(level)
     assert "2 fixed pin(s): 1 of the 2 sequences that passed the first screen not screened or judged" \
         in level["unsearched"]
     assert not result.complete and calls["judge"] == 1
@@ -379,3 +379,74 @@ def test_with_little_search_time_left_the_judging_goes_one_sequence_at_a_time(mo
     result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
     assert sizes == [1, 1]
     assert _answer(result)["plans"] == BEFORE[10.0]["plans"]
+
+
+def _counts_add_up(level) -> bool:
+    """Every sequence within the tolerance nominally is screened out, judged,
+    not screened or not judged (no cascade at these sizes)."""
+    return (level["screened_out"] + level["judged"] + level["not_screened"] + level.get("not_judged", 0)
+            == level["nominal_within"])
+
+
+def test_a_block_whose_screen_ends_past_the_search_time_still_judges_one_chunk(monkeypatch):
+    """The search time ends while the block screens (after the probe and the
+    block's start): the block still judges its first chunk, so a block
+    started always judges, and leaves the other survivor unjudged."""
+    from pipeline.planning.tight import screen as screen_module
+    from pipeline.planning.tight.judge import TrialBench
+    monkeypatch.setattr(screen_module, "MAX_ROWS", 1)  # one sequence per chunk of the judging
+    calls = {"failures": 0}
+    failures = TrialBench.failures
+
+    def counted(self, *args, **kwargs):
+        calls["failures"] += 1  # the probe's, then the block's screen
+        return failures(self, *args, **kwargs)
+
+    monkeypatch.setattr(TrialBench, "failures", counted)
+    monkeypatch.setattr(Deadline, "search_over", lambda self: calls["failures"] >= 2)
+    result = _search(10.0).run(2, candidates=3, deadline=Deadline(3600.0))
+    level = result.levels[-1]
+    assert level["pins"] == 2 and level["judged"] == 1 and level["not_judged"] == 1 and _counts_add_up(level)
+    assert len(result.plans) == 1
+
+
+@pytest.mark.parametrize("judge_pace, pace", [
+    (None, 1.5),  # before a full judgement: the screen's 0.01 s a replay x 50 trials x SCREEN_TO_JUDGE (3)
+    (0.2, 1.5),   # a measured 0.6 s a sequence of 3 pins is faster than that: the slower one counts
+    (1.0, 3.0),   # 1 s a pin: 3 s a sequence of 3 pins
+])
+def test_the_judging_pace_is_the_slower_of_the_measured_and_the_screen_estimate(judge_pace, pace):
+    assert pacing.judging_pace(judge_pace, 3, 1.0, 100, 50) == pytest.approx(pace)
+
+
+def test_the_evidence_stops_between_its_judgements_once_the_search_time_is_over(monkeypatch):
+    """When nothing orients, the fewest-set sequences are judged one at a
+    time: with the search time ending after the first judgement, the 1-pin
+    level's other two are named as not judged, the deeper levels' evidence
+    as not judged at all, and the one judged keeps the complete search's
+    numbers."""
+    from pipeline.planning.tight import screen as screen_module
+    from pipeline.planning.tight.judge import TrialBench
+    calls = {"evidence": False, "judge": 0}
+    judge, several_sets = TrialBench.judge, screen_module.LevelScreen.several_sets
+
+    def counted(self, *args, **kwargs):
+        calls["judge"] += calls["evidence"]  # the evidence's judgements only
+        return judge(self, *args, **kwargs)
+
+    def evidence(self, *args, **kwargs):
+        calls["evidence"] = True
+        return several_sets(self, *args, **kwargs)
+
+    monkeypatch.setattr(TrialBench, "judge", counted)
+    monkeypatch.setattr(screen_module.LevelScreen, "several_sets", evidence)
+    monkeypatch.setattr(Deadline, "search_over", lambda self: calls["judge"] >= 1)
+    result = _search(1.0).run(3, candidates=3, deadline=Deadline(3600.0))
+    assert calls["judge"] == 1 and not result.plans and not result.complete
+    assert "the fewest-set sequences of 1 fixed pin(s): 2 not judged (the time limit ended their judging)" \
+        in result.unsearched
+    assert "the fewest-set sequences of 2 level(s) (the evidence when nothing orients): not judged" \
+        in result.unsearched
+    one_pin = [[list(p.labels), p.verdict["in_tolerance"], p.verdict["trials"]] for p in result.best_effort
+               if len(p.labels) == 1]
+    assert len(one_pin) == 1 and one_pin[0] in BEFORE[1.0]["best"]

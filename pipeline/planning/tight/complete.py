@@ -388,6 +388,9 @@ class FixedPinSearch:
                 result.unsearched.append(f"the fewest-set sequences of {screen.name}: ranked among the sequences "
                                          "rolled out in full only (the time limit ended the roll-out of the "
                                          "spread-out ones)")
+            if screen.evidence_left:
+                result.unsearched.append(f"the fewest-set sequences of {screen.name}: {screen.evidence_left} not "
+                                         "judged (the time limit ended their judging)")
         result.best_effort = self.ranked(_distinct(runners_up))[:keep]
 
     def _not_reached(self, result: FixedSearch, last: Level, depth: int) -> None:

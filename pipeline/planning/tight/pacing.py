@@ -6,7 +6,8 @@ whose first stages could fill the limit still judges, and the reserve for
 verifying stays whole: the enumeration's share is
 :data:`pipeline.planning.tight.enumerate.ENUMERATION_SHARE`; the probe
 (the level's first screen) goes on by :func:`probe_goes_on`; a chunk of
-sequences judged in full is cut by :func:`fitting`. Without a limit none of
+sequences judged in full is cut by :func:`fitting`, at the pace
+:func:`judging_pace` estimates. Without a limit none of
 these cuts anything.
 """
 from __future__ import annotations
@@ -18,6 +19,10 @@ from pipeline.planning.tight.enumerate import finishes_in_time
 PROBE_CHUNK = 256  # candidates probed at once under a time limit (the clock is read between chunks)
 PROBE_SHARE = 0.3  # of the search time left, the most a probe uses under a limit (see probe_goes_on) ...
 JUDGE_SHARE = 0.5  # ... unless it ends leaving this share to screen and judge what it probed
+# A full judgement's cost per trial over the screen's: the screen's trials meet
+# the pins in states the probe and earlier blocks rolled out more often
+# (measured 3.3 on the pear cam's 3- and 4-pin levels).
+SCREEN_TO_JUDGE = 3.0
 
 
 def probe_goes_on(now: float, started: float, done: int, total: int, search_end: float) -> bool:
@@ -39,3 +44,13 @@ def fitting(step: int, seconds_left: float, per_sequence: float) -> int:
     if not math.isfinite(seconds_left) or per_sequence <= 0.0:
         return step
     return max(1, min(step, int(seconds_left / per_sequence)))
+
+
+def judging_pace(judge_pace, n_pins: int, screen_seconds: float, screen_replays: int, full_trials: int) -> float:
+    """Seconds to judge one sequence of ``n_pins`` pins on ``full_trials``
+    trials: the last full judgement's ``judge_pace`` (seconds per sequence
+    and pin; ``None`` before the first), or the screen's pace
+    (``screen_seconds`` for ``screen_replays`` sequence-trial replays)
+    times ``SCREEN_TO_JUDGE``, whichever is slower."""
+    from_screen = screen_seconds / max(screen_replays, 1) * full_trials * SCREEN_TO_JUDGE
+    return max((judge_pace or 0.0) * n_pins, from_screen)

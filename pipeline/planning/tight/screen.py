@@ -82,6 +82,7 @@ class LevelScreen:
         self.rank = lambda plans: sorted(plans, key=FixedPlan.rank_key)  # best first; the search sets its own
         self.fail_counts = None  # per trial of the full set: the judged sequences it failed (learn)
         self.evidence_cut = False  # the time limit ended the roll-out of its spread-out sequences
+        self.evidence_left = 0  # ... or the judging of its fewest-set sequences, leaving this many
         self.judge_pace = None  # seconds per sequence and pin of the last full judgement (this level's or before)
 
     @property
@@ -269,17 +270,17 @@ class LevelScreen:
         into ``got``; stop once ``got`` has enough (see
         :meth:`_screen_and_judge`), or after the first chunk once
         ``deadline``'s search is over; under a limit a chunk is cut to what
-        ends within the search time left at the screen's pace (at least one
-        sequence). With a family check (:attr:`family_checked`) the block's
-        orienting plans are checked at its end, else as they are judged.
-        Returns the survivors left unjudged."""
+        ends within the search time left (at least one sequence) at the pace
+        :func:`~pipeline.planning.tight.pacing.judging_pace` estimates. With a
+        family check (:attr:`family_checked`) the block's orienting plans are
+        checked at its end, else as they are judged. Returns the survivors
+        left unjudged."""
         screen, full, cascade, share = stages
         family_checked = self.family_checked
         started = time.monotonic()
         fails = self.bench.failures(*self.sequences(block), screen, beat.stretch(done, done + share * block.size))
-        # a full judgement's pace: the last one measured, else the screen's (which shares more rollouts)
-        per_sequence = max((self.judge_pace or 0.0) * self.n_pins,
-                           (time.monotonic() - started) / (block.size * screen[0].size) * full[0].size)
+        per_sequence = pacing.judging_pace(self.judge_pace, self.n_pins, time.monotonic() - started,
+                                           block.size * screen[0].size, full[0].size)
         alive = block[fails <= allowed][np.argsort(fails[fails <= allowed], kind="stable")]
         record["screened_out"] += int(block.size - alive.size)
         judging = beat.stretch(done + share * block.size, done + block.size)
@@ -289,19 +290,19 @@ class LevelScreen:
             if start and deadline.search_over():
                 unjudged = int(alive.size - start)
                 break
-            size = pacing.fitting(step, deadline.search_left(), per_sequence)
-            # members kept from this block's earlier plans already count
-            chunk = self._drop_known_broken(alive[start:start + size], screen, allowed, record)
+            lo, size = start, pacing.fitting(step, deadline.search_left(), per_sequence)
             start += size
+            # members kept from this block's earlier plans already count
+            chunk = self._drop_known_broken(alive[lo:start], screen, allowed, record)
             if len(got.judged) >= candidates:  # the first ones are judged in full, for the evidence
-                size = chunk.size
+                before = chunk.size
                 chunk = self._hard_trials(chunk, full, allowed, record)
                 chunk = self._cascade(chunk, cascade, allowed, record)
-                got.cascaded += size - chunk.size
+                got.cascaded += before - chunk.size
             if chunk.size == 0:
                 continue
             self._judge(chunk, full, span, got.judged, got.pending,
-                        judging.part((start - size) / alive.size, (start - size + chunk.size) / alive.size))
+                        judging.part(lo / alive.size, (lo + chunk.size) / alive.size))
             if not family_checked:
                 self._check_family(got.pending, got.found, got.found_idx, record)
             if got.enough(candidates, family_checked):
@@ -437,7 +438,10 @@ class LevelScreen:
         (:func:`~pipeline.planning.tight.fewest.fewest_sets`; ``complete``
         rolls out the spread-out sequences that might be among them until
         ``stop()``; ``evidence_cut`` then says the ranking is over the
-        sequences rolled out in full only)."""
+        sequences rolled out in full only). They are judged one at a time,
+        the fewest-set first, and once ``stop()`` no further one is
+        (``evidence_left`` counts them): one judgement of a many-edged part
+        takes seconds."""
         level, bench = self.level, self.bench
         if level.size == 0:
             return []
@@ -451,9 +455,16 @@ class LevelScreen:
         if best.size == 0:
             return []
         spread = orient.row_spans(level.theta[best], bench.order)
-        inputs = bench.trials(self.n_pins)
+        rows = stack(bench.trials(self.n_pins))
+        plans = []
         with Heartbeat(f"{self.name}: judging the fewest-set sequences for the evidence", best.size,
                        "sequence", progress) as beat:
-            verdicts = bench.judge(*self.sequences(best), stack(inputs), stretch=beat.stretch(0, best.size))
-            return [self.plan(i, s, v) for i, s, v in zip(best, spread, verdicts)]
+            for k in range(best.size):
+                if k and stop is not None and stop():
+                    self.evidence_left = int(best.size - k)
+                    beat.finish(k, "the time limit ended it here")
+                    break
+                verdict = next(bench.judge(*self.sequences(best[k:k + 1]), rows, stretch=beat.stretch(k, k + 1)))
+                plans.append(self.plan(best[k], spread[k], verdict))
+        return plans
 
