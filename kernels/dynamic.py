@@ -92,7 +92,7 @@ import math
 import numpy as np
 
 from ._numba import jit
-from .geometry import _closest_feature, _other_contact_gap, _ray_first_contact
+from .geometry import GAP_CACHE_HEAD, _cached_gap, _closest_feature, _ray_first_contact
 from .support import _power, _table_sizes
 
 # Statuses as in rollout.py (ok, miss, jammed, truncated).
@@ -242,6 +242,8 @@ def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, f
     force = np.empty((nrec, 3))
     twist = np.empty((nrec, 6))
     n_rec = 0
+    gap_cache = np.empty(GAP_CACHE_HEAD + 32)  # the notch test's near edges
+    gap_cache[0] = -1.0
     # Pin path in the belt frame: P(tau) = (-tau, d + v_pin tau); the part
     # starts at rest with its centroid at the origin.
     cs, sn = math.cos(theta_i), math.sin(theta_i)
@@ -362,7 +364,9 @@ def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, f
             if travel > _MAX_TRAVEL:
                 status, reason = JAMMED, R_TRAVEL
                 break
-            if not convex and _other_contact_gap(verts, qx, qy, cx, cy, rp, _SAME_FEATURE) < 0.0:
+            # Only the sign counts, which the cached gap keeps exactly.
+            if not convex and _cached_gap(verts, qx, qy, cx, cy, rp, _SAME_FEATURE,
+                                          gap_cache) < 0.0:
                 status, reason = JAMMED, R_NOTCH
                 break
             continue

@@ -488,3 +488,89 @@ def _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature):
         if math.hypot(px - cx, py - cy) > same_feature:
             gap = min(gap, math.hypot(qx - px, qy - py) - r_pin)
     return gap
+
+
+# The near-edge cache of ``_cached_gap``: ``cache[0]`` the number of near
+# edges (-1: empty), ``cache[1:3]`` the pin centre it was made at,
+# ``cache[3]`` a lower bound on the distance from there to every other edge,
+# ``cache[4:]`` the near edges' indices.
+GAP_CACHE_HEAD = 4
+GAP_NEAR_REACH = 0.03  # beyond the pin radius (units of the lengths), an edge is near
+_GAP_MARGIN = 1e-9  # the far bound must clear zero by this much (rounding)
+
+
+@jit
+def _near_edges(verts, qx, qy, reach, cache):
+    """Fill ``cache`` at the pin centre ``q``: the edges within ``reach`` of
+    ``q`` and a lower bound on the distance of every other edge. Returns
+    False (cache left empty) when the near edges do not fit."""
+    n = verts.shape[0]
+    room = cache.shape[0] - GAP_CACHE_HEAD
+    count = 0
+    far = np.inf
+    for j in range(n):
+        k = j + 1 if j + 1 < n else 0
+        ax, ay, bx, by = verts[j, 0], verts[j, 1], verts[k, 0], verts[k, 1]
+        dx = max(min(ax, bx) - qx, 0.0, qx - max(ax, bx))
+        dy = max(min(ay, by) - qy, 0.0, qy - max(ay, by))
+        dist = math.sqrt(dx * dx + dy * dy)  # the bounding box: a lower bound
+        if dist < reach:
+            px, py, t, length = _closest_on_segment(verts, j, qx, qy)
+            dist = math.hypot(qx - px, qy - py)
+            if dist < reach:
+                if count == room:
+                    cache[0] = -1.0
+                    return False
+                cache[GAP_CACHE_HEAD + count] = j
+                count += 1
+                continue
+        far = min(far, dist)
+    cache[0], cache[1], cache[2], cache[3] = count, qx, qy, far
+    return True
+
+
+@jit
+def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
+    """``_other_contact_gap`` where it can matter, a positive lower bound of
+    it elsewhere, from the near edges kept in ``cache``.
+
+    Returns the exact gap (bit for bit) whenever it is at most the bound of
+    the far edges; otherwise a value in ``(0, gap]``: both then say "no
+    second contact", and an event function needs the value only below zero
+    (a caller that needs it above, to locate a crossing, calls
+    ``_other_contact_gap``).
+
+    Notes
+    -----
+    The distance from ``q`` to a segment is 1-Lipschitz in ``q``, so every
+    edge not in the near list stays at least ``far - |q - q0|`` from ``q``,
+    where ``far`` bounds their distances from the centre ``q0`` the list was
+    made at. While that bound minus ``r_pin`` clears zero, only the near
+    edges are measured; once it does not, the list is made again at ``q``
+    (within ``r_pin + GAP_NEAR_REACH``, then tighter reaches if it does not
+    fit, and if none fits the gap is measured over every edge). The excluded
+    contact feature only removes candidates, so the bound holds with it too.
+    """
+    far = -np.inf
+    if cache[0] >= 0.0:
+        far = cache[3] - math.hypot(qx - cache[1], qy - cache[2]) - r_pin
+    if not far > _GAP_MARGIN:
+        reach = GAP_NEAR_REACH
+        for _ in range(3):
+            if _near_edges(verts, qx, qy, r_pin + reach, cache):
+                break
+            reach *= 0.25
+        if cache[0] >= 0.0:
+            far = cache[3] - r_pin
+    if far > _GAP_MARGIN:
+        gap = far
+        for m in range(int(cache[0])):
+            j = int(cache[GAP_CACHE_HEAD + m])
+            px, py, t, length = _closest_on_segment(verts, j, qx, qy)
+            d = math.hypot(qx - px, qy - py) - r_pin
+            # The contact's own feature is tested only where it would lower
+            # the minimum (the minimum is the same, in any order).
+            if d < gap and math.hypot(px - cx, py - cy) > same_feature:
+                gap = d
+        return gap
+    return _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)

@@ -49,7 +49,7 @@ import math
 import numpy as np
 
 from ._numba import jit, jit_inline
-from .geometry import (EDGE, VERTEX, _is_convex, _keyhole, _normalise_loops,
+from .geometry import (EDGE, VERTEX, _cached_gap, _is_convex, _keyhole, _normalise_loops,
                        _other_contact_gap, _ray_first_contact)
 from .models import (_DEC_TAKE, MINPOWER, MINPOWER_POINTS, NO_MODEL, SEPARATE, SLIDE_NEG,
                      SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide, _minpower_twist,
@@ -112,7 +112,8 @@ MIN_STEPS = 1000
 _W_Y, _W_YNEW, _W_K1, _W_KEND, _W_YLOC, _W_TMP, _W_YI, _W_YTRY = 0, 1, 2, 3, 4, 5, 6, 7
 _W_KS = 8  # six rows: the Runge-Kutta stages
 _W_GEND, _W_GWORK, _W_MASK, _W_WARM, _W_WSAVE = 14, 15, 16, 17, 18
-_W_ROWS = 19
+_W_GAP = 19  # the near-edge cache of the second-contact test (geometry._cached_gap)
+_W_ROWS = 20
 _W_COLS = 29
 # The warm-start history (row ``_W_WARM``): three entries of ``_WARM_STRIDE``
 # values, latest first, each the twist (3), the travel and P's gradient (3),
@@ -454,9 +455,13 @@ def _step(verts, quad, prm, kind, idx, y0, s0, k1, h, y1, ks, tmp, warm):
 
 
 @jit
-def _events(verts, prm, kind, idx, y, g):
+def _events(verts, prm, kind, idx, y, g, gap_cache, exact_gap):
     """Event values at ``y`` into ``g``: leave the feature at its start/end,
-    separation (``n . v_p``) and a second contact; all negative when crossed."""
+    separation (``n . v_p``) and a second contact; all negative when crossed.
+
+    The second contact's value is exact when negative; when positive it may
+    be a lower bound (``geometry._cached_gap``, with the near-edge cache
+    ``gap_cache``) unless ``exact_gap``, for locating its crossing."""
     _, _, rp, vpwx, vpwy, _, _, convex, _ = prm
     cx, cy, nx, ny, g[0], g[1] = _contact_geometry(verts, kind, idx, y[1], y[2])
     cs, sn = math.cos(y[0]), math.sin(y[0])
@@ -464,7 +469,9 @@ def _events(verts, prm, kind, idx, y, g):
     if convex:
         g[3] = np.inf
     else:
-        g[3] = _other_contact_gap(verts, y[1], y[2], cx, cy, rp, _SAME_FEATURE) + _NOTCH_TOL
+        gap = (_other_contact_gap(verts, y[1], y[2], cx, cy, rp, _SAME_FEATURE) if exact_gap else
+               _cached_gap(verts, y[1], y[2], cx, cy, rp, _SAME_FEATURE, gap_cache))
+        g[3] = gap + _NOTCH_TOL
 
 
 @jit
@@ -514,10 +521,11 @@ def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
     s0, h : belt travel at the step's start, and the full step's size.
     trial : ``(y0, k1, y1, k_end, g1)``: the full step's start state and
         slope, end state and slope, and event values at its end.
-    scratch : ``(y_out, ks, tmp, warm, g, mask, yi, y_try)``: the state
-        just before the crossing (written); ``ks, tmp, warm`` as for
-        ``_step``; event values, the events that count, an interpolated and
-        a trial state.
+    scratch : ``(y_out, ks, tmp, warm, g, mask, yi, y_try, gap_cache)``:
+        the state just before the crossing (written); ``ks, tmp, warm`` as
+        for ``_step``; event values, the events that count, an interpolated
+        and a trial state; the near-edge cache of ``_events`` (the second
+        contact's value is measured exactly once it counts).
 
     Returns
     -------
@@ -535,10 +543,10 @@ def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
     over the four), so an earlier event found while refining takes over.
     """
     y0, k1, y1, k_end, g1 = trial
-    y_out, ks, tmp, warm, g, mask, yi, y_try = scratch
+    y_out, ks, tmp, warm, g, mask, yi, y_try, gap_cache = scratch
     for j in range(4):
         mask[j] = 1.0 if g1[j] < -_EVENT_TOL else 0.0
-    _events(verts, prm, kind, idx, y0, g)
+    _events(verts, prm, kind, idx, y0, g, gap_cache, mask[3] != 0.0)
     f0 = _min_over(g, mask)
     f1 = _min_over(g1, mask)
     # 1. Root of the event function along the interpolant (Illinois).
@@ -551,7 +559,7 @@ def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
         if not (lo < alpha < hi):
             alpha = 0.5 * (lo + hi)
         _hermite(y0, k1, y1, k_end, h, alpha, yi)
-        _events(verts, prm, kind, idx, yi, g)
+        _events(verts, prm, kind, idx, yi, g, gap_cache, mask[3] != 0.0)
         f = _min_over(g, mask)
         if f < 0.0:
             hi, f_hi = alpha, f
@@ -578,7 +586,7 @@ def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
             alpha = 0.5 * (lo + hi)
         n_steps += 1
         _step(verts, quad, prm, kind, idx, y0, s0, k1, alpha * h, y_try, ks, tmp, warm)
-        _events(verts, prm, kind, idx, y_try, g)
+        _events(verts, prm, kind, idx, y_try, g, gap_cache, mask[3] != 0.0)
         for j in range(4):
             if mask[j] == 0.0 and g[j] < -_EVENT_TOL:
                 mask[j] = 1.0  # an earlier event than the ones seen so far
@@ -606,16 +614,16 @@ def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
             slope = 0.0
             if it < 8:
                 _hermite(y0, k1, y1, k_end, h, alpha + 1e-7, yi)
-                _events(verts, prm, kind, idx, yi, g)
+                _events(verts, prm, kind, idx, yi, g, gap_cache, mask[3] != 0.0)
                 f_up = _min_over(g, mask)
                 _hermite(y0, k1, y1, k_end, h, alpha, yi)
-                _events(verts, prm, kind, idx, yi, g)
+                _events(verts, prm, kind, idx, yi, g, gap_cache, mask[3] != 0.0)
                 slope = (f_up - _min_over(g, mask)) / 1e-7
             nxt = alpha - f / slope if slope < 0.0 else 0.5 * (lo + hi)
         prev_alpha, prev_f = alpha, f
         # Aim slightly early so the kept state lies before the crossing.
         alpha = nxt - 1e-13 / h
-    _events(verts, prm, kind, idx, y_out, g)
+    _events(verts, prm, kind, idx, y_out, g, gap_cache, mask[3] != 0.0)
     ev = 0
     best = np.inf
     for j in range(4):
@@ -911,6 +919,8 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     g_end = work[_W_GEND]
     mask = work[_W_MASK]
     warm = work[_W_WARM]
+    gap_cache = work[_W_GAP]
+    gap_cache[0] = -1.0  # empty: the work array may come from another part
     sigma, kind, idx = _first_contact(verts, prm, theta_i, d, y, warm, mask)
     if not math.isfinite(sigma):
         return MISS, JAM_NONE, theta_i % two_pi, 0.0, 0.0, 0, 0.0, 0, 0, 0
@@ -979,13 +989,13 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         # intervenes (FSAL), and the end slope of the dense output otherwise.
         st_e, mode_e, fx_e, fy_e = _derivative(verts, quad, prm, kind, idx, y_new, s + h, warm,
                                                k_end)
-        _events(verts, prm, kind, idx, y_new, g_end)
+        _events(verts, prm, kind, idx, y_new, g_end, gap_cache, False)
         ev = _first_event(g_end, _EVENT_TOL)
         frac = 1.0
         if ev >= 0:
             trial = (y, k1, y_new, k_end, g_end)
             scratch = (y_located, ks, tmp, warm, work[_W_GWORK], mask, work[_W_YI],
-                       work[_W_YTRY])
+                       work[_W_YTRY], gap_cache)
             frac, ev, n_loc = _locate(verts, quad, prm, kind, idx, s, h, trial, scratch)
             steps += n_loc
             for i in range(5):

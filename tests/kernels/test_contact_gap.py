@@ -3,6 +3,10 @@
 ``geometry._other_contact_gap`` skips edges whose bounding box is too far to
 lower the gap found so far; the value must be the same, bit for bit, as the
 minimum over every edge (the reference below, the function as it was).
+``geometry._cached_gap`` measures only the edges near the pin while the
+others provably stay clear: it must give that same value wherever the value
+is negative (a second contact), and a positive value no larger than it
+elsewhere.
 """
 import math
 
@@ -11,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kernels._numba import jit
-from kernels.geometry import _closest_on_segment, _other_contact_gap
+from kernels.geometry import GAP_CACHE_HEAD, _cached_gap, _closest_on_segment, _other_contact_gap
 from strategies import star_polygons
 
 
@@ -43,3 +47,132 @@ def test_gap_is_the_minimum_over_every_edge(xy, seed, r_pin):
             qx, qy = rng.uniform(-2, 2, 2)
         got = _other_contact_gap(verts, qx, qy, cx, cy, r_pin, 1e-3)
         assert got == _reference(verts, qx, qy, cx, cy, r_pin, 1e-3)
+
+
+@settings(max_examples=60, deadline=None)
+@given(star_polygons(min_n=8, max_n=40, min_radius=0.1), st.integers(min_value=0, max_value=2**31 - 1),
+       st.floats(min_value=0.01, max_value=0.3), st.floats(min_value=0.005, max_value=0.2),
+       st.sampled_from([GAP_CACHE_HEAD + 3, GAP_CACHE_HEAD + 25]))
+def test_cached_gap_is_exact_wherever_it_is_negative(xy, seed, r_pin, stride, size):
+    # A pin walking along the outline and across it, one cache for the walk:
+    # the cache is made at one point and read at the next ones, as in a
+    # rollout, including where the pin dips into the part (negative gaps) and
+    # with a cache too small for the near edges (the exact fallback).
+    verts = np.ascontiguousarray(xy, dtype=float)
+    rng = np.random.default_rng(seed)
+    n = len(verts)
+    cache = np.empty(size)
+    cache[0] = -1.0
+    j, s, side = rng.integers(n), rng.uniform(), rng.uniform(0.5, 1.2)
+    for _ in range(120):
+        s += rng.uniform(-0.2, 1.0) * stride / np.linalg.norm(verts[(j + 1) % n] - verts[j])
+        while s > 1.0:
+            s -= 1.0
+            j = (j + 1) % n
+        s = max(s, 0.0)
+        cx, cy = verts[j] + s * (verts[(j + 1) % n] - verts[j])
+        ex, ey = verts[(j + 1) % n] - verts[j]
+        normal = np.array([ey, -ex]) / math.hypot(ex, ey)  # outward (counter-clockwise outline)
+        side = min(max(side + rng.normal(0, 0.1), 0.3), 1.5)
+        qx, qy = np.array([cx, cy]) + side * r_pin * normal
+        want = _reference(verts, qx, qy, cx, cy, r_pin, 1e-3)
+        got = _cached_gap(verts, qx, qy, cx, cy, r_pin, 1e-3, cache)
+        if want <= 0.0:
+            assert got == want
+        else:
+            assert 0.0 < got <= want + 1e-12
+
+
+def test_cached_gap_walk_meets_second_contacts():
+    # The walk of the property test, on a comb whose teeth are closer than
+    # the pin: with the pin pressed in, far edges become second contacts.
+    comb = np.array([[0, 0], [1, 0], [1, 0.3], [0.8, 0.3], [0.8, 0.1], [0.7, 0.1], [0.7, 0.3],
+                     [0.5, 0.3], [0.5, 0.1], [0.4, 0.1], [0.4, 0.3], [0, 0.3]], dtype=float)
+    cache = np.empty(GAP_CACHE_HEAD + 25)
+    cache[0] = -1.0
+    seen = {"negative": 0, "bound": 0}
+    for y in np.linspace(0.35, 0.12, 60):
+        for x in np.linspace(0.3, 0.9, 25):
+            cx, cy = x, 0.3 if not (0.4 < x < 0.5 or 0.7 < x < 0.8) else 0.1
+            want = _reference(comb, x, y, cx, cy, 0.06, 1e-3)
+            got = _cached_gap(comb, x, y, cx, cy, 0.06, 1e-3, cache)
+            if want <= 0.0:
+                seen["negative"] += 1
+                assert got == want
+            else:
+                seen["bound"] += got != want
+                assert 0.0 < got <= want + 1e-12
+    assert seen["negative"] > 50 and seen["bound"] > 50
+
+
+_BOTH_WAYS = r'''
+import json, math, sys
+import numpy as np
+import kernels.dynamic as D, kernels.geometry as G, kernels.rollout as R
+prepared, static_cases, dynamic_cases = json.loads(sys.argv[1])
+arrays = np.load(prepared)
+verts, quad = arrays["verts"], arrays["quad"]
+area, a, m_max = (float(x) for x in arrays["scalars"])
+convex = False
+def run():
+    out = []
+    for th, d, mu in static_cases:
+        r = R._rollout(verts, area, a, quad, m_max, convex, 0, mu, 3.0 / a, math.radians(th), d, 0.0,
+                       np.inf, R.DEFAULT_DS_MAX, R.DEFAULT_TOL, False)
+        out.append([float(x) for x in r[:7]])
+    for th, d, v_pin in dynamic_cases:
+        r = D._dyn_rollout(verts, area, a, quad, convex, 0.2, 3.0 / a, math.radians(th), d, v_pin, 0.5,
+                           0.0, D.DEFAULT_V_REG, D.DEFAULT_H, np.inf, 3000, False)
+        out.append([float(x) for x in r[:7]])
+    return out
+cached = run()
+def exact(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
+    return G._other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)
+R._cached_gap = D._cached_gap = exact
+print(json.dumps({"cached": cached, "exact": run()}))
+'''
+
+
+def _u_bracket():
+    """A 60 x 40 mm U with 4 mm fillets at its four outer corners and a 20 mm
+    wide, 25 mm deep slot: pins meet the slot's walls (notches) and the
+    fillets' short edges bring edges in and out of the near list."""
+    pts = []
+    for cx, cy, a0 in ((56, 4, -90), (56, 36, 0)):
+        pts += [(cx + 4 * math.cos(math.radians(a0 + 15 * k)), cy + 4 * math.sin(math.radians(a0 + 15 * k)))
+                for k in range(7)]
+    pts += [(40.0, 40.0), (40.0, 15.0), (20.0, 15.0), (20.0, 40.0)]
+    for cx, cy, a0 in ((4, 36, 90), (4, 4, 180)):
+        pts += [(cx + 4 * math.cos(math.radians(a0 + 15 * k)), cy + 4 * math.sin(math.radians(a0 + 15 * k)))
+                for k in range(7)]
+    return pts
+
+
+def test_rollouts_are_the_same_with_the_cached_gap(tmp_path):
+    # Static and dynamic rollouts of a slotted part, run as plain Python
+    # twice: with the near-edge cache and with every edge measured at every
+    # test (the code before the cache). Every result must be the same, bit
+    # for bit, notch jams included.
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    static_cases = [[th, d, mu] for th in (0.0, 35.0, 90.0, 180.0, 200.0, 270.0, 300.0)
+                    for d, mu in ((-0.4, 0.2), (0.0, 0.5), (0.3, 0.2))]
+    dynamic_cases = [[0.0, 0.0, 0.0], [90.0, 0.2, 0.5], [270.0, -0.1, 0.0]]
+    root = Path(__file__).resolve().parents[2]
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=str(root))
+    # The part is prepared here, compiled (its support table would take
+    # half a minute as plain Python).
+    from pipeline.parts.part import Part
+    verts, area, a, quad, m_max, convex = Part.from_vertices(_u_bracket()).prepared()
+    assert not convex
+    np.savez(tmp_path / "part.npz", verts=verts, quad=quad, scalars=[area, a, m_max])
+    args = json.dumps([str(tmp_path / "part.npz"), static_cases, dynamic_cases])
+    res = subprocess.run([sys.executable, "-c", _BOTH_WAYS, args], capture_output=True, text=True,
+                         env=env, check=True, cwd=root)
+    got = json.loads(res.stdout)
+    assert got["cached"] == got["exact"]
+    reasons = [row[1] for row in got["exact"][:len(static_cases)]]
+    assert reasons.count(2) >= 3  # rollout.JAM_NOTCH: the slot caught the pin
