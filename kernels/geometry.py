@@ -493,7 +493,7 @@ def _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature):
 # The near-edge cache of ``_cached_gap``: ``cache[0]`` the number of near
 # edges (-1: empty), ``cache[1:3]`` the pin centre it was made at,
 # ``cache[3]`` a lower bound on the distance from there to every other edge,
-# ``cache[4:]`` the near edges' indices.
+# ``cache[4:]`` pairs: a near edge's index and its distance from there.
 GAP_CACHE_HEAD = 4
 GAP_NEAR_REACH = 0.03  # beyond the pin radius (units of the lengths), an edge is near
 _GAP_MARGIN = 1e-9  # the far bound must clear zero by this much (rounding)
@@ -505,7 +505,7 @@ def _near_edges(verts, qx, qy, reach, cache):
     ``q`` and a lower bound on the distance of every other edge. Returns
     False (cache left empty) when the near edges do not fit."""
     n = verts.shape[0]
-    room = cache.shape[0] - GAP_CACHE_HEAD
+    room = (cache.shape[0] - GAP_CACHE_HEAD) // 2
     count = 0
     far = np.inf
     for j in range(n):
@@ -521,7 +521,8 @@ def _near_edges(verts, qx, qy, reach, cache):
                 if count == room:
                     cache[0] = -1.0
                     return False
-                cache[GAP_CACHE_HEAD + count] = j
+                cache[GAP_CACHE_HEAD + 2 * count] = j
+                cache[GAP_CACHE_HEAD + 2 * count + 1] = dist
                 count += 1
                 continue
         far = min(far, dist)
@@ -552,8 +553,10 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
     contact feature only removes candidates, so the bound holds with it too.
     """
     far = -np.inf
+    moved = 0.0
     if cache[0] >= 0.0:
-        far = cache[3] - math.hypot(qx - cache[1], qy - cache[2]) - r_pin
+        moved = math.hypot(qx - cache[1], qy - cache[2])
+        far = cache[3] - moved - r_pin
     if not far > _GAP_MARGIN:
         reach = GAP_NEAR_REACH
         for _ in range(3):
@@ -561,11 +564,15 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
                 break
             reach *= 0.25
         if cache[0] >= 0.0:
-            far = cache[3] - r_pin
+            far, moved = cache[3] - r_pin, 0.0
     if far > _GAP_MARGIN:
         gap = far
         for m in range(int(cache[0])):
-            j = int(cache[GAP_CACHE_HEAD + m])
+            j = int(cache[GAP_CACHE_HEAD + 2 * m])
+            near = cache[GAP_CACHE_HEAD + 2 * m + 1] - moved - r_pin
+            if near > _GAP_MARGIN:
+                gap = min(gap, near)  # this edge, too, is still clear
+                continue
             px, py, t, length = _closest_on_segment(verts, j, qx, qy)
             d = math.hypot(qx - px, qy - py) - r_pin
             # The contact's own feature is tested only where it would lower
