@@ -8,7 +8,7 @@ physics or of the driver's bookkeeping. One thread computes one rollout of
 the grid, final state only (no trajectory).
 
 Scratch: each thread holds a fixed-size local array of ``_W_ROWS x _W_COLS``
-float64 (19 x 29, 4.3 KiB) that does not depend on the polygon; the polygon, its
+float64 (20 x 29, 4.5 KiB) that does not depend on the polygon; the polygon, its
 quadrature rule and the grid live in global memory. There is no polygon
 size limit beyond the step budget that applies on the CPU too.
 

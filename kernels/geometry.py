@@ -491,12 +491,13 @@ def _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature):
 
 
 # The near-edge cache of ``_cached_gap``: ``cache[0]`` the number of near
-# edges (-1: empty), ``cache[1:3]`` the pin centre it was made at,
+# edges (-1: empty; -2: they did not fit, measure every edge until the pin
+# has moved ``GAP_NEAR_REACH``), ``cache[1:3]`` the pin centre it was made at,
 # ``cache[3]`` a lower bound on the distance from there to every other edge,
 # ``cache[4:]`` pairs: a near edge's index and its distance from there.
 GAP_CACHE_HEAD = 4
 GAP_NEAR_REACH = 0.03  # beyond the pin radius (units of the lengths), an edge is near
-_GAP_MARGIN = 1e-9  # the far bound must clear zero by this much (rounding)
+_GAP_MARGIN = 1e-9  # a bound must clear zero by this much per unit length (rounding)
 
 
 @jit
@@ -519,7 +520,7 @@ def _near_edges(verts, qx, qy, reach, cache):
             dist = math.hypot(qx - px, qy - py)
             if dist < reach:
                 if count == room:
-                    cache[0] = -1.0
+                    cache[0], cache[1], cache[2] = -2.0, qx, qy
                     return False
                 cache[GAP_CACHE_HEAD + 2 * count] = j
                 cache[GAP_CACHE_HEAD + 2 * count + 1] = dist
@@ -549,28 +550,33 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
     made at. While that bound minus ``r_pin`` clears zero, only the near
     edges are measured; once it does not, the list is made again at ``q``
     (within ``r_pin + GAP_NEAR_REACH``, then tighter reaches if it does not
-    fit, and if none fits the gap is measured over every edge). The excluded
+    fit; if none fits, every edge is measured until the pin has moved
+    ``GAP_NEAR_REACH``). The margin by which a bound must clear zero grows
+    with the lengths it is made of, so rounding cannot flip it. The excluded
     contact feature only removes candidates, so the bound holds with it too.
     """
     far = -np.inf
     moved = 0.0
-    if cache[0] >= 0.0:
+    if cache[0] != -1.0:
         moved = math.hypot(qx - cache[1], qy - cache[2])
+        if cache[0] == -2.0 and moved < GAP_NEAR_REACH:
+            return _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)
         far = cache[3] - moved - r_pin
-    if not far > _GAP_MARGIN:
+    margin = _GAP_MARGIN * (1.0 + r_pin + moved)
+    if not (cache[0] >= 0.0 and far > margin):
         reach = GAP_NEAR_REACH
         for _ in range(3):
             if _near_edges(verts, qx, qy, r_pin + reach, cache):
                 break
             reach *= 0.25
         if cache[0] >= 0.0:
-            far, moved = cache[3] - r_pin, 0.0
-    if far > _GAP_MARGIN:
+            far, moved, margin = cache[3] - r_pin, 0.0, _GAP_MARGIN * (1.0 + r_pin)
+    if cache[0] >= 0.0 and far > margin:
         gap = far
         for m in range(int(cache[0])):
             j = int(cache[GAP_CACHE_HEAD + 2 * m])
             near = cache[GAP_CACHE_HEAD + 2 * m + 1] - moved - r_pin
-            if near > _GAP_MARGIN:
+            if near > margin:
                 gap = min(gap, near)  # this edge, too, is still clear
                 continue
             px, py, t, length = _closest_on_segment(verts, j, qx, qy)
