@@ -99,7 +99,7 @@ verts, area, a, quad, m_max, convex = part.prepared()
 n, changes = 0, 0
 for th in theta:
     for dd in d:
-        r = R._rollout(verts, area, a, quad, m_max, convex, 0, mu, rp / a, np.radians(th), dd, 0.0,
+        r = R._rollout(verts, area, a, quad, m_max, convex, 0, mu, rp, np.radians(th), dd, 0.0,
                        np.inf, R.DEFAULT_DS_MAX, R.DEFAULT_TOL, False)
         n += 1
         changes += r[5]
@@ -130,7 +130,7 @@ def rates(part) -> tuple[float, float]:
     raw = np.vstack([quad[:f + 2 * n], [[f, n, 0.0]]])
     out = []
     for q in (quad, raw):
-        args = (verts, area, a, q, m_max, convex, 0, MU_C, R_PIN / a)
+        args = (verts, area, a, q, m_max, convex, 0, MU_C, R_PIN)  # mm: the kernels take the part's unit
         _rollout_grid(*args, np.radians(THETA[:2]), D[:2], 0.0, np.inf, DEFAULT_DS_MAX, DEFAULT_TOL, 1)
         best = math.inf
         for _ in range(2):
