@@ -536,11 +536,11 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
     """``_other_contact_gap`` where it can matter, a positive lower bound of
     it elsewhere, from the near edges kept in ``cache``.
 
-    Returns the exact gap (bit for bit) whenever it is at most the bound of
-    the far edges; otherwise a value in ``(0, gap]``: both then say "no
-    second contact", and an event function needs the value only below zero
-    (a caller that needs it above, to locate a crossing, calls
-    ``_other_contact_gap``).
+    Returns the exact gap (bit for bit) wherever it is at most zero;
+    elsewhere a value in ``(0, gap]`` (the exact gap, or the bound of an edge
+    left unmeasured): both then say "no second contact", and an event
+    function needs the value only below zero (a caller that needs it above,
+    to locate a crossing, calls ``_other_contact_gap``).
 
     Notes
     -----
