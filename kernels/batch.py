@@ -9,7 +9,7 @@ the result does not depend on the thread count.
 """
 import numpy as np
 
-from ._numba import jit
+from ._numba import jit, jit_alloc
 from .drive import DYNAMIC, NO_DYNAMIC, NO_STATIC, STATIC, _as_grid, _drive
 from .rollout import max_steps_for
 from .support import _table_sizes
@@ -23,7 +23,7 @@ def blocks_for(threads, total):
     return max(1, min(int(threads) * BLOCKS_PER_THREAD, -(-int(total) // _CHUNK)))
 
 
-@jit
+@jit_alloc
 def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
                   max_travel, ds_max, tol, n_blocks):
     """Rollouts over the outer product ``d x theta_i`` (radians for theta_i).
@@ -40,7 +40,7 @@ def _rollout_grid(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     return _as_grid(out, nd, nt)
 
 
-@jit
+@jit_alloc
 def _dyn_rollout_grid(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, fr,
                       restitution, eps, h, max_travel, max_steps, n_blocks):
     """Dynamic rollouts (``dynamic._dyn_rollout``) over the outer product

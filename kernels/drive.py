@@ -32,7 +32,7 @@ parameters and ``NO_STATIC`` or ``NO_DYNAMIC`` for the other.
 import numpy as np
 from numba import prange
 
-from ._numba import jit, jit_parallel
+from ._numba import jit, jit_alloc, jit_parallel
 from .dynamic import _dyn_rollout
 from .rollout import _W_COLS, _W_ROWS, _rollout_core
 
@@ -62,7 +62,7 @@ def _inputs(k, grid, theta_i, d, mu_c):
     return theta_i[k], d[k], mu_c[k]
 
 
-@jit
+@jit_alloc
 def _outputs(n):
     """The seven result arrays of ``n`` rollouts: ``status``, ``reason``
     (int8), ``theta_f``, ``dy``, ``contact_travel``, ``feature_changes``
@@ -100,7 +100,7 @@ def _static_rollout(k, grid, verts, area, a, quad, m_max, convex, mu_c, theta_i,
     _store(k, res, status, reason, theta_f, dy, travel, changes, peak)
 
 
-@jit
+@jit_alloc
 def _dynamic_rollout(k, grid, verts, area, a, quad, convex, mu_c, theta_i, d, prm, status,
                      reason, theta_f, dy, travel, changes, peak):
     """Dynamic rollout ``k`` (``_inputs``), final state only, stored at ``k``.
@@ -158,7 +158,7 @@ def _drive(kind, grid, n, chunk, n_blocks, verts, area, a, quad, m_max, convex, 
     return status, reason, theta_f, dy, travel, changes, peak
 
 
-@jit
+@jit_alloc
 def _as_grid(out, nd, nt):
     """The seven flat results of ``_drive`` over a grid as ``(nd, nt)`` arrays."""
     return (out[0].reshape((nd, nt)), out[1].reshape((nd, nt)), out[2].reshape((nd, nt)),

@@ -91,7 +91,7 @@ import math
 
 import numpy as np
 
-from ._numba import jit
+from ._numba import jit, jit_alloc
 from .geometry import GAP_CACHE_HEAD, _cached_gap, _closest_feature, _ray_first_contact
 from .support import _power, _table_sizes
 
@@ -202,7 +202,7 @@ def _coulomb(dnn, dnt, dtt, vfn, vft, b, mu):
     return rn / dnn, 0.0, 2
 
 
-@jit
+@jit_alloc
 def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, fr, restitution,
                  eps, h, max_travel, max_steps, record):
     """Dynamic passage of a prepared part (``rollout._prepare``) past one pin.
@@ -366,7 +366,7 @@ def _dyn_rollout(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, f
                 break
             # Only the sign counts, which the cached gap keeps exactly.
             if not convex and _cached_gap(verts, qx, qy, cx, cy, rp, _SAME_FEATURE,
-                                          gap_cache) < 0.0:
+                                          gap_cache, False) < 0.0:
                 status, reason = JAMMED, R_NOTCH
                 break
             continue

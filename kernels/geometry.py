@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ._numba import jit
+from ._numba import jit, jit_alloc
 
 EDGE = 0
 VERTEX = 1
@@ -134,7 +134,7 @@ def _centroid(xy):
     return ox + sx / (3.0 * a2), oy + sy / (3.0 * a2), 0.5 * a2
 
 
-@jit
+@jit_alloc
 def _normalise(xy):
     """Counter-clockwise copy of ``xy`` with the area centroid at the origin.
 
@@ -153,7 +153,7 @@ def _normalise(xy):
     return out, abs(area), a
 
 
-@jit
+@jit_alloc
 def _keyhole(xy, starts):
     """One closed polygon whose signed edges bound the material of a part
     with holes: the outline, then each hole, joined by bridges.
@@ -199,7 +199,7 @@ def _keyhole(xy, starts):
     return out
 
 
-@jit
+@jit_alloc
 def _normalise_loops(xy, starts):
     """Outline and holes oriented and centred on the material's area centroid.
 
@@ -299,7 +299,7 @@ def _cross_o(verts, o, a, b):
             - (verts[a, 1] - verts[o, 1]) * (verts[b, 0] - verts[o, 0]))
 
 
-@jit
+@jit_alloc
 def _convex_hull(verts):
     """Indices of the convex hull vertices, counter-clockwise (Andrew's monotone chain).
 
@@ -332,7 +332,7 @@ def _convex_hull(verts):
     return hull[: m - 1].copy()
 
 
-@jit
+@jit_alloc
 def _stable_edges(verts):
     """Stable resting edges against a fence (spec section 6).
 
@@ -485,9 +485,27 @@ def _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature):
             if dx * dx + dy * dy > reach * reach * (1.0 + 1e-9):
                 continue
         px, py, t, length = _closest_on_segment(verts, j, qx, qy)
-        if math.hypot(px - cx, py - cy) > same_feature:
+        if _other_feature(px, py, cx, cy, same_feature):
             gap = min(gap, math.hypot(qx - px, qy - py) - r_pin)
     return gap
+
+
+_SQUARED_SLACK = 1e-9  # a squared length this far (relative) from the limit decides without math.hypot
+
+
+@jit
+def _other_feature(px, py, cx, cy, same_feature):
+    """``math.hypot(px - cx, py - cy) > same_feature``, the same answer,
+    from the squared distance unless that lies within ``_SQUARED_SLACK`` of
+    the limit (``hypot`` is a library call, several times a product)."""
+    dx, dy = px - cx, py - cy
+    d2 = dx * dx + dy * dy
+    limit = same_feature * same_feature
+    if d2 > limit * (1.0 + _SQUARED_SLACK):
+        return True
+    if d2 < limit * (1.0 - _SQUARED_SLACK):
+        return False
+    return math.hypot(dx, dy) > same_feature
 
 
 # The near-edge cache of ``_cached_gap``: ``cache[0]`` the number of near
@@ -532,15 +550,18 @@ def _near_edges(verts, qx, qy, reach, cache):
 
 
 @jit
-def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
+def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache, exact):
     """``_other_contact_gap`` where it can matter, a positive lower bound of
-    it elsewhere, from the near edges kept in ``cache``.
+    it elsewhere, from the near edges kept in ``cache``; with ``exact``,
+    ``_other_contact_gap`` everywhere, bit for bit.
 
     Returns the exact gap (bit for bit) wherever it is at most zero;
     elsewhere a value in ``(0, gap]`` (the exact gap, or the bound of an edge
     left unmeasured): both then say "no second contact", and an event
-    function needs the value only below zero (a caller that needs it above,
-    to locate a crossing, calls ``_other_contact_gap``).
+    function needs the value only below zero. A caller that needs it above,
+    to locate a crossing, asks for ``exact``: every near edge is then
+    measured, and the minimum over them is the answer where the bound on the
+    other edges clears it; elsewhere every edge is measured.
 
     Notes
     -----
@@ -551,14 +572,19 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
     edges are measured; once it does not, the list is made again at ``q``
     (within ``r_pin + GAP_NEAR_REACH``, then tighter reaches if it does not
     fit; if none fits, every edge is measured until the pin has moved
-    ``GAP_NEAR_REACH``). The margin by which a bound must clear zero grows
-    with the lengths it is made of, so rounding cannot flip it. The excluded
-    contact feature only removes candidates, so the bound holds with it too.
+    ``GAP_NEAR_REACH``). The margin by which a bound must clear zero (or
+    the near minimum, with ``exact``) grows with the lengths it is made of,
+    so rounding cannot flip it. The excluded contact feature only removes
+    candidates, so the bound holds with it too. Only the decisions use
+    ``sqrt`` of a sum of squares; every value returned below zero, and every
+    value with ``exact``, comes from ``math.hypot`` as in
+    ``_other_contact_gap``.
     """
     far = -np.inf
     moved = 0.0
     if cache[0] != -1.0:
-        moved = math.hypot(qx - cache[1], qy - cache[2])
+        dx, dy = qx - cache[1], qy - cache[2]
+        moved = math.sqrt(dx * dx + dy * dy)
         if cache[0] == -2.0 and moved < GAP_NEAR_REACH:
             return _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)
         far = cache[3] - moved - r_pin
@@ -572,18 +598,18 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
         if cache[0] >= 0.0:
             far, moved, margin = cache[3] - r_pin, 0.0, _GAP_MARGIN * (1.0 + r_pin)
     if cache[0] >= 0.0 and far > margin:
-        gap = far
+        gap = np.inf if exact else far
         for m in range(int(cache[0])):
             j = int(cache[GAP_CACHE_HEAD + 2 * m])
             near = cache[GAP_CACHE_HEAD + 2 * m + 1] - moved - r_pin
-            if near > margin:
+            if near > margin and not exact:
                 gap = min(gap, near)  # this edge, too, is still clear
                 continue
             px, py, t, length = _closest_on_segment(verts, j, qx, qy)
-            d = math.hypot(qx - px, qy - py) - r_pin
-            # The contact's own feature is tested only where it would lower
-            # the minimum (the minimum is the same, in any order).
-            if d < gap and math.hypot(px - cx, py - cy) > same_feature:
-                gap = d
-        return gap
+            # The contact's own feature is left out first (the minimum is
+            # the same, in any order).
+            if _other_feature(px, py, cx, cy, same_feature):
+                gap = min(gap, math.hypot(qx - px, qy - py) - r_pin)
+        if not exact or gap < far - margin * (1.0 + abs(gap)):
+            return gap
     return _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)

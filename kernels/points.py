@@ -12,13 +12,13 @@ rollouts (jams, many contact changes), which cluster in neighbouring points,
 spread over every thread: ``_rollout_points`` for the quasi-static models,
 ``_dyn_rollout_points`` for the dynamic one.
 """
-from ._numba import jit
+from ._numba import jit, jit_alloc
 from .drive import DYNAMIC, NO_DYNAMIC, NO_STATIC, STATIC, _drive
 from .rollout import max_steps_for
 from .support import _table_sizes
 
 
-@jit
+@jit_alloc
 def _rollout_points(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
                     max_travel, ds_max, tol, n_threads):
     """Final states of rollouts at the points ``(theta_i[k], d[k], mu_c[k])``.
@@ -42,7 +42,7 @@ def _rollout_points(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, the
     return out[0], out[1], out[2], out[3]
 
 
-@jit
+@jit_alloc
 def _dyn_rollout_points(verts, area, a, quad, convex, mu_c, r_pin, theta_i, d, v_pin, fr,
                         restitution, eps, h, max_travel, max_steps, n_threads):
     """Dynamic rollouts at scattered points ``(theta_i[k], d[k], mu_c[k])``.

@@ -48,9 +48,9 @@ import math
 
 import numpy as np
 
-from ._numba import jit, jit_inline
+from ._numba import jit, jit_alloc, jit_inline
 from .geometry import (EDGE, VERTEX, _cached_gap, _is_convex, _keyhole, _normalise_loops,
-                       _other_contact_gap, _ray_first_contact)
+                       _ray_first_contact)
 from .models import (_DEC_TAKE, MINPOWER, MINPOWER_POINTS, NO_MODEL, SEPARATE, SLIDE_NEG,
                      SLIDE_POS, TWIST_OK, _contact_twist, _continued_slide, _minpower_twist,
                      _minpower_twist_points)
@@ -179,7 +179,7 @@ def _prepare_loops(xy, starts):
     return verts, area, a, quad, m_max, convex
 
 
-@jit
+@jit_alloc
 def _prepared_loops(xy, starts):
     """``_prepare_loops`` without the support table, and the number of
     material edges (outline, holes and their bridges)."""
@@ -469,9 +469,8 @@ def _events(verts, prm, kind, idx, y, g, gap_cache, exact_gap):
     if convex:
         g[3] = np.inf
     else:
-        gap = (_other_contact_gap(verts, y[1], y[2], cx, cy, rp, _SAME_FEATURE) if exact_gap else
-               _cached_gap(verts, y[1], y[2], cx, cy, rp, _SAME_FEATURE, gap_cache))
-        g[3] = gap + _NOTCH_TOL
+        g[3] = _cached_gap(verts, y[1], y[2], cx, cy, rp, _SAME_FEATURE, gap_cache,
+                           exact_gap) + _NOTCH_TOL
 
 
 @jit
@@ -638,7 +637,7 @@ def max_steps_for(n_vertices):
     return max(MIN_STEPS, min(MAX_STEPS, MAX_STEPS_WORK // max(n_vertices, 1)))
 
 
-@jit
+@jit_alloc
 def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
              max_travel, ds_max, tol, record):
     """Roll a prepared part (see ``_prepare``) past one pin.
@@ -677,7 +676,7 @@ def _rollout(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d
     return res[0], res[1], res[2], res[3], res[4], res[5], res[6], res[7], res[8]
 
 
-@jit
+@jit_alloc
 def _rollout_budget(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta_i, d, v_pin,
                     max_travel, ds_max, tol, record, max_steps):
     """``_rollout`` with an explicit step budget ``max_steps``; returns its

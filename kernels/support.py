@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 
-from ._numba import jit, jit_inline
+from ._numba import jit, jit_alloc, jit_inline
 from .edge_integrals import _edge_support, _support_sum, _table_sizes  # noqa: F401 (re-exported)
 from .support_table import _has_table, _moment_power, _table_support
 
@@ -56,7 +56,7 @@ _GL_X = 0.5 * (_GL_X + 1.0)
 _GL_W = 0.5 * _GL_W
 
 
-@jit
+@jit_alloc
 def _support(verts, rx, ry):
     """E(r), G(r) and N(r) of the polygon ``verts`` (counter-clockwise; a
     keyhole polygon of ``geometry._keyhole`` for a part with holes).
@@ -66,7 +66,7 @@ def _support(verts, rx, ry):
     return _support_sum(_fan_quadrature(verts), rx, ry)
 
 
-@jit
+@jit_alloc
 def _fan_quadrature(verts):
     """The support table of the polygon ``verts``: a collapsed
     Gauss-Legendre rule over its centroid fan, its vertices and its edges'
@@ -122,7 +122,7 @@ def _fan_quadrature(verts):
     return out
 
 
-@jit
+@jit_alloc
 def _point_table(quad, pts):
     """The support table ``quad`` with its quadrature rows replaced by the
     point support ``pts`` (``(K, 3)`` rows ``(x, y, w)``, units of a,
@@ -174,7 +174,7 @@ def _power(quad, area, vx, vy, om):
             f * r[8], f * r[9])
 
 
-@jit
+@jit_alloc
 def _max_moment(verts, area):
     """m_max = E(0) / A: the belt's friction moment on a part spinning about its
     centroid, in units of mu_s m g times length (2R/3 for a disc of radius R)."""

@@ -71,7 +71,7 @@ import math
 import numpy as np
 from numba import prange
 
-from ._numba import jit, jit_parallel
+from ._numba import jit, jit_alloc, jit_parallel
 from .edge_integrals import _edge_support, _support_sum, _table_sizes
 
 _R_INNER = 1.25  # units of a: the outline lies within the unit disc
@@ -137,7 +137,7 @@ def _has_table(quad):
     return quad[quad.shape[0] - 1, 2] > 0.0
 
 
-@jit
+@jit_alloc
 def _moments(quad, order):
     """``M[j, k] = integral w^j conj(w)^k dA`` (real and imaginary parts) of
     the material of ``quad``, for ``j + k <= order``, by a collapsed Gauss
@@ -178,7 +178,7 @@ def _moments(quad, order):
     return re, im
 
 
-@jit
+@jit_alloc
 def _twin_edges(quad):
     """``True`` for each edge walked once each way (a bridge of
     ``geometry._keyhole``): the pair cancels and is never a near edge."""
@@ -285,7 +285,7 @@ def _poly_value(block, xl, yl):
     return val
 
 
-@jit
+@jit_alloc
 def _fit(vals, out):
     """Tensor Chebyshev interpolation of ``vals`` (at the cell's Chebyshev
     points) written as monomial coefficients into ``out`` (three to a row)."""
@@ -317,7 +317,7 @@ def _fit(vals, out):
             out[idx // 3, idx % 3] = acc
 
 
-@jit
+@jit_alloc
 def _far_values(quad, f, n, cell, near, n_near):
     """E of the edges far from a grid cell ``cell`` (``(x0, y0, width)``) at
     its Chebyshev points: the exact sum less its ``n_near`` near edges."""
@@ -336,7 +336,7 @@ def _far_values(quad, f, n, cell, near, n_near):
     return vals
 
 
-@jit
+@jit_alloc
 def _child_far_values(quad, f, n, cell, near, n_near, parent, parent_cell, parent_near):
     """``_far_values`` of a split cell's child: its parent's polynomial
     ``parent`` (valid over the parent cell ``parent_cell``, whose far edges
@@ -410,7 +410,7 @@ def _top_cells(quad, f, n, every, n_every, r_grid, n_grid, skip_inside):
     return near, count, vals
 
 
-@jit
+@jit_alloc
 def _grid_cells(quad, f, n, twin, r_grid, n_grid, top, cells, coefs, nears):
     """Fit every cell of one grid, splitting a cell with more than
     ``_SPLIT_NEAR`` near edges into four (down to ``_MAX_SPLIT`` times);
@@ -499,7 +499,7 @@ def _with_table(quad):
     return _table_from(quad, twin, inner, outer)
 
 
-@jit
+@jit_alloc
 def _table_from(quad, twin, inner, outer):
     """The table of ``_with_table`` from the top-level cells of the inner and
     outer grids (``_top_cells``)."""

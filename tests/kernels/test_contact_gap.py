@@ -6,7 +6,7 @@ minimum over every edge (the reference below, the function as it was).
 ``geometry._cached_gap`` measures only the edges near the pin while the
 others provably stay clear: it must give that same value wherever the value
 is negative (a second contact), and a positive value no larger than it
-elsewhere.
+elsewhere; asked for the exact value, that value everywhere.
 """
 import math
 
@@ -76,11 +76,14 @@ def test_cached_gap_is_exact_wherever_it_is_negative(xy, seed, r_pin, stride, si
         side = min(max(side + rng.normal(0, 0.1), 0.3), 1.5)
         qx, qy = np.array([cx, cy]) + side * r_pin * normal
         want = _reference(verts, qx, qy, cx, cy, r_pin, 1e-3)
-        got = _cached_gap(verts, qx, qy, cx, cy, r_pin, 1e-3, cache)
+        got = _cached_gap(verts, qx, qy, cx, cy, r_pin, 1e-3, cache, False)
         if want <= 0.0:
             assert got == want
         else:
             assert 0.0 < got <= want + 1e-12
+        # Asked for the exact value (locating a crossing), it is the
+        # reference's everywhere, bit for bit, from the same cache.
+        assert _cached_gap(verts, qx, qy, cx, cy, r_pin, 1e-3, cache, True) == want
 
 
 def test_cached_gap_walk_meets_second_contacts():
@@ -95,7 +98,8 @@ def test_cached_gap_walk_meets_second_contacts():
         for x in np.linspace(0.3, 0.9, 25):
             cx, cy = x, 0.3 if not (0.4 < x < 0.5 or 0.7 < x < 0.8) else 0.1
             want = _reference(comb, x, y, cx, cy, 0.06, 1e-3)
-            got = _cached_gap(comb, x, y, cx, cy, 0.06, 1e-3, cache)
+            got = _cached_gap(comb, x, y, cx, cy, 0.06, 1e-3, cache, False)
+            assert _cached_gap(comb, x, y, cx, cy, 0.06, 1e-3, cache, True) == want
             if want <= 0.0:
                 seen["negative"] += 1
                 assert got == want
@@ -126,7 +130,7 @@ def run():
         out.append([float(x) for x in r[:7]])
     return out
 cached = run()
-def exact(verts, qx, qy, cx, cy, r_pin, same_feature, cache):
+def exact(verts, qx, qy, cx, cy, r_pin, same_feature, cache, exact):
     return G._other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)
 R._cached_gap = D._cached_gap = exact
 print(json.dumps({"cached": cached, "exact": run()}))
