@@ -516,6 +516,7 @@ def _other_feature(px, py, cx, cy, same_feature):
 GAP_CACHE_HEAD = 4
 GAP_NEAR_REACH = 0.03  # beyond the pin radius (units of the lengths), an edge is near
 _GAP_MARGIN = 1e-9  # a bound must clear zero by this much per unit length (rounding)
+_GAP_EXACT_REACH = 0.1  # an exact gap below this remakes the list to hold its edge (units of the lengths)
 
 
 @jit
@@ -561,7 +562,10 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache, exact):
     function needs the value only below zero. A caller that needs it above,
     to locate a crossing, asks for ``exact``: every near edge is then
     measured, and the minimum over them is the answer where the bound on the
-    other edges clears it; elsewhere every edge is measured.
+    other edges clears it; elsewhere every edge is measured, and the list is
+    made again there to hold the nearest other edge (the edges within ``gap
+    + GAP_NEAR_REACH`` beyond the pin, for a gap under ``_GAP_EXACT_REACH``):
+    the search's next points lie close by.
 
     Notes
     -----
@@ -590,11 +594,7 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache, exact):
         far = cache[3] - moved - r_pin
     margin = _GAP_MARGIN * (1.0 + r_pin + moved)
     if not (cache[0] >= 0.0 and far > margin):
-        reach = GAP_NEAR_REACH
-        for _ in range(3):
-            if _near_edges(verts, qx, qy, r_pin + reach, cache):
-                break
-            reach *= 0.25
+        _remake_near(verts, qx, qy, r_pin, GAP_NEAR_REACH, cache)
         if cache[0] >= 0.0:
             far, moved, margin = cache[3] - r_pin, 0.0, _GAP_MARGIN * (1.0 + r_pin)
     if cache[0] >= 0.0 and far > margin:
@@ -612,4 +612,19 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache, exact):
                 gap = min(gap, math.hypot(qx - px, qy - py) - r_pin)
         if not exact or gap < far - margin * (1.0 + abs(gap)):
             return gap
-    return _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)
+    gap = _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)
+    if exact and gap < _GAP_EXACT_REACH:
+        # A crossing's search evaluates the next points near this one: the
+        # list made here holds the nearest other edge, so they can use it.
+        _remake_near(verts, qx, qy, r_pin, max(gap, 0.0) + GAP_NEAR_REACH, cache)
+    return gap
+
+
+@jit
+def _remake_near(verts, qx, qy, r_pin, reach, cache):
+    """Make the near-edge list at ``q`` with edges within ``r_pin + reach``,
+    or a quarter and a sixteenth of ``reach`` where they do not fit."""
+    for _ in range(3):
+        if _near_edges(verts, qx, qy, r_pin + reach, cache):
+            return
+        reach *= 0.25
