@@ -79,7 +79,7 @@ def test_a_row_states_the_recorded_plan(part):
 # --------------------------------------------------------------------------- the corpus under a time limit
 
 CORPUS_HEADING = "### Real parts planned under a time limit"
-CORPUS_RECORD = ROOT / "benchmarks" / "records" / "real_parts_limit50_near_gap_2026-11-29.json"
+CORPUS_RECORD = ROOT / "benchmarks" / "records" / "real_parts_limit50_no_refcount_2026-11-29.json"
 
 
 def _corpus_rows() -> dict:
