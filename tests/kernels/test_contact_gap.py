@@ -15,7 +15,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kernels._numba import jit
-from kernels.geometry import GAP_CACHE_HEAD, _cached_gap, _closest_on_segment, _other_contact_gap
+from kernels.geometry import (GAP_CACHE_HEAD, GAP_NEAR_REACH, _cached_gap, _closest_on_segment, _other_contact_gap,
+                              _other_feature)
 from strategies import star_polygons
 
 
@@ -107,6 +108,54 @@ def test_cached_gap_walk_meets_second_contacts():
                 seen["bound"] += got != want
                 assert 0.0 < got <= want + 1e-12
     assert seen["negative"] > 50 and seen["bound"] > 50
+
+
+@jit
+def _hypot_over(px, py, cx, cy, same_feature):
+    """The plain comparison ``_other_feature`` stands for, compiled (the same libm)."""
+    return math.hypot(px - cx, py - cy) > same_feature
+
+
+def test_other_feature_is_the_hypot_comparison_at_the_limit():
+    # Points a few ulps either side of the limit, where the squared lengths
+    # cannot decide and math.hypot must, and points well clear of it.
+    rng = np.random.default_rng(7)
+    undecided = 0
+    for same in (1e-3, 0.37, 2.5):
+        for _ in range(3000):
+            cx, cy = rng.uniform(-2.0, 2.0, 2)
+            ang = rng.uniform(0.0, 2.0 * math.pi)
+            r = same * (1.0 + int(rng.integers(-6, 7)) * 2.0**-52 if rng.uniform() < 0.8 else rng.uniform(0.5, 1.5))
+            px, py = cx + r * math.cos(ang), cy + r * math.sin(ang)
+            d2 = (px - cx) ** 2 + (py - cy) ** 2
+            undecided += abs(d2 / same**2 - 1.0) <= 1e-9
+            assert _other_feature(px, py, cx, cy, same) == _hypot_over(px, py, cx, cy, same)
+    assert undecided > 5000  # the hand-over to math.hypot ran
+
+
+def test_an_exact_fallback_keeps_the_nearest_other_edge():
+    # Above the comb's middle tooth, farther from the other teeth than the
+    # near reach: an exact gap measures every edge, and the list made there
+    # holds the nearest other edge, so the next point of a search nearby is
+    # served from it (the same value as over every edge).
+    comb = np.array([[0, 0], [1, 0], [1, 0.3], [0.8, 0.3], [0.8, 0.1], [0.7, 0.1], [0.7, 0.3],
+                     [0.5, 0.3], [0.5, 0.1], [0.4, 0.1], [0.4, 0.3], [0, 0.3]], dtype=float)
+    r_pin, x, cx, cy = 0.04, 0.6, 0.6, 0.3
+    cache = np.empty(GAP_CACHE_HEAD + 25)
+    cache[0] = -1.0
+    y = cy + r_pin
+    want = _reference(comb, x, y, cx, cy, r_pin, 1e-3)
+    assert GAP_NEAR_REACH < want < 0.1  # beyond the near reach: the first list cannot decide
+    assert _cached_gap(comb, x, y, cx, cy, r_pin, 1e-3, cache, True) == want
+    gaps = [(_closest_on_segment(comb, j, x, y), j) for j in range(len(comb))]
+    nearest = min(j for (p, j) in gaps if math.hypot(p[0] - cx, p[1] - cy) > 1e-3
+                  and math.hypot(x - p[0], y - p[1]) - r_pin == want)
+    listed = [int(cache[GAP_CACHE_HEAD + 2 * m]) for m in range(int(cache[0]))]
+    assert nearest in listed
+    y2 = y + 1e-4
+    assert _cached_gap(comb, x, y2, cx, cy, r_pin, 1e-3, cache, True) == _reference(comb, x, y2, cx, cy, r_pin,
+                                                                                       1e-3)
+    assert [int(cache[GAP_CACHE_HEAD + 2 * m]) for m in range(int(cache[0]))] == listed  # served, not remade
 
 
 _BOTH_WAYS = r'''
