@@ -491,6 +491,7 @@ def _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature):
 
 
 _SQUARED_SLACK = 1e-9  # a squared length this far (relative) from the limit decides without math.hypot
+_SQUARED_FLOOR = 1e-290  # below this squared limit, math.hypot decides
 
 
 @jit
@@ -501,6 +502,8 @@ def _other_feature(px, py, cx, cy, same_feature):
     dx, dy = px - cx, py - cy
     d2 = dx * dx + dy * dy
     limit = same_feature * same_feature
+    if limit < _SQUARED_FLOOR:  # near the subnormals a product loses the slack's precision
+        return math.hypot(dx, dy) > same_feature
     if d2 > limit * (1.0 + _SQUARED_SLACK):
         return True
     if d2 < limit * (1.0 - _SQUARED_SLACK):
@@ -613,7 +616,7 @@ def _cached_gap(verts, qx, qy, cx, cy, r_pin, same_feature, cache, exact):
         if not exact or gap < far - margin * (1.0 + abs(gap)):
             return gap
     gap = _other_contact_gap(verts, qx, qy, cx, cy, r_pin, same_feature)
-    if exact and gap < _GAP_EXACT_REACH:
+    if exact and gap < _GAP_EXACT_REACH and cache[0] != -2.0:  # (-2: no list fitted here at the near reach)
         # A crossing's search evaluates the next points near this one: the
         # list made here holds the nearest other edge, so they can use it.
         _remake_near(verts, qx, qy, r_pin, max(gap, 0.0) + GAP_NEAR_REACH, cache)

@@ -131,6 +131,12 @@ def test_other_feature_is_the_hypot_comparison_at_the_limit():
             undecided += abs(d2 / same**2 - 1.0) <= 1e-9
             assert _other_feature(px, py, cx, cy, same) == _hypot_over(px, py, cx, cy, same)
     assert undecided > 5000  # the hand-over to math.hypot ran
+    # A squared limit among the subnormals, whose rounding is coarser than the slack.
+    for same in (1e-160, 3e-162):
+        for _ in range(3000):
+            ang, r = rng.uniform(0.0, 2.0 * math.pi), same * (1.0 + rng.uniform(-1e-2, 1e-2))
+            px, py = r * math.cos(ang), r * math.sin(ang)
+            assert _other_feature(px, py, 0.0, 0.0, same) == _hypot_over(px, py, 0.0, 0.0, same)
 
 
 def test_an_exact_fallback_keeps_the_nearest_other_edge():
