@@ -498,16 +498,17 @@ _SQUARED_FLOOR = 1e-290  # below this squared limit, math.hypot decides
 def _other_feature(px, py, cx, cy, same_feature):
     """``math.hypot(px - cx, py - cy) > same_feature``, the same answer,
     from the squared distance unless that lies within ``_SQUARED_SLACK`` of
-    the limit (``hypot`` is a library call, several times a product)."""
+    the limit or the squared limit is below ``_SQUARED_FLOOR``, where a
+    product's rounding among the subnormals is coarser than the slack
+    (``hypot`` is a library call, several times a product)."""
     dx, dy = px - cx, py - cy
-    d2 = dx * dx + dy * dy
     limit = same_feature * same_feature
-    if limit < _SQUARED_FLOOR:  # near the subnormals a product loses the slack's precision
-        return math.hypot(dx, dy) > same_feature
-    if d2 > limit * (1.0 + _SQUARED_SLACK):
-        return True
-    if d2 < limit * (1.0 - _SQUARED_SLACK):
-        return False
+    if limit >= _SQUARED_FLOOR:
+        d2 = dx * dx + dy * dy
+        if d2 > limit * (1.0 + _SQUARED_SLACK):
+            return True
+        if d2 < limit * (1.0 - _SQUARED_SLACK):
+            return False
     return math.hypot(dx, dy) > same_feature
 
 
