@@ -91,8 +91,12 @@ def profile(outline: str, seconds: float) -> tuple[dict, collections.Counter]:
         time.sleep(1.0)
         with tempfile.TemporaryDirectory() as tmp:
             data = Path(tmp) / "perf.data"
-            subprocess.run(["perf", "record", "-p", str(child.pid), "-o", str(data), "sleep", str(seconds)],
-                           capture_output=True, check=True)
+            rec = subprocess.run(["perf", "record", "-p", str(child.pid), "-o", str(data), "sleep", str(seconds)],
+                                 capture_output=True, text=True)
+            if rec.returncode:
+                last = (rec.stderr.strip().splitlines() or ["no message"])[-1]
+                sys.exit(f"kernel_profile: perf record failed ({last}): allow it with "
+                         "'sysctl kernel.perf_event_paranoid=1' or run as root")
             report = subprocess.run(["perf", "report", "-i", str(data), "--no-children", "--sort", "dso,symbol",
                                      "-g", "none"], capture_output=True, text=True, check=True).stdout
         jit, library = _samples(report)
