@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[2]
 # Lowest first. A module belongs to the layer of its longest matching prefix.
 LAYERS = (
     ("kernels",),  # physics only: Numba, arrays in and out
-    ("pipeline", "pipeline.errors", "pipeline.logs", "pipeline.progress", "pipeline.provenance",
+    ("pipeline", "pipeline.errors", "pipeline.logs", "pipeline.progress", "pipeline.provenance", "pipeline.rows",
      "pipeline.checks"),  # utilities every layer may use
     ("pipeline.parts",),  # Part, families, outline readers
     ("pipeline.config",),  # schema, defaults; checks part outlines, so above parts

@@ -21,6 +21,7 @@ from pipeline.parts.part import Part
 from pipeline.planning.claims.trials import corner_inputs, perturbed_batch
 from pipeline.planning.core.settings import KernelSettings, VerifySettings
 from pipeline.progress import SILENT, Stretch
+from pipeline.rows import unique_rows
 
 
 def replay(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
@@ -151,9 +152,9 @@ class ReplayMemo:
 
     def nodes(self, parent, heights, speeds) -> np.ndarray:
         """The number of each prefix ``parent`` followed by a pin at ``heights``, ``speeds``."""
-        uniq, inverse = np.unique(np.column_stack([parent, heights, speeds]), axis=0, return_inverse=True)
+        uniq, inverse = unique_rows(np.column_stack([parent, heights, speeds]), return_inverse=True)
         ids = [self.prefixes.setdefault((int(p), float(h), float(v)), len(self.prefixes) + 1) for p, h, v in uniq]
-        return np.asarray(ids, dtype=np.int64)[inverse.ravel()]
+        return np.asarray(ids, dtype=np.int64)[inverse]
 
     def lookup(self, nodes, trials) -> np.ndarray:
         """Where each (prefix, trial) state is kept (-1: not kept)."""
@@ -244,11 +245,11 @@ def distinct_rows(theta, d, mu, v_pin, support) -> tuple:
     n = theta.size
     columns = [theta, d, mu, v_pin, np.zeros(n) if support is None else support]
     key = np.column_stack([np.broadcast_to(np.asarray(c, float), (n,)) for c in columns])
-    _, first, inverse = np.unique(np.ascontiguousarray(key).view(np.int64), axis=0, return_index=True,
-                                  return_inverse=True)
+    _, first, inverse = unique_rows(np.ascontiguousarray(key).view(np.int64), return_index=True,
+                                    return_inverse=True)
     if first.size == n:
         return None, None
-    return first, inverse.ravel()
+    return first, inverse
 
 
 def replay_shared(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, pin_radius, model,
@@ -277,8 +278,7 @@ def replay_shared(part: Part, pin_heights, pin_speeds, theta, y_c, mu, offsets, 
     jam = np.zeros((1, n), bool)
     sup = None if support is None else np.broadcast_to(np.asarray(support, dtype=int), (n,))
     for k in range(n_pins):
-        nodes, node = np.unique(np.column_stack([node, heights[:, k], speeds[:, k]]), axis=0, return_inverse=True)
-        node = node.ravel()
+        nodes, node = unique_rows(np.column_stack([node, heights[:, k], speeds[:, k]]), return_inverse=True)
         parent = nodes[:, 0].astype(int)
         th, yc, jam = th[parent], yc[parent], jam[parent]
         rows, cols = np.nonzero(~jam)
@@ -303,8 +303,7 @@ def rollouts_by_speed(part, theta, d, mu, v_pin, pin_radius, model, kw, support=
     v_pin = np.broadcast_to(np.asarray(v_pin, dtype=float), theta.shape)
     supports = supports or [None]
     support = np.zeros(theta.size, int) if support is None else np.asarray(support, dtype=int)
-    groups, group_of = np.unique(np.column_stack([v_pin, support]), axis=0, return_inverse=True)
-    group_of = group_of.ravel()
+    groups, group_of = unique_rows(np.column_stack([v_pin, support]), return_inverse=True)
 
     def batch(rows, g, share):
         v, s = groups[g]

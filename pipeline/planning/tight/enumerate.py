@@ -73,6 +73,7 @@ from pipeline.planning.claims.replay import rollouts_by_speed
 from pipeline.planning.tight.fewest import ROUNDING
 from pipeline.planning.tight.outcomes import Outcomes
 from pipeline.progress import BATCH_SECONDS, NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
+from pipeline.rows import unique_rows
 
 QUANTUM = 0.05  # deg and mm: poses that round to the same multiple share one nominal rollout
 MAX_PAIRS = 4_000_000  # (sequence, pin, state) triples handled at once
@@ -409,8 +410,7 @@ class NominalTree:
         if keys.shape[0] == 0:
             empty = np.zeros(theta.shape)
             return empty.astype(np.int8), empty, empty
-        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
-        inverse = inverse.ravel()
+        uniq, inverse = unique_rows(keys, return_inverse=True)
         status, theta_f, dy, known = self._outcomes.lookup(uniq)
         new = np.flatnonzero(~known)
         if new.size:

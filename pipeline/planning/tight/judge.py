@@ -34,6 +34,7 @@ from pipeline.planning.claims.trials import trial_inputs
 from pipeline.planning.core.resting import resting_states
 from pipeline.planning.core.settings import ClaimSettings, Friction, SearchSettings, VerifySettings
 from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
+from pipeline.rows import unique_rows
 
 MAX_ROWS = 150_000  # trials replayed in one batch
 MAX_KEPT = 2_000_000  # trial states after a prefix kept for reuse (about 250 MB at most)
@@ -139,9 +140,7 @@ class TrialBench:
         th, yc = np.asarray(th0, float)[None, :].copy(), np.asarray(yc0, float)[None, :].copy()
         jam = np.zeros((1, n), bool)
         for k in range(n_pins):
-            nodes, node = np.unique(np.column_stack([node, heights[:, k], speeds[:, k]]), axis=0,
-                                    return_inverse=True)
-            node = node.ravel()
+            nodes, node = unique_rows(np.column_stack([node, heights[:, k], speeds[:, k]]), return_inverse=True)
             parent = nodes[:, 0].astype(int)
             th, yc, jam = th[parent], yc[parent], jam[parent]
             rows_, cols = np.nonzero(~jam)
