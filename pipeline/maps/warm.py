@@ -30,6 +30,7 @@ import time
 
 import numpy as np
 
+from kernels.int_table import EMPTY, insert_keys, lookup_keys
 from pipeline.maps.simulate import compute_map, dynamic_rollout, rollout, rollout_points
 from pipeline.parts.part import Part
 
@@ -79,12 +80,16 @@ THETA, D = np.array([10.0, 100.0]), np.array([-0.3, 0.2])  # two tiny rollouts p
 def _run_plan_kernels(part: Part) -> None:
     """One tiny call of each kernel entry point a plan reaches: the part's
     preparation (support table) and resting states, and scattered points
-    (the planner's trials; the dynamic model for moving pins' speed limits).
-    A part without holes is prepared by kernels of its own."""
+    (the planner's trials; the dynamic model for moving pins' speed limits),
+    and the table of the planner's memo of trial states. A part without
+    holes is prepared by kernels of its own."""
     Part.from_vertices([(0.0, 0.0), (60.0, 0.0), (15.0, 35.0)], name="warm-up triangle").prepared()
     part.stable_states()
     rollout_points(part, THETA, D, 0.2, 3.0, threads=1)
     rollout_points(part, THETA, D, 0.2, 3.0, model="dynamic", belt_speed=50.0, threads=1)
+    slots, at = np.full(4, EMPTY, dtype=np.int64), np.zeros(4, dtype=np.int64)
+    insert_keys(slots, at, np.array([7], dtype=np.int64), np.array([0], dtype=np.int64), 0)
+    lookup_keys(slots, at, np.array([7], dtype=np.int64), np.zeros(1, dtype=np.int64))
 
 
 def _run_other_kernels(part: Part) -> None:

@@ -101,7 +101,7 @@ def test_replays_reuse_the_states_of_earlier_calls_and_give_the_same_numbers():
     heights = search.pins.heights[rng.integers(0, 6, size=(40, 3))]
     speeds = np.zeros_like(heights)
     for rows, lo, hi in ((probe, 0, 40), (screen, 0, 15), (screen, 10, 40), (full, 5, 12), (full, 0, 40)):
-        before = len(bench.kept.at)
+        before = len(bench.kept)
         tf, jam = bench.replay(heights[lo:hi], speeds[lo:hi], rows)
         th, yc, mu, offs, sup = rows
         ref_tf, ref_jam = replay_shared(part, heights[lo:hi], speeds[lo:hi], th, yc, mu, offs, bench.pin_radius,
@@ -110,7 +110,7 @@ def test_replays_reuse_the_states_of_earlier_calls_and_give_the_same_numbers():
                                         support=sup, supports=bench.supports)
         np.testing.assert_array_equal(tf, ref_tf)
         np.testing.assert_array_equal(jam, ref_jam)
-        assert len(bench.kept.at) > before or rows is full
+        assert len(bench.kept) > before or rows is full
 
 
 def test_verifying_plans_with_a_memo_gives_the_same_records():
@@ -158,4 +158,4 @@ def test_sampled_carried_sets_with_a_memo_are_the_same():
         kept, plain = sampled_plan(planner, labels, 0.0, VerifySettings(trials=30), memo=memo), \
             sampled_plan(planner, labels, 0.0, VerifySettings(trials=30))
         assert kept.to_dict() == plain.to_dict()
-    assert len(memo.at) < 3 * 3 * len(memo.trials)  # the shared first pins were kept once
+    assert len(memo) < 3 * 3 * len(memo.trials)  # the shared first pins were kept once

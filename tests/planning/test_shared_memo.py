@@ -106,10 +106,10 @@ def test_a_replay_with_a_memo_of_other_settings_gives_its_own_numbers():
     theta, y_c, mu, offsets = _trials()
     memo = ReplayMemo()
     first = replay(TRAPEZOID, heights, speeds, theta, y_c, mu, offsets, 3.0, "minpower", memo=memo)
-    kept = len(memo.at)
+    kept = len(memo)
     other = replay(TRAPEZOID, heights, speeds, theta, y_c, mu, offsets, 1.0, "minpower", memo=memo)
     alone = replay(TRAPEZOID, heights, speeds, theta, y_c, mu, offsets, 1.0, "minpower")
-    assert kept > 0 and len(memo.at) == kept  # the other radius neither read nor wrote it
+    assert kept > 0 and len(memo) == kept  # the other radius neither read nor wrote it
     for a, b in zip(other, alone):
         assert np.array_equal(a, b)
     assert not np.array_equal(first[0], other[0])  # the radius matters here, so a wrong read would show
@@ -144,6 +144,6 @@ def test_a_full_memo_keeps_what_fits():
     memo.serves(TRAPEZOID, 3.0, "minpower", kernel_kw(0.05, 1e-6, None, 0.5), None)
     nodes, trials = np.ones(8, dtype=np.int64), np.arange(8, dtype=np.int64)
     memo.add(nodes, trials, np.arange(8.0), np.zeros(8), np.array([""] * 8, dtype=object), np.zeros(8, bool))
-    assert len(memo.at) == 5 and memo.half_full
+    assert len(memo) == 5 and memo.half_full
     assert (memo.lookup(nodes, trials) >= 0).tolist() == [True] * 5 + [False] * 3
     assert memo.get(memo.lookup(nodes[:5], trials[:5]))[0].tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]

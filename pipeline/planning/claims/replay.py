@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from kernels.int_table import EMPTY, insert_keys, lookup_keys
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, JAM_REASONS, JAMMED, MISS, TRUNCATED
 
 from pipeline.maps import simulate
@@ -114,16 +115,22 @@ class ReplayMemo:
 
     def __init__(self, max_kept: int = 1_000_000):
         self.max_kept = int(max_kept)
-        self.prefixes, self.trials, self.at, self.reasons = {}, {}, {}, {"": 0}
+        self.prefixes, self.trials, self.reasons = {}, {}, {"": 0}
+        # where each (prefix, trial) state is kept: a table in two arrays (kernels.int_table)
+        self.slot_keys, self.slot_at, self.size = np.full(1024, EMPTY, dtype=np.int64), np.zeros(1024, np.int64), 0
         self.theta, self.y_c = np.zeros(256), np.zeros(256)
         self.reason, self.missed = np.zeros(256, dtype=np.int32), np.zeros(256, bool)
         self.rollout = None  # (part, supports, settings) of the first replay
+
+    def __len__(self) -> int:
+        """The number of states kept."""
+        return self.size
 
     @property
     def half_full(self) -> bool:
         """True once half of ``max_kept`` is used (a later stage then does
         better with a memo of its own)."""
-        return 2 * len(self.at) >= self.max_kept
+        return 2 * self.size >= self.max_kept
 
     def serves(self, part: Part, pin_radius, model, kw: dict, supports) -> bool:
         """Whether replays of ``part`` with these rollout settings (pin radius,
@@ -158,8 +165,10 @@ class ReplayMemo:
 
     def lookup(self, nodes, trials) -> np.ndarray:
         """Where each (prefix, trial) state is kept (-1: not kept)."""
-        get = self.at.get
-        return np.array([get(c, -1) for c in ((nodes << 32) | trials).tolist()], dtype=np.int64)
+        codes = (np.asarray(nodes, dtype=np.int64) << 32) | np.asarray(trials, dtype=np.int64)
+        out = np.empty(codes.size, dtype=np.int64)
+        lookup_keys(self.slot_keys, self.slot_at, codes, out)
+        return out
 
     def get(self, at) -> tuple:
         """``(theta, y_c, jam reason, missed)`` kept at ``at``."""
@@ -168,7 +177,7 @@ class ReplayMemo:
 
     def add(self, nodes, trials, theta, y_c, reasons, missed) -> None:
         """Keep these states, as many as there is room for (the first ones)."""
-        start, n = len(self.at), np.size(nodes)
+        start, n = self.size, np.size(nodes)
         if start + n > self.max_kept:
             n = max(0, self.max_kept - start)
             if n == 0:
@@ -180,8 +189,28 @@ class ReplayMemo:
             self.reason, self.missed = np.concatenate([self.reason, self.reason]), np.concatenate([self.missed,
                                                                                                   self.missed])
         self.theta[start:start + n], self.y_c[start:start + n], self.missed[start:start + n] = theta, y_c, missed
-        self.reason[start:start + n] = [self.reasons.setdefault(r, len(self.reasons)) for r in reasons]
-        self.at.update(zip(((nodes << 32) | trials).tolist(), range(start, start + n)))
+        names, which = np.unique(np.asarray(reasons, dtype=str), return_inverse=True)
+        codes = np.array([self.reasons.setdefault(r, len(self.reasons)) for r in names.tolist()], dtype=np.int32)
+        self.reason[start:start + n] = codes[which.ravel()] if n else []
+        self._index((np.asarray(nodes, dtype=np.int64) << 32) | np.asarray(trials, dtype=np.int64),
+                    np.arange(start, start + n, dtype=np.int64))
+
+    def _index(self, codes, at) -> None:
+        """Enter ``codes -> at`` in the table, in a table twice as large (or
+        more) when this one would end more than half full."""
+        size = insert_keys(self.slot_keys, self.slot_at, codes, at, self.size)
+        if size < 0:
+            n_slots = self.slot_keys.size
+            while n_slots < 2 * (self.size + codes.size):
+                n_slots *= 2
+            held = self.slot_keys != EMPTY
+            old_codes, old_at = self.slot_keys[held], self.slot_at[held]
+            self.slot_keys, self.slot_at = np.full(n_slots, EMPTY, dtype=np.int64), np.zeros(n_slots, np.int64)
+            insert_keys(self.slot_keys, self.slot_at, old_codes, old_at, 0)
+            size = insert_keys(self.slot_keys, self.slot_at, codes, at, self.size)
+            if size < 0:
+                raise ValueError("a replay memo key is negative: prefix and trial numbers start at 0")
+        self.size = size
 
 
 def kernel_kw(ds_max, tol, belt_speed, mu_s) -> dict:
