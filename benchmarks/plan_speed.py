@@ -15,14 +15,20 @@ from __future__ import annotations
 import argparse
 import platform
 import statistics
+import sys
 import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
-from pipeline.config import load_config
-from pipeline.parts.part import Part
-from pipeline.planning import PlannerSettings, plan_tight_all
+# The checkout this script lives in, not whichever pinfeed the environment
+# has installed (an editable install of another worktree would win otherwise).
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from pipeline.config import load_config  # noqa: E402
+from pipeline.parts.part import Part  # noqa: E402
+from pipeline.planning import PlannerSettings, plan_tight_all  # noqa: E402
 
 PARTS = {
     "asym_triangle": [[0, 0], [60, 0], [15, 35]],

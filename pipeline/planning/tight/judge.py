@@ -37,7 +37,7 @@ from pipeline.progress import NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
 from pipeline.rows import unique_rows
 
 MAX_ROWS = 150_000  # trials replayed in one batch
-MAX_KEPT = 2_000_000  # trial states after a prefix kept for reuse (about 250 MB at most)
+MAX_KEPT = 2_000_000  # trial states after a prefix kept for reuse (about 170 MB at most)
 
 
 def stack(rows) -> tuple:
