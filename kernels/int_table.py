@@ -62,11 +62,11 @@ def lookup_keys(keys, values, queries, out):
         j = _first_slot(q, bits) & mask
         while True:
             k = keys[j]
+            if k == EMPTY:  # first, so that a query of EMPTY finds nothing
+                out[i] = -1
+                break
             if k == q:
                 out[i] = values[j]
-                break
-            if k == EMPTY:
-                out[i] = -1
                 break
             j = (j + 1) & mask
 

@@ -8,8 +8,10 @@ a twentieth of a plan's time. :func:`unique_rows` sorts the columns with
 lexicographic order (first column first), the index of each one's first
 occurrence and each row's index among them. Rows are equal when every
 column compares equal (``==``, so ``-0.0`` equals ``0.0``, as in
-``np.unique``); the planner's callers compare floats bit for bit by
-viewing them as ``int64`` first, as before.
+``np.unique``); of rows that differ only in the sign of a zero, the first
+one is returned (``np.unique`` returns either when its sort is not stable).
+The planner's callers that must tell such rows apart compare them bit for
+bit, viewed as ``int64``.
 """
 from __future__ import annotations
 

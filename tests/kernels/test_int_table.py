@@ -1,7 +1,8 @@
 """``kernels.int_table`` against a Python dict: batches of inserts (keys
 repeated within and across batches, keys that share their first slot, keys
 up to 2**62) and lookups of present and absent keys, in tables from 2 slots
-up; and its refusals (a negative key, a table that would end over half full)."""
+up; and its refusals (a negative key, a table that would end over half full)
+and a query of ``EMPTY`` itself, which finds nothing."""
 from __future__ import annotations
 
 import numpy as np
@@ -66,3 +67,14 @@ def test_refusals_leave_the_table_as_it_was():
     assert insert_keys(keys, values, np.array([1, 2, 3, 4]), np.arange(4), 0) == 4  # exactly half
     one, one_value = np.full(1, EMPTY, np.int64), np.zeros(1, np.int64)
     assert insert_keys(one, one_value, np.zeros(0, np.int64), np.zeros(0, np.int64), 0) == 0
+
+
+def test_a_query_of_empty_itself_finds_nothing():
+    keys, values = np.full(8, EMPTY, np.int64), np.zeros(8, np.int64)
+    insert_keys(keys, values, np.array([5, 9], dtype=np.int64), np.array([0, 1], dtype=np.int64), 0)
+    out = np.zeros(3, np.int64)
+    lookup_keys(keys, values, np.array([EMPTY, 9, 6], dtype=np.int64), out)
+    assert out.tolist() == [-1, 1, -1]
+    one, one_value, got = np.full(1, EMPTY, np.int64), np.zeros(1, np.int64), np.zeros(1, np.int64)
+    lookup_keys(one, one_value, np.array([3], dtype=np.int64), got)  # a table of one slot: no hash bits
+    assert got[0] == -1

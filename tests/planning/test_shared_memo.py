@@ -147,3 +147,28 @@ def test_a_full_memo_keeps_what_fits():
     assert len(memo) == 5 and memo.half_full
     assert (memo.lookup(nodes, trials) >= 0).tolist() == [True] * 5 + [False] * 3
     assert memo.get(memo.lookup(nodes[:5], trials[:5]))[0].tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]
+
+
+def test_equal_trials_in_one_replay_do_not_displace_the_next_replays_states(tmp_path):
+    """With no friction spread (``mu_sigma`` 0) the box's corners come in
+    equal pairs, one trial number each, so a replay keeps some (prefix,
+    trial) states twice. The memo once placed states by its count of
+    distinct keys, so the next replay's states overwrote kept ones: every
+    replay through the bench must still give the numbers of a replay alone."""
+    config = load_config()
+    config["catalog_dir"] = str(tmp_path)
+    config["planner"].update(pins="auto", depth=2, tolerance_deg=10.0, mu_c=0.2, frictions=[])
+    config["verify"].update(trials=30, rule="point", mu_sigma=0.0)
+    s = PlannerSettings.from_config(config).at(0.2)
+    bench = TrialBench(TRAPEZOID, s.friction, s.claims, s.verify, s.search)
+    rows = bench.held_out(2)
+    th, yc, mu, offsets, sup = rows
+    ids = ReplayMemo().trial_ids(th, yc, mu, offsets, sup)
+    assert np.unique(ids).size < ids.size  # equal trials are there
+    for block in ([[14.0, 6.0], [14.0, 10.0]], [[20.0, 6.0], [14.0, 6.0], [6.0, 14.0], [14.0, 10.0]]):
+        heights = np.array(block)
+        finals, jammed = bench.replay(heights, np.zeros(heights.shape), rows)
+        for k, h in enumerate(heights):
+            alone = replay(TRAPEZOID, h, [0.0, 0.0], th, yc, mu, offsets, bench.pin_radius, bench.model,
+                           bench.step.ds_max, bench.step.tol)
+            assert np.array_equal(finals[k], alone[0] % 360.0) and np.array_equal(jammed[k], alone[2] != "")

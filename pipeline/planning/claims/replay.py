@@ -117,20 +117,21 @@ class ReplayMemo:
         self.max_kept = int(max_kept)
         self.prefixes, self.trials, self.reasons = {}, {}, {"": 0}
         # where each (prefix, trial) state is kept: a table in two arrays (kernels.int_table)
-        self.slot_keys, self.slot_at, self.size = np.full(1024, EMPTY, dtype=np.int64), np.zeros(1024, np.int64), 0
+        self.slot_keys, self.slot_at = np.full(1024, EMPTY, dtype=np.int64), np.zeros(1024, np.int64)
+        self.size, self.written = 0, 0  # distinct (prefix, trial) keys; states written
         self.theta, self.y_c = np.zeros(256), np.zeros(256)
         self.reason, self.missed = np.zeros(256, dtype=np.int32), np.zeros(256, bool)
         self.rollout = None  # (part, supports, settings) of the first replay
 
     def __len__(self) -> int:
-        """The number of states kept."""
+        """The number of (prefix, trial) states kept."""
         return self.size
 
     @property
     def half_full(self) -> bool:
         """True once half of ``max_kept`` is used (a later stage then does
         better with a memo of its own)."""
-        return 2 * self.size >= self.max_kept
+        return 2 * self.written >= self.max_kept
 
     def serves(self, part: Part, pin_radius, model, kw: dict, supports) -> bool:
         """Whether replays of ``part`` with these rollout settings (pin radius,
@@ -176,8 +177,10 @@ class ReplayMemo:
         return self.theta[at], self.y_c[at], names[self.reason[at]], self.missed[at]
 
     def add(self, nodes, trials, theta, y_c, reasons, missed) -> None:
-        """Keep these states, as many as there is room for (the first ones)."""
-        start, n = self.size, np.size(nodes)
+        """Keep these states, as many as there is room for (the first ones).
+        A (prefix, trial) given twice, in one call or two, is kept at its
+        last place (equal trials have equal states)."""
+        start, n = self.written, np.size(nodes)
         if start + n > self.max_kept:
             n = max(0, self.max_kept - start)
             if n == 0:
@@ -194,6 +197,7 @@ class ReplayMemo:
         self.reason[start:start + n] = codes[which.ravel()] if n else []
         self._index((np.asarray(nodes, dtype=np.int64) << 32) | np.asarray(trials, dtype=np.int64),
                     np.arange(start, start + n, dtype=np.int64))
+        self.written = start + n
 
     def _index(self, codes, at) -> None:
         """Enter ``codes -> at`` in the table, in a table twice as large (or
