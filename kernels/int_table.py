@@ -45,6 +45,18 @@ def _first_slot(key, bits):
 
 
 @jit
+def _slot(keys, key, bits):
+    """The slot of ``key`` in the table ``keys`` of ``2**bits`` slots, or the
+    free slot where the probe from its first slot ends (an ``EMPTY`` key is
+    never found: the probe stops at the first free slot it meets)."""
+    mask = keys.size - 1
+    j = _first_slot(key, bits)
+    while keys[j] != EMPTY and keys[j] != key:
+        j = (j + 1) & mask
+    return j
+
+
+@jit
 def lookup_keys(keys, values, queries, out):
     """``out[i]``: the value of ``queries[i]`` in the table ``keys, values``
     (``len(keys)`` a power of two), or -1 where it holds no such key.
@@ -55,20 +67,10 @@ def lookup_keys(keys, values, queries, out):
     queries : int64 keys (>= 0) to look up.
     out : int64 array of ``len(queries)`` (written).
     """
-    mask = keys.size - 1
     bits = _bits(keys.size)
     for i in range(queries.size):
-        q = queries[i]
-        j = _first_slot(q, bits) & mask
-        while True:
-            k = keys[j]
-            if k == EMPTY:  # first, so that a query of EMPTY finds nothing
-                out[i] = -1
-                break
-            if k == q:
-                out[i] = values[j]
-                break
-            j = (j + 1) & mask
+        j = _slot(keys, queries[i], bits)
+        out[i] = -1 if keys[j] == EMPTY else values[j]
 
 
 @jit
@@ -85,20 +87,11 @@ def insert_keys(keys, values, new_keys, new_values, size):
     for i in range(new_keys.size):
         if new_keys[i] < 0:
             return -1
-    mask = keys.size - 1
     bits = _bits(keys.size)
     for i in range(new_keys.size):
-        q = new_keys[i]
-        j = _first_slot(q, bits) & mask
-        while True:
-            k = keys[j]
-            if k == EMPTY:
-                keys[j] = q
-                values[j] = new_values[i]
-                size += 1
-                break
-            if k == q:
-                values[j] = new_values[i]
-                break
-            j = (j + 1) & mask
+        j = _slot(keys, new_keys[i], bits)
+        if keys[j] == EMPTY:
+            keys[j] = new_keys[i]
+            size += 1
+        values[j] = new_values[i]
     return size
