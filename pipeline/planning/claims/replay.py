@@ -124,7 +124,7 @@ class ReplayMemo:
         self.rollout = None  # (part, supports, settings) of the first replay
 
     def __len__(self) -> int:
-        """The number of (prefix, trial) states kept."""
+        """The number of distinct (prefix, trial) states kept."""
         return self.size
 
     @property
@@ -166,10 +166,15 @@ class ReplayMemo:
 
     def lookup(self, nodes, trials) -> np.ndarray:
         """Where each (prefix, trial) state is kept (-1: not kept)."""
-        codes = (np.asarray(nodes, dtype=np.int64) << 32) | np.asarray(trials, dtype=np.int64)
+        codes = self._codes(nodes, trials)
         out = np.empty(codes.size, dtype=np.int64)
         lookup_keys(self.slot_keys, self.slot_at, codes, out)
         return out
+
+    @staticmethod
+    def _codes(nodes, trials) -> np.ndarray:
+        """One int64 key per (prefix, trial): the prefix's number above bit 32."""
+        return (np.asarray(nodes, dtype=np.int64) << 32) | np.asarray(trials, dtype=np.int64)
 
     def get(self, at) -> tuple:
         """``(theta, y_c, jam reason, missed)`` kept at ``at``."""
@@ -194,9 +199,8 @@ class ReplayMemo:
         self.theta[start:start + n], self.y_c[start:start + n], self.missed[start:start + n] = theta, y_c, missed
         names, which = np.unique(np.asarray(reasons, dtype=str), return_inverse=True)
         codes = np.array([self.reasons.setdefault(r, len(self.reasons)) for r in names.tolist()], dtype=np.int32)
-        self.reason[start:start + n] = codes[which.ravel()] if n else []
-        self._index((np.asarray(nodes, dtype=np.int64) << 32) | np.asarray(trials, dtype=np.int64),
-                    np.arange(start, start + n, dtype=np.int64))
+        self.reason[start:start + n] = codes[which]
+        self._index(self._codes(nodes, trials), np.arange(start, start + n, dtype=np.int64))
         self.written = start + n
 
     def _index(self, codes, at) -> None:
