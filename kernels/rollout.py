@@ -16,7 +16,10 @@ from ``models._contact_twist``::
 Within one contact feature (an edge or a vertex) the right-hand side is
 smooth, and an embedded Runge-Kutta pair (Cash-Karp 5(4)) with local error
 control takes large steps where the motion is slow and small ones where it
-is not (on a vertex the geometry varies on the scale of ``r_pin``, not a).
+is not (on a vertex the geometry varies on the scale of ``r_pin``, not a);
+the control keeps its proposed step per kind of feature (a travel on edges,
+a turn on vertices, ``_first_step_size``), so the short edges and small
+vertices of a flattened arc each take a step or two.
 The pin is projected back to distance ``r_pin`` after every step to stop
 drift. Feature
 changes, separation and second contacts are events located by the Illinois
@@ -78,8 +81,12 @@ _EVENT_TOL = 1e-10  # event functions may dip this far below zero (units of a)
 # event function). Every event is a point where the right-hand side stays
 # continuous (the contact normal is continuous from an edge to its vertex,
 # and the sliding twist scales with n . v_p down to zero at separation), so
-# ending the feature delta early or late moves the end state by O(delta^2).
-_LOCATE_TOL = 1e-8
+# ending the feature delta early or late moves the end state by O(delta^2)
+# (an edge's end reached delta early puts the pin delta^2 / (2 r_pin) off the
+# vertex's circle, which the projection removes). 1e-5 keeps that under the
+# step tolerance DEFAULT_TOL for pins down to 1e-3 a, and lets most events
+# be located with one real step after the interpolant's root (1e-8 took two).
+_LOCATE_TOL = 1e-5
 _SAME_FEATURE = 1e-3  # contact points closer than this (units of a) are one feature
 _NOTCH_TOL = 1e-6  # a second contact counts when this much closer than r_pin
 _JAM_ANGLE = 1e-5  # radians
@@ -91,6 +98,8 @@ DEFAULT_DS_MAX = 0.1  # units of a
 DEFAULT_TOL = 1e-7  # local error per step, units of a and radians
 _TAKE_PER_TOL = 0.1  # minpower solve threshold per unit of tol (see _solve_take)
 _DTHETA_CAP = 0.2  # radians of contact-normal turn per step
+_VERTEX_TURN = 1.25  # a vertex step's turn, in exterior angles (_first_step_size)
+_VERTEX_TURN_MIN = 0.01  # radians: a floor for nearly straight vertices
 _GROW_MAX = 2.0  # largest step growth between accepted steps
 
 # Step budget: a rollout ends with status ``truncated`` and reason
@@ -756,19 +765,47 @@ def _recontact(verts, prm, y):
 
 
 @jit_inline
-def _first_step_size(k1, h_max, kind, rp):
+def _first_step_size(verts, k1, h_max, kind, idx, rp, vertex_turn):
     """Step size to try: ``h_max`` capped so that the contact normal turns
     by at most ``_DTHETA_CAP`` (with the part on an edge; around the vertex
     on a vertex), so no event function can cross zero twice within one
-    step."""
+    step.
+
+    On a vertex the turn is also capped at ``vertex_turn`` (the step
+    control's last proposal on a vertex, as a turn) and at 1.25 times the
+    vertex's exterior angle (but at least 0.01 rad): the pin leaves the vertex
+    within that turn, so a longer step would be cut back by the event
+    anyway, and on a flattened arc (exterior angles of a few degrees) it was
+    mostly rejected first by the error control (the pin circles the vertex
+    on the scale of r_pin)."""
     h = h_max
     if abs(k1[0]) * h > _DTHETA_CAP:
         h = _DTHETA_CAP / abs(k1[0])
     if kind == VERTEX:
-        turn = math.sqrt(k1[1] * k1[1] + k1[2] * k1[2]) / rp
-        if turn * h > _DTHETA_CAP:
-            h = _DTHETA_CAP / turn
+        turn = _turn_rate(k1, rp)
+        cap = min(_DTHETA_CAP, max(min(vertex_turn, _VERTEX_TURN * _exterior_angle(verts, idx)),
+                                   _VERTEX_TURN_MIN))
+        if turn * h > cap:
+            h = cap / turn
     return h
+
+
+@jit_inline
+def _turn_rate(k1, rp):
+    """How fast the contact normal turns with the pin on a vertex (radians
+    per unit travel): the pin's speed around it over ``rp``."""
+    return math.sqrt(k1[1] * k1[1] + k1[2] * k1[2]) / rp
+
+
+@jit_inline
+def _exterior_angle(verts, idx):
+    """The angle (radians, in [0, pi]) between the edges into and out of
+    vertex ``idx``: how far the contact normal turns around it."""
+    n = verts.shape[0]
+    i, k = (idx - 1 + n) % n, (idx + 1) % n
+    ax, ay = verts[idx, 0] - verts[i, 0], verts[idx, 1] - verts[i, 1]
+    bx, by = verts[k, 0] - verts[idx, 0], verts[k, 1] - verts[idx, 1]
+    return abs(math.atan2(ax * by - ay * bx, ax * bx + ay * by))
 
 
 @jit_inline
@@ -936,6 +973,12 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         n_traj = 1
     separated = False
     have_k1 = False
+    # The step control's proposal is kept per kind of feature: a travel on
+    # edges, a turn on vertices (where the motion's scale is r_pin, not a).
+    # Along a flattened arc the pin alternates between short edges and
+    # vertices; restarting each edge from the vertex's short steps took
+    # three or four steps an edge where one or two do.
+    h_edge, vertex_turn, last_kind = ds_max, _DTHETA_CAP, kind
     st, mode, fx, fy = TWIST_OK, SEPARATE, 0.0, 0.0
     while True:
         if steps >= max_steps:
@@ -975,7 +1018,10 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
         if s >= s_cap:
             status = TRUNCATED
             break
-        h = _first_step_size(k1, min(h_next, s_cap - s), kind, rp)
+        if kind != last_kind:
+            h_next = h_edge if kind == EDGE else ds_max  # on a vertex, vertex_turn caps it
+            last_kind = kind
+        h = _first_step_size(verts, k1, min(h_next, s_cap - s), kind, idx, rp, vertex_turn)
         ok, err, h, rejected, attempts = _adaptive_step(verts, quad, prm, kind, idx, y, s, k1, h,
                                                         tol, y_new, ks, tmp, warm,
                                                         work[_W_WSAVE])
@@ -984,6 +1030,10 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             status, reason = JAMMED, JAM_NO_PUSH
             break
         h_next = _next_step_size(err, tol, h, rejected, ds_max)
+        if kind == VERTEX:
+            vertex_turn = _turn_rate(k1, rp) * h_next
+        else:
+            h_edge = h_next
         # Slope at the step's end: the next step's first stage when no event
         # intervenes (FSAL), and the end slope of the dense output otherwise.
         st_e, mode_e, fx_e, fy_e = _derivative(verts, quad, prm, kind, idx, y_new, s + h, warm,
