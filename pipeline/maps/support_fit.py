@@ -61,7 +61,8 @@ from scipy import optimize
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.parts.part import Part
-from pipeline.parts.support import Support, material_distance, point_support
+from pipeline.parts.support import (Support, format_mm, material_distance, on_print_grid,
+                                    point_support)
 from pipeline.progress import Heartbeat
 
 COLUMNS = ("theta_i_deg", "d", "theta_f_deg")
@@ -151,8 +152,7 @@ class SupportFit:
     @property
     def spec(self) -> str:
         """The fitted support as ``--support`` text (``points:x,y,w ...``, mm, part frame)."""
-        return "points:" + " ".join(f"{x:.3f},{y:.3f},{w:.4f}" for (x, y), w in
-                                     zip(self.support.points, self.support.weights))
+        return _points_text(self.support)
 
     def to_dict(self) -> dict:
         """The JSON ``pinfeed support fit --json`` prints."""
@@ -344,9 +344,25 @@ def fit_support(part: Part, pushes: Pushes, mu_c: float | None, pin_radius: floa
     if not layouts:
         raise PinfeedError(f"no {n_points} points inside the outline hold the centroid; try --points 3")
     _search(objective, layouts, refine, part.a, again_from_best=True)
-    support = objective.support_of(objective.best_flat)
+    support = _as_printed(part, objective.support_of(objective.best_flat))
     return SupportFit(support, objective.residuals(support), objective.residuals(None), len(pushes),
                       objective.evaluations)
+
+
+def _points_text(support: Support) -> str:
+    """``--support`` text of a point support (mm, part frame)."""
+    return "points:" + " ".join(f"{format_mm(x)},{format_mm(y)},{w:.4f}"
+                                for (x, y), w in zip(support.points, support.weights))
+
+
+def _as_printed(part, support: Support) -> Support:
+    """``support`` with its points where their printed text puts them (within
+    a micrometre, on the material) and their weights balancing the part
+    there: what the fit reports is what the printed text reads back as."""
+    pts = on_print_grid(part, support.points)
+    w = statics_weights(pts)
+    return point_support(part, pts, support.weights if w is None else w, kind=support.kind,
+                         label=support.label)
 
 
 # --------------------------------------------------------------------------- a family of fits
@@ -383,8 +399,7 @@ class FamilyFit:
     @property
     def spec(self) -> str:
         """The family as ``--support-family`` text: ``points:x,y,w x,y,w ...; points:...``."""
-        return "; ".join("points:" + " ".join(f"{x:.3f},{y:.3f},{w:.4f}" for (x, y), w in
-                                              zip(m.points, m.weights)) for m in self.members)
+        return "; ".join(_points_text(m) for m in self.members)
 
     def to_dict(self) -> dict:
         """The JSON ``pinfeed support fit --family --json`` prints."""
@@ -469,8 +484,8 @@ def fit_support_family(part: Part, pushes: Pushes, mu_c: float | None, pin_radiu
     members, chi = [], []
     for i in pick:
         pts = flats[i].reshape(-1, 2)
-        members.append(point_support(part, pts, statics_weights(pts), kind="points",
-                                     label=f"fitted {len(members) + 1}"))
+        members.append(_as_printed(part, point_support(part, pts, statics_weights(pts), kind="points",
+                                                       label=f"fitted {len(members) + 1}")))
         chi.append(ok[i][1])
     return FamilyFit(members, chi, threshold, sigma, estimated, n, best.evaluations + recorder.evaluations,
                      len(ok))

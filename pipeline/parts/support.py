@@ -183,6 +183,42 @@ def _off_material(part, xy: np.ndarray):
     return k, int(where[k]), float(boundary_distance(loop, xy[k:k + 1])[0])
 
 
+PRINT_DECIMALS = 3  # support points are printed in mm to this many decimals
+
+
+def on_print_grid(part, xy: np.ndarray, decimals: int = PRINT_DECIMALS) -> np.ndarray:
+    """``xy`` (part frame, mm) rounded as ``format_mm`` prints it, each point
+    kept on the material, so that printed support text reads back.
+
+    A fitted point on the material's edge may round to just outside it
+    (0.3 um off a slanted edge), and the text would then be refused. Such a
+    point takes the nearest corner of its rounding cell that is on the
+    material, with more decimals where none is (a sharp corner's tip)."""
+    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    out = np.round(xy, decimals)
+    for k in range(xy.shape[0]):
+        if _off_material(part, out[k:k + 1]) is None:
+            continue
+        out[k] = xy[k]
+        for dec in range(decimals, 10):
+            step = 10.0 ** -dec
+            lo, hi = np.floor(xy[k] / step) * step, np.ceil(xy[k] / step) * step
+            corners = [np.round(np.array([x, y]), dec) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])]
+            corners.sort(key=lambda c: float(np.hypot(*(c - xy[k]))))
+            good = [c for c in corners if _off_material(part, c[None]) is None]
+            if good:
+                out[k] = good[0]
+                break
+    return out
+
+
+def format_mm(x: float) -> str:
+    """A coordinate as support text prints it: 3 decimals, more only where
+    ``on_print_grid`` needed them."""
+    text = f"{x:.{PRINT_DECIMALS}f}"
+    return text if float(text) == x else f"{x:.9f}".rstrip("0")
+
+
 def point_support(part, points, weights=None, kind: str = "points",
                   label: str | None = None) -> Support:
     """A checked point support of ``part``.
