@@ -83,10 +83,13 @@ _EVENT_TOL = 1e-10  # event functions may dip this far below zero (units of a)
 # and the sliding twist scales with n . v_p down to zero at separation), so
 # ending the feature delta early or late moves the end state by O(delta^2)
 # (an edge's end reached delta early puts the pin delta^2 / (2 r_pin) off the
-# vertex's circle, which the projection removes). 1e-5 keeps that under the
-# step tolerance DEFAULT_TOL for pins down to 1e-3 a, and lets most events
-# be located with one real step after the interpolant's root (1e-8 took two).
+# vertex's circle, which the projection removes). A rollout locates to
+# ``_locate_tol``: at most 1e-5 (most events then take one real step after
+# the interpolant's root; 1e-8 took two), less where that error would pass
+# the step tolerance or the angle delta / r_pin would pass 1e-3 rad (small
+# pins, fine tolerances).
 _LOCATE_TOL = 1e-5
+_LOCATE_ANGLE = 1e-3  # radians
 _SAME_FEATURE = 1e-3  # contact points closer than this (units of a) are one feature
 _NOTCH_TOL = 1e-6  # a second contact counts when this much closer than r_pin
 _JAM_ANGLE = 1e-5  # radians
@@ -517,7 +520,7 @@ def _hermite(y0, k0, y1, k1, h, alpha, out):
 
 
 @jit
-def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
+def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch, loc_tol):
     """Shrink the step from ``y0`` to end on the first event crossed by the
     full step of size ``h`` to ``y1`` (slope ``k_end``, event values ``g1``).
 
@@ -534,6 +537,8 @@ def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
         for ``_step``; event values, the events that count, an interpolated
         and a trial state; the near-edge cache of ``_events`` (the second
         contact's value is measured exactly once it counts).
+    loc_tol : how close to the crossing the kept state must be
+        (``_locate_tol``).
 
     Returns
     -------
@@ -599,9 +604,9 @@ def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
             if mask[j] == 0.0 and g[j] < -_EVENT_TOL:
                 mask[j] = 1.0  # an earlier event than the ones seen so far
         f = _min_over(g, mask)
-        # Close enough when within _LOCATE_TOL of the crossing; a state a
-        # hair past it (f >= -_LOCATE_TOL / 10) is kept too.
-        close = -0.1 * _LOCATE_TOL <= f <= _LOCATE_TOL
+        # Close enough when within loc_tol of the crossing; a state a hair
+        # past it (f >= -loc_tol / 10) is kept too.
+        close = -0.1 * loc_tol <= f <= loc_tol
         if f < 0.0:
             hi = alpha
         else:
@@ -638,6 +643,15 @@ def _locate(verts, quad, prm, kind, idx, s0, h, trial, scratch):
         if mask[j] != 0.0 and g[j] < best:
             best, ev = g[j], j
     return frac, ev, n_steps
+
+
+@jit_inline
+def _locate_tol(rp, tol):
+    """How close to its crossing an event is located (units of the event
+    function): ``_LOCATE_TOL``, or less where the state's error delta^2 /
+    (2 rp) would pass ``tol`` or the pin's angle delta / rp around a vertex
+    would pass ``_LOCATE_ANGLE``."""
+    return min(_LOCATE_TOL, math.sqrt(2.0 * rp * tol), _LOCATE_ANGLE * rp)
 
 
 @jit
@@ -945,6 +959,7 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
     n_force = 0
     two_pi = 2.0 * math.pi
     prm = (model, mu_c, rp, -1.0, v_pin, area, m_max, convex, _solve_take(tol))
+    loc_tol = _locate_tol(rp, tol)
     y = work[_W_Y]
     y_new = work[_W_YNEW]
     k1 = work[_W_K1]
@@ -1045,7 +1060,8 @@ def _rollout_core(verts, area, a, quad, m_max, convex, model, mu_c, r_pin, theta
             trial = (y, k1, y_new, k_end, g_end)
             scratch = (y_located, ks, tmp, warm, work[_W_GWORK], mask, work[_W_YI],
                        work[_W_YTRY], gap_cache)
-            frac, ev, n_loc = _locate(verts, quad, prm, kind, idx, s, h, trial, scratch)
+            frac, ev, n_loc = _locate(verts, quad, prm, kind, idx, s, h, trial, scratch,
+                                      loc_tol)
             steps += n_loc
             for i in range(5):
                 y_new[i] = y_located[i]

@@ -357,7 +357,7 @@ def _points_text(support: Support) -> str:
 
 def _as_printed(part, support: Support) -> Support:
     """``support`` with its points where their printed text puts them (within
-    a micrometre, on the material) and their weights balancing the part
+    1.5 um, on the material) and their weights balancing the part
     there: what the fit reports is what the printed text reads back as."""
     pts = on_print_grid(part, support.points)
     w = statics_weights(pts)

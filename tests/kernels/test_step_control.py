@@ -5,10 +5,11 @@ small exterior angle; each one is a contact feature. Three rules keep that
 cheap without moving the answers: a vertex step turns the contact normal at
 most 1.25 exterior angles (the pin has left the vertex by then), the step
 control keeps its proposal per kind of feature (a travel on edges, a turn on
-vertices), and events are located to 1e-5 (the state at a located event is
-then off by O(1e-10), see ``_LOCATE_TOL``). The references here are closed
-forms (exterior angles), a much finer tolerance (1e-10) and step counts of
-the rule each test names.
+vertices), and events are located to 1e-5 at most (the state at a located
+event is then off by delta^2 / (2 r_pin): at most the step tolerance, and
+less for small pins and fine tolerances, see ``_locate_tol``). The
+references here are closed forms (exterior angles), a much finer tolerance
+(1e-10) and step counts of the rule each test names.
 """
 from __future__ import annotations
 
@@ -19,8 +20,9 @@ import pytest
 
 from conftest import circular_diff
 from kernels.geometry import EDGE, VERTEX
-from kernels.rollout import (_DTHETA_CAP, _VERTEX_TURN, _VERTEX_TURN_MIN, OK, _exterior_angle,
-                             _first_step_size, _rollout_budget, max_steps_for)
+from kernels.rollout import (_DTHETA_CAP, _LOCATE_ANGLE, _LOCATE_TOL, _VERTEX_TURN, _VERTEX_TURN_MIN,
+                             OK, TRUNCATED, _exterior_angle, _first_step_size, _locate_tol,
+                             _rollout_budget, max_steps_for)
 from pipeline.parts.part import Part
 
 MU_C, R_PIN = 0.2, 3.0
@@ -87,7 +89,7 @@ def test_a_straight_vertex_still_gets_a_step():
 
 def _grid(part, tol):
     prep = part.prepared()
-    budget = max_steps_for(prep[3].shape[0])
+    budget = max_steps_for(prep[0].shape[0])
     out = [_rollout_budget(*prep, 0, MU_C, R_PIN, t, d, 0.0, np.inf, 0.1, tol, False, 100 * budget)
            for t in THETA for d in D]
     status = np.array([r[0] for r in out])
@@ -102,8 +104,8 @@ def test_flattened_arcs_cost_few_steps_per_feature_change(name):
     """Each short edge and small vertex of a flattened arc ends a step on an
     event. Restarting every edge from the vertex's short steps, trying a
     vertex with a turn of 0.2 rad and locating each event to 1e-8 took about
-    eight integration steps per feature change on these parts (7.7 and 8.2);
-    the rules above take about six (6.3 and 5.8)."""
+    eight integration steps per feature change on these parts (8.2 on the
+    disk, 7.7 on the plate); the rules above take about six (5.8 and 6.3)."""
     _, _, steps, changes = _grid(ARC_PARTS[name], 1e-7)
     assert changes > 5 * THETA.size * D.size  # the grid does cross arcs
     assert steps / changes <= 7.0
@@ -123,3 +125,26 @@ def test_flattened_arcs_converge_to_a_fine_tolerance(name):
     assert np.median(err) <= 3e-5
     assert np.percentile(err, 90) <= 3e-4
     assert (err > 0.01).mean() <= 0.05
+
+
+@pytest.mark.parametrize("rp, tol", [(0.08, 1e-7), (1e-3, 1e-7), (0.08, 1e-10), (1e-5, 1e-12), (10.0, 1e-7)])
+def test_events_are_located_to_what_the_step_tolerance_and_the_pin_allow(rp, tol):
+    delta = _locate_tol(rp, tol)
+    assert delta <= _LOCATE_TOL
+    assert delta * delta / (2 * rp) <= tol * (1 + 1e-12)  # the state's error at a located event
+    assert delta / rp <= _LOCATE_ANGLE * (1 + 1e-12)  # the pin's angle around a vertex
+    assert delta == pytest.approx(min(_LOCATE_TOL, math.sqrt(2 * rp * tol), _LOCATE_ANGLE * rp))
+
+
+@pytest.mark.parametrize("r_pin", [0.01, 0.2])
+def test_a_small_pin_rolls_around_an_arc_without_bouncing(r_pin):
+    """A small pin (r_pin 0.01 mm on a 40 mm disk: 7e-4 a) circles each
+    vertex within a tiny turn; an event located too early would put it back
+    on the edge it left, again and again."""
+    prep = ARC_PARTS["64-gon disk"].prepared()
+    budget = max_steps_for(prep[0].shape[0])
+    for t in THETA[::3]:
+        for d in D:
+            r = _rollout_budget(*prep, 0, MU_C, r_pin, t, d, 0.0, np.inf, 0.1, 1e-7, False, budget)
+            assert r[0] != TRUNCATED
+            assert r[5] < 200  # feature changes: the pin passes about ten vertices
