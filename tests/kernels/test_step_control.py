@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from conftest import circular_diff
+from drawn_shapes import circle, rounded_rectangle
 from kernels.geometry import EDGE, VERTEX
 from kernels.rollout import (_DTHETA_CAP, _LOCATE_ANGLE, _LOCATE_TOL, _VERTEX_TURN, _VERTEX_TURN_MIN,
                              OK, TRUNCATED, _exterior_angle, _first_step_size, _locate_tol,
@@ -30,30 +31,16 @@ THETA = np.radians(np.arange(0.0, 360.0, 10.0) + 0.37)
 D = np.array([-0.7, -0.3, 0.2, 0.6])
 
 
-def _regular(n, r=20.0, cx=0.0, cy=0.0, phase=0.0):
-    return [(cx + r * math.cos(phase + 2 * math.pi * k / n), cy + r * math.sin(phase + 2 * math.pi * k / n))
-            for k in range(n)]
-
-
-def _filleted_plate(w=50.0, h=40.0, r=6.0, per_corner=14):
-    pts = []
-    for cx, cy, a0 in ((w - r, r, -90), (w - r, h - r, 0), (r, h - r, 90), (r, r, 180)):
-        for k in range(per_corner + 1):
-            a = math.radians(a0 + 90.0 * k / per_corner)
-            pts.append((cx + r * math.cos(a), cy + r * math.sin(a)))
-    return pts
-
-
 ARC_PARTS = {
-    "64-gon disk": Part.from_vertices(_regular(64)),
-    "plate, 6 mm fillets, a hole": Part.from_vertices(_filleted_plate(),
-                                                      holes=[_regular(16, 3.25, 12.0, 20.0)]),
+    "64-gon disk": Part.from_vertices(circle(0.0, 0.0, 20.0, 64)),
+    "plate, 6 mm fillets, a hole": Part.from_vertices(rounded_rectangle(50.0, 40.0, 6.0, 14),
+                                                      holes=[circle(12.0, 20.0, 3.25, 16)]),
 }
 
 
 @pytest.mark.parametrize("n", [3, 5, 8, 64])
 def test_exterior_angle_of_a_regular_polygon(n):
-    verts = np.array(_regular(n, phase=0.3))
+    verts = circle(0.0, 0.0, 20.0, n, phase=0.3)
     for idx in range(n):
         assert _exterior_angle(verts, idx) == pytest.approx(2 * math.pi / n, abs=1e-12)
 
@@ -66,7 +53,7 @@ def test_exterior_angle_of_a_straight_vertex_is_zero():
 @pytest.mark.parametrize("n", [16, 64, 200])
 @pytest.mark.parametrize("speed", [0.05, 1.0, 20.0])
 def test_a_vertex_step_turns_at_most_a_quarter_past_the_vertex(n, speed):
-    verts = np.array(_regular(n))
+    verts = circle(0.0, 0.0, 20.0, n)
     rp = 0.1
     k1 = np.array([0.0, speed * 0.6, speed * 0.8, 0.0, 0.0])  # the pin moves at `speed` around it
     h = _first_step_size(verts, k1, 1.0, VERTEX, 2, rp, _DTHETA_CAP)

@@ -16,6 +16,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from drawn_shapes import circle, rounded_rectangle
 from kernels.batch import _rollout_grid
 from kernels.edge_integrals import _support_sum, _table_sizes
 from kernels.rollout import DEFAULT_DS_MAX, DEFAULT_TOL, _prepare, _prepare_loops
@@ -26,24 +27,10 @@ from kernels.support_table import (_N_INNER, _N_OUTER, _R_INNER, _R_OUTER, TABLE
 from pipeline.parts.part import Part, _stack
 
 
-def _rounded_rectangle(w, h, r, per_corner):
-    pts = []
-    for cx, cy, a0 in ((w - r, r, -90), (w - r, h - r, 0), (r, h - r, 90), (r, r, 180)):
-        for k in range(per_corner + 1):
-            a = math.radians(a0 + 90.0 * k / per_corner)
-            pts.append((cx + r * math.cos(a), cy + r * math.sin(a)))
-    return np.array(pts)
-
-
-def _circle(cx, cy, r, n):
-    t = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
-    return np.column_stack([cx + r * np.cos(t), cy + r * np.sin(t)])
-
-
 # A 50 x 40 mm plate with 6 mm fillets (60 outline vertices) and two holes of
 # 16 vertices: 96 material edges with the keyhole's bridges.
-PLATE = _rounded_rectangle(50.0, 40.0, 6.0, 14)
-PLATE_HOLES = [_circle(12.0, 20.0, 3.25, 16), _circle(38.0, 20.0, 3.25, 16)]
+PLATE = rounded_rectangle(50.0, 40.0, 6.0, 14)
+PLATE_HOLES = [circle(12.0, 20.0, 3.25, 16), circle(38.0, 20.0, 3.25, 16)]
 # A non-convex filleted L bracket (no holes), 26 outline vertices.
 L_BRACKET = np.array([(0, 0), (50, 0), (50, 12)]
                      + [(17 + 5 * math.cos(math.radians(270 - 90 * k / 20)),
@@ -77,8 +64,8 @@ def test_parts_with_many_edges_carry_a_table_and_small_ones_do_not():
     n = _table_sizes(raw)[1]
     assert n >= TABLE_MIN_EDGES
     # Just below the threshold: exact sums, bit for bit the code of before.
-    below = _prepare(_circle(0.0, 0.0, 10.0, TABLE_MIN_EDGES - 1))[3]
-    at = _prepare(_circle(0.0, 0.0, 10.0, TABLE_MIN_EDGES))[3]
+    below = _prepare(circle(0.0, 0.0, 10.0, TABLE_MIN_EDGES - 1))[3]
+    at = _prepare(circle(0.0, 0.0, 10.0, TABLE_MIN_EDGES))[3]
     assert not _has_table(below) and _has_table(at)
 
 
@@ -134,7 +121,7 @@ def test_table_matches_the_exact_sums_on_random_stars(n, wobble, seed):
     ang += np.arange(n) * 1e-3  # distinct
     rad = 30.0 * (1.0 - wobble * rng.uniform(0.0, 1.0, n))
     outline = np.column_stack([rad * np.cos(ang), rad * np.sin(ang)])
-    hole = _circle(0.0, 0.0, 0.3 * 30.0 * (1.0 - wobble), 12)[::-1]
+    hole = circle(0.0, 0.0, 0.3 * 30.0 * (1.0 - wobble), 12)[::-1]
     verts, _, _, quad, _, _ = _prepare_loops(*_stack(outline, [hole]))
     raw = _raw(quad)
     f, m = _table_sizes(raw)

@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 
 import strategies as sts
 from conftest import TRIANGLE, circular_diff, fewer_examples
+from drawn_shapes import circle
 from pipeline.errors import PinfeedError
 from pipeline.maps import simulate
 from pipeline.maps.support_fit import _into_outline
@@ -30,20 +31,15 @@ from pipeline.parts.support_family import parse_support_family, sample_tripods, 
 from pipeline.planning.family.member_spaces import TripodSpace, inset_corners, member_space
 
 
-def _circle(cx, cy, r, n):
-    t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
-    return np.column_stack([cx + r * np.cos(t), cy + r * np.sin(t)])
-
-
 OUTLINE = np.array([(0.0, 0.0), (60.0, 0.0), (60.0, 40.0), (0.0, 40.0)])
 HOLE_1 = np.array([(34.0, 8.0), (52.0, 8.0), (52.0, 30.0), (34.0, 30.0)])  # big, off-centre
-HOLE_2 = _circle(12.0, 30.0, 4.0, 12)
+HOLE_2 = circle(12.0, 30.0, 4.0, 12)
 PLATE = Part.from_vertices(OUTLINE, "plate", holes=[HOLE_1, HOLE_2])
 SOLID = Part.from_vertices(OUTLINE, "plate")
 SHIFT = PLATE.vertices[0] - OUTLINE[0]  # drawing frame -> the plate's part frame
 # The triangle with an off-centre hole: its uniform rollouts differ from the
 # solid triangle's by up to 12 degrees on the grid below.
-TRI_HOLED = Part.from_vertices(TRIANGLE, "tri-hole", holes=[_circle(26.0, 9.0, 7.0, 16)])
+TRI_HOLED = Part.from_vertices(TRIANGLE, "tri-hole", holes=[circle(26.0, 9.0, 7.0, 16)])
 TRI_SOLID = Part.from_vertices(TRIANGLE, "tri")
 R_PIN = 3.0
 
@@ -275,7 +271,7 @@ def test_tripods_stand_on_the_material_away_from_every_rim():
 def test_tripods_of_a_washer_step_over_the_hole_under_the_centroid():
     """A square frame: the centroid sits in the (diamond) hole, so the smallest
     leg triangles about it fall in the hole and are dropped."""
-    washer = Part.from_vertices(_circle(0.0, 0.0, 30.0, 4), "frame", holes=[_circle(0.0, 0.0, 14.0, 4)])
+    washer = Part.from_vertices(circle(0.0, 0.0, 30.0, 4), "frame", holes=[circle(0.0, 0.0, 14.0, 4)])
     inside_hole = 14.0 / np.sqrt(2.0)  # the diamond's inscribed radius
     for m in sample_tripods(washer, 6, inset=0.05):
         on, dist = material_distance(washer, m.points)
@@ -311,7 +307,7 @@ def test_a_family_list_on_a_holed_part_and_its_errors():
 def test_worst_member_starts_leave_legs_in_holes_out():
     """A small hole at the plate's top-right corner swallows that corner's
     inset point; every start stands on the material, inset from every rim."""
-    part = Part.from_vertices(OUTLINE, "corner-hole", holes=[_circle(52.0, 32.0, 3.0, 12)])
+    part = Part.from_vertices(OUTLINE, "corner-hole", holes=[circle(52.0, 32.0, 3.0, 12)])
     d = 0.2 * part.a
     plain = inset_corners(part.vertices, d)
     kept = inset_corners(part.vertices, d, part.holes)

@@ -3,24 +3,19 @@ edge (where a fit often puts them) stay on the material once rounded to
 the printed decimals."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
 from conftest import TRIANGLE, fewer_examples
+from drawn_shapes import circle
 from pipeline.parts.part import Part
 from pipeline.parts.support import (PRINT_DECIMALS, _off_material, format_mm, on_print_grid,
                                     parse_support)
 
 
-def _circle(cx, cy, r, n):
-    return [(cx + r * math.cos(2 * math.pi * k / n), cy + r * math.sin(2 * math.pi * k / n)) for k in range(n)]
-
-
 TRI = Part.from_vertices(TRIANGLE, "asym_triangle")
-HOLED = Part.from_vertices(TRIANGLE, "tri-hole", holes=[_circle(26.0, 9.0, 7.0, 16)])
+HOLED = Part.from_vertices(TRIANGLE, "tri-hole", holes=[circle(26.0, 9.0, 7.0, 16)])
 SLIVER = Part.from_vertices([(0.0, 0.0), (60.0, 0.0), (60.0, 0.01)], "sliver")
 
 
