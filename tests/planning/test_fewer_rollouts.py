@@ -31,7 +31,7 @@ class EagerTree(NominalTree):
     """The enumeration as it was: every column of every candidate rolled out
     at once, each distinct key once per batch, nothing reused."""
 
-    def _columns(self, theta, dy_pin, v_pin, stretch, span=None):
+    def _columns(self, theta, dy_pin, v_pin, stretch, span=None, orders=None, keys=None):
         self._outcomes.codes = self._outcomes.codes[:0]  # forget: roll out every key of the batch
         self._outcomes.status, self._outcomes.theta_f, self._outcomes.dy = (
             self._outcomes.status[:0], self._outcomes.theta_f[:0], self._outcomes.dy[:0])

@@ -105,9 +105,9 @@ def test_the_cluster_bound_is_met_when_the_hidden_finals_close_the_cheapest_gaps
 
 
 def test_what_was_rolled_out_before_changes_no_sequence_within_the_limit_nor_the_evidence():
-    """The states go in the order of their drops so far, so which sequences
-    stop depends on what the tree rolled out before; the sequences within the
-    limit and the fewest-set sequences do not."""
+    """Each candidate takes its states cheapest first, and what the tree
+    rolled out before is free, so which sequences stop depends on it; the
+    sequences within the limit and the fewest-set sequences do not."""
     part = PARTS["l_bracket"]()
     pins = _pins(part, 9)
     order = part.symmetry_order()
@@ -141,9 +141,9 @@ def test_a_stopped_roll_out_ranks_the_sequences_rolled_out_in_full_and_says_so()
 
 
 def test_the_deepest_level_is_the_same_in_any_chunks(monkeypatch):
-    """Which sequences stop depends on the order of the states, fixed for the
-    whole deepest level, so the chunks a time limit cuts it into change no
-    row."""
+    """Which sequences stop depends on each candidate's order of the states,
+    fixed when the deepest level begins, so the chunks a time limit cuts it
+    into change no row."""
     from pipeline.planning.tight import enumerate as enumerate_module
     from pipeline.progress import Deadline
     part = PARTS["t_bracket"]()
@@ -153,7 +153,6 @@ def test_the_deepest_level_is_the_same_in_any_chunks(monkeypatch):
     def deepest(deadline=None):
         tree = NominalTree(part, pins, 0.2, 3.0)
         two = tree.extend(tree.extend(tree.root()))
-        tree._column_tries[:], tree._column_drops[:] = 0, 0  # no drops yet: the first chunk will reorder them
         return tree.extend(two, span=span) if deadline is None else tree.extend(two, deadline=deadline, span=span)
 
     want = deepest()

@@ -36,7 +36,10 @@ ranks the level's sequences by their clusters of finals) rolls out the
 columns of those that might rank among its fewest-cluster sequences
 (:meth:`NominalTree.complete`), so it picks exactly the sequences a full
 enumeration would. Every candidate within the limit has had every column
-rolled out, from the same rounded keys, exactly as at once.
+rolled out, from the same rounded keys, exactly as at once. Since most
+candidates stop after two columns, each candidate takes its columns
+cheapest first (:mod:`~pipeline.planning.tight.column_order`: keys known or
+whose pin clears the part, then keys that many candidates share).
 
 A sequence is dropped (with all its extensions) when, on its nominal path:
 
@@ -70,6 +73,7 @@ from kernels.rollout import JAMMED, MISS, TRUNCATED
 from pipeline.parts.part import Part
 from pipeline.planning.claims import orient
 from pipeline.planning.claims.replay import rollouts_by_speed
+from pipeline.planning.tight.column_order import ColumnOrder, clears
 from pipeline.planning.tight.fewest import ROUNDING
 from pipeline.planning.tight.outcomes import Outcomes
 from pipeline.progress import BATCH_SECONDS, NO_DEADLINE, SILENT, Deadline, Heartbeat, Stretch
@@ -232,26 +236,29 @@ class NominalTree:
         sequences enumerated are the same in any chunks.) ``span``: as for
         :meth:`levels`, for this level; its columns then go in one order for
         the whole level (see :meth:`_columns`)."""
-        if span is not None:
-            span = (*span[:2], self._drop_order())
         per_parent = max(1, self.heights.size * level.theta.shape[1])
         step = max(1, MAX_PAIRS // per_parent)
+        cells = None
+        if span is not None:
+            cells = self._cells(level)
+            span = (*span[:2], self._column_order(level, span, cells[-1]))
         if deadline.limited:
-            return self._extend_timed(level, step, stretch, deadline, stop_at, span)
+            return self._extend_timed(level, step, stretch, deadline, stop_at, span, cells)
         if level.size <= step:
-            return self._extend(level, stretch, span)
+            return self._extend(level, stretch, span, cells)
         parts = [self._extend(level.rows(i, i + step),
-                              stretch.part(i / level.size, min(i + step, level.size) / level.size), span)
+                              stretch.part(i / level.size, min(i + step, level.size) / level.size), span,
+                              self._cell_rows(cells, i, i + step))
                  for i in range(0, level.size, step)]
         return _joined(parts)
 
     def _extend_timed(self, level: Level, step: int, stretch: Stretch, deadline: Deadline,
-                      stop_at: float | None = None, span: tuple | None = None) -> Level:
+                      stop_at: float | None = None, span: tuple | None = None, cells=None) -> Level:
         """:meth:`extend` under a time limit: chunks of parents sized by the pace
         of the ones before (up to ``step``), the deadline (and ``stop_at``)
         read between them."""
         if level.size == 0:
-            return self._extend(level, stretch, span)
+            return self._extend(level, stretch, span, cells)
         parts, done, size = [], 0, min(step, FIRST_PARENTS)
         started = deadline.elapsed() if stop_at is not None else 0.0
 
@@ -267,7 +274,8 @@ class NominalTree:
         while done < level.size and not (parts and stop()):
             hi = min(level.size, done + size)
             t0 = time.monotonic()
-            parts.append(self._extend(level.rows(done, hi), stretch.part(done / level.size, hi / level.size), span))
+            parts.append(self._extend(level.rows(done, hi), stretch.part(done / level.size, hi / level.size), span,
+                                      self._cell_rows(cells, done, hi)))
             took = max(time.monotonic() - t0, 1e-6)
             size = max(1, min(step, int((hi - done) * min(8.0, max(0.125, BATCH_SECONDS / took)))))
             done = hi
@@ -276,22 +284,69 @@ class NominalTree:
             out.cut = (done * self.heights.size, level.size * self.heights.size)
         return out
 
-    def _extend(self, level: Level, stretch: Stretch = SILENT, span: tuple | None = None) -> Level:
+    def _cells(self, level: Level) -> tuple:
+        """``(theta, y_c, dy_pin, v_pin, keys)`` of every (candidate, column)
+        cell of the level after ``level`` (each parent once per pin): the
+        pose (deg), centroid height and pin offset (mm), the pin's speed and
+        the rollout keys (``(..., 4)``, :meth:`_keys`)."""
         n_pins, n = self.heights.size, level.size
         theta = np.repeat(level.theta, n_pins, axis=0)
         y_c = np.repeat(level.y, n_pins, axis=0)
-        y_pin = np.tile(self.heights, n)[:, None]
-        v_pin = np.broadcast_to(np.tile(self.speeds, n)[:, None], theta.shape)
-        status, theta_f, dy, unrolled = self._columns(theta, y_pin - y_c, v_pin, stretch, span)
+        dy_pin = np.tile(self.heights, n)[:, None] - y_c
+        v_pin = self._speeds_of(n)
+        return theta, y_c, dy_pin, v_pin, self._keys(theta, dy_pin, v_pin)
+
+    def _column_order(self, level: Level, span: tuple, keys) -> ColumnOrder:
+        """The deepest level's order of each candidate's columns after
+        ``level`` (cells ``keys``): cheapest first when some sequence of
+        ``level`` ended within the span limit (a near miss, so a plan may
+        end the next level), else the drop order, which makes the evidence
+        cheaper (:mod:`~pipeline.planning.tight.column_order`)."""
+        if (orient.row_spans(level.theta, span[1]) <= span[0]).any():
+            return ColumnOrder.cheapest(keys, self._outcomes, self._misses)
+        return ColumnOrder.shared(self._drop_order())
+
+    def _cell_rows(self, cells, lo: int, hi: int):
+        """The cells (:meth:`_cells`) of the parents ``lo`` to ``hi`` (``None`` stays ``None``)."""
+        if cells is None:
+            return None
+        n_pins = self.heights.size
+        return tuple(x[lo * n_pins:hi * n_pins] for x in cells)
+
+    def _extend(self, level: Level, stretch: Stretch = SILENT, span: tuple | None = None, cells=None) -> Level:
+        n_pins, n = self.heights.size, level.size
+        theta, y_c, dy_pin, v_pin, keys = self._cells(level) if cells is None else cells
+        orders = None if span is None else span[2].orders(keys)
+        status, theta_f, dy, unrolled = self._columns(theta, dy_pin, v_pin, stretch, span, orders, keys)
         seq = np.concatenate([np.repeat(level.seq, n_pins, axis=0),
                               np.tile(np.arange(n_pins, dtype=np.int16), n)[:, None]], axis=1)
-        keep, step_margin, touched = self._rules(status, y_pin - y_c, None if unrolled is None
+        keep, step_margin, touched = self._rules(status, dy_pin, None if unrolled is None
                                                  else ~unrolled.any(axis=1))
         margin = np.minimum(np.repeat(level.margin, n_pins), step_margin)
         out = Level(seq[keep], theta_f[keep], (y_c + dy)[keep], margin[keep])
         if unrolled is not None:
             out.unrolled, out.touched = unrolled[keep], touched[keep]
         return out
+
+    def _speeds_of(self, n: int) -> np.ndarray:
+        """``(n * pins, columns)``: the pin speed of every cell of ``n`` parents' candidates."""
+        return np.broadcast_to(np.tile(self.speeds, n)[:, None], (n * self.speeds.size, self.column_support.size))
+
+    def _keys(self, theta, dy_pin, v_pin, col_support=None) -> np.ndarray:
+        """The rollout keys ``(..., 4)`` of the cells ``theta`` (deg), ``dy_pin``
+        (mm) and ``v_pin``, columns ``col_support``'s (default all): the pose and
+        offset rounded to ``QUANTUM``, the speed's index and the support."""
+        col_support = self.column_support if col_support is None else col_support
+        speed_index = np.searchsorted(np.unique(self.speeds), v_pin)
+        support = np.broadcast_to(col_support[None, :], theta.shape)
+        return np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM), speed_index,
+                         support], axis=-1).astype(np.int64)
+
+    def _misses(self, keys: np.ndarray) -> np.ndarray:
+        """Whether the pins of the key rows ``keys`` clear the part (an
+        estimate that orders the deepest level's columns; :func:`clears`)."""
+        return clears(self.part.vertices, keys[:, 0] * QUANTUM, keys[:, 1] * QUANTUM,
+                      np.unique(self.speeds)[keys[:, 2]], self.pin_radius)
 
     def _rules(self, status, dy_pin, whole=None):
         """The rules of the module's docstring on rollouts' ``status`` and pin
@@ -308,54 +363,59 @@ class NominalTree:
         step_margin = np.where(touched, np.minimum(d_abs - self.d_min, self.d_max - d_abs), np.inf).min(axis=1)
         return ~bad, step_margin, touched.any(axis=1)
 
-    def _columns(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT, span: tuple | None = None):
+    def _columns(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT, span: tuple | None = None, orders=None,
+                 keys=None):
         """:meth:`_rollouts` of every (candidate sequence, column) pair, one
-        column at a time: a candidate whose rollout in one column jams (or runs
-        out of steps) or passes a centroid it touches within ``pin_halfwidth``
-        is dropped whatever its other columns do, so its other columns are not
-        rolled out. Those entries keep the pose they started from and read
-        ``JAMMED``: the candidate is dropped all the same, and every surviving
-        candidate has all its columns rolled out, exactly as at once. The
-        columns go in the order of the share of candidates each dropped so far
-        (any order gives the same survivors).
+        column of each candidate at a time: a candidate whose rollout in one
+        column jams (or runs out of steps) or passes a centroid it touches
+        within ``pin_halfwidth`` is dropped whatever its other columns do, so
+        its other columns are not rolled out. Those entries keep the pose they
+        started from and read ``JAMMED``: the candidate is dropped all the
+        same, and every surviving candidate has all its columns rolled out,
+        exactly as at once. Without ``span`` the columns go in the order of the
+        share of candidates each dropped so far (any order gives the same
+        survivors).
 
-        With ``span`` (``(limit_deg, order, columns)``), a candidate whose
+        With ``span`` (``(limit_deg, order, ColumnOrder)``), a candidate whose
         columns rolled out so far span more than the limit stops too: its
         other columns keep the pose they started from, read ``MISS`` and are
         marked in the fourth array returned (``unrolled``; ``None`` without
-        ``span``). Which candidates stop (and so the level's count of
-        sequences) then depends on the order of the columns, so the columns
-        go in the one order ``columns`` for every chunk of the level (the drop
-        order when the level began: how a time limit chunks the level then
-        changes nothing; what the tree rolled out before may); the
-        candidates within the limit and the evidence do not depend on it. The drop order pays twice here: a
-        candidate dropped is not rolled out again for the evidence, and the
-        columns that tell candidates apart come first (the heart cam's
-        evidence rolled out 64,512 stopped sequences with it, 326,656 in the
-        states' own order)."""
+        ``span``). Each candidate then takes its columns in its own order,
+        ``orders`` (``(candidates, columns)``, from the level's
+        :class:`~pipeline.planning.tight.column_order.ColumnOrder`: the
+        cheapest keys first). Which candidates stop (and so the level's count
+        of sequences) depends on that order, which is fixed when the level
+        begins, so chunks and time limits change nothing; the candidates
+        within the limit and the evidence do not depend on it. ``keys``: the
+        cells' rollout keys, if known (:meth:`_cells`)."""
         n, cols = theta.shape
         status = np.full(theta.shape, JAMMED, dtype=np.int8)
         theta_f, dy = theta.astype(float, copy=True), np.zeros(theta.shape)
         unrolled = None if span is None else np.zeros(theta.shape, bool)
+        if orders is None:
+            orders = np.broadcast_to(self._drop_order()[None, :], theta.shape)
         alive = np.arange(n)
-        order = self._drop_order() if span is None else span[2]
-        for k, c in enumerate(order):
+        for k in range(cols):
             if alive.size == 0:
                 break
-            st, tf, d = self._rollouts(theta[alive, c:c + 1], dy_pin[alive, c:c + 1], v_pin[alive, c:c + 1],
-                                       stretch.part(k / cols, (k + 1) / cols), columns=np.array([c]))
-            status[alive, c], theta_f[alive, c], dy[alive, c] = st[:, 0], tf[:, 0], d[:, 0]
-            st = st[:, 0]
+            c = orders[alive, k]
+            st, tf, d = self._rollouts(theta[alive, c][None, :], dy_pin[alive, c][None, :], v_pin[alive, c][None, :],
+                                       stretch.part(k / cols, (k + 1) / cols), columns=c,
+                                       keys=None if keys is None else keys[alive, c])
+            st = st[0]
+            status[alive, c], theta_f[alive, c], dy[alive, c] = st, tf[0], d[0]
             drop = (st == JAMMED) | (st == TRUNCATED) | ((st != MISS) & (np.abs(dy_pin[alive, c]) < self.pin_halfwidth))
-            self._column_tries[c] += alive.size
-            self._column_drops[c] += int(drop.sum())
+            self._column_tries += np.bincount(c, minlength=cols)
+            self._column_drops += np.bincount(c[drop], minlength=cols)
             alive = alive[~drop]
             if span is not None and 0 < k < cols - 1 and alive.size:
+                done = orders[alive, :k + 1]
                 # ROUNDING: a row within the limit is never stopped by rounding in its partial span
-                wide = orient.row_spans(theta_f[np.ix_(alive, order[:k + 1])], span[1]) > span[0] + ROUNDING
-                stop, rest = alive[wide], order[k + 1:]
-                status[np.ix_(stop, rest)] = MISS
-                unrolled[np.ix_(stop, rest)] = True
+                wide = orient.row_spans(np.take_along_axis(theta_f[alive], done, axis=1), span[1]) > span[0] + ROUNDING
+                stop = alive[wide]
+                rest = orders[stop, k + 1:]
+                status[stop[:, None], rest] = MISS
+                unrolled[stop[:, None], rest] = True
                 alive = alive[~wide]
         return status, theta_f, dy, unrolled
 
@@ -393,24 +453,24 @@ class NominalTree:
             level.dropped = np.zeros(level.size, bool)
         level.dropped[rows] |= broken
 
-    def _rollouts(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT, columns=None):
+    def _rollouts(self, theta, dy_pin, v_pin, stretch: Stretch = SILENT, columns=None, keys=None):
         """``(status, theta_f, dy)`` arrays shaped like ``theta`` for the pin offsets
         ``dy_pin`` (mm) and pin speeds ``v_pin``, one rollout per distinct
         quantised pose and speed (``stretch`` is told the share done); the
         columns of ``theta`` are the tree's columns ``columns`` (default all).
         An outcome is a function of its key alone, so the outcomes of keys
         rolled out before (by any level, chunk or column of this tree) are
-        reused (:class:`~pipeline.planning.tight.outcomes.Outcomes`)."""
+        reused (:class:`~pipeline.planning.tight.outcomes.Outcomes`). ``keys``:
+        the cells' keys (``(..., 4)``), if known."""
         a = self.part.a
-        speed_index = np.searchsorted(np.unique(self.speeds), v_pin)
-        col_support = self.column_support if columns is None else self.column_support[columns]
-        support = np.broadcast_to(col_support[None, :], theta.shape)
-        keys = np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM), speed_index,
-                         support], axis=-1).reshape(-1, 4).astype(np.int64)
+        if keys is None:
+            col_support = self.column_support if columns is None else self.column_support[columns]
+            keys = self._keys(theta, dy_pin, v_pin, col_support)
+        keys = keys.reshape(-1, 4)
         if keys.shape[0] == 0:
             empty = np.zeros(theta.shape)
             return empty.astype(np.int8), empty, empty
-        uniq, inverse = unique_rows(keys, return_inverse=True)
+        uniq, inverse = _distinct(keys)
         status, theta_f, dy, known = self._outcomes.lookup(uniq)
         new = np.flatnonzero(~known)
         if new.size:
@@ -448,3 +508,15 @@ def _joined(parts) -> Level:
                                        for p in parts])
         out.touched = np.concatenate([np.ones(p.size, bool) if p.touched is None else p.touched for p in parts])
     return out
+
+
+def _distinct(keys) -> tuple:
+    """``unique_rows(keys, return_inverse=True)`` (the distinct key rows in
+    lexicographic order and each row's index among them), through one int64
+    code per row where the keys fit (:meth:`Outcomes.key_codes
+    <pipeline.planning.tight.outcomes.Outcomes.key_codes>` keeps that order)."""
+    codes = Outcomes.key_codes(keys)
+    if codes is None:
+        return unique_rows(keys, return_inverse=True)
+    _, first, inverse = np.unique(codes, return_index=True, return_inverse=True)
+    return keys[first], inverse.reshape(-1)

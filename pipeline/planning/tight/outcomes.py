@@ -25,8 +25,10 @@ class Outcomes:
         self.theta_f, self.dy = np.zeros(0), np.zeros(0)
 
     @staticmethod
-    def _codes(keys):
-        """One int64 per key row, or ``None`` where a key is out of range."""
+    def key_codes(keys):
+        """One int64 per key row (``(n, 4)``: pose, offset, speed, support),
+        ordered as the rows are lexicographically, or ``None`` where a key is
+        out of range."""
         t, d, v, s = keys.T
         if keys.size and (t.min() < 0 or t.max() >= 1 << 14 or np.abs(d).max() >= 1 << 30 or v.max() >= 1 << 8
                           or s.max() >= 1 << 8 or v.min() < 0 or s.min() < 0):
@@ -38,7 +40,7 @@ class Outcomes:
         n = keys.shape[0]
         status, theta_f, dy = np.zeros(n, dtype=np.int8), np.zeros(n), np.zeros(n)
         known = np.zeros(n, bool)
-        codes = self._codes(keys)
+        codes = self.key_codes(keys)
         if codes is None or self.codes.size == 0:
             return status, theta_f, dy, known
         at = np.minimum(np.searchsorted(self.codes, codes), self.codes.size - 1)
@@ -46,9 +48,16 @@ class Outcomes:
         status[known], theta_f[known], dy[known] = self.status[at[known]], self.theta_f[at[known]], self.dy[at[known]]
         return status, theta_f, dy, known
 
+    def known_codes(self, codes):
+        """``(n,)``: whether each of the key codes ``codes`` has its outcome kept."""
+        if self.codes.size == 0:
+            return np.zeros(codes.shape, bool)
+        at = np.minimum(np.searchsorted(self.codes, codes), self.codes.size - 1)
+        return self.codes[at] == codes
+
     def add(self, keys, status, theta_f, dy) -> None:
         """Keep the outcomes of the (new) key rows ``keys``, while there is room."""
-        codes = self._codes(keys)
+        codes = self.key_codes(keys)
         if codes is None or self.codes.size + codes.size > MAX_OUTCOMES:
             return
         order = np.argsort(np.concatenate([self.codes, codes]), kind="stable")
