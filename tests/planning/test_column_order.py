@@ -118,7 +118,7 @@ def test_cheapest_first_rolls_out_fewer_touching_rollouts_for_the_same_level(nam
     assert [tuple(cheap.seq[i]) for i in got] == [tuple(shared.seq[i]) for i in want]
 
 
-def test_the_deepest_level_goes_cheapest_first_after_a_near_miss_only():
+def test_the_deepest_level_goes_cheapest_first_after_a_near_miss_or_without_evidence():
     part = PARTS["triangle"]()
     tree = NominalTree(part, _pins(part, 9), 0.2, R_PIN)
     two = tree.extend(tree.extend(tree.root()))
@@ -131,3 +131,5 @@ def test_the_deepest_level_goes_cheapest_first_after_a_near_miss_only():
     assert shared.codes is None
     np.testing.assert_array_equal(shared.orders(tree._cells(far)[-1][:3]),
                                   np.tile(tree._drop_order(), (3, 1)))
+    # a search that keeps no evidence (the moving-pin stage) always goes cheapest first
+    assert tree._column_order(far, (*span, False), tree._cells(far)[-1]).codes is not None

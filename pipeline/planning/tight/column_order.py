@@ -5,7 +5,8 @@ On the deepest level of a search a candidate stops as soon as the columns
 (:mod:`~pipeline.planning.tight.enumerate`), and most candidates stop after
 two. Two orders serve two different ends there:
 
-- **Cheapest first**, when a plan may end the level: what the level costs
+- **Cheapest first**, when a plan may end the level or no evidence is
+  kept: what the level costs
   is the number of distinct rollout keys among the columns rolled out
   first, so each candidate rolls out first the columns whose keys cost
   least: keys already known, and keys whose pin clears the part (a miss
@@ -24,8 +25,10 @@ two. Two orders serve two different ends there:
   stopped sequences to roll out, the drop order 48,128 of 447,245.
 
 :meth:`NominalTree.levels <pipeline.planning.tight.enumerate.NominalTree.levels>`
-takes cheapest first when some sequence of the level before ended within
-the span limit (a near miss, so a plan may follow), else the drop order.
+takes cheapest first when the search keeps no evidence (the moving-pin
+stage and the nearest "yes"'s searches keep their plans only) or some
+sequence of the level before ended within the span limit (a near miss, so a
+plan may follow), else the drop order.
 Either order is fixed when the level begins, from the keys of all its
 candidates, so it does not depend on how the level is cut into chunks (nor
 on a time limit).

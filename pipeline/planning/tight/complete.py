@@ -277,7 +277,8 @@ class FixedPinSearch:
         level without a plan joins ``levels``. Returns the deepest level
         enumerated in full (the root when none was)."""
         last = root if root is not None else self.tree.root()
-        span = (self.bench.tolerance + SLACK_DEG, self.bench.order)  # the deepest level's nominal span stop
+        # the deepest level's nominal span stop (and whether its evidence may be wanted)
+        span = (self.bench.tolerance + SLACK_DEG, self.bench.order, self.evidence)
         for level in self.tree.levels(depth, root, self._level_heralds(progress, deadline), deadline, span):
             n_pins = len(self.prefix.labels) + (level.seq.shape[1] if level.size else len(result.levels) + 1)
             if level.cut:  # the time limit ended the enumeration: screen what it enumerated, if time is left

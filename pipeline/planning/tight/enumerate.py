@@ -37,9 +37,10 @@ columns of those that might rank among its fewest-cluster sequences
 (:meth:`NominalTree.complete`), so it picks exactly the sequences a full
 enumeration would. Every candidate within the limit has had every column
 rolled out, from the same rounded keys, exactly as at once. Since most
-candidates stop after two columns, each candidate takes its columns
-cheapest first (:mod:`~pipeline.planning.tight.column_order`: keys known or
-whose pin clears the part, then keys that many candidates share).
+candidates stop after two columns, the order of their columns sets the
+level's cost: after a near miss each candidate takes its cheapest columns
+first, else all take the drop order, which makes the evidence cheaper
+(:mod:`~pipeline.planning.tight.column_order`).
 
 A sequence is dropped (with all its extensions) when, on its nominal path:
 
@@ -203,9 +204,12 @@ class NominalTree:
         does stops once it has used ``ENUMERATION_SHARE`` of the search time
         left when it started (the rest is for screening what it enumerated;
         :func:`finishes_in_time`), and a level it cuts short is the last
-        (``Level.cut``). ``span``: ``(limit_deg, symmetry order)``: the
-        deepest level stops a candidate once its finals spread over the limit
-        (see the module's docstring); ``None``: every column of every level."""
+        (``Level.cut``). ``span``: ``(limit_deg, symmetry order[, evidence])``:
+        the deepest level stops a candidate once its finals spread over the
+        limit (see the module's docstring); ``evidence`` (default True) says
+        whether the search may rank that level for its evidence (it sets the
+        order of the columns, :meth:`_column_order`); ``None``: every column
+        of every level."""
         heartbeat = heartbeat or (lambda length, n: Heartbeat("", n))
         level = self.root() if root is None else root
         for k in range(depth):
@@ -298,11 +302,13 @@ class NominalTree:
 
     def _column_order(self, level: Level, span: tuple, keys) -> ColumnOrder:
         """The deepest level's order of each candidate's columns after
-        ``level`` (cells ``keys``): cheapest first when some sequence of
-        ``level`` ended within the span limit (a near miss, so a plan may
-        end the next level), else the drop order, which makes the evidence
-        cheaper (:mod:`~pipeline.planning.tight.column_order`)."""
-        if (orient.row_spans(level.theta, span[1]) <= span[0]).any():
+        ``level`` (cells ``keys``): cheapest first when the search keeps no
+        evidence (``span[2]`` False) or some sequence of ``level`` ended
+        within the span limit (a near miss, so a plan may end the next
+        level), else the drop order, which makes the evidence cheaper
+        (:mod:`~pipeline.planning.tight.column_order`)."""
+        evidence = span[2] if len(span) > 2 else True
+        if not evidence or (orient.row_spans(level.theta, span[1]) <= span[0]).any():
             return ColumnOrder.cheapest(keys, self._outcomes, self._misses)
         return ColumnOrder.shared(self._drop_order())
 
@@ -383,7 +389,7 @@ class NominalTree:
         ``span``). Each candidate then takes its columns in its own order,
         ``orders`` (``(candidates, columns)``, from the level's
         :class:`~pipeline.planning.tight.column_order.ColumnOrder`: the
-        cheapest keys first). Which candidates stop (and so the level's count
+        cheapest keys first, or the drop order; :meth:`_column_order`). Which candidates stop (and so the level's count
         of sequences) depends on that order, which is fixed when the level
         begins, so chunks and time limits change nothing; the candidates
         within the limit and the evidence do not depend on it. ``keys``: the
