@@ -66,25 +66,37 @@ def test_each_row_takes_its_cheapest_columns_first(rows, cols, seed):
                      np.zeros(len(known_rows)))
     known = {tuple(k) for k in known_rows}
 
-    def misses(k):
-        return k[:, 1] == -2
+    def misses(codes):
+        return Outcomes.key_rows(codes)[:, 1] == -2
 
-    order = ColumnOrder.cheapest(keys, outcomes, misses)
+    codes = Outcomes.key_codes(keys.reshape(-1, 4)).reshape(rows, cols)
+    order = ColumnOrder.cheapest(codes, outcomes, misses)
     # the tie-break: columns by their count of new (not free) keys over the level
     new = [len({tuple(k) for k in keys[:, c] if tuple(k) not in known}) for c in range(cols)]
     rank = np.argsort(np.argsort(new, kind="stable"), kind="stable")
     np.testing.assert_array_equal(order.rank, rank)
-    want = _brute_orders(keys, known, misses, rank)
+    want = _brute_orders(keys, known, lambda k: k[:, 1] == -2, rank)
     # a miss is free only for ordering: new-key counts still include it
-    np.testing.assert_array_equal(order.orders(keys), want)
+    np.testing.assert_array_equal(order.orders(codes, rows), want)
+
+
+@given(st.lists(st.tuples(st.integers(0, 7199), st.integers(-2**30 + 1, 2**30 - 1), st.integers(0, 255),
+                          st.integers(0, 255)), min_size=1, max_size=50))
+def test_key_codes_keep_the_order_of_the_keys_and_decode_to_them(rows):
+    keys = np.array(rows, dtype=np.int64)
+    codes = Outcomes.key_codes(keys)
+    np.testing.assert_array_equal(Outcomes.key_rows(codes), keys)
+    np.testing.assert_array_equal(np.argsort(codes, kind="stable"), np.lexsort(keys.T[::-1]))
 
 
 def _deepest(part, pins, span, mode, monkeypatch):
     """The deepest (third) level with every candidate's columns ``cheapest``
     first or in one order (``shared``), and the rollouts that touched the part."""
-    def column_order(self, level, span, keys):
+    real = NominalTree._column_order
+
+    def column_order(self, level, span, step):
         if mode == "cheapest":
-            return ColumnOrder.cheapest(keys, self._outcomes, self._misses)
+            return real(self, level, (*span[:2], False), step)  # no evidence kept: cheapest first
         return ColumnOrder.shared(self._drop_order())
     monkeypatch.setattr(NominalTree, "_column_order", column_order)
     tree = NominalTree(part, pins, 0.2, R_PIN)
@@ -125,11 +137,13 @@ def test_the_deepest_level_goes_cheapest_first_after_a_near_miss_or_without_evid
     near = orient.row_spans(two.theta, part.symmetry_order()) <= 11.0
     assert near.any() and not near.all()
     span = (11.0, part.symmetry_order())
-    assert tree._column_order(two, span, tree._cells(two)[-1]).codes is not None  # cheapest first
+    whole, chunked = tree._column_order(two, span, 10**6), tree._column_order(two, span, 7)
+    assert whole.codes is not None  # cheapest first
+    for k in ("rank", "codes", "score"):  # gathered in chunks of parents: the same scores
+        np.testing.assert_array_equal(getattr(chunked, k), getattr(whole, k))
     far = type(two)(two.seq[~near], two.theta[~near], two.y[~near], two.margin[~near])
-    shared = tree._column_order(far, span, tree._cells(far)[-1])
+    shared = tree._column_order(far, span, 10**6)
     assert shared.codes is None
-    np.testing.assert_array_equal(shared.orders(tree._cells(far)[-1][:3]),
-                                  np.tile(tree._drop_order(), (3, 1)))
+    np.testing.assert_array_equal(shared.orders(None, 3), np.tile(tree._drop_order(), (3, 1)))
     # a search that keeps no evidence (the moving-pin stage) always goes cheapest first
-    assert tree._column_order(far, (*span, False), tree._cells(far)[-1]).codes is not None
+    assert tree._column_order(far, (*span, False), 10**6).codes is not None

@@ -13,8 +13,8 @@ two. Two orders serve two different ends there:
   costs about 1/400 of a rollout that touches; :func:`clears`), then keys
   that more of the level's cells share, ties in the order of the columns'
   count of new keys over the level. On the T bracket of
-  ``benchmarks/plan_speed.py`` the nominal paths take 110,068 rollouts
-  (70,421 that touch) where the drop order took 211,696 (143,553).
+  ``benchmarks/plan_speed.py`` the nominal paths take 128,320 rollouts
+  (70,421 that touch the part) where the drop order took 211,696 (143,553).
 - **The drop order** (the columns by the share of candidates each dropped
   so far, the same for every candidate), when nothing is likely to orient
   and the evidence will rank the level: a candidate dropped is not rolled
@@ -75,37 +75,31 @@ class ColumnOrder:
         return cls(rank)
 
     @classmethod
-    def cheapest(cls, keys: np.ndarray, outcomes: Outcomes, misses=None) -> "ColumnOrder":
-        """Cheapest first for the cells ``keys`` (``(candidates, columns, 4)``)
-        of a level about to be rolled out, with ``outcomes`` the keys known
-        and ``misses`` (optional) a function of key rows that says which pins
-        clear the part."""
-        cols = keys.shape[1]
-        codes = Outcomes.key_codes(keys.reshape(-1, 4))
-        if codes is None:
-            return cls.shared(np.arange(cols))
+    def cheapest(cls, codes: np.ndarray, outcomes: Outcomes, misses=None) -> "ColumnOrder":
+        """Cheapest first for the cells of a level about to be rolled out, by
+        their key codes ``codes`` (``(candidates, columns)``, :meth:`Outcomes.key_codes
+        <pipeline.planning.tight.outcomes.Outcomes.key_codes>`), with
+        ``outcomes`` the keys known and ``misses`` (optional) a function of
+        key codes that says which pins clear the part."""
+        cols = codes.shape[1]
         uniq, inverse, counts = np.unique(codes, return_inverse=True, return_counts=True)
         known = outcomes.known_codes(uniq)
-        free = known.copy()
-        if misses is not None:
-            first = np.zeros(uniq.size, dtype=np.int64)
-            first[inverse] = np.arange(codes.size)  # a cell of each code: its key row
-            free |= misses(keys.reshape(-1, 4)[first])
+        free = known | misses(uniq) if misses is not None else known
         score = np.where(free, codes.size + 1, counts).astype(np.int64)
         cells = inverse.reshape(-1, cols)
         per_column = [np.unique(cells[~known[cells[:, c]], c]).size for c in range(cols)]
         rank = cls.shared(np.argsort(per_column, kind="stable")).rank
         return cls(rank, uniq, score)
 
-    def orders(self, keys: np.ndarray) -> np.ndarray:
-        """``(candidates, columns)``: each candidate's columns in order, for
-        its cells ``keys`` (``(candidates, columns, 4)``)."""
-        n, cols = keys.shape[:2]
-        codes = None if self.codes is None else Outcomes.key_codes(keys.reshape(-1, 4))
-        if codes is None or self.codes.size == 0:
+    def orders(self, codes: np.ndarray | None, n: int) -> np.ndarray:
+        """``(n, columns)``: each of ``n`` candidates' columns in order, for
+        their cells' key codes ``codes`` (``(n, columns)``; ``None``, or a
+        shared order: every candidate takes ``rank``'s order)."""
+        cols = self.rank.size
+        if codes is None or self.codes is None or self.codes.size == 0:
             return np.broadcast_to(np.argsort(self.rank)[None, :], (n, cols)).copy()
         at = np.minimum(np.searchsorted(self.codes, codes), self.codes.size - 1)
-        score = np.where(self.codes[at] == codes, self.score[at], 0).reshape(n, cols)
+        score = np.where(self.codes[at] == codes, self.score[at], 0)
         # Highest score first, then the lower rank: one integer per cell.
         return np.argsort(-score * cols + self.rank[None, :], axis=1, kind="stable")
 

@@ -238,31 +238,28 @@ class NominalTree:
         not end before the search is over (:func:`finishes_in_time`): the
         level returned is then ``cut``. (An outcome depends on its rounded pose only, so the
         sequences enumerated are the same in any chunks.) ``span``: as for
-        :meth:`levels`, for this level; its columns then go in one order for
-        the whole level (see :meth:`_columns`)."""
+        :meth:`levels`, for this level; each candidate's order of its columns
+        is then fixed for the whole level (:meth:`_column_order`)."""
         per_parent = max(1, self.heights.size * level.theta.shape[1])
         step = max(1, MAX_PAIRS // per_parent)
-        cells = None
         if span is not None:
-            cells = self._cells(level)
-            span = (*span[:2], self._column_order(level, span, cells[-1]))
+            span = (*span[:2], self._column_order(level, span, step))
         if deadline.limited:
-            return self._extend_timed(level, step, stretch, deadline, stop_at, span, cells)
+            return self._extend_timed(level, step, stretch, deadline, stop_at, span)
         if level.size <= step:
-            return self._extend(level, stretch, span, cells)
+            return self._extend(level, stretch, span)
         parts = [self._extend(level.rows(i, i + step),
-                              stretch.part(i / level.size, min(i + step, level.size) / level.size), span,
-                              self._cell_rows(cells, i, i + step))
+                              stretch.part(i / level.size, min(i + step, level.size) / level.size), span)
                  for i in range(0, level.size, step)]
         return _joined(parts)
 
     def _extend_timed(self, level: Level, step: int, stretch: Stretch, deadline: Deadline,
-                      stop_at: float | None = None, span: tuple | None = None, cells=None) -> Level:
+                      stop_at: float | None = None, span: tuple | None = None) -> Level:
         """:meth:`extend` under a time limit: chunks of parents sized by the pace
         of the ones before (up to ``step``), the deadline (and ``stop_at``)
         read between them."""
         if level.size == 0:
-            return self._extend(level, stretch, span, cells)
+            return self._extend(level, stretch, span)
         parts, done, size = [], 0, min(step, FIRST_PARENTS)
         started = deadline.elapsed() if stop_at is not None else 0.0
 
@@ -278,8 +275,7 @@ class NominalTree:
         while done < level.size and not (parts and stop()):
             hi = min(level.size, done + size)
             t0 = time.monotonic()
-            parts.append(self._extend(level.rows(done, hi), stretch.part(done / level.size, hi / level.size), span,
-                                      self._cell_rows(cells, done, hi)))
+            parts.append(self._extend(level.rows(done, hi), stretch.part(done / level.size, hi / level.size), span))
             took = max(time.monotonic() - t0, 1e-6)
             size = max(1, min(step, int((hi - done) * min(8.0, max(0.125, BATCH_SECONDS / took)))))
             done = hi
@@ -300,29 +296,26 @@ class NominalTree:
         v_pin = self._speeds_of(n)
         return theta, y_c, dy_pin, v_pin, self._keys(theta, dy_pin, v_pin)
 
-    def _column_order(self, level: Level, span: tuple, keys) -> ColumnOrder:
+    def _column_order(self, level: Level, span: tuple, step: int) -> ColumnOrder:
         """The deepest level's order of each candidate's columns after
-        ``level`` (cells ``keys``): cheapest first when the search keeps no
-        evidence (``span[2]`` False) or some sequence of ``level`` ended
-        within the span limit (a near miss, so a plan may end the next
-        level), else the drop order, which makes the evidence cheaper
-        (:mod:`~pipeline.planning.tight.column_order`)."""
+        ``level``: cheapest first when the search keeps no evidence
+        (``span[2]`` False) or some sequence of ``level`` ended within the
+        span limit (a near miss, so a plan may end the next level), else the
+        drop order, which makes the evidence cheaper
+        (:mod:`~pipeline.planning.tight.column_order`). The level's key codes
+        are gathered ``step`` parents at a time (memory stays bounded)."""
         evidence = span[2] if len(span) > 2 else True
-        if not evidence or (orient.row_spans(level.theta, span[1]) <= span[0]).any():
-            return ColumnOrder.cheapest(keys, self._outcomes, self._misses)
-        return ColumnOrder.shared(self._drop_order())
+        if evidence and not (orient.row_spans(level.theta, span[1]) <= span[0]).any():
+            return ColumnOrder.shared(self._drop_order())
+        codes = [_codes(self._cells(level.rows(i, i + step))[-1]) for i in range(0, level.size, step)]
+        if not codes or any(c is None for c in codes):
+            return ColumnOrder.shared(self._drop_order())
+        return ColumnOrder.cheapest(np.concatenate(codes), self._outcomes, self._misses)
 
-    def _cell_rows(self, cells, lo: int, hi: int):
-        """The cells (:meth:`_cells`) of the parents ``lo`` to ``hi`` (``None`` stays ``None``)."""
-        if cells is None:
-            return None
-        n_pins = self.heights.size
-        return tuple(x[lo * n_pins:hi * n_pins] for x in cells)
-
-    def _extend(self, level: Level, stretch: Stretch = SILENT, span: tuple | None = None, cells=None) -> Level:
+    def _extend(self, level: Level, stretch: Stretch = SILENT, span: tuple | None = None) -> Level:
         n_pins, n = self.heights.size, level.size
-        theta, y_c, dy_pin, v_pin, keys = self._cells(level) if cells is None else cells
-        orders = None if span is None else span[2].orders(keys)
+        theta, y_c, dy_pin, v_pin, keys = self._cells(level)
+        orders = None if span is None else span[2].orders(_codes(keys), theta.shape[0])
         status, theta_f, dy, unrolled = self._columns(theta, dy_pin, v_pin, stretch, span, orders, keys)
         seq = np.concatenate([np.repeat(level.seq, n_pins, axis=0),
                               np.tile(np.arange(n_pins, dtype=np.int16), n)[:, None]], axis=1)
@@ -348,9 +341,10 @@ class NominalTree:
         return np.stack([np.round(np.mod(theta, 360.0) / QUANTUM), np.round(dy_pin / QUANTUM), speed_index,
                          support], axis=-1).astype(np.int64)
 
-    def _misses(self, keys: np.ndarray) -> np.ndarray:
-        """Whether the pins of the key rows ``keys`` clear the part (an
+    def _misses(self, codes: np.ndarray) -> np.ndarray:
+        """Whether the pins of the key codes ``codes`` clear the part (an
         estimate that orders the deepest level's columns; :func:`clears`)."""
+        keys = Outcomes.key_rows(codes)
         return clears(self.part.vertices, keys[:, 0] * QUANTUM, keys[:, 1] * QUANTUM,
                       np.unique(self.speeds)[keys[:, 2]], self.pin_radius)
 
@@ -526,3 +520,10 @@ def _distinct(keys) -> tuple:
         return unique_rows(keys, return_inverse=True)
     _, first, inverse = np.unique(codes, return_index=True, return_inverse=True)
     return keys[first], inverse.reshape(-1)
+
+
+def _codes(keys) -> np.ndarray | None:
+    """``(candidates, columns)`` key codes of the cells ``keys`` (``(candidates,
+    columns, 4)``), or ``None`` where a key is out of the codes' range."""
+    codes = Outcomes.key_codes(keys.reshape(-1, 4))
+    return None if codes is None else codes.reshape(keys.shape[:2])

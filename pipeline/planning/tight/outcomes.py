@@ -35,6 +35,14 @@ class Outcomes:
             return None
         return (((t << 31) + (d + (1 << 30))) << 16) + (v << 8) + s
 
+    @staticmethod
+    def key_rows(codes) -> np.ndarray:
+        """The key rows ``(n, 4)`` of the codes ``codes`` (:meth:`key_codes` undone)."""
+        codes = np.asarray(codes, dtype=np.int64)
+        rest = codes >> 16
+        return np.stack([rest >> 31, (rest & ((1 << 31) - 1)) - (1 << 30), (codes >> 8) & 0xFF, codes & 0xFF],
+                        axis=-1)
+
     def lookup(self, keys):
         """``(status, theta_f, dy, known)`` arrays over the key rows ``keys``."""
         n = keys.shape[0]
