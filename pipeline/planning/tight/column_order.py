@@ -6,10 +6,9 @@ On the deepest level of a search a candidate stops as soon as the columns
 two. Two orders serve two different ends there:
 
 - **Cheapest first**, when a plan may end the level or no evidence is
-  kept: what the level costs
-  is the number of distinct rollout keys among the columns rolled out
-  first, so each candidate rolls out first the columns whose keys cost
-  least: keys already known, and keys whose pin clears the part (a miss
+  kept: what the level costs is the number of distinct rollout keys among
+  the columns rolled out first, so each candidate rolls out first the
+  columns whose keys cost least: keys already known, and keys whose pin clears the part (a miss
   costs about 1/400 of a rollout that touches; :func:`clears`), then keys
   that more of the level's cells share, ties in the order of the columns'
   count of new keys over the level. On the T bracket of
