@@ -51,8 +51,7 @@ class Outcomes:
         codes = self.key_codes(keys)
         if codes is None or self.codes.size == 0:
             return status, theta_f, dy, known
-        at = np.minimum(np.searchsorted(self.codes, codes), self.codes.size - 1)
-        known = self.codes[at] == codes
+        at, known = self._find(codes)
         status[known], theta_f[known], dy[known] = self.status[at[known]], self.theta_f[at[known]], self.dy[at[known]]
         return status, theta_f, dy, known
 
@@ -60,8 +59,13 @@ class Outcomes:
         """``(n,)``: whether each of the key codes ``codes`` has its outcome kept."""
         if self.codes.size == 0:
             return np.zeros(codes.shape, bool)
+        return self._find(codes)[1]
+
+    def _find(self, codes):
+        """``(at, known)``: where each code is (or would go) among the kept
+        codes (not empty), and whether it is there."""
         at = np.minimum(np.searchsorted(self.codes, codes), self.codes.size - 1)
-        return self.codes[at] == codes
+        return at, self.codes[at] == codes
 
     def add(self, keys, status, theta_f, dy) -> None:
         """Keep the outcomes of the (new) key rows ``keys``, while there is room."""
